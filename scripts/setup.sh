@@ -1,0 +1,22 @@
+#!/usr/bin/env bash
+# Installs everything vgpu-rt needs on a fresh Debian 12 machine (run as root or with sudo).
+# Idempotent: skips apt when every package is already present.
+set -euo pipefail
+pkgs=(
+  build-essential cmake ninja-build pkg-config
+  libglm-dev libopenimageio-dev openimageio-tools libtinygltf-dev libstb-dev nlohmann-json3-dev
+  doctest-dev libbenchmark-dev libcli11-dev libmeshoptimizer-dev
+  clang libclang-rt-14-dev clang-format
+  python3-matplotlib
+)
+missing=()
+for p in "${pkgs[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if ((${#missing[@]})); then
+  sudo_cmd=""
+  [ "$(id -u)" -ne 0 ] && sudo_cmd="sudo"
+  echo "setup: installing ${missing[*]}" >&2
+  $sudo_cmd apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $sudo_cmd apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi
