@@ -1,0 +1,343 @@
+// The fragment processor and pipeline state: passes, limits, queries, masks, statistics.
+#include "vgpu/gpu.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+
+namespace vgpu {
+
+struct Gpu::Chunk {
+  uint64_t launched = 0, shaded = 0, masked = 0, discarded = 0, idle = 0;
+};
+
+Gpu::Gpu(const Profile& profile, int threads, int lanes) : profile_(profile), lanes_(lanes) {
+  if (lanes != 1 && lanes != 4 && lanes != 8 && lanes != 16)
+    throw Error("lane width must be 1, 4, 8 or 16 (got " + std::to_string(lanes) + ")");
+  if (threads <= 0) threads = int(std::max(1u, std::thread::hardware_concurrency()));
+  for (int i = 1; i < threads; ++i) workers_.emplace_back([this] { worker_loop(); });
+}
+
+Gpu::~Gpu() {
+  {
+    std::lock_guard lk(mu_);
+    stop_ = true;
+  }
+  cv_work_.notify_all();
+  for (auto& w : workers_) w.join();
+}
+
+void Gpu::fail(const std::string& what) const { throw Error(what); }
+
+Texture Gpu::make_texture(std::string name, int width, int height, int channels,
+                          Format format) const {
+  Texture t(std::move(name), std::max(width, 1), std::max(height, 1), channels, format);
+  if (width <= 0 || height <= 0) fail("texture '" + t.name() + "' has an empty size");
+  check_texture(t);
+  return t;
+}
+
+void Gpu::check_texture(const Texture& t) const {
+  const int m = profile_.max_texture_size;
+  if (t.width() > m || t.height() > m)
+    fail("texture '" + t.name() + "' is " + std::to_string(t.width()) + "x" +
+         std::to_string(t.height()) + " texels; profile " + profile_.name + " allows at most " +
+         std::to_string(m) + "x" + std::to_string(m));
+}
+
+void Gpu::use_program(const Program& program) {
+  if (in_draw_) fail(std::string("program '") + program.name() + "': no recursion (bind inside a pass)");
+  program_ = &program;
+  if (program.id() == loaded_program_) return;
+  loaded_program_ = program.id();
+  const Program::Analysis a = program.analyze();
+  Counters c;
+  c.program_loads = 1;
+  c.program_bytes = uint64_t(a.instructions) * profile_.instruction_bytes;
+  stats_.program(program.name(), program.paper_name(), a.instructions).counters += c;
+  stats_.totals += c;
+}
+
+void Gpu::bind_texture(int unit, const Texture& texture) {
+  if (unit < 0 || unit >= kMaxTextureUnits)
+    fail("texture unit " + std::to_string(unit) + " does not exist (0.." +
+         std::to_string(kMaxTextureUnits - 1) + ")");
+  check_texture(texture);
+  units_[unit] = &texture;
+}
+
+void Gpu::unbind_textures() { units_.fill(nullptr); }
+
+void Gpu::set_targets(std::initializer_list<Texture*> targets) {
+  targets_.assign(targets.begin(), targets.end());
+  for (Texture* t : targets_) check_texture(*t);
+}
+
+void Gpu::begin_query() {
+  if (query_active_) fail("begin_query: a query is already active");
+  query_active_ = true;
+  query_count_ = 0;
+}
+
+uint64_t Gpu::end_query() {
+  if (!query_active_) fail("end_query: no query is active");
+  query_active_ = false;
+  Counters c;
+  c.queries = 1;
+  c.query_readbacks = 1;
+  stats_.totals += c;
+  if (program_) stats_.program(program_->name(), program_->paper_name(), 0).counters += c;
+  if (!stats_.passes.empty()) stats_.passes.back().query_result = int64_t(query_count_);
+  return query_count_;
+}
+
+const PassRecord& Gpu::draw() {
+  if (targets_.empty()) fail("draw: no render target set");
+  return draw(Rect{0, 0, targets_[0]->width(), targets_[0]->height()});
+}
+
+template <int W>
+void Gpu::run_rows(const Program& p, const Rect& r, int y0, int y1, Chunk& out) const {
+  using L = SimdLanes<W>;
+  using F = typename L::F;
+  using M = typename L::M;
+  BoundTexture views[kMaxTextureUnits];
+  for (int u = 0; u < kMaxTextureUnits; ++u)
+    if (units_[u])
+      views[u] = {units_[u]->data().data(), units_[u]->width(), units_[u]->height(),
+                  units_[u]->channels()};
+  const bool dynamic = profile_.branching == Branching::dynamic;
+  Fragments<L> f(views, dynamic, &out.idle, nullptr);
+  const F iota([](auto i) { return float(i); });
+  const int nout = p.outputs();
+  const bool idle_kill = p.idle_discards();
+  alignas(64) float lanes_out[4][W];
+  bool bools[W] = {};
+
+  for (int y = y0; y < y1; ++y) {
+    const uint8_t* st = stencil_test_ ? stencil_test_->row(y) : nullptr;
+    const uint8_t* wk = work_mask_ ? work_mask_->row(y) : nullptr;
+    uint8_t* sw = stencil_write_ ? stencil_write_->row_mut(y) : nullptr;
+    for (int x = r.x0; x < r.x1; x += W) {
+      const int n = std::min(W, r.x1 - x);
+      out.launched += uint64_t(n);
+      // live: fragments in the quad that pass the stencil test.
+      M live = iota < float(n);
+      if (st) {
+        for (int i = 0; i < n; ++i) bools[i] = st[x + i] != 0;
+        live = live && M(bools, stdx::element_aligned);
+      }
+      const int nlive = lanes_on(live);
+      out.masked += uint64_t(n - nlive);
+      out.shaded += uint64_t(nlive);
+      if (nlive == 0) continue;
+      // run: live fragments the host actually executes (all of them unless a work mask says idle).
+      M run = live;
+      if (wk) {
+        for (int i = 0; i < n; ++i) bools[i] = wk[x + i] != 0;
+        run = run && M(bools, stdx::element_aligned);
+      }
+      M kill(false);
+      if (any(run)) {
+        f.reset(iota + float(x) + 0.5f, F(float(y) + 0.5f), run);
+        p.run(f);
+        kill = f.killed() && run;
+        for (int o = 0; o < nout; ++o) {
+          Texture& t = *targets_[o];
+          const Vec4<F>& v = f.output(o);
+          v.x.copy_to(lanes_out[0], stdx::element_aligned);
+          v.y.copy_to(lanes_out[1], stdx::element_aligned);
+          v.z.copy_to(lanes_out[2], stdx::element_aligned);
+          v.w.copy_to(lanes_out[3], stdx::element_aligned);
+          const int ch = t.channels();
+          const Format fmt = t.format();
+          for (int i = 0; i < n; ++i) {
+            if (!run[i] || kill[i]) continue;
+            float* dst = t.texel_mut(x + i, y);
+            for (int c = 0; c < ch; ++c) dst[c] = round_to(fmt, lanes_out[c][i]);
+          }
+        }
+      }
+      int nkill = lanes_on(kill);
+      if (wk) {
+        // Idle fragments: outputs keep their previous values (copied from the passthrough units).
+        for (int i = 0; i < n; ++i) {
+          if (!live[i] || run[i]) continue;
+          if (idle_kill) {
+            ++nkill;
+            continue;
+          }
+          for (int o = 0; o < nout; ++o) {
+            Texture& t = *targets_[o];
+            const Texture& src = *units_[p.passthrough(o)];
+            std::copy_n(src.texel(x + i, y), t.channels(), t.texel_mut(x + i, y));
+          }
+        }
+      }
+      out.discarded += uint64_t(nkill);
+      if (sw)
+        for (int i = 0; i < n; ++i)
+          if (live[i]) sw[x + i] = (run[i] ? !kill[i] : !idle_kill) ? 1 : 0;
+    }
+  }
+}
+
+void Gpu::parallel_rows(const Rect& r, const std::function<void(int, int, Chunk&)>& body,
+                        std::vector<Chunk>& chunks) {
+  const int rows = r.height();
+  // Enough chunks to balance uneven rows, few enough to keep scheduling cheap.
+  const int nchunks = std::max(1, std::min(rows, threads() * 8));
+  chunks.assign(size_t(nchunks), Chunk{});
+  std::atomic<int> next{0};
+  const std::function<void()> job = [&] {
+    for (;;) {
+      const int k = next.fetch_add(1);
+      if (k >= nchunks) return;
+      const int ya = r.y0 + int(int64_t(rows) * k / nchunks);
+      const int yb = r.y0 + int(int64_t(rows) * (k + 1) / nchunks);
+      body(ya, yb, chunks[size_t(k)]);
+    }
+  };
+  if (workers_.empty() || nchunks == 1 || r.area() < 4096) {
+    job();
+    return;
+  }
+  {
+    std::lock_guard lk(mu_);
+    job_ = &job;
+    ++job_serial_;
+    busy_ = int(workers_.size());
+  }
+  cv_work_.notify_all();
+  job();
+  std::unique_lock lk(mu_);
+  cv_done_.wait(lk, [&] { return busy_ == 0; });
+  job_ = nullptr;
+}
+
+void Gpu::worker_loop() {
+  uint64_t seen = 0;
+  std::unique_lock lk(mu_);
+  for (;;) {
+    cv_work_.wait(lk, [&] { return stop_ || job_serial_ != seen; });
+    if (stop_) return;
+    seen = job_serial_;
+    const std::function<void()>* job = job_;
+    lk.unlock();
+    (*job)();
+    lk.lock();
+    if (--busy_ == 0) cv_done_.notify_one();
+  }
+}
+
+const PassRecord& Gpu::draw(const Rect& rect) {
+  const auto t0 = std::chrono::steady_clock::now();
+  if (!program_) fail("draw: no program bound");
+  const Program& p = *program_;
+  const std::string pname = p.name();
+  if (in_draw_) fail("program '" + pname + "': no recursion (a pass started inside a pass)");
+
+  // The profile's limits.
+  if (p.outputs() > profile_.max_outputs)
+    fail("program '" + pname + "' writes " + std::to_string(p.outputs()) +
+         " outputs; profile " + profile_.name + " allows " +
+         std::to_string(profile_.max_outputs) + " (no multiple render targets)");
+  if (int(targets_.size()) != p.outputs())
+    fail("program '" + pname + "' writes " + std::to_string(p.outputs()) + " outputs but " +
+         std::to_string(targets_.size()) + " render targets are set");
+  const Program::Analysis a = p.analyze();
+  if (a.instructions > profile_.max_instructions)
+    fail("program '" + pname + "' has " + std::to_string(a.instructions) +
+         " instructions; profile " + profile_.name + " allows " +
+         std::to_string(profile_.max_instructions));
+  const Texture& t0tex = *targets_[0];
+  for (Texture* t : targets_) {
+    if (t->width() != t0tex.width() || t->height() != t0tex.height())
+      fail("program '" + pname + "': render targets differ in size");
+    for (int u = 0; u < kMaxTextureUnits; ++u)
+      if (units_[u] == t)
+        fail("program '" + pname + "' reads texture '" + t->name() + "' (unit " +
+             std::to_string(u) + ") while rendering to it: read/write hazard, use ping-pong");
+  }
+  for (int u = 0; u < kMaxTextureUnits; ++u)
+    if (a.fetches.per_unit[u] && !units_[u])
+      fail("program '" + pname + "' fetches from texture unit " + std::to_string(u) +
+           ", which has no texture bound");
+  if (rect.x0 < 0 || rect.y0 < 0 || rect.x1 > t0tex.width() || rect.y1 > t0tex.height() ||
+      rect.x0 > rect.x1 || rect.y0 > rect.y1)
+    fail("program '" + pname + "': drawn rectangle outside the render target");
+  auto check_mask = [&](const Stencil* s, const char* what) {
+    if (s && (s->width() != t0tex.width() || s->height() != t0tex.height()))
+      fail("program '" + pname + "': " + what + " size differs from the render target");
+  };
+  check_mask(stencil_test_, "stencil");
+  check_mask(stencil_write_, "stencil");
+  check_mask(work_mask_, "work mask");
+  if (work_mask_ && !p.idle_discards()) {
+    if (!p.has_passthrough())
+      fail("program '" + pname + "' declares no passthrough, so it cannot skip idle fragments");
+    for (int o = 0; o < p.outputs(); ++o) {
+      const Texture* src = units_[p.passthrough(o)];
+      if (!src || src->width() != targets_[o]->width() || src->height() != targets_[o]->height() ||
+          src->channels() != targets_[o]->channels())
+        fail("program '" + pname + "': passthrough unit " + std::to_string(p.passthrough(o)) +
+             " does not hold a texture shaped like render target " + std::to_string(o));
+    }
+  }
+
+  in_draw_ = true;
+  std::vector<Chunk> chunks;
+  auto body = [&](int ya, int yb, Chunk& c) {
+    switch (lanes_) {
+      case 1: run_rows<1>(p, rect, ya, yb, c); break;
+      case 4: run_rows<4>(p, rect, ya, yb, c); break;
+      case 8: run_rows<8>(p, rect, ya, yb, c); break;
+      default: run_rows<16>(p, rect, ya, yb, c); break;
+    }
+  };
+  parallel_rows(rect, body, chunks);
+  in_draw_ = false;
+
+  Chunk sum;
+  for (const Chunk& c : chunks) {
+    sum.launched += c.launched;
+    sum.shaded += c.shaded;
+    sum.masked += c.masked;
+    sum.discarded += c.discarded;
+    sum.idle += c.idle;
+  }
+  // Static per-fragment costs times shaded fragments: identical at any width and thread count.
+  Counters c;
+  c.passes = 1;
+  c.fragments_launched = sum.launched;
+  c.fragments_shaded = sum.shaded;
+  c.fragments_masked = sum.masked;
+  c.fragments_discarded = sum.discarded;
+  c.lanes_idle = sum.idle;
+  c.instructions = sum.shaded * uint64_t(a.instructions);
+  uint64_t read_per_frag = 0;
+  for (int u = 0; u < kMaxTextureUnits; ++u)
+    if (a.fetches.per_unit[u])
+      read_per_frag += uint64_t(a.fetches.per_unit[u]) * uint64_t(units_[u]->bytes_per_texel());
+  c.texture_fetches = sum.shaded * uint64_t(a.fetches.total());
+  c.bytes_read = sum.shaded * read_per_frag;
+  uint64_t write_per_frag = 0;
+  for (Texture* t : targets_) write_per_frag += uint64_t(t->bytes_per_texel());
+  c.bytes_written = (sum.shaded - sum.discarded) * write_per_frag;
+  if (query_active_) query_count_ += sum.shaded - sum.discarded;
+  c.host_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+
+  FrameStats::ProgramTotals& totals = stats_.program(pname, p.paper_name(), a.instructions);
+  totals.counters += c;
+  totals.instructions = a.instructions;
+  stats_.totals += c;
+  PassRecord rec{pname, rect.width(), rect.height(), c, -1};
+  if (stats_.keep_pass_records) {
+    stats_.passes.push_back(std::move(rec));
+    return stats_.passes.back();
+  }
+  last_pass_ = std::move(rec);
+  return last_pass_;
+}
+
+}  // namespace vgpu

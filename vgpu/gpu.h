@@ -1,0 +1,124 @@
+// The virtual GPU: a 2004 programmable fragment pipeline as a small state machine.
+//
+//   gpu.use_program(p);             // counted as a program load when p differs from the last
+//   gpu.bind_texture(0, rays);      // texture units: the only way a program reads memory
+//   gpu.set_targets({&state_b});    // render-to-texture: one target on fp30, up to 4 on fp40
+//   gpu.begin_query();              // occlusion query: counts fragments not discarded
+//   gpu.draw();                     // one pass: the program runs on every fragment of a quad
+//   uint64_t n = gpu.end_query();   // reading the count back is a CPU-GPU sync, counted
+//
+// The processor runs W fragments at a time as host SIMD lanes, rows split over threads; images
+// and statistics are bit-identical for any thread count and any width. The profile's limits are
+// enforced: a violation throws vgpu::Error naming the program.
+#pragma once
+
+#include <array>
+#include <condition_variable>
+#include <functional>
+#include <initializer_list>
+#include <memory>
+#include <mutex>
+#include <stdexcept>
+#include <thread>
+#include <vector>
+
+#include "vgpu/profile.h"
+#include "vgpu/program.h"
+#include "vgpu/stats.h"
+#include "vgpu/texture.h"
+
+namespace vgpu {
+
+struct Error : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// A rectangle of the render target in pixels: [x0, x1) x [y0, y1).
+struct Rect {
+  int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+  int width() const { return x1 - x0; }
+  int height() const { return y1 - y0; }
+  uint64_t area() const { return uint64_t(width()) * uint64_t(height()); }
+};
+
+class Gpu {
+ public:
+  // threads = 0: one per host core. lanes: 1 (scalar reference), 4, 8 or 16.
+  explicit Gpu(const Profile& profile, int threads = 0, int lanes = kLanes);
+  ~Gpu();
+  Gpu(const Gpu&) = delete;
+  Gpu& operator=(const Gpu&) = delete;
+
+  const Profile& profile() const { return profile_; }
+  int threads() const { return int(workers_.size()) + 1; }
+  int lanes() const { return lanes_; }
+
+  // Video memory: a texture the profile can hold (throws Error past max_texture_size).
+  Texture make_texture(std::string name, int width, int height, int channels,
+                       Format format = Format::fp32) const;
+  void check_texture(const Texture& t) const;
+
+  // Pipeline state.
+  void use_program(const Program& program);
+  void bind_texture(int unit, const Texture& texture);
+  void unbind_textures();
+  void set_targets(std::initializer_list<Texture*> targets);
+  // Early-z / stencil mask: fragments whose stencil is 0 are skipped before shading.
+  void set_stencil_test(const Stencil* stencil) { stencil_test_ = stencil; }
+  // After each pass, the stencil of every shaded fragment becomes 1 if it survived, 0 if killed.
+  void set_stencil_write(Stencil* stencil) { stencil_write_ = stencil; }
+
+  // Emulator shortcut, not hardware: fragments whose work mask is 0 run no host code. They are
+  // counted exactly as if shaded (the statistics use each program's static per-fragment counts),
+  // their outputs are copied from the program's passthrough units and they are discarded if the
+  // program says idle fragments are. The host marks a fragment idle only where the program's
+  // result provably equals that (a finished ray), so images and statistics do not change.
+  void set_work_mask(const Stencil* work) { work_mask_ = work; }
+
+  // One pass over rect (default: the whole first target).
+  const PassRecord& draw();
+  const PassRecord& draw(const Rect& rect);
+
+  // Occlusion queries: begin, draw one or more passes, end returns the surviving fragments.
+  // end_query() reads the result back (a synchronisation, counted as a query read-back).
+  void begin_query();
+  uint64_t end_query();
+
+  FrameStats& stats() { return stats_; }
+  const FrameStats& stats() const { return stats_; }
+
+ private:
+  struct Chunk;
+  template <int W>
+  void run_rows(const Program& p, const Rect& r, int y0, int y1, Chunk& out) const;
+  void parallel_rows(const Rect& r, const std::function<void(int, int, Chunk&)>& body,
+                     std::vector<Chunk>& chunks);
+  void worker_loop();
+  [[noreturn]] void fail(const std::string& what) const;
+
+  Profile profile_;
+  int lanes_;
+  const Program* program_ = nullptr;
+  uint32_t loaded_program_ = 0;
+  std::array<const Texture*, kMaxTextureUnits> units_{};
+  std::vector<Texture*> targets_;
+  const Stencil* stencil_test_ = nullptr;
+  Stencil* stencil_write_ = nullptr;
+  const Stencil* work_mask_ = nullptr;
+  bool in_draw_ = false;
+  bool query_active_ = false;
+  uint64_t query_count_ = 0;
+  FrameStats stats_;
+  PassRecord last_pass_;
+
+  // Thread pool: the calling thread works too.
+  std::vector<std::thread> workers_;
+  std::mutex mu_;
+  std::condition_variable cv_work_, cv_done_;
+  const std::function<void()>* job_ = nullptr;
+  uint64_t job_serial_ = 0;
+  int busy_ = 0;
+  bool stop_ = false;
+};
+
+}  // namespace vgpu

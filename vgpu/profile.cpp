@@ -1,0 +1,80 @@
+// The profile table. Sources are named per figure; see ../shared/paper/HARDWARE.md.
+#include "vgpu/profile.h"
+
+#include <stdexcept>
+
+namespace vgpu {
+
+const std::vector<Profile>& profiles() {
+  static const std::vector<Profile> table = [] {
+    std::vector<Profile> t;
+    Profile fx;
+    fx.name = "gf5700";
+    fx.display = "GeForce FX 5700 (NV36), Cg fp30";
+    fx.cg_profile = "fp30";
+    fx.pipelines = 4;            // hexus.net FX 5700 Ultra review p.2: 4 pipes, 1 TMU each
+    fx.core_mhz = 425;           // FX 5700 non-Ultra (secondary sources); paper omits variant
+    fx.mem_gbps = 8.8;           // FX 5700 non-Ultra, 128-bit @ 550 MHz effective
+    fx.max_outputs = 1;          // OpenGL/Cg fp30 writes one color output
+    fx.max_instructions = 1024;  // Mesa MAX_NV_FRAGMENT_PROGRAM_INSTRUCTIONS
+    fx.branching = Branching::none;  // NVIDIA Cg docs, fp30: no data-dependent branching/loops
+    fx.branch_granularity = 1;
+    fx.max_texture_size = 4096;  // NV3x GL_MAX_TEXTURE_SIZE / RECTANGLE size (driver caps)
+    fx.precision = Format::fp32;  // fp30 "float" is IEEE single; "half" is fp16
+    fx.bus_mbps = 2112;          // AGP 8x: 264 MB/s x 8 (GPU Gems 2, ch. 30)
+    fx.program_load_us = 50;     // model parameter (no public figure)
+    fx.readback_us = 100;        // model parameter (no public figure; GPU Gems 2 ch. 6: a stall)
+    fx.pass_us = 50;             // model parameter (no public figure)
+    t.push_back(fx);
+
+    Profile g6;
+    g6.name = "gf6600";
+    g6.display = "GeForce 6600 (NV43), Cg fp40";
+    g6.cg_profile = "fp40";
+    g6.pipelines = 8;            // Tom's Hardware 6600 GT review: 8 pixel pipelines
+    g6.core_mhz = 300;           // 6600 non-GT (Tom's Hardware); GT is 500 MHz
+    g6.mem_gbps = 11.2;          // one non-GT board, 700 MHz effective x 128 bit (Tom's Hardware)
+    g6.max_outputs = 4;          // MRT (NVIDIA CineFX 3.0 brief; "up to 4": forum source)
+    g6.max_instructions = 65536; // NV_fragment_program2 (fp40) executed-instruction limit
+    g6.branching = Branching::dynamic;  // NVIDIA Cg docs, fp40
+    g6.branch_granularity = 1024;  // ~1000 pixels on NV4x (AnandTech)
+    g6.max_texture_size = 4096;  // NV4x driver caps
+    g6.precision = Format::fp32;  // FP32 and FP16 equal speed on GeForce 6 (CineFX 3.0 brief)
+    g6.bus_mbps = 4000;          // PCI Express x16, one direction (PCI-SIG 1.0a: 250 MB/s/lane)
+    g6.program_load_us = 20;     // model parameter (no public figure)
+    g6.readback_us = 50;         // model parameter (no public figure)
+    g6.pass_us = 20;             // model parameter (no public figure)
+    t.push_back(g6);
+
+    Profile m;
+    m.name = "rtx4090";
+    m.display = "GeForce RTX 4090 (AD102), as a fragment pipeline";
+    m.cg_profile = "ps_5_0-class";
+    m.pipelines = 16384;         // CUDA cores (NVIDIA RTX 4090 specifications)
+    m.core_mhz = 2520;           // boost clock (NVIDIA RTX 4090 specifications)
+    m.mem_gbps = 1008;           // 384-bit GDDR6X @ 21 Gbps (NVIDIA RTX 4090 specifications)
+    m.max_outputs = 8;           // D3D11+ simultaneous render targets
+    m.max_instructions = 1 << 20;  // effectively unlimited (model parameter)
+    m.branching = Branching::dynamic;
+    m.branch_granularity = 32;   // one warp (NVIDIA CUDA programming guide)
+    m.max_texture_size = 32768;  // D3D12 feature level 12 max texture dimension
+    m.precision = Format::fp32;
+    m.bus_mbps = 32000;          // PCI Express 4.0 x16, one direction
+    m.program_load_us = 2;       // model parameter
+    m.readback_us = 10;          // model parameter
+    m.pass_us = 3;               // model parameter
+    t.push_back(m);
+    return t;
+  }();
+  return table;
+}
+
+const Profile& profile(std::string_view name) {
+  for (const Profile& p : profiles())
+    if (p.name == name) return p;
+  std::string known;
+  for (const Profile& p : profiles()) known += (known.empty() ? "" : ", ") + p.name;
+  throw std::invalid_argument("unknown profile '" + std::string(name) + "' (known: " + known + ")");
+}
+
+}  // namespace vgpu

@@ -1,0 +1,80 @@
+// Fragment programs: a kernel functor with a name, its paper name, its outputs, and code written
+// once over lanes. Wrapping it in KernelProgram<K> compiles it for every lane width and for the
+// counting run that derives its instruction count and fetches from the code itself.
+//
+// A kernel K provides:
+//   static constexpr const char* name;        // English name, used in statistics and logs
+//   static constexpr const char* paper_name;  // the paper's name (e.g. "generadorRayos")
+//   static constexpr int outputs;             // render targets written (1 on fp30)
+//   template <class L> void operator()(Fragments<L>& f) const;
+// and may provide, for the emulator's host shortcut (see Gpu::set_work_mask):
+//   static constexpr std::array<int, outputs> passthrough;  // unit holding output i's old value
+//   static constexpr bool idle_discards;                     // an idle fragment is discarded
+// Uniforms are the functor's data members, set by the host between passes.
+#pragma once
+
+#include <array>
+#include <string>
+
+#include "vgpu/fragment.h"
+
+namespace vgpu {
+
+class Program {
+ public:
+  virtual ~Program() = default;
+  virtual const char* name() const = 0;
+  virtual const char* paper_name() const = 0;
+  virtual int outputs() const = 0;
+  virtual bool has_passthrough() const = 0;
+  virtual int passthrough(int output) const = 0;
+  virtual bool idle_discards() const = 0;
+  uint32_t id() const { return id_; }
+
+  virtual void run(Fragments<SimdLanes<1>>& f) const = 0;
+  virtual void run(Fragments<SimdLanes<4>>& f) const = 0;
+  virtual void run(Fragments<SimdLanes<8>>& f) const = 0;
+  virtual void run(Fragments<SimdLanes<16>>& f) const = 0;
+  virtual void run(Fragments<CountingLanes>& f) const = 0;
+
+  // The counting run: static instructions per fragment and fetches per unit, with the current
+  // uniforms (a uniform loop bound, e.g. the number of lights, changes the count).
+  struct Analysis {
+    int instructions = 0;
+    FetchTally fetches;
+  };
+  Analysis analyze() const;
+
+ protected:
+  Program();
+
+ private:
+  uint32_t id_;
+};
+
+template <class K>
+class KernelProgram final : public Program {
+ public:
+  K kernel;  // uniforms live here: the host sets them between passes
+
+  explicit KernelProgram(K k = K{}) : kernel(std::move(k)) {}
+  const char* name() const override { return K::name; }
+  const char* paper_name() const override { return K::paper_name; }
+  int outputs() const override { return K::outputs; }
+  bool has_passthrough() const override { return requires { K::passthrough; }; }
+  int passthrough(int output) const override {
+    if constexpr (requires { K::passthrough; }) return K::passthrough[output];
+    else return -1;
+  }
+  bool idle_discards() const override {
+    if constexpr (requires { K::idle_discards; }) return K::idle_discards;
+    else return false;
+  }
+  void run(Fragments<SimdLanes<1>>& f) const override { kernel(f); }
+  void run(Fragments<SimdLanes<4>>& f) const override { kernel(f); }
+  void run(Fragments<SimdLanes<8>>& f) const override { kernel(f); }
+  void run(Fragments<SimdLanes<16>>& f) const override { kernel(f); }
+  void run(Fragments<CountingLanes>& f) const override { kernel(f); }
+};
+
+}  // namespace vgpu

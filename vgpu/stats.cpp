@@ -1,0 +1,108 @@
+// Statistics arithmetic and their JSON and table forms.
+#include "vgpu/stats.h"
+
+// GCC 12 reports false positives inside nlohmann_json's templates.
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#pragma GCC diagnostic ignored "-Wrestrict"
+
+#include <cstdio>
+#include <nlohmann/json.hpp>
+
+namespace vgpu {
+
+#define VGPU_COUNTER_FIELDS(X)                                                               \
+  X(passes) X(fragments_launched) X(fragments_shaded) X(fragments_masked)                   \
+  X(fragments_discarded) X(lanes_idle) X(instructions) X(texture_fetches) X(bytes_read)     \
+  X(bytes_written) X(program_loads) X(program_bytes) X(queries) X(query_readbacks)
+
+Counters& Counters::operator+=(const Counters& o) {
+#define X(f) f += o.f;
+  VGPU_COUNTER_FIELDS(X)
+#undef X
+  host_ms += o.host_ms;
+  return *this;
+}
+
+bool Counters::same_counts(const Counters& o) const {
+#define X(f) if (f != o.f) return false;
+  VGPU_COUNTER_FIELDS(X)
+#undef X
+  return true;
+}
+
+static nlohmann::ordered_json counters_json(const Counters& c) {
+  nlohmann::ordered_json j;
+#define X(f) j[#f] = c.f;
+  VGPU_COUNTER_FIELDS(X)
+#undef X
+  j["host_ms"] = c.host_ms;
+  return j;
+}
+
+FrameStats::ProgramTotals& FrameStats::program(const std::string& name,
+                                               const std::string& paper_name, int instructions) {
+  for (ProgramTotals& p : programs)
+    if (p.name == name) return p;
+  programs.push_back({name, paper_name, instructions, {}});
+  return programs.back();
+}
+
+const FrameStats::ProgramTotals* FrameStats::find(const std::string& name) const {
+  for (const ProgramTotals& p : programs)
+    if (p.name == name) return &p;
+  return nullptr;
+}
+
+void FrameStats::clear() {
+  passes.clear();
+  programs.clear();
+  totals = {};
+}
+
+std::string FrameStats::to_json(int indent) const {
+  nlohmann::ordered_json j;
+  j["totals"] = counters_json(totals);
+  auto progs = nlohmann::ordered_json::array();
+  for (const ProgramTotals& p : programs) {
+    nlohmann::ordered_json e;
+    e["name"] = p.name;
+    e["paper_name"] = p.paper_name;
+    e["instructions"] = p.instructions;
+    for (auto& [k, v] : counters_json(p.counters).items()) e[k] = v;
+    progs.push_back(e);
+  }
+  j["programs"] = progs;
+  return j.dump(indent);
+}
+
+static std::string human(uint64_t v) {
+  char buf[32];
+  if (v >= 10'000'000'000ull) std::snprintf(buf, sizeof buf, "%.1fG", v / 1e9);
+  else if (v >= 10'000'000ull) std::snprintf(buf, sizeof buf, "%.1fM", v / 1e6);
+  else if (v >= 100'000ull) std::snprintf(buf, sizeof buf, "%.1fk", v / 1e3);
+  else std::snprintf(buf, sizeof buf, "%llu", static_cast<unsigned long long>(v));
+  return buf;
+}
+
+std::string FrameStats::to_table() const {
+  std::string out;
+  char line[512];
+  std::snprintf(line, sizeof line, "%-24s %-22s %7s %9s %9s %9s %9s %9s %9s %6s %6s %9s\n",
+                "kernel", "paper name", "passes", "launched", "shaded", "discarded", "fetches",
+                "read B", "written B", "loads", "reads", "host ms");
+  out += line;
+  auto row = [&](const std::string& n, const std::string& pn, const Counters& c) {
+    std::snprintf(line, sizeof line, "%-24s %-22s %7s %9s %9s %9s %9s %9s %9s %6s %6s %9.2f\n",
+                  n.c_str(), pn.c_str(), human(c.passes).c_str(),
+                  human(c.fragments_launched).c_str(), human(c.fragments_shaded).c_str(),
+                  human(c.fragments_discarded).c_str(), human(c.texture_fetches).c_str(),
+                  human(c.bytes_read).c_str(), human(c.bytes_written).c_str(),
+                  human(c.program_loads).c_str(), human(c.query_readbacks).c_str(), c.host_ms);
+    out += line;
+  };
+  for (const ProgramTotals& p : programs) row(p.name, p.paper_name, p.counters);
+  row("total", "", totals);
+  return out;
+}
+
+}  // namespace vgpu

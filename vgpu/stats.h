@@ -1,0 +1,62 @@
+// Statistics: everything the virtual GPU does is counted, per pass, per program and per frame.
+// Counters are plain integers summed per thread, so they are identical for any thread count.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace vgpu {
+
+struct Counters {
+  uint64_t passes = 0;               // render-to-texture passes (draws)
+  uint64_t fragments_launched = 0;   // fragments in the drawn rectangles
+  uint64_t fragments_shaded = 0;     // fragments the program ran on (launched minus masked)
+  uint64_t fragments_masked = 0;     // skipped by the early-z/stencil mask before shading
+  uint64_t fragments_discarded = 0;  // shaded, then killed (no write, not counted by a query)
+  uint64_t lanes_idle = 0;           // SIMD lanes issued without a live fragment, or idle in a branch
+  uint64_t instructions = 0;         // fragment-program instructions executed (shaded x static count)
+  uint64_t texture_fetches = 0;      // texels fetched through texture units
+  uint64_t bytes_read = 0;           // bytes fetched through texture units
+  uint64_t bytes_written = 0;        // bytes written to render targets
+  uint64_t program_loads = 0;        // binds of a program different from the last one
+  uint64_t program_bytes = 0;        // bytes of program code uploaded by those loads
+  uint64_t queries = 0;              // occlusion queries issued
+  uint64_t query_readbacks = 0;      // query results read back by the host (a CPU-GPU sync)
+  double host_ms = 0;                // host wall time (the only counter that varies run to run)
+
+  Counters& operator+=(const Counters& o);
+  // Every integer counter equal (host_ms excluded).
+  bool same_counts(const Counters& o) const;
+};
+
+// One pass as recorded: which program, what it drew, what it cost.
+struct PassRecord {
+  std::string program;
+  int width = 0, height = 0;  // drawn rectangle, fragments
+  Counters counters;          // counters.passes == 1
+  int64_t query_result = -1;  // fragments that passed, if the pass ran inside a query
+};
+
+// A frame's statistics: every pass, and per-program totals in order of first use.
+struct FrameStats {
+  struct ProgramTotals {
+    std::string name;
+    std::string paper_name;
+    int instructions = 0;  // static instruction count
+    Counters counters;
+  };
+  std::vector<PassRecord> passes;
+  std::vector<ProgramTotals> programs;
+  Counters totals;
+  bool keep_pass_records = true;  // off: only per-program and frame totals (long renders)
+
+  ProgramTotals& program(const std::string& name, const std::string& paper_name, int instructions);
+  const ProgramTotals* find(const std::string& name) const;
+  void clear();
+
+  std::string to_json(int indent = 2) const;  // {"totals": {...}, "programs": [...]}
+  std::string to_table() const;               // human-readable, one row per program
+};
+
+}  // namespace vgpu

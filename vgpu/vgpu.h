@@ -1,0 +1,11 @@
+// The virtual GPU's public header: include this one to use it.
+#pragma once
+
+#include "vgpu/format.h"
+#include "vgpu/fragment.h"
+#include "vgpu/gpu.h"
+#include "vgpu/lanes.h"
+#include "vgpu/profile.h"
+#include "vgpu/program.h"
+#include "vgpu/stats.h"
+#include "vgpu/texture.h"
