@@ -1,0 +1,634 @@
+// Generates the paper's test scenes (Fal, Vasconcelos & Delrieux) as glTF 2.0 files in ../../scenes/.
+//
+//   cd scripts/make_scenes && npm ci && node make_scenes.mjs
+//
+// Every file is a single .gltf with its buffer embedded as a base64 data URI. Conventions shared by
+// all scenes (what host/gltf_loader.cpp reads):
+//   - world units, +Y up, floors at y = 0;
+//   - meshes are indexed TRIANGLES (u16 indices) with float POSITION and NORMAL; winding is
+//     counter-clockwise seen from outside; normals are smooth (area-weighted face normals) for
+//     curved meshes, exact for analytic spheres, flat for planes;
+//   - nodes carry translation / rotation (unit quaternion) / uniform scale only;
+//   - materials: pbrMetallicRoughness.baseColorFactor = colour, metallicFactor = reflection
+//     coefficient, and the same value again as extras.reflect (which wins when present);
+//   - one perspective camera node (glTF: looks down local -Z, +Y up, yfov vertical, aspect 1);
+//   - KHR_lights_punctual point lights with intensity 1.0 (the renderer multiplies colour by
+//     intensity and applies no physical falloff).
+// The output is deterministic: no randomness, no timestamps, fixed iteration orders.
+
+import { readFileSync, writeFileSync, mkdirSync } from 'node:fs';
+import { createRequire } from 'node:module';
+import { dirname, join } from 'node:path';
+import { fileURLToPath } from 'node:url';
+import { MeshoptSimplifier } from 'meshoptimizer';
+
+const require = createRequire(import.meta.url);
+const bunny = require('bunny');
+const teapot = require('teapot');
+const HERE = dirname(fileURLToPath(import.meta.url));
+const pkgVersion = (name) => JSON.parse(readFileSync(join(HERE, 'node_modules', name, 'package.json'), 'utf8')).version;
+const OUT_DIR = join(HERE, '..', '..', 'scenes');
+
+// ---------------------------------------------------------------------------------------------
+// Small vector helpers
+// ---------------------------------------------------------------------------------------------
+const sub = (a, b) => [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+const add = (a, b) => [a[0] + b[0], a[1] + b[1], a[2] + b[2]];
+const scl = (a, s) => [a[0] * s, a[1] * s, a[2] * s];
+const dot = (a, b) => a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+const cross = (a, b) => [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
+const len = (a) => Math.sqrt(dot(a, a));
+const norm = (a) => scl(a, 1 / len(a));
+const round = (x, d = 6) => {
+  const r = Math.round(x * 10 ** d) / 10 ** d;
+  return Object.is(r, -0) ? 0 : r;
+};
+const roundv = (v, d = 6) => v.map((x) => round(x, d));
+const deg = (x) => (x * Math.PI) / 180;
+
+// Quaternion [x, y, z, w] from a rotation matrix given by its columns.
+function quatFromBasis(cx, cy, cz) {
+  const m00 = cx[0], m10 = cx[1], m20 = cx[2];
+  const m01 = cy[0], m11 = cy[1], m21 = cy[2];
+  const m02 = cz[0], m12 = cz[1], m22 = cz[2];
+  const tr = m00 + m11 + m22;
+  let q;
+  if (tr > 0) {
+    const s = Math.sqrt(tr + 1) * 2;
+    q = [(m21 - m12) / s, (m02 - m20) / s, (m10 - m01) / s, s / 4];
+  } else if (m00 > m11 && m00 > m22) {
+    const s = Math.sqrt(1 + m00 - m11 - m22) * 2;
+    q = [s / 4, (m01 + m10) / s, (m02 + m20) / s, (m21 - m12) / s];
+  } else if (m11 > m22) {
+    const s = Math.sqrt(1 + m11 - m00 - m22) * 2;
+    q = [(m01 + m10) / s, s / 4, (m12 + m21) / s, (m02 - m20) / s];
+  } else {
+    const s = Math.sqrt(1 + m22 - m00 - m11) * 2;
+    q = [(m02 + m20) / s, (m12 + m21) / s, s / 4, (m10 - m01) / s];
+  }
+  if (q[3] < 0) q = q.map((x) => -x); // keep w >= 0
+  const l = Math.hypot(...q);
+  return q.map((x) => x / l);
+}
+
+// Quaternion rotating by `angle` radians about unit `axis`.
+const quatAxisAngle = (axis, angle) => {
+  const s = Math.sin(angle / 2);
+  return [axis[0] * s, axis[1] * s, axis[2] * s, Math.cos(angle / 2)];
+};
+
+// Rotate v by unit quaternion q.
+function quatRotate(q, v) {
+  const u = [q[0], q[1], q[2]];
+  const w = q[3];
+  const t = scl(cross(u, v), 2);
+  return add(add(v, scl(t, w)), cross(u, t));
+}
+
+// Camera basis for a camera at `eye` looking at `target` (glTF camera: -Z forward, +Y up).
+function lookAt(eye, target, worldUp = [0, 1, 0]) {
+  const f = norm(sub(target, eye));
+  const z = scl(f, -1);
+  const x = norm(cross(worldUp, z));
+  const y = cross(z, x);
+  return { x, y, z, f, q: quatFromBasis(x, y, z) };
+}
+
+// ---------------------------------------------------------------------------------------------
+// Meshes: { positions: [[x,y,z]...], normals: [[x,y,z]...], tris: [[a,b,c]...] }
+// ---------------------------------------------------------------------------------------------
+
+// Merge vertices with identical coordinates (to 1e-5) so seams share normals; drops faces that
+// collapse. Keeps the first occurrence's order, so the result is deterministic.
+function weld(positions, tris) {
+  const map = new Map();
+  const out = [];
+  const remap = positions.map((p) => {
+    const k = p.map((v) => v.toFixed(5)).join(',');
+    if (!map.has(k)) {
+      map.set(k, out.length);
+      out.push(p.slice());
+    }
+    return map.get(k);
+  });
+  const t = [];
+  for (const [a, b, c] of tris) {
+    const A = remap[a], B = remap[b], C = remap[c];
+    if (A !== B && B !== C && A !== C) t.push([A, B, C]);
+  }
+  return { positions: out, tris: t };
+}
+
+// Smooth normals: the sum of unnormalised face normals (|n| = 2 * area) around each vertex.
+function smoothNormals(positions, tris) {
+  const acc = positions.map(() => [0, 0, 0]);
+  for (const [a, b, c] of tris) {
+    const n = cross(sub(positions[b], positions[a]), sub(positions[c], positions[a]));
+    for (const v of [a, b, c]) acc[v] = add(acc[v], n);
+  }
+  return acc.map((n) => (len(n) > 0 ? norm(n) : [0, 1, 0]));
+}
+
+// Drop unreferenced vertices, renumbering in order of first use.
+function compact(positions, tris) {
+  const remap = new Map();
+  const out = [];
+  const t = tris.map((tri) =>
+    tri.map((v) => {
+      if (!remap.has(v)) {
+        remap.set(v, out.length);
+        out.push(positions[v]);
+      }
+      return remap.get(v);
+    })
+  );
+  return { positions: out, tris: t };
+}
+
+function smoothMesh(positions, tris) {
+  return { positions, tris, normals: smoothNormals(positions, tris) };
+}
+
+// UV sphere centred at the origin: `segments` around the Y axis, `bands` from pole to pole.
+// Triangles: 2 * segments * (bands - 1). Normals are exact (the unit position).
+function uvSphere(radius, segments, bands) {
+  const positions = [[0, radius, 0]];
+  const normals = [[0, 1, 0]];
+  for (let i = 1; i < bands; i++) {
+    const theta = (Math.PI * i) / bands;
+    for (let j = 0; j < segments; j++) {
+      const phi = (2 * Math.PI * j) / segments;
+      const n = [Math.sin(theta) * Math.sin(phi), Math.cos(theta), Math.sin(theta) * Math.cos(phi)];
+      normals.push(n);
+      positions.push(scl(n, radius));
+    }
+  }
+  positions.push([0, -radius, 0]);
+  normals.push([0, -1, 0]);
+  const bottom = positions.length - 1;
+  const ring = (i, j) => 1 + (i - 1) * segments + (((j % segments) + segments) % segments);
+  const tris = [];
+  for (let j = 0; j < segments; j++) tris.push([0, ring(1, j), ring(1, j + 1)]);
+  for (let i = 1; i < bands - 1; i++) {
+    for (let j = 0; j < segments; j++) {
+      const a = ring(i, j), b = ring(i + 1, j), c = ring(i + 1, j + 1), d = ring(i, j + 1);
+      tris.push([a, b, c], [a, c, d]);
+    }
+  }
+  for (let j = 0; j < segments; j++) tris.push([bottom, ring(bands - 1, j + 1), ring(bands - 1, j)]);
+  return { positions, normals, tris };
+}
+
+// Axis-aligned rectangle in the local XZ plane at y = 0, facing +Y, centred at the origin.
+function quadXZ(sx, sz) {
+  const x = sx / 2, z = sz / 2;
+  return {
+    positions: [[-x, 0, -z], [-x, 0, z], [x, 0, z], [x, 0, -z]],
+    normals: [[0, 1, 0], [0, 1, 0], [0, 1, 0], [0, 1, 0]],
+    tris: [[0, 1, 2], [0, 2, 3]],
+  };
+}
+
+// Rectangle in the local XY plane, facing +Z, bottom edge at y = 0, centred on x = 0.
+function quadXY(sx, sy) {
+  const x = sx / 2;
+  return {
+    positions: [[-x, 0, 0], [x, 0, 0], [x, sy, 0], [-x, sy, 0]],
+    normals: [[0, 0, 1], [0, 0, 1], [0, 0, 1], [0, 0, 1]],
+    tris: [[0, 1, 2], [0, 2, 3]],
+  };
+}
+
+// Checkerboard of n x n separate squares of side `cell` in the XZ plane, centred at the origin.
+// Returns two meshes: squares where (i + j) is even, and where it is odd.
+function checker(n, cell) {
+  const parts = [{ positions: [], normals: [], tris: [] }, { positions: [], normals: [], tris: [] }];
+  const h = (n * cell) / 2;
+  for (let i = 0; i < n; i++) {
+    for (let j = 0; j < n; j++) {
+      const m = parts[(i + j) % 2];
+      const x0 = -h + i * cell, x1 = x0 + cell, z0 = -h + j * cell, z1 = z0 + cell;
+      const b = m.positions.length;
+      m.positions.push([x0, 0, z0], [x0, 0, z1], [x1, 0, z1], [x1, 0, z0]);
+      m.normals.push([0, 1, 0], [0, 1, 0], [0, 1, 0], [0, 1, 0]);
+      m.tris.push([b, b + 1, b + 2], [b, b + 2, b + 3]);
+    }
+  }
+  return parts;
+}
+
+// Loop subdivision (1 -> 4 triangles) with the usual crease rule on open boundaries.
+function loopSubdivide(positions, tris) {
+  const edgeKey = (a, b) => (a < b ? `${a}_${b}` : `${b}_${a}`);
+  const edges = new Map(); // key -> { a, b, opp: [vertices opposite], mid }
+  const order = [];
+  for (const t of tris) {
+    for (let k = 0; k < 3; k++) {
+      const a = t[k], b = t[(k + 1) % 3], c = t[(k + 2) % 3];
+      const key = edgeKey(a, b);
+      if (!edges.has(key)) {
+        edges.set(key, { a, b, opp: [] });
+        order.push(key);
+      }
+      edges.get(key).opp.push(c);
+    }
+  }
+  const nv = positions.length;
+  const ring = positions.map(() => []);
+  const boundaryNbrs = positions.map(() => []);
+  for (const key of order) {
+    const e = edges.get(key);
+    ring[e.a].push(e.b);
+    ring[e.b].push(e.a);
+    if (e.opp.length === 1) {
+      boundaryNbrs[e.a].push(e.b);
+      boundaryNbrs[e.b].push(e.a);
+    }
+  }
+  // Even (old) vertices.
+  const out = positions.map((p, v) => {
+    if (boundaryNbrs[v].length > 0) {
+      if (boundaryNbrs[v].length !== 2) return p.slice(); // corner / non-manifold: keep
+      const [q, r] = boundaryNbrs[v];
+      return add(scl(p, 0.75), scl(add(positions[q], positions[r]), 0.125));
+    }
+    const n = ring[v].length;
+    const beta = n === 3 ? 3 / 16 : 3 / (8 * n);
+    let s = [0, 0, 0];
+    for (const q of ring[v]) s = add(s, positions[q]);
+    return add(scl(p, 1 - n * beta), scl(s, beta));
+  });
+  // Odd (edge) vertices.
+  for (const key of order) {
+    const e = edges.get(key);
+    const pa = positions[e.a], pb = positions[e.b];
+    let p;
+    if (e.opp.length === 2) {
+      p = add(scl(add(pa, pb), 3 / 8), scl(add(positions[e.opp[0]], positions[e.opp[1]]), 1 / 8));
+    } else {
+      p = scl(add(pa, pb), 0.5);
+    }
+    e.mid = out.length;
+    out.push(p);
+  }
+  const t2 = [];
+  for (const [a, b, c] of tris) {
+    const ab = edges.get(edgeKey(a, b)).mid, bc = edges.get(edgeKey(b, c)).mid, ca = edges.get(edgeKey(c, a)).mid;
+    t2.push([a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]);
+  }
+  if (out.length !== nv + order.length) throw new Error('loop subdivision bookkeeping');
+  return { positions: out, tris: t2 };
+}
+
+// meshoptimizer simplification to as close to `targetFaces` as the simplifier gets: tries a
+// range of index-count targets and keeps the closest result (ties: the first found).
+function simplifyTo(positions, tris, targetFaces, flags = []) {
+  const idx = new Uint32Array(tris.flat());
+  const pos = new Float32Array(positions.flat());
+  let best = null;
+  for (let t = targetFaces - 40; t <= targetFaces + 40; t++) {
+    const [res] = MeshoptSimplifier.simplify(idx, pos, 3, t * 3, 1.0, flags);
+    const faces = res.length / 3;
+    if (best === null || Math.abs(faces - targetFaces) < Math.abs(best.length / 3 - targetFaces)) best = res;
+    if (faces === targetFaces) break;
+  }
+  const t = [];
+  for (let i = 0; i < best.length; i += 3) t.push([best[i], best[i + 1], best[i + 2]]);
+  return compact(positions, t);
+}
+
+function bboxOf(points) {
+  const lo = [Infinity, Infinity, Infinity], hi = [-Infinity, -Infinity, -Infinity];
+  for (const p of points) for (let i = 0; i < 3; i++) { lo[i] = Math.min(lo[i], p[i]); hi[i] = Math.max(hi[i], p[i]); }
+  return { lo, hi };
+}
+
+function signedVolume(positions, tris) {
+  let v = 0;
+  for (const [a, b, c] of tris) v += dot(positions[a], cross(positions[b], positions[c])) / 6;
+  return v;
+}
+
+// ---------------------------------------------------------------------------------------------
+// glTF writer
+// ---------------------------------------------------------------------------------------------
+class Gltf {
+  constructor(name, description, source) {
+    this.name = name;
+    this.description = description;
+    this.source = source;
+    this.json = {
+      asset: { version: '2.0', generator: 'vgpu-rt scripts/make_scenes/make_scenes.mjs', extras: { description, source } },
+      extensionsUsed: ['KHR_lights_punctual'],
+      extensions: { KHR_lights_punctual: { lights: [] } },
+      scene: 0,
+      scenes: [{ name, nodes: [] }],
+      nodes: [],
+      meshes: [],
+      materials: [],
+      cameras: [],
+      accessors: [],
+      bufferViews: [],
+      buffers: [],
+    };
+    this.chunks = [];
+    this.byteLength = 0;
+    this.faces = 0;
+    this.worldPoints = []; // world-space positions of every vertex, for bounds / framing
+    this.materialInfo = [];
+  }
+
+  addBytes(bytes, target) {
+    const pad = (4 - (this.byteLength % 4)) % 4;
+    if (pad) { this.chunks.push(new Uint8Array(pad)); this.byteLength += pad; }
+    const view = { buffer: 0, byteOffset: this.byteLength, byteLength: bytes.byteLength, target };
+    this.chunks.push(new Uint8Array(bytes.buffer, bytes.byteOffset, bytes.byteLength));
+    this.byteLength += bytes.byteLength;
+    this.json.bufferViews.push(view);
+    return this.json.bufferViews.length - 1;
+  }
+
+  addVec3Accessor(vectors, name) {
+    const f = new Float32Array(vectors.length * 3);
+    vectors.forEach((v, i) => f.set(v, i * 3));
+    const lo = [Infinity, Infinity, Infinity], hi = [-Infinity, -Infinity, -Infinity];
+    for (let i = 0; i < f.length; i++) { lo[i % 3] = Math.min(lo[i % 3], f[i]); hi[i % 3] = Math.max(hi[i % 3], f[i]); }
+    const view = this.addBytes(f, 34962);
+    this.json.accessors.push({ name, bufferView: view, byteOffset: 0, componentType: 5126, count: vectors.length, type: 'VEC3', min: lo, max: hi });
+    return this.json.accessors.length - 1;
+  }
+
+  addIndexAccessor(tris, vertexCount, name) {
+    const flat = tris.flat();
+    const u16 = vertexCount <= 65535;
+    const arr = u16 ? new Uint16Array(flat) : new Uint32Array(flat);
+    const view = this.addBytes(arr, 34963);
+    let lo = Infinity, hi = -Infinity;
+    for (const v of flat) { lo = Math.min(lo, v); hi = Math.max(hi, v); }
+    this.json.accessors.push({ name, bufferView: view, byteOffset: 0, componentType: u16 ? 5123 : 5125, count: flat.length, type: 'SCALAR', min: [lo], max: [hi] });
+    return this.json.accessors.length - 1;
+  }
+
+  // reflect: reflection coefficient (0 = none); roughness only matters to other viewers.
+  material(name, color, reflect, roughness = 0.5) {
+    this.json.materials.push({
+      name,
+      pbrMetallicRoughness: { baseColorFactor: [...roundv(color, 4), 1], metallicFactor: reflect, roughnessFactor: roughness },
+      extras: { reflect },
+    });
+    this.materialInfo.push({ name, color: roundv(color, 4), reflect });
+    return this.json.materials.length - 1;
+  }
+
+  // primitives: [{ mesh: {positions, normals, tris}, material }]
+  mesh(name, primitives) {
+    const prims = primitives.map(({ mesh, material }, k) => {
+      const tag = primitives.length > 1 ? `${name}[${k}]` : name;
+      return {
+        attributes: {
+          POSITION: this.addVec3Accessor(mesh.positions, `${tag} POSITION`),
+          NORMAL: this.addVec3Accessor(mesh.normals, `${tag} NORMAL`),
+        },
+        indices: this.addIndexAccessor(mesh.tris, mesh.positions.length, `${tag} indices`),
+        material,
+        mode: 4,
+      };
+    });
+    this.json.meshes.push({ name, primitives: prims });
+    return { index: this.json.meshes.length - 1, primitives };
+  }
+
+  node(fields) {
+    const n = { ...fields };
+    if (n.translation) n.translation = roundv(n.translation);
+    if (n.rotation) n.rotation = roundv(n.rotation, 7);
+    this.json.nodes.push(n);
+    this.json.scenes[0].nodes.push(this.json.nodes.length - 1);
+    return this.json.nodes.length - 1;
+  }
+
+  // Mesh instance; world transform = T * R * S (uniform s).
+  instance(name, meshRef, { t = [0, 0, 0], r = [0, 0, 0, 1], s = 1 } = {}) {
+    const node = { name, mesh: meshRef.index };
+    if (t.some((x) => x !== 0)) node.translation = t;
+    if (r[3] !== 1) node.rotation = r;
+    if (s !== 1) node.scale = [s, s, s];
+    this.node(node);
+    const rr = node.rotation ?? [0, 0, 0, 1];
+    const tt = node.translation ?? [0, 0, 0];
+    for (const { mesh } of meshRef.primitives) {
+      this.faces += mesh.tris.length;
+      for (const p of mesh.positions) this.worldPoints.push(add(quatRotate(rr, scl(p, s)), tt));
+    }
+    return node;
+  }
+
+  // Perspective camera at `eye` looking at `target`; yfov chosen so the `frame` points fill
+  // `fill` of the half-height/half-width of the 256x256 frame (aspect 1).
+  camera(eye, target, framePoints, fill) {
+    const { x, y, f, q } = lookAt(eye, target);
+    let m = 0;
+    for (const p of framePoints) {
+      const d = sub(p, eye);
+      const depth = dot(d, f);
+      m = Math.max(m, Math.abs(dot(d, x)) / depth, Math.abs(dot(d, y)) / depth);
+    }
+    const yfov = round(2 * Math.atan(m / fill), 4);
+    this.json.cameras.push({ name: 'camera', type: 'perspective', perspective: { aspectRatio: 1.0, yfov, znear: 0.05, zfar: 200 } });
+    this.node({ name: 'camera', camera: 0, translation: eye, rotation: q });
+    this.cameraInfo = { eye: roundv(eye, 4), target: roundv(target, 4), yfov, yfovDeg: round((yfov * 180) / Math.PI, 1) };
+  }
+
+  light(name, position, color = [1, 1, 1], intensity = 1.0) {
+    const lights = this.json.extensions.KHR_lights_punctual.lights;
+    lights.push({ name, type: 'point', color, intensity });
+    this.node({ name, translation: position, extensions: { KHR_lights_punctual: { light: lights.length - 1 } } });
+    (this.lightInfo ??= []).push({ position: roundv(position, 4), color, intensity });
+  }
+
+  write(file) {
+    const all = new Uint8Array(this.byteLength + ((4 - (this.byteLength % 4)) % 4));
+    let o = 0;
+    for (const c of this.chunks) { all.set(c, o); o += c.byteLength; }
+    this.json.buffers.push({ byteLength: all.byteLength, uri: 'data:application/octet-stream;base64,' + Buffer.from(all).toString('base64') });
+    this.json.asset.extras.faces = this.faces;
+    writeFileSync(join(OUT_DIR, file), JSON.stringify(this.json, null, 1) + '\n');
+    const b = bboxOf(this.worldPoints);
+    const info = { file, description: this.description, source: this.source, faces: this.faces, bounds: { lo: roundv(b.lo, 3), hi: roundv(b.hi, 3) }, camera: this.cameraInfo, lights: this.lightInfo, materials: this.materialInfo };
+    console.log(JSON.stringify(info));
+    return info;
+  }
+}
+
+// Transform mesh positions by uniform scale s then translation t (for framing computations).
+const placed = (mesh, s, t, r = [0, 0, 0, 1]) => mesh.positions.map((p) => add(quatRotate(r, scl(p, s)), t));
+
+// ---------------------------------------------------------------------------------------------
+// Source meshes
+// ---------------------------------------------------------------------------------------------
+await MeshoptSimplifier.ready;
+mkdirSync(OUT_DIR, { recursive: true });
+
+// Stanford bunny, raw coordinates: x in [-4.96, 4.95], y in [0, 9.65], z in [-3.73, 3.81], +Y up,
+// head towards -X. Closed (every edge shared by two faces), genus 0, CCW outward.
+const bunnyRaw = weld(bunny.positions, bunny.cells);
+if (bunnyRaw.tris.length !== 3674) throw new Error(`bunny: expected 3674 faces, got ${bunnyRaw.tris.length}`);
+if (signedVolume(bunnyRaw.positions, bunnyRaw.tris) <= 0) throw new Error('bunny winding is not CCW outward');
+const bunnyMesh = smoothMesh(bunnyRaw.positions, bunnyRaw.tris);
+const bunnyLowRaw = simplifyTo(bunnyRaw.positions, bunnyRaw.tris, 948);
+const bunnyLowMesh = smoothMesh(bunnyLowRaw.positions, bunnyLowRaw.tris);
+const BUNNY_SCALE = 0.3; // world: about 3.0 x 2.9 x 2.3, base on y = 0
+const bunnyBase = -bunnyMesh.positions.reduce((m, p) => Math.min(m, p[1]), Infinity) * BUNNY_SCALE;
+
+// Utah teapot: 992 faces with seams (duplicated vertices) and open rims; +Y up, centred,
+// x in [-16.07, 16.07]. Welded, Loop-subdivided twice (15872 faces) and simplified to ~5030.
+const teapotRaw = weld(teapot.positions, teapot.cells);
+if (signedVolume(teapotRaw.positions, teapotRaw.tris) <= 0) throw new Error('teapot winding is not CCW outward');
+const teapotSub = loopSubdivide(...Object.values(loopSubdivide(teapotRaw.positions, teapotRaw.tris)));
+const teapotLow = simplifyTo(teapotSub.positions, teapotSub.tris, 5030, ['RegularizeLight']);
+const teapotMesh = smoothMesh(teapotLow.positions, teapotLow.tris);
+
+const summary = [];
+const WHITE = [1, 1, 1];
+const V = (name) => `npm ${name} ${pkgVersion(name)}`;
+const SRC_PROC = 'procedural (this script)';
+const SRC_BUNNY = `${V('bunny')}, scaled by 0.3`;
+const SRC_BUNNY_LOW = `${V('bunny')}, simplified with ${V('meshoptimizer')} (MeshoptSimplifier.simplify), scaled by 0.3`;
+const SRC_TEAPOT = `${V('teapot')}, welded, Loop-subdivided twice (15872 faces) and simplified with ${V('meshoptimizer')} (MeshoptSimplifier.simplify, RegularizeLight), scaled by 0.15`;
+
+// ---------------------------------------------------------------------------------------------
+// 1. sphere.gltf — Table 1 "Sphere"
+// ---------------------------------------------------------------------------------------------
+{
+  const g = new Gltf('sphere', 'Table 1 "Sphere": a UV sphere (radius 1.5, 32 segments x 24 bands, slightly reflective) above a 14 x 14 floor quad', SRC_PROC);
+  const mSphere = g.material('red', [0.8, 0.12, 0.08], 0.3, 0.2);
+  const mFloor = g.material('floor', [0.75, 0.75, 0.7], 0.0, 0.8);
+  const sphere = uvSphere(1.5, 32, 24); // 1472 faces
+  const c = [0, 2.0, 0];
+  g.instance('sphere', g.mesh('sphere', [{ mesh: sphere, material: mSphere }]), { t: c });
+  g.instance('floor', g.mesh('floor', [{ mesh: quadXZ(14, 14), material: mFloor }]));
+  g.camera([0, 3.2, 7.5], [0, 1.7, 0], placed(sphere, 1, c), 0.6);
+  g.light('light', [-4, 8, 5], WHITE);
+  summary.push(g.write('sphere.gltf'));
+}
+
+// ---------------------------------------------------------------------------------------------
+// 2, 3. bunny.gltf and bunny-low.gltf — Table 1 "Bunny3", Fig. 2
+// ---------------------------------------------------------------------------------------------
+for (const [file, mesh, what, src] of [
+  ['bunny.gltf', bunnyMesh, 'Table 1 "Bunny3" and Fig. 2 (3851-face model): the Stanford bunny alone, all faces, non-reflective', SRC_BUNNY],
+  ['bunny-low.gltf', bunnyLowMesh, 'Fig. 2 (948-face model): the Stanford bunny alone, simplified, non-reflective; same camera and light as bunny.gltf', SRC_BUNNY_LOW],
+]) {
+  const g = new Gltf(file.replace('.gltf', ''), what, src);
+  const m = g.material('bunny', [0.85, 0.72, 0.55], 0.0, 0.6);
+  const t = [0, bunnyBase, 0];
+  g.instance('bunny', g.mesh('bunny', [{ mesh, material: m }]), { s: BUNNY_SCALE, t });
+  // Same camera and light for both levels of detail (framed on the full-detail bunny).
+  g.camera([2.2, 3.0, 6.5], [0, 1.4, 0], placed(bunnyMesh, BUNNY_SCALE, t), 0.85);
+  g.light('light', [4, 7, 6], WHITE);
+  summary.push(g.write(file));
+}
+
+// ---------------------------------------------------------------------------------------------
+// 4. bunny-refl.gltf — Table 1 "BunnyRefl", Fig. 4
+// ---------------------------------------------------------------------------------------------
+{
+  const g = new Gltf('bunny-refl', 'Table 1 "BunnyRefl" and Fig. 4: the full bunny (turned 30 degrees towards the camera) on a reflective 12 x 12 floor in front of two 7 x 4.5 reflective walls meeting at right angles behind it, for mutual reflections', `${SRC_BUNNY}; floor and walls procedural`);
+  const mBunny = g.material('bunny', [0.85, 0.72, 0.55], 0.0, 0.6);
+  const mFloor = g.material('floor', [0.55, 0.6, 0.7], 0.5, 0.3);
+  const mMirrorL = g.material('mirror-left', [0.75, 0.85, 0.8], 0.7, 0.1);
+  const mMirrorR = g.material('mirror-right', [0.85, 0.8, 0.75], 0.6, 0.1);
+  const t = [-0.4, bunnyBase, 0];
+  const r = quatAxisAngle([0, 1, 0], deg(30)); // turn its head (at -X) a little towards the camera
+  g.instance('bunny', g.mesh('bunny', [{ mesh: bunnyMesh, material: mBunny }]), { s: BUNNY_SCALE, t, r });
+  g.instance('floor', g.mesh('floor', [{ mesh: quadXZ(12, 12), material: mFloor }]));
+  // Two vertical 7 x 4.5 mirrors meeting at right angles behind the bunny, a V open towards
+  // the camera; the corner is at (0, 0, -3.5). quadXY faces +Z; yaw it by +-45 degrees about Y.
+  const W = 7, H = 4.5, corner = [0, 0, -3.5];
+  const wall = quadXY(W, H);
+  const left = quatAxisAngle([0, 1, 0], deg(45)); // faces (+x, +z)/sqrt2, spans towards -x
+  const right = quatAxisAngle([0, 1, 0], deg(-45)); // faces (-x, +z)/sqrt2, spans towards +x
+  const half = W / 2 / Math.SQRT2;
+  g.instance('mirror-left', g.mesh('mirror-left', [{ mesh: wall, material: mMirrorL }]), { t: add(corner, [-half, 0, half]), r: left });
+  g.instance('mirror-right', g.mesh('mirror-right', [{ mesh: wall, material: mMirrorR }]), { t: add(corner, [half, 0, half]), r: right });
+  g.camera([0, 3.2, 8.5], [0, 1.6, -1.0], placed(bunnyMesh, BUNNY_SCALE, t, r).concat([[0, 4.5, -3.5]]), 0.7);
+  g.light('light', [3.5, 7, 5], WHITE);
+  summary.push(g.write('bunny-refl.gltf'));
+}
+
+// ---------------------------------------------------------------------------------------------
+// 5. classic.gltf — Fig. 1 (Whitted-style test scene, 848 faces)
+// ---------------------------------------------------------------------------------------------
+{
+  const g = new Gltf('classic', 'Fig. 1: the classic (Whitted-style) ray-tracing test scene: a mirror sphere and two coloured reflective spheres (one floating) over an 8 x 8 red/yellow checkerboard of separate quads (16 x 16 units)', SRC_PROC);
+  const mRed = g.material('checker-red', [0.8, 0.1, 0.08], 0.0, 0.7);
+  const mYellow = g.material('checker-yellow', [0.9, 0.8, 0.15], 0.0, 0.7);
+  const mMirror = g.material('mirror-sphere', [0.9, 0.9, 0.92], 0.7, 0.05);
+  const mBlue = g.material('blue-sphere', [0.2, 0.35, 0.85], 0.4, 0.2);
+  const mGreen = g.material('green-sphere', [0.2, 0.7, 0.3], 0.4, 0.2);
+  const [even, odd] = checker(8, 2.0); // 16 x 16 floor, 128 faces
+  g.instance('checker', g.mesh('checker', [{ mesh: even, material: mRed }, { mesh: odd, material: mYellow }]));
+  const big = uvSphere(1.5, 20, 10); // 360 faces
+  const small = uvSphere(0.9, 15, 7); // 180 faces each
+  const cBig = [0, 1.55, -1.0], cBlue = [-2.4, 0.95, 1.4], cGreen = [2.2, 1.9, 1.6];
+  g.instance('mirror-sphere', g.mesh('mirror-sphere', [{ mesh: big, material: mMirror }]), { t: cBig });
+  const smallBlue = g.mesh('blue-sphere', [{ mesh: small, material: mBlue }]);
+  const smallGreen = g.mesh('green-sphere', [{ mesh: small, material: mGreen }]);
+  g.instance('blue-sphere', smallBlue, { t: cBlue });
+  g.instance('green-sphere', smallGreen, { t: cGreen }); // floating, like Whitted's glass ball
+  g.camera([0, 2.8, 8.5], [0, 1.3, 0], placed(big, 1, cBig).concat(placed(small, 1, cBlue), placed(small, 1, cGreen)), 0.75);
+  g.light('light', [-5, 9, 6], WHITE);
+  summary.push(g.write('classic.gltf'));
+}
+
+// ---------------------------------------------------------------------------------------------
+// 6. teapot.gltf — Fig. 3 (5030 faces, three shading models)
+// ---------------------------------------------------------------------------------------------
+{
+  const g = new Gltf('teapot', 'Fig. 3 (5030 faces, three shading models): the Utah teapot alone, slightly shiny (roughness 0.25), non-reflective', SRC_TEAPOT);
+  const m = g.material('porcelain', [0.75, 0.78, 0.85], 0.0, 0.25);
+  const S = 0.15; // world: about 4.8 x 2.4 x 3.0
+  const lo = teapotMesh.positions.reduce((a, p) => Math.min(a, p[1]), Infinity);
+  const t = [0, Math.ceil(-lo * S * 1e6) / 1e6, 0]; // rests on y = 0 (never below)
+  g.instance('teapot', g.mesh('teapot', [{ mesh: teapotMesh, material: m }]), { s: S, t });
+  g.camera([2.0, 3.4, 6.5], [0.25, 1.1, 0], placed(teapotMesh, S, t), 0.88);
+  g.light('light', [-3, 6, 6], WHITE);
+  summary.push(g.write('teapot.gltf'));
+}
+
+// ---------------------------------------------------------------------------------------------
+// scenes/README.md (generated, so its numbers always match the files)
+// ---------------------------------------------------------------------------------------------
+const fmtv = (v) => `(${v.join(', ')})`;
+const lines = [
+  '# Scenes',
+  '',
+  "The test scenes of Fal, Vasconcelos & Delrieux's paper, as glTF 2.0 files (one `.gltf` each, buffer",
+  'embedded as a base64 data URI). This file is written by the generator; do not edit it by hand.',
+  '',
+  'Regenerate (deterministic, byte-identical output):',
+  '',
+  '```sh',
+  'cd scripts/make_scenes && npm ci && node make_scenes.mjs',
+  '```',
+  '',
+  'Conventions: world units, +Y up, floors at y = 0; indexed TRIANGLES (u16) with float POSITION and',
+  'NORMAL, counter-clockwise seen from outside; smooth area-weighted normals on meshes, exact normals on',
+  'spheres, flat normals on planes; nodes use translation / rotation / uniform scale only.',
+  'Material colour = `pbrMetallicRoughness.baseColorFactor`, reflection coefficient = `metallicFactor`,',
+  'repeated as `extras.reflect`. Camera: one perspective node (looks down local -Z, +Y up, vertical',
+  '`yfov`, `aspectRatio` 1 for the 256x256 frame). Lights: `KHR_lights_punctual` point lights, white,',
+  'intensity 1 (the renderer uses colour x intensity, no physical falloff).',
+  '',
+];
+for (const s of summary) {
+  const cam = s.camera, L = s.lights.map((l) => `${fmtv(l.position)}`).join(', ');
+  const mats = s.materials.map((m) => `${m.name} ${fmtv(m.color)} reflect ${m.reflect}`).join('; ');
+  lines.push(
+    `- \`${s.file}\`: ${s.description}; data: ${s.source}; ${s.faces} faces; ` +
+      `bounds ${fmtv(s.bounds.lo)} to ${fmtv(s.bounds.hi)}; camera at ${fmtv(cam.eye)} looking at ${fmtv(cam.target)}, ` +
+      `yfov ${cam.yfov} rad (${cam.yfovDeg} deg); point light at ${L}; materials: ${mats}.`
+  );
+}
+lines.push('');
+writeFileSync(join(OUT_DIR, 'README.md'), lines.join('\n'));
