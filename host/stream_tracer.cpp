@@ -1,0 +1,364 @@
+// The stream ray tracer's host loop: which pass runs next, steered by occlusion queries.
+#include "host/stream_tracer.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+
+namespace host {
+
+using namespace kernels;
+using vgpu::Format;
+using vgpu::KernelProgram;
+using vgpu::Stencil;
+using vgpu::Texture;
+
+namespace {
+double ms_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+}  // namespace
+
+struct StreamTracer::State {
+  // Static textures.
+  Texture v[3], n[3], colors, lists, pointers;
+  // Dynamic textures (ping-pong pairs where a pass reads what it replaces).
+  Texture rays[2], origins[2], shadow_rays, trav[2], vs[2], isect[2], result[2], counter;
+  int cur_rays = 0, cur_trav = 0, cur_vs = 0, cur_isect = 0, cur_result = 0;
+  Stencil grid_mask, isect_mask;
+  // Programs, with their uniforms.
+  KernelProgram<GenerateRays> generate;
+  KernelProgram<InitTraversal> init;
+  KernelProgram<ResetTraversal> reset;
+  KernelProgram<Traversal> traversal;
+  KernelProgram<RaysInGrid> in_grid;
+  KernelProgram<UpdateVoxel> update;
+  KernelProgram<Intersections> intersect;
+  KernelProgram<NextTriangle> next;
+  KernelProgram<RaysIntersecting> intersecting;
+  KernelProgram<Shader> shader;
+  KernelProgram<ReflectedRays> reflected;
+  KernelProgram<ReflectionOrigin> origin;
+  KernelProgram<ReflectionDirection> direction;
+  KernelProgram<ShadowRays> shadow;
+  uint64_t rays_traced = 0;
+};
+
+kernels::ShadingModel parse_shading(const std::string& name) {
+  if (name == "diffuse") return ShadingModel::diffuse;
+  if (name == "phong") return ShadingModel::phong;
+  if (name == "phong-atten") return ShadingModel::phong_atten;
+  throw std::invalid_argument("unknown shading model '" + name +
+                              "' (known: diffuse, phong, phong-atten)");
+}
+
+StreamTracer::StreamTracer(const Scene& scene, const Grid& grid, const RenderOptions& options)
+    : scene_(scene), grid_(grid), opt_(options) {
+  const auto t0 = std::chrono::steady_clock::now();
+  gpu_ = std::make_unique<vgpu::Gpu>(vgpu::profile(opt_.profile), opt_.threads, opt_.lanes);
+  s_ = std::make_unique<State>();
+  vgpu::Gpu& gpu = *gpu_;
+  const int maxs = gpu.profile().max_texture_size;
+
+  // Scene textures: triangle i at texel (i mod width, i div width).
+  const size_t ntri = scene.triangle_count();
+  const int sw = int(std::min<size_t>(std::max<size_t>(ntri, 1), size_t(maxs)));
+  const size_t sh = (ntri + sw - 1) / sw;
+  if (sh > size_t(maxs))
+    throw vgpu::Error("scene has " + std::to_string(ntri) + " triangles; profile " +
+                      gpu.profile().name + " holds at most " + std::to_string(size_t(maxs) * maxs) +
+                      " in one " + std::to_string(maxs) + "x" + std::to_string(maxs) + " texture");
+  const std::vector<glm::vec3>* P[3] = {&scene.p0, &scene.p1, &scene.p2};
+  const std::vector<glm::vec3>* N[3] = {&scene.n0, &scene.n1, &scene.n2};
+  for (int c = 0; c < 3; ++c) {
+    s_->v[c] = gpu.make_texture("vertices" + std::to_string(c), sw, int(sh), 3);
+    s_->n[c] = gpu.make_texture("normals" + std::to_string(c), sw, int(sh), 3);
+    for (size_t i = 0; i < ntri; ++i) {
+      float* tv = s_->v[c].texel_mut(int(i % sw), int(i / sw));
+      float* tn = s_->n[c].texel_mut(int(i % sw), int(i / sw));
+      for (int k = 0; k < 3; ++k) tv[k] = (*P[c])[i][k], tn[k] = (*N[c])[i][k];
+    }
+  }
+  s_->colors = gpu.make_texture("colors", sw, int(sh), 4);
+  for (size_t i = 0; i < ntri; ++i) {
+    const Material& m = scene.materials[scene.material[i]];
+    float* t = s_->colors.texel_mut(int(i % sw), int(i / sw));
+    t[0] = m.color.r, t[1] = m.color.g, t[2] = m.color.b, t[3] = m.reflect;
+  }
+
+  // Grid textures: the lists, each closed by -1 (entry 0 is the -1 every empty voxel shares),
+  // and the voxel pointers at (X*sizeY + Y, Z).
+  const glm::ivec3 r = grid.res;
+  if (size_t(r.x) * r.y > size_t(maxs) || r.z > maxs)
+    throw vgpu::Error("grid " + std::to_string(r.x) + "x" + std::to_string(r.y) + "x" +
+                      std::to_string(r.z) + " needs a " + std::to_string(r.x * r.y) + "x" +
+                      std::to_string(r.z) + " voxel pointer texture; profile " +
+                      gpu.profile().name + " allows " + std::to_string(maxs) + "x" +
+                      std::to_string(maxs));
+  size_t nonempty = 0;
+  for (size_t vox = 0; vox < grid.voxels(); ++vox) nonempty += grid.start[vox + 1] > grid.start[vox];
+  const size_t list_len = 1 + grid.tris.size() + nonempty;
+  if (list_len >= (size_t(1) << 24))
+    throw vgpu::Error("grid lists hold " + std::to_string(list_len) +
+                      " entries; list positions are exact floats only below 2^24");
+  const int lw = int(std::min<size_t>(list_len, size_t(maxs)));
+  const size_t lh = (list_len + lw - 1) / lw;
+  if (lh > size_t(maxs))
+    throw vgpu::Error("grid lists hold " + std::to_string(list_len) + " entries; profile " +
+                      gpu.profile().name + " holds at most " + std::to_string(size_t(maxs) * maxs) +
+                      " (use a coarser grid)");
+  s_->lists = gpu.make_texture("triangle lists", lw, int(lh), 1);
+  s_->pointers = gpu.make_texture("voxel pointers", r.x * r.y, r.z, 1);
+  size_t k = 0;
+  auto put = [&](float value) {
+    s_->lists.texel_mut(int(k % lw), int(k / lw))[0] = value;
+    ++k;
+  };
+  put(kNone);
+  for (int z = 0; z < r.z; ++z)
+    for (int y = 0; y < r.y; ++y)
+      for (int x = 0; x < r.x; ++x) {
+        const auto tris = grid.triangles_in(grid.index(x, y, z));
+        float start = 0;
+        if (!tris.empty()) {
+          start = float(k);
+          for (uint32_t t : tris) put(float(t));
+          put(kNone);
+        }
+        s_->pointers.texel_mut(x * r.y + y, z)[0] = start;
+      }
+
+  // Dynamic textures: one texel per pixel.
+  const int W = opt_.width, H = opt_.height;
+  for (int i = 0; i < 2; ++i) {
+    const std::string sfx = i ? " B" : " A";
+    s_->rays[i] = gpu.make_texture("rays" + sfx, W, H, 4);
+    s_->origins[i] = gpu.make_texture("origins" + sfx, W, H, 4);
+    s_->trav[i] = gpu.make_texture("traversal" + sfx, W, H, 4);
+    s_->vs[i] = gpu.make_texture("voxel state" + sfx, W, H, 4);
+    s_->isect[i] = gpu.make_texture("intersection" + sfx, W, H, 4);
+    s_->result[i] = gpu.make_texture("result" + sfx, W, H, 4);
+  }
+  s_->shadow_rays = gpu.make_texture("shadow rays", W, H, 4);
+  // Counting passes need a colour target; only their query result matters.
+  s_->counter = gpu.make_texture("counter", W, H, 1, Format::fp16);
+  s_->grid_mask = Stencil(W, H, 1);
+  s_->isect_mask = Stencil(W, H, 1);
+
+  // Uniforms that do not change during a frame.
+  GridUniforms g;
+  g.lo = grid.lo;
+  g.cell = grid.cell;
+  g.res = glm::vec3(r);
+  g.list_width = float(lw);
+  const float diag = glm::length(grid.hi - grid.lo);
+  g.t_slack = 1e-5f * diag;
+  SceneUniforms su{float(sw)};
+  s_->init.kernel.grid = g;
+  s_->reset.kernel.grid = g;
+  s_->traversal.kernel.grid = g;
+  s_->update.kernel.grid = g;
+  s_->intersect.kernel.grid = g;
+  s_->intersect.kernel.scene = su;
+  s_->next.kernel.grid = g;
+  s_->shader.kernel.scene = su;
+  s_->shader.kernel.model = opt_.shading;
+  s_->shader.kernel.atten_dist = 0.5f * diag;
+  s_->origin.kernel.scene = su;
+  s_->origin.kernel.offset = 1e-4f * diag;
+  s_->direction.kernel.scene = su;
+  gpu.stats().keep_pass_records = opt_.keep_pass_records;
+  init_ms_ = ms_since(t0);
+}
+
+StreamTracer::~StreamTracer() = default;
+
+uint64_t StreamTracer::texture_bytes() const {
+  uint64_t b = 0;
+  for (const Texture* t : {&s_->v[0], &s_->v[1], &s_->v[2], &s_->n[0], &s_->n[1], &s_->n[2],
+                           &s_->colors, &s_->lists, &s_->pointers, &s_->shadow_rays, &s_->counter})
+    b += t->bytes();
+  for (int i = 0; i < 2; ++i)
+    for (const Texture* t : {&s_->rays[i], &s_->origins[i], &s_->trav[i], &s_->vs[i],
+                             &s_->isect[i], &s_->result[i]})
+      b += t->bytes();
+  return b;
+}
+
+const vgpu::PassRecord& StreamTracer::pass(const vgpu::Program& p,
+                                           std::initializer_list<const Texture*> in, Texture& out,
+                                           const Stencil* work) {
+  vgpu::Gpu& gpu = *gpu_;
+  gpu.use_program(p);
+  gpu.unbind_textures();
+  int unit = 0;
+  for (const Texture* t : in) gpu.bind_texture(unit++, *t);
+  gpu.set_targets({&out});
+  // The same finished-ray mask either skips fragments on the modeled hardware (masks on) or
+  // only saves the emulator's host work (masks off: every fragment is charged).
+  gpu.set_stencil_test(nullptr);
+  gpu.set_work_mask(work && opt_.host_shortcut ? work : nullptr);
+  gpu.set_work_mask_counts_as_masked(opt_.masks);
+  if (work && opt_.masks) gpu.set_work_mask(work);
+  const vgpu::PassRecord& rec = gpu.draw();
+  if (opt_.trace_pixel && opt_.trace_out) {
+    const int x = opt_.trace_pixel->x, y = opt_.trace_pixel->y;
+    const float* t = out.texel(x, y);
+    char line[256];
+    int n = std::snprintf(line, sizeof line, "  %-22s %-24s -> %-14s (", p.paper_name(), p.name(),
+                          out.name().c_str());
+    for (int c = 0; c < out.channels(); ++c)
+      n += std::snprintf(line + n, sizeof line - size_t(n), "%s%g", c ? ", " : "", t[c]);
+    *opt_.trace_out << line << ")\n";
+  }
+  return rec;
+}
+
+uint64_t StreamTracer::count(const vgpu::Program& p, const Texture& in, const Stencil* work,
+                             Stencil* write) {
+  vgpu::Gpu& gpu = *gpu_;
+  gpu.set_stencil_write(write);
+  gpu.begin_query();
+  pass(p, {&in}, s_->counter, work);
+  const uint64_t n = gpu.end_query();
+  gpu.set_stencil_write(nullptr);
+  if (opt_.trace_pixel && opt_.trace_out) *opt_.trace_out << "    query: " << n << " fragments\n";
+  return n;
+}
+
+void StreamTracer::trace(Texture& origins, Texture& rays, bool primary, const Camera& cam) {
+  vgpu::Gpu& gpu = *gpu_;
+  State& s = *s_;
+  auto swap = [](int& i) { i ^= 1; };
+  gpu.clear(s.isect[s.cur_isect], {kFar, 0, 0, kNone});
+  gpu.clear(s.vs[s.cur_vs], {0, 0, 0, kNone});
+  // Enter the grid.
+  if (primary) {
+    s.init.kernel.eye = cam.position;
+    pass(s.init, {&rays}, s.trav[s.cur_trav ^ 1]);
+  } else {
+    pass(s.reset, {&origins, &rays}, s.trav[s.cur_trav ^ 1]);
+  }
+  swap(s.cur_trav);
+  s.grid_mask.fill(1);
+  uint64_t walking = count(s.in_grid, s.trav[s.cur_trav], nullptr, &s.grid_mask);
+  s.rays_traced += walking;
+  while (walking > 0) {
+    // The first triangle of each ray's new voxel.
+    pass(s.update, {&s.trav[s.cur_trav], &s.vs[s.cur_vs], &s.pointers, &s.lists},
+         s.vs[s.cur_vs ^ 1], &s.grid_mask);
+    swap(s.cur_vs);
+    uint64_t testing =
+        count(s.intersecting, s.vs[s.cur_vs], &s.grid_mask, &(s.isect_mask = s.grid_mask));
+    // One triangle per pass, until no ray has a triangle left in its voxel.
+    while (testing > 0) {
+      pass(s.intersect,
+           {&origins, &rays, &s.trav[s.cur_trav], &s.vs[s.cur_vs], &s.isect[s.cur_isect], &s.v[0],
+            &s.v[1], &s.v[2]},
+           s.isect[s.cur_isect ^ 1], &s.isect_mask);
+      swap(s.cur_isect);
+      pass(s.next, {&s.vs[s.cur_vs], &s.lists}, s.vs[s.cur_vs ^ 1], &s.isect_mask);
+      swap(s.cur_vs);
+      testing = count(s.intersecting, s.vs[s.cur_vs], &s.isect_mask, &s.isect_mask);
+    }
+    // One voxel step for every ray still walking.
+    pass(s.traversal, {&origins, &rays, &s.trav[s.cur_trav], &s.isect[s.cur_isect]},
+         s.trav[s.cur_trav ^ 1], &s.grid_mask);
+    swap(s.cur_trav);
+    walking = count(s.in_grid, s.trav[s.cur_trav], &s.grid_mask, &s.grid_mask);
+  }
+}
+
+RenderResult StreamTracer::render(const Camera& cam) {
+  const auto t0 = std::chrono::steady_clock::now();
+  vgpu::Gpu& gpu = *gpu_;
+  State& s = *s_;
+  gpu.stats().clear();
+  s.rays_traced = 0;
+  const int W = opt_.width, H = opt_.height;
+  RenderResult res;
+  res.width = W;
+  res.height = H;
+
+  // generadorRayos: one primary ray per pixel; every primary ray starts at the eye.
+  GenerateRays& g = s.generate.kernel;
+  g.forward = cam.forward;
+  g.right = glm::normalize(glm::cross(cam.forward, cam.up));
+  g.up = glm::cross(g.right, cam.forward);
+  g.tan_half_fov = std::tan(0.5f * cam.yfov);
+  g.aspect = float(W) / float(H);
+  g.width = float(W);
+  g.height = float(H);
+  if (opt_.trace_pixel && opt_.trace_out)
+    *opt_.trace_out << "pixel " << opt_.trace_pixel->x << "," << opt_.trace_pixel->y << ":\n";
+  int ro = 0;  // origins[ro]: this iteration's ray origins; origins[ro ^ 1]: its hit points
+  gpu.clear(s.origins[ro], {cam.position.x, cam.position.y, cam.position.z, 0});
+  pass(s.generate, {}, s.rays[s.cur_rays]);
+  gpu.clear(s.result[s.cur_result], {0, 0, 0, 1});
+
+  const int iterations = 1 + std::max(0, opt_.bounces);
+  for (int it = 0; it < iterations; ++it) {
+    if (opt_.trace_pixel && opt_.trace_out) *opt_.trace_out << "iteration " << it + 1 << ":\n";
+    res.iterations = it + 1;
+    Texture& rays = s.rays[s.cur_rays];
+    trace(s.origins[ro], rays, it == 0, cam);
+    const Texture& hits = s.isect[s.cur_isect];
+    if (it == 0) {
+      res.depth.assign(size_t(W) * H, 0.0f);
+      res.hit_id.assign(size_t(W) * H, -1.0f);
+      for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+          const float* t = hits.texel(x, y);
+          if (t[3] >= 0) {
+            res.depth[size_t(y) * W + x] = t[0];
+            res.hit_id[size_t(y) * W + x] = float(scene_.id[size_t(t[3])]);
+          }
+        }
+    }
+    // inicioReflejo: hit points, the shader's record and the next rays' origins.
+    Texture& surface = s.origins[ro ^ 1];
+    pass(s.origin, {&s.origins[ro], &rays, &hits, &s.v[0], &s.v[1], &s.v[2]}, surface);
+    // shader: one pass per light, after that light's shadow rays are traced.
+    const auto& lights = scene_.lights;
+    for (size_t li = 0; li < lights.size(); ++li) {
+      Shader& sh = s.shader.kernel;
+      sh.light = lights[li].position;
+      sh.light_color = lights[li].color;
+      sh.first_light = li == 0;
+      sh.last_light = li + 1 == lights.size();
+      sh.shadows = opt_.shadows;
+      if (opt_.shadows) {
+        s.shadow.kernel.light = lights[li].position;
+        pass(s.shadow, {&surface, &s.result[s.cur_result]}, s.shadow_rays);
+        trace(surface, s.shadow_rays, false, cam);
+      }
+      pass(s.shader,
+           {&surface, &rays, &s.result[s.cur_result], &s.isect[s.cur_isect], &s.colors, &s.v[0],
+            &s.v[1], &s.v[2], &s.n[0], &s.n[1], &s.n[2]},
+           s.result[s.cur_result ^ 1]);
+      s.cur_result ^= 1;
+    }
+    if (it + 1 == iterations) break;
+    // rayosReflejados: stop when no ray was reflected.
+    if (count(s.reflected, s.result[s.cur_result], nullptr, nullptr) == 0) break;
+    pass(s.direction,
+         {&rays, &surface, &s.result[s.cur_result], &s.v[0], &s.v[1], &s.v[2], &s.n[0], &s.n[1],
+          &s.n[2]},
+         s.rays[s.cur_rays ^ 1]);
+    s.cur_rays ^= 1;
+    ro ^= 1;
+  }
+
+  const Texture& out = s.result[s.cur_result];
+  res.rgb.resize(size_t(W) * H * 3);
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x)
+      for (int c = 0; c < 3; ++c) res.rgb[(size_t(y) * W + x) * 3 + c] = out.texel(x, y)[c];
+  res.stats = gpu.stats();
+  res.rays_traced = s.rays_traced;
+  res.render_ms = ms_since(t0);
+  return res;
+}
+
+}  // namespace host

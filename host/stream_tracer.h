@@ -1,0 +1,79 @@
+// The paper's pipeline on the virtual GPU: static textures uploaded once (initialization), then
+// per frame: generate rays -> enter the grid -> alternate traversal and intersection passes
+// steered by occlusion-query counts -> shade (one pass per light, shadow rays through the same
+// kernels) -> reflected rays through the same pipeline, up to a maximum number of iterations.
+#pragma once
+
+#include <functional>
+#include <optional>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "host/grid.h"
+#include "host/scene.h"
+#include "kernels/kernels.h"
+#include "vgpu/vgpu.h"
+
+namespace host {
+
+struct RenderOptions {
+  int width = 256, height = 256;  // the paper's image size
+  int bounces = 2;                // reflection iterations after the primary one (Fig. 1: 3 in all)
+  kernels::ShadingModel shading = kernels::ShadingModel::phong;
+  bool shadows = true;
+  std::string profile = "gf5700";
+  int threads = 0;                // 0: every host core
+  int lanes = vgpu::kLanes;
+  // Early-z/stencil masks for finished rays (the paper's future work): masked fragments cost
+  // nothing. Off: every fragment runs every pass, as on the paper's GeForce FX.
+  bool masks = false;
+  // Emulator shortcut: skip host work for fragments whose result cannot change (finished rays);
+  // their statistics are charged as if run. Off only to check that it changes nothing.
+  bool host_shortcut = true;
+  std::optional<glm::ivec2> trace_pixel;  // print every pass this pixel took part in
+  std::ostream* trace_out = nullptr;
+  bool keep_pass_records = false;
+};
+
+struct RenderResult {
+  int width = 0, height = 0;
+  std::vector<float> rgb;     // width*height*3, linear, row 0 = top
+  std::vector<float> depth;   // distance to the primary hit, 0 where the ray misses
+  std::vector<float> hit_id;  // input triangle id of the primary hit, -1 where it misses
+  vgpu::FrameStats stats;
+  double render_ms = 0;
+  int iterations = 0;         // ray-tracing iterations run (primary included)
+  uint64_t rays_traced = 0;   // rays entering a trace (primary, reflected, shadow)
+};
+
+class StreamTracer {
+ public:
+  // Initialization, timed apart from rendering: the static textures (scene and grid) are built
+  // and checked against the profile's limits. Throws vgpu::Error naming the limit.
+  StreamTracer(const Scene& scene, const Grid& grid, const RenderOptions& options);
+  ~StreamTracer();
+  RenderResult render(const Camera& camera);
+  double init_ms() const { return init_ms_; }
+  uint64_t texture_bytes() const;  // static + dynamic textures, as the modeled card holds them
+
+ private:
+  struct State;
+  void trace(vgpu::Texture& origins, vgpu::Texture& rays, bool primary, const Camera& cam);
+  const vgpu::PassRecord& pass(const vgpu::Program& p, std::initializer_list<const vgpu::Texture*> in,
+                               vgpu::Texture& out, const vgpu::Stencil* work = nullptr);
+  uint64_t count(const vgpu::Program& p, const vgpu::Texture& in, const vgpu::Stencil* work,
+                 vgpu::Stencil* write);
+
+  const Scene& scene_;
+  const Grid& grid_;
+  RenderOptions opt_;
+  std::unique_ptr<vgpu::Gpu> gpu_;
+  std::unique_ptr<State> s_;
+  double init_ms_ = 0;
+};
+
+// Names of the shading models as the CLI spells them.
+kernels::ShadingModel parse_shading(const std::string& name);
+
+}  // namespace host

@@ -1,0 +1,56 @@
+// initTraversal: once per frame, the voxel where each primary ray enters the grid (paper
+// Sec. 2.2): the smallest t that brings the camera ray onto the grid box (slab test), and the
+// voxel holding that point. Rays that miss the box are done at once.
+#pragma once
+
+#include "kernels/common.h"
+
+namespace kernels {
+
+// Shared with reinicializarTraversal: entry (voxel, t) of a ray from o along d, tmax bounding it.
+template <class L>
+inline Vec4<typename L::F> grid_entry(const Vec3<typename L::F>& o, const Vec3<typename L::F>& d,
+                                      const typename L::F& tmax, const GridUniforms& g) {
+  using F = typename L::F;
+  auto slab = [&](const F& oa, const F& da, float lo, float cell, float res, F& tnear, F& tfar) {
+    const F inv = F(1.0f) / da;
+    const F t0 = (F(lo) - oa) * inv, t1 = (F(lo + cell * res) - oa) * inv;
+    // Parallel to this slab: inside it for every t, or outside for every t.
+    const auto parallel = da == F(0.0f);
+    const auto inside = (oa >= F(lo)) && (oa <= F(lo + cell * res));
+    tnear = max(tnear, select(parallel, select(inside, F(-kFar), F(kFar)), min(t0, t1)));
+    tfar = min(tfar, select(parallel, select(inside, F(kFar), F(-kFar)), max(t0, t1)));
+  };
+  F tnear = F(0.0f), tfar = tmax;
+  slab(o.x, d.x, g.lo.x, g.cell.x, g.res.x, tnear, tfar);
+  slab(o.y, d.y, g.lo.y, g.cell.y, g.res.y, tnear, tfar);
+  slab(o.z, d.z, g.lo.z, g.cell.z, g.res.z, tnear, tfar);
+  const auto enters = (tnear <= tfar) && (tmax >= F(0.0f));
+  const Vec3<F> p = o + d * tnear;  // world space, on or inside the box
+  auto cell_of = [&](const F& pa, float lo, float cell, float res) {
+    return min(max(floor((pa - F(lo)) / F(cell)), F(0.0f)), F(res - 1.0f));
+  };
+  const Vec4<F> entry{cell_of(p.x, g.lo.x, g.cell.x, g.res.x), cell_of(p.y, g.lo.y, g.cell.y, g.res.y),
+                      cell_of(p.z, g.lo.z, g.cell.z, g.res.z), tnear};
+  const Vec4<F> done{F(kNone), F(0.0f), F(0.0f), F(0.0f)};
+  return select(enters, entry, done);
+}
+
+struct InitTraversal {
+  static constexpr const char* name = "init traversal";
+  static constexpr const char* paper_name = "initTraversal";
+  static constexpr int outputs = 1;  // -> traversal
+  enum Unit { kRays };
+
+  glm::vec3 eye{0.0f};  // camera position, world space: every primary ray starts there
+  GridUniforms grid;
+
+  template <class L>
+  void operator()(Fragments<L>& f) const {
+    using F = typename L::F;
+    const Vec4<F> ray = f.fetch_own(kRays);
+    f.out(0) = grid_entry<L>(splat<F>(eye), ray.xyz(), ray.w, grid);
+  }
+};
+
+}  // namespace kernels

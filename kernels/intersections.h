@@ -1,0 +1,47 @@
+// intersecciones: tests each ray against one triangle of its current voxel per pass (paper
+// Sec. 2.3) and keeps the nearest hit. A hit counts only inside the current voxel, between the
+// ray's entry and exit parameters (with a small slack, t_slack, so a hit on a shared voxel face
+// is not lost to rounding); a hit beyond the voxel is found again in the voxel that holds it.
+#pragma once
+
+#include "kernels/common.h"
+
+namespace kernels {
+
+struct Intersections {
+  static constexpr const char* name = "intersections";
+  static constexpr const char* paper_name = "intersecciones";
+  static constexpr int outputs = 1;  // -> intersection
+  enum Unit { kOrigins, kRays, kTraversal, kVoxelState, kIntersection, kV0, kV1, kV2 };
+  static constexpr std::array<int, 1> passthrough{kIntersection};
+
+  GridUniforms grid;
+  SceneUniforms scene;
+
+  template <class L>
+  void operator()(Fragments<L>& f) const {
+    using F = typename L::F;
+    const Vec4<F> vs = f.fetch_own(kVoxelState);
+    const Vec4<F> best = f.fetch_own(kIntersection);
+    const auto testing = vs.w >= F(0.0f);
+    Vec4<F> next = best;
+    if (f.branch(testing)) {
+      const Vec3<F> o = f.fetch_own(kOrigins).xyz();
+      const Vec4<F> ray = f.fetch_own(kRays);
+      const Vec4<F> trav = f.fetch_own(kTraversal);
+      const Vec3<F> d = ray.xyz();
+      const Vec3<F> p0 = fetch_id(f, kV0, vs.w, scene.width).xyz();
+      const Vec3<F> p1 = fetch_id(f, kV1, vs.w, scene.width).xyz();
+      const Vec3<F> p2 = fetch_id(f, kV2, vs.w, scene.width).xyz();
+      F u, v;
+      const F t = intersect_triangle(o, d, p0, p1, p2, u, v);
+      const F t_exit = min3(voxel_exits(o, d, trav.xyz(), grid));
+      const auto in_voxel = (t >= trav.w - F(grid.t_slack)) && (t <= t_exit + F(grid.t_slack));
+      const auto nearer = testing && in_voxel && (t < best.x) && (t < ray.w);
+      next = select(nearer, Vec4<F>{t, u, v, vs.w}, best);
+    }
+    f.out(0) = next;
+  }
+};
+
+}  // namespace kernels

@@ -1,0 +1,55 @@
+// Every texture of the stream ray tracer and its channel layout, in one place (paper Sec. 3.3).
+// Static textures hold the scene and the grid; dynamic textures hold one texel of ray state per
+// pixel, ping-ponged between passes because a pass may not read the texture it writes.
+//
+// Static (scene), indexed by internal triangle id i at texel (i mod width, i div width):
+//   vertices0/1/2   xyz    corner positions, world space       (paper: texturaVertices)
+//   normals0/1/2    xyz    corner normals, world space, unit   (paper: texturaNormales)
+//   colors          rgba   rgb = colour, a = reflection coefficient (paper: texturaColores)
+// Static (grid):
+//   triangle lists  x      triangle ids of each voxel, voxels one after another, each list
+//                          closed by -1; texel of list entry k at (k mod width, k div width)
+//                          (paper: texturaTriangulos)
+//   voxel pointers  x      index of the voxel's first list entry; voxel (X,Y,Z) at texel
+//                          (X*sizeY + Y, Z) (paper: texturaTriangulosEnVoxel)
+//
+// Dynamic (per pixel):
+//   origins         xyz = ray origin, world space; w unused    (paper: texturaInicioRayos)
+//   rays            xyz = ray direction (unit), w = tmax; tmax < 0 marks no ray (paper: texturaRayos)
+//   traversal       xyz = current voxel, w = ray parameter t where the ray enters it;
+//                   x = -1 once the ray is done: left the grid, or found its hit
+//                   (paper: texturaEstadoTraversal)
+//   voxel state     x = position in the triangle lists, w = triangle to test next;
+//                   w = -1: nothing left to test in this voxel   (paper: texturaEstadoVoxel)
+//   intersection    x = t of the nearest valid hit so far, w = its triangle, -1 for none;
+//                   yz = barycentrics (u, v) of that hit      (paper: texturaEstadoInterseccion)
+//   surface         xyz = hit point (offset off the surface, the next ray's origin),
+//                   w = hit triangle or -1                      (written by inicioReflejo)
+//   result          rgb = colour accumulated so far, a = weight of the current ray in the final
+//                   colour (product of the reflection coefficients met so far) (paper: texturaResultado)
+#pragma once
+
+#include <glm/glm.hpp>
+
+namespace kernels {
+
+// "No triangle" and "ray done" markers, and the parameter standing for infinity (it survives
+// fp16 storage as +inf).
+inline constexpr float kNone = -1.0f;
+inline constexpr float kFar = 1e30f;
+
+// Uniforms describing the grid (world space).
+struct GridUniforms {
+  glm::vec3 lo{0.0f};    // grid box minimum corner
+  glm::vec3 cell{1.0f};  // world size of one voxel
+  glm::vec3 res{1.0f};   // voxels per axis, as floats
+  float list_width = 1;  // width of the triangle-list texture, texels
+  float t_slack = 0;     // tolerance of the in-voxel rule, world units along a unit ray
+};
+
+// Uniforms describing the scene textures' layout.
+struct SceneUniforms {
+  float width = 1;  // width of the vertex/normal/color textures, texels
+};
+
+}  // namespace kernels

@@ -1,0 +1,33 @@
+// proximoTriangulo: advances each ray to the next triangle of its voxel's list. At the -1 that
+// closes the list the ray is marked ready for traversal (voxel state w = -1).
+#pragma once
+
+#include "kernels/common.h"
+
+namespace kernels {
+
+struct NextTriangle {
+  static constexpr const char* name = "next triangle";
+  static constexpr const char* paper_name = "proximoTriangulo";
+  static constexpr int outputs = 1;  // -> voxel state
+  enum Unit { kVoxelState, kLists };
+  static constexpr std::array<int, 1> passthrough{kVoxelState};
+
+  GridUniforms grid;
+
+  template <class L>
+  void operator()(Fragments<L>& f) const {
+    using F = typename L::F;
+    const Vec4<F> vs = f.fetch_own(kVoxelState);
+    const auto testing = vs.w >= F(0.0f);
+    Vec4<F> next = vs;
+    if (f.branch(testing)) {
+      const F pos = vs.x + F(1.0f);
+      const F tri = fetch_id(f, kLists, pos, grid.list_width).x;
+      next = select(testing, Vec4<F>{pos, F(0.0f), F(0.0f), tri}, vs);
+    }
+    f.out(0) = next;
+  }
+};
+
+}  // namespace kernels

@@ -1,0 +1,50 @@
+// traversal: one step of the 3D-DDA (Amanatides & Woo) per pass (paper Sec. 2.2). A ray whose
+// voxel produced a valid hit is done; otherwise it moves to the next voxel along the ray, and
+// is done when that voxel lies outside the grid. Ties (the ray leaves through an edge or a
+// corner) step every tied axis at once, so the walk never visits a voxel for zero length.
+#pragma once
+
+#include "kernels/common.h"
+
+namespace kernels {
+
+struct Traversal {
+  static constexpr const char* name = "traversal";
+  static constexpr const char* paper_name = "traversal";
+  static constexpr int outputs = 1;  // -> traversal
+  enum Unit { kOrigins, kRays, kTraversal, kIntersection };
+  static constexpr std::array<int, 1> passthrough{kTraversal};  // done rays keep their state
+
+  GridUniforms grid;
+
+  template <class L>
+  void operator()(Fragments<L>& f) const {
+    using F = typename L::F;
+    const Vec4<F> trav = f.fetch_own(kTraversal);
+    const Vec4<F> hit = f.fetch_own(kIntersection);
+    const Vec3<F> o = f.fetch_own(kOrigins).xyz(), d = f.fetch_own(kRays).xyz();
+    const auto walking = trav.x >= F(0.0f);
+    Vec4<F> next = trav;
+    if (f.branch(walking)) {
+      const Vec3<F> vox = trav.xyz();
+      const Vec3<F> exits = voxel_exits(o, d, vox, grid);
+      const F t_exit = min3(exits);
+      auto step = [&](const F& da, const F& ta) {
+        return select(ta == t_exit, select(da > F(0.0f), F(1.0f), F(-1.0f)), F(0.0f));
+      };
+      const Vec3<F> nv{vox.x + step(d.x, exits.x), vox.y + step(d.y, exits.y),
+                       vox.z + step(d.z, exits.z)};
+      const auto outside = (nv.x < F(0.0f)) || (nv.y < F(0.0f)) || (nv.z < F(0.0f)) ||
+                           (nv.x >= F(grid.res.x)) || (nv.y >= F(grid.res.y)) ||
+                           (nv.z >= F(grid.res.z));
+      const auto found = hit.w >= F(0.0f);  // a hit inside this voxel ends the walk
+      const auto done = found || outside;
+      const Vec4<F> stepped{nv.x, nv.y, nv.z, t_exit};
+      const Vec4<F> finished{F(kNone), F(0.0f), F(0.0f), trav.w};
+      next = select(walking, select(done, finished, stepped), trav);
+    }
+    f.out(0) = next;
+  }
+};
+
+}  // namespace kernels

@@ -1,0 +1,37 @@
+// actualizarVoxel: for each ray that has just entered a voxel, the first triangle to test there:
+// the voxel pointer texture gives the start of the voxel's list, the list gives the triangle.
+// An empty voxel's list is just -1, so the ray goes straight back to traversal.
+#pragma once
+
+#include "kernels/common.h"
+
+namespace kernels {
+
+struct UpdateVoxel {
+  static constexpr const char* name = "update voxel";
+  static constexpr const char* paper_name = "actualizarVoxel";
+  static constexpr int outputs = 1;  // -> voxel state
+  enum Unit { kTraversal, kVoxelState, kPointers, kLists };
+  static constexpr std::array<int, 1> passthrough{kVoxelState};
+
+  GridUniforms grid;
+
+  template <class L>
+  void operator()(Fragments<L>& f) const {
+    using F = typename L::F;
+    const Vec4<F> trav = f.fetch_own(kTraversal);
+    const Vec4<F> vs = f.fetch_own(kVoxelState);
+    const auto load = (trav.x >= F(0.0f)) && (vs.w < F(0.0f));
+    Vec4<F> next = vs;
+    if (f.branch(load)) {
+      // Voxel (X, Y, Z) lives at texel (X * sizeY + Y, Z).
+      const F px = trav.x * F(grid.res.y) + trav.y + F(0.5f), py = trav.z + F(0.5f);
+      const F start = f.fetch(kPointers, px, py).x;
+      const F tri = fetch_id(f, kLists, start, grid.list_width).x;
+      next = select(load, Vec4<F>{start, F(0.0f), F(0.0f), tri}, vs);
+    }
+    f.out(0) = next;
+  }
+};
+
+}  // namespace kernels
