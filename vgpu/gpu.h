@@ -72,8 +72,15 @@ class Gpu {
   // counted exactly as if shaded (the statistics use each program's static per-fragment counts),
   // their outputs are copied from the program's passthrough units and they are discarded if the
   // program says idle fragments are. The host marks a fragment idle only where the program's
-  // result provably equals that (a finished ray), so images and statistics do not change.
+  // result provably equals that (a finished ray) and the fragment takes none of the program's
+  // f.branch() blocks (each counts it as an idle lane), so images and statistics do not change.
   void set_work_mask(const Stencil* work) { work_mask_ = work; }
+  // Model the same mask as an early-z/stencil test instead: idle fragments are charged as
+  // masked (no shading, no fetches, no query count) while their state is still carried over.
+  void set_work_mask_counts_as_masked(bool masked) { work_masked_ = masked; }
+
+  // glClear: every texel of t becomes value (channels() floats). Counted as a clear and its bytes.
+  void clear(Texture& t, std::initializer_list<float> value);
 
   // One pass over rect (default: the whole first target).
   const PassRecord& draw();
@@ -90,7 +97,8 @@ class Gpu {
  private:
   struct Chunk;
   template <int W>
-  void run_rows(const Program& p, const Rect& r, int y0, int y1, Chunk& out) const;
+  void run_rows(const Program& p, const Rect& r, int y0, int y1, uint64_t idle_branches,
+                Chunk& out) const;
   void parallel_rows(const Rect& r, const std::function<void(int, int, Chunk&)>& body,
                      std::vector<Chunk>& chunks);
   void worker_loop();
@@ -105,6 +113,7 @@ class Gpu {
   const Stencil* stencil_test_ = nullptr;
   Stencil* stencil_write_ = nullptr;
   const Stencil* work_mask_ = nullptr;
+  bool work_masked_ = false;
   bool in_draw_ = false;
   bool query_active_ = false;
   uint64_t query_count_ = 0;

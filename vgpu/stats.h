@@ -21,6 +21,7 @@ struct Counters {
   uint64_t bytes_written = 0;        // bytes written to render targets
   uint64_t program_loads = 0;        // binds of a program different from the last one
   uint64_t program_bytes = 0;        // bytes of program code uploaded by those loads
+  uint64_t clears = 0;               // render-target clears (glClear: no fragment program)
   uint64_t queries = 0;              // occlusion queries issued
   uint64_t query_readbacks = 0;      // query results read back by the host (a CPU-GPU sync)
   double host_ms = 0;                // host wall time (the only counter that varies run to run)
