@@ -301,6 +301,7 @@ RenderResult StreamTracer::render(const Camera& cam) {
   for (int it = 0; it < iterations; ++it) {
     if (opt_.trace_pixel && opt_.trace_out) *opt_.trace_out << "iteration " << it + 1 << ":\n";
     res.iterations = it + 1;
+    if (opt_.progress) opt_.progress(it + 1, iterations);
     Texture& rays = s.rays[s.cur_rays];
     trace(s.origins[ro], rays, it == 0, cam);
     const Texture& hits = s.isect[s.cur_isect];

@@ -34,6 +34,8 @@ struct RenderOptions {
   std::optional<glm::ivec2> trace_pixel;  // print every pass this pixel took part in
   std::ostream* trace_out = nullptr;
   bool keep_pass_records = false;
+  // Called at the start of each ray-tracing iteration (1-based) with the iteration count.
+  std::function<void(int iteration, int iterations)> progress;
 };
 
 struct RenderResult {

@@ -1,0 +1,29 @@
+// Image files through OpenImageIO: writing renders and AOVs without ever leaving a partial file,
+// and comparing two images (share of differing pixels, RMS error, PSNR).
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace host {
+
+// Writes width x height pixels of `channels` floats (row 0 = top). The format follows the
+// extension (.png: 8-bit, clamped to [0, 1]; .exr: float). The file is written under a
+// temporary name and renamed at the end, so a failure leaves nothing behind. Throws
+// host::InputError "PATH: problem".
+void write_image(const std::string& path, int width, int height, int channels,
+                 const std::vector<float>& pixels);
+
+// Checks a path can be written as an image before any work is done (extension, directory).
+void check_image_path(const std::string& path);
+
+struct ImageComparison {
+  int width = 0, height = 0, channels = 0;
+  double differing_share = 0;  // pixels where some channel differs by more than `threshold`
+  double rms_error = 0, psnr = 0, max_error = 0;
+  double threshold = 0;
+};
+// OpenImageIO's ImageBufAlgo::compare over every channel.
+ImageComparison compare_images(const std::string& a, const std::string& b, double threshold);
+
+}  // namespace host

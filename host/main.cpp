@@ -1,0 +1,272 @@
+// vgpu-rt: the command line. `render` runs the stream ray tracer on the virtual GPU and prints
+// the pass statistics; `scenes` lists the bundled scenes; `compare` diffs two images.
+
+// GCC 12 reports false positives inside nlohmann_json's templates.
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#pragma GCC diagnostic ignored "-Wrestrict"
+#include <CLI/CLI.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <regex>
+#include <unistd.h>
+
+#include "host/camera.h"
+#include "host/gltf_loader.h"
+#include "host/grid.h"
+#include "host/image_io.h"
+#include "host/stream_tracer.h"
+#include "vgpu/vgpu.h"
+
+namespace {
+
+struct RenderArgs {
+  std::string scene = "bunny";
+  std::string size = "256x256";
+  std::string out;
+  int bounces = 2;
+  std::string shading = "phong";
+  std::string shadows = "on";
+  std::string grid = "auto";
+  std::string profile = "gf5700";
+  int threads = 0;
+  int lanes = vgpu::kLanes;
+  std::string masks = "off";
+  std::string stats = "table";
+  std::string stats_json;
+  std::vector<std::string> aovs;
+  std::string trace_pixel;
+  bool quiet = false;
+};
+
+struct UsageError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+glm::ivec2 parse_pair(const std::string& text, const std::string& what, const std::regex& re) {
+  std::smatch m;
+  if (!std::regex_match(text, m, re)) throw UsageError(what + ": cannot parse '" + text + "'");
+  return {std::stoi(m[1]), std::stoi(m[2])};
+}
+
+bool parse_on_off(const std::string& v, const std::string& what) {
+  if (v == "on") return true;
+  if (v == "off") return false;
+  throw UsageError(what + ": expected on or off, got '" + v + "'");
+}
+
+nlohmann::ordered_json counters_json(const vgpu::Counters& c) {
+  return {{"passes", c.passes},
+          {"fragments_launched", c.fragments_launched},
+          {"fragments_shaded", c.fragments_shaded},
+          {"fragments_masked", c.fragments_masked},
+          {"fragments_discarded", c.fragments_discarded},
+          {"lanes_idle", c.lanes_idle},
+          {"instructions", c.instructions},
+          {"texture_fetches", c.texture_fetches},
+          {"bytes_read", c.bytes_read},
+          {"bytes_written", c.bytes_written},
+          {"program_loads", c.program_loads},
+          {"program_bytes", c.program_bytes},
+          {"clears", c.clears},
+          {"queries", c.queries},
+          {"query_readbacks", c.query_readbacks},
+          {"host_ms", c.host_ms}};
+}
+
+int run_render(const RenderArgs& a) {
+  // Validate everything before any work, so a bad argument costs nothing and writes nothing.
+  host::RenderOptions opt;
+  const glm::ivec2 size = parse_pair(a.size, "--size", std::regex(R"((\d{1,5})[xX](\d{1,5}))"));
+  if (size.x < 1 || size.y < 1 || size.x > 16384 || size.y > 16384)
+    throw UsageError("--size: " + a.size + " is outside 1x1..16384x16384");
+  opt.width = size.x;
+  opt.height = size.y;
+  if (a.bounces < 0 || a.bounces > 64) throw UsageError("--bounces: expected 0..64");
+  opt.bounces = a.bounces;
+  opt.shading = host::parse_shading(a.shading);
+  opt.shadows = parse_on_off(a.shadows, "--shadows");
+  opt.masks = parse_on_off(a.masks, "--masks");
+  opt.profile = vgpu::profile(a.profile).name;
+  opt.threads = a.threads;
+  opt.lanes = a.lanes;
+  const host::GridSpec grid_spec = host::parse_grid_spec(a.grid);
+  if (a.stats != "table" && a.stats != "json" && a.stats != "none")
+    throw UsageError("--stats: expected table, json or none, got '" + a.stats + "'");
+  std::string aov_depth, aov_hit;
+  for (const std::string& aov : a.aovs) {
+    const auto eq = aov.find('=');
+    const std::string kind = aov.substr(0, eq), file = eq == std::string::npos ? "" : aov.substr(eq + 1);
+    if (file.empty()) throw UsageError("--aov: expected depth=FILE.exr or hit=FILE.exr, got '" + aov + "'");
+    if (kind == "depth") aov_depth = file;
+    else if (kind == "hit") aov_hit = file;
+    else throw UsageError("--aov: unknown AOV '" + kind + "' (known: depth, hit)");
+    host::check_image_path(file);
+  }
+  if (!a.out.empty()) host::check_image_path(a.out);
+  if (!a.trace_pixel.empty()) {
+    const glm::ivec2 p = parse_pair(a.trace_pixel, "--trace-pixel", std::regex(R"((\d+),(\d+))"));
+    if (p.x >= opt.width || p.y >= opt.height)
+      throw UsageError("--trace-pixel: " + a.trace_pixel + " is outside the " + a.size + " image");
+    opt.trace_pixel = p;
+    opt.trace_out = &std::cout;
+  }
+
+  const std::string path = host::resolve_scene(a.scene);
+  const host::Scene scene = host::load_scene(path);
+  const auto t0 = std::chrono::steady_clock::now();
+  const host::Grid grid = host::build_grid(scene, grid_spec);
+  const float aspect = float(opt.width) / float(opt.height);
+  const host::Camera cam = scene.camera ? *scene.camera : host::frame_bounds(scene.bounds(), aspect);
+  const bool tty = ::isatty(2) && !a.quiet;
+  if (!a.quiet)
+    opt.progress = [&](int it, int n) {
+      std::fprintf(stderr, tty ? "\rvgpu-rt: iteration %d/%d" : "vgpu-rt: iteration %d/%d\n", it, n);
+      std::fflush(stderr);
+    };
+  host::StreamTracer tracer(scene, grid, opt);
+  const double init_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  const host::RenderResult r = tracer.render(cam);
+  if (tty) std::fprintf(stderr, "\n");
+
+  if (!a.out.empty()) host::write_image(a.out, r.width, r.height, 3, r.rgb);
+  if (!aov_depth.empty()) host::write_image(aov_depth, r.width, r.height, 1, r.depth);
+  if (!aov_hit.empty()) host::write_image(aov_hit, r.width, r.height, 1, r.hit_id);
+
+  nlohmann::ordered_json j;
+  j["scene"] = scene.name;
+  j["scene_path"] = path;
+  j["engine"] = "stream";
+  j["triangles"] = scene.triangle_count();
+  j["input_triangles"] = scene.input_triangles;
+  j["dropped_degenerate"] = scene.dropped_degenerate;
+  j["grid"] = {grid.res.x, grid.res.y, grid.res.z};
+  j["grid_references"] = grid.references();
+  j["profile"] = opt.profile;
+  j["size"] = {r.width, r.height};
+  j["bounces"] = opt.bounces;
+  j["iterations"] = r.iterations;
+  j["shading"] = a.shading;
+  j["shadows"] = opt.shadows;
+  j["masks"] = opt.masks;
+  j["threads"] = opt.threads;
+  j["lanes"] = opt.lanes;
+  j["init_ms"] = init_ms;
+  j["grid_build_ms"] = grid.build_ms;
+  j["render_ms"] = r.render_ms;
+  j["texture_bytes"] = tracer.texture_bytes();
+  j["rays_traced"] = r.rays_traced;
+  j["totals"] = counters_json(r.stats.totals);
+  auto ks = nlohmann::ordered_json::array();
+  for (const auto& p : r.stats.programs) {
+    nlohmann::ordered_json k;
+    k["name"] = p.name;
+    k["paper_name"] = p.paper_name;
+    k["instructions"] = p.instructions;
+    const nlohmann::ordered_json c = counters_json(p.counters);
+    for (auto& [key, v] : c.items()) k[key] = v;
+    ks.push_back(k);
+  }
+  j["kernels"] = ks;
+  if (!a.stats_json.empty()) {
+    const std::string tmp = a.stats_json + ".tmp";
+    std::ofstream f(tmp);
+    f << j.dump(2) << "\n";
+    f.close();
+    if (!f || std::rename(tmp.c_str(), a.stats_json.c_str()) != 0) {
+      std::remove(tmp.c_str());
+      throw host::InputError(a.stats_json + ": cannot write the statistics");
+    }
+  }
+  if (a.stats == "json") {
+    std::cout << j.dump(2) << "\n";
+  } else if (a.stats == "table") {
+    std::cout << r.stats.to_table();
+    std::printf("scene %s: %zu triangles (%u dropped as degenerate), grid %dx%dx%d (%llu references)\n",
+                scene.name.c_str(), scene.triangle_count(), scene.dropped_degenerate, grid.res.x,
+                grid.res.y, grid.res.z, static_cast<unsigned long long>(grid.references()));
+    std::printf("profile %s, %dx%d, %d iteration(s), %s shading, shadows %s, masks %s\n",
+                opt.profile.c_str(), r.width, r.height, r.iterations, a.shading.c_str(),
+                a.shadows.c_str(), a.masks.c_str());
+    std::printf("initialization %.1f ms (grid %.1f ms), render %.1f ms (host, emulated)\n", init_ms,
+                grid.build_ms, r.render_ms);
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"vgpu-rt: a virtual 2004 GPU and the stream ray tracer of Fal, Vasconcelos & "
+               "Delrieux (after Purcell et al. 2002)"};
+  app.require_subcommand(1);
+  RenderArgs a;
+  auto* render = app.add_subcommand("render", "Render a scene on the virtual GPU and print the pass statistics");
+  render->add_option("scene", a.scene, "glTF file (.gltf/.glb) or a scene name from scenes/")->capture_default_str();
+  render->add_option("--size", a.size, "Image size WxH")->capture_default_str();
+  render->add_option("--out", a.out, "Write the image (.png or .exr)");
+  render->add_option("--bounces", a.bounces, "Reflection iterations after the primary one")->capture_default_str();
+  render->add_option("--shading", a.shading, "diffuse | phong | phong-atten")->capture_default_str();
+  render->add_option("--shadows", a.shadows, "on | off")->capture_default_str();
+  render->add_option("--grid", a.grid, "auto | N | AxBxC voxels")->capture_default_str();
+  render->add_option("--profile", a.profile, "gf5700 | gf6600 | rtx4090")->capture_default_str();
+  render->add_option("--threads", a.threads, "Host threads (0: all cores)")->capture_default_str();
+  render->add_option("--lanes", a.lanes, "SIMD lanes per batch: 1 (scalar reference), 4, 8, 16")->capture_default_str();
+  render->add_option("--masks", a.masks, "Early-z masks for finished rays (paper's future work): on | off")->capture_default_str();
+  render->add_option("--stats", a.stats, "table | json | none")->capture_default_str();
+  render->add_option("--stats-json", a.stats_json, "Also write the statistics as JSON to this file");
+  render->add_option("--aov", a.aovs, "depth=FILE.exr (distance to primary hit) or hit=FILE.exr (triangle id)");
+  render->add_option("--trace-pixel", a.trace_pixel, "X,Y: print every pass this pixel took part in and its state");
+  render->add_flag("--quiet,-q", a.quiet, "No progress on stderr");
+  auto* scenes = app.add_subcommand("scenes", "List the scenes in scenes/");
+  std::string ca, cb;
+  double threshold = 1.0 / 255.0;
+  auto* compare = app.add_subcommand("compare", "Compare two images (OpenImageIO): differing pixels, RMS, PSNR");
+  compare->add_option("a", ca, "First image")->required();
+  compare->add_option("b", cb, "Second image")->required();
+  compare->add_option("--threshold", threshold, "Per-channel difference that makes a pixel differ")->capture_default_str();
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::fprintf(stderr, "vgpu-rt: %s (see vgpu-rt --help)\n", e.what());
+    return 2;
+  }
+  try {
+    if (*render) return run_render(a);
+    if (*scenes) {
+      for (const auto& [name, path] : host::list_scenes()) {
+        try {
+          const host::Scene s = host::load_scene(path);
+          std::printf("%-14s %7zu triangles  %s\n", name.c_str(), s.triangle_count(), path.c_str());
+        } catch (const std::exception& e) {
+          std::printf("%-14s (unreadable: %s)\n", name.c_str(), e.what());
+        }
+      }
+      return 0;
+    }
+    if (*compare) {
+      const host::ImageComparison c = host::compare_images(ca, cb, threshold);
+      std::printf("%dx%d, %d channels: %.4f%% of pixels differ by more than %g; RMS %.6g, PSNR %.2f dB, max %.6g\n",
+                  c.width, c.height, c.channels, 100.0 * c.differing_share, c.threshold,
+                  c.rms_error, c.psnr, c.max_error);
+      return 0;
+    }
+  } catch (const UsageError& e) {
+    std::fprintf(stderr, "vgpu-rt: %s\n", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "vgpu-rt: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}
