@@ -201,8 +201,11 @@ const vgpu::PassRecord& StreamTracer::pass(const vgpu::Program& p,
   gpu.set_work_mask(work && opt_.host_shortcut ? work : nullptr);
   gpu.set_work_mask_counts_as_masked(opt_.masks);
   if (work && opt_.masks) gpu.set_work_mask(work);
+  // The traced pixel takes part unless the finished-ray mask says its ray is done.
+  const bool traced = opt_.trace_pixel && opt_.trace_out &&
+                      (!work || work->get(opt_.trace_pixel->x, opt_.trace_pixel->y) != 0);
   const vgpu::PassRecord& rec = gpu.draw();
-  if (opt_.trace_pixel && opt_.trace_out) {
+  if (traced && !p.idle_discards()) {
     const int x = opt_.trace_pixel->x, y = opt_.trace_pixel->y;
     const float* t = out.texel(x, y);
     char line[256];
@@ -218,12 +221,20 @@ const vgpu::PassRecord& StreamTracer::pass(const vgpu::Program& p,
 uint64_t StreamTracer::count(const vgpu::Program& p, const Texture& in, const Stencil* work,
                              Stencil* write) {
   vgpu::Gpu& gpu = *gpu_;
+  const bool traced = opt_.trace_pixel && opt_.trace_out &&
+                      (!work || work->get(opt_.trace_pixel->x, opt_.trace_pixel->y) != 0);
   gpu.set_stencil_write(write);
   gpu.begin_query();
   pass(p, {&in}, s_->counter, work);
   const uint64_t n = gpu.end_query();
   gpu.set_stencil_write(nullptr);
-  if (opt_.trace_pixel && opt_.trace_out) *opt_.trace_out << "    query: " << n << " fragments\n";
+  if (traced) {
+    char line[160];
+    const char* mine = !write ? "" : write->get(opt_.trace_pixel->x, opt_.trace_pixel->y) ? "counted" : "discarded";
+    std::snprintf(line, sizeof line, "  %-22s %-24s    query: %llu rays; this one %s\n",
+                  p.paper_name(), p.name(), static_cast<unsigned long long>(n), mine);
+    *opt_.trace_out << line;
+  }
   return n;
 }
 
@@ -342,7 +353,7 @@ RenderResult StreamTracer::render(const Camera& cam) {
     }
     if (it + 1 == iterations) break;
     // rayosReflejados: stop when no ray was reflected.
-    if (count(s.reflected, s.result[s.cur_result], nullptr, nullptr) == 0) break;
+    if (count(s.reflected, s.result[s.cur_result], nullptr, &s.grid_mask) == 0) break;
     pass(s.direction,
          {&rays, &surface, &s.result[s.cur_result], &s.v[0], &s.v[1], &s.v[2], &s.n[0], &s.n[1],
           &s.n[2]},
