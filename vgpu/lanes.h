@@ -45,6 +45,24 @@ using stdx::floor;
 using stdx::max;
 using stdx::min;
 using stdx::sqrt;
+// MIN and MAX as fragment programs define them (ARB_fragment_program: MIN = a < b ? a : b,
+// MAX = a > b ? a : b), so a NaN or a signed zero gives the same result at every width:
+// stdx::min is std::min at width 1 but minps at wider widths, and those disagree on NaN and
+// +-0. Non-templates, so overload resolution prefers them to stdx::min found by ADL.
+#define VGPU_LANE_MIN_MAX(W)                                                                  \
+  inline stdx::fixed_size_simd<float, W> min(const stdx::fixed_size_simd<float, W>& a,       \
+                                             const stdx::fixed_size_simd<float, W>& b) {     \
+    return select(a < b, a, b);                                                             \
+  }                                                                                         \
+  inline stdx::fixed_size_simd<float, W> max(const stdx::fixed_size_simd<float, W>& a,       \
+                                             const stdx::fixed_size_simd<float, W>& b) {     \
+    return select(a > b, a, b);                                                             \
+  }
+VGPU_LANE_MIN_MAX(1)
+VGPU_LANE_MIN_MAX(4)
+VGPU_LANE_MIN_MAX(8)
+VGPU_LANE_MIN_MAX(16)
+#undef VGPU_LANE_MIN_MAX
 
 // ---------------------------------------------------------------------------------------------
 // The counting lane family: one fragment in plain floats, where every arithmetic, compare and
@@ -91,8 +109,8 @@ inline CFloat select(CMask m, CFloat a, CFloat b) { ++OpCounter::ops; return m.v
 inline bool any(CMask m) { return m.v; }
 inline bool all(CMask m) { return m.v; }
 inline int lanes_on(CMask m) { return m.v ? 1 : 0; }
-inline CFloat min(CFloat a, CFloat b) { ++OpCounter::ops; return CFloat(std::fmin(a.v, b.v)); }
-inline CFloat max(CFloat a, CFloat b) { ++OpCounter::ops; return CFloat(std::fmax(a.v, b.v)); }
+inline CFloat min(CFloat a, CFloat b) { ++OpCounter::ops; return a.v < b.v ? a : b; }
+inline CFloat max(CFloat a, CFloat b) { ++OpCounter::ops; return a.v > b.v ? a : b; }
 inline CFloat abs(CFloat a) { ++OpCounter::ops; return CFloat(std::fabs(a.v)); }
 inline CFloat floor(CFloat a) { ++OpCounter::ops; return CFloat(std::floor(a.v)); }
 inline CFloat sqrt(CFloat a) { ++OpCounter::ops; return CFloat(std::sqrt(a.v)); }
