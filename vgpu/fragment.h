@@ -80,6 +80,7 @@ class Fragments {
   // Either way the kernel must write its results through select(m, ...).
   bool branch(const M& m) {
     if constexpr (L::counting) {
+      ++*idle_;  // the counting run tallies branch() calls
       return true;
     } else {
       *idle_ += uint64_t(lanes_on(live_ && !m));

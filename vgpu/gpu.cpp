@@ -92,12 +92,15 @@ uint64_t Gpu::end_query() {
 }
 
 const PassRecord& Gpu::draw() {
-  if (targets_.empty()) fail("draw: no render target set");
+  if (targets_.empty())
+    fail(program_ ? "program '" + std::string(program_->name()) + "': draw with no render target set"
+                  : std::string("draw: no render target set"));
   return draw(Rect{0, 0, targets_[0]->width(), targets_[0]->height()});
 }
 
 template <int W>
-void Gpu::run_rows(const Program& p, const Rect& r, int y0, int y1, Chunk& out) const {
+void Gpu::run_rows(const Program& p, const Rect& r, int y0, int y1, uint64_t idle_branches,
+                   Chunk& out) const {
   using L = SimdLanes<W>;
   using F = typename L::F;
   using M = typename L::M;
@@ -163,14 +166,17 @@ void Gpu::run_rows(const Program& p, const Rect& r, int y0, int y1, Chunk& out) 
         // Idle fragments: outputs keep their previous values (copied from the passthrough units).
         for (int i = 0; i < n; ++i) {
           if (!live[i] || run[i]) continue;
+          out.idle += idle_branches;  // an idle fragment takes none of the program's branches
           if (idle_kill) {
             ++nkill;
             continue;
           }
           for (int o = 0; o < nout; ++o) {
             Texture& t = *targets_[o];
-            const Texture& src = *units_[p.passthrough(o)];
-            std::copy_n(src.texel(x + i, y), t.channels(), t.texel_mut(x + i, y));
+            const float* s = units_[p.passthrough(o)]->texel(x + i, y);
+            float* d = t.texel_mut(x + i, y);
+            // Rounded as the program's own store would be: the source may have a wider format.
+            for (int c = 0; c < t.channels(); ++c) d[c] = round_to(t.format(), s[c]);
           }
         }
       }
@@ -287,12 +293,13 @@ const PassRecord& Gpu::draw(const Rect& rect) {
 
   in_draw_ = true;
   std::vector<Chunk> chunks;
+  const uint64_t idle_branches = uint64_t(a.branches);
   auto body = [&](int ya, int yb, Chunk& c) {
     switch (lanes_) {
-      case 1: run_rows<1>(p, rect, ya, yb, c); break;
-      case 4: run_rows<4>(p, rect, ya, yb, c); break;
-      case 8: run_rows<8>(p, rect, ya, yb, c); break;
-      default: run_rows<16>(p, rect, ya, yb, c); break;
+      case 1: run_rows<1>(p, rect, ya, yb, idle_branches, c); break;
+      case 4: run_rows<4>(p, rect, ya, yb, idle_branches, c); break;
+      case 8: run_rows<8>(p, rect, ya, yb, idle_branches, c); break;
+      default: run_rows<16>(p, rect, ya, yb, idle_branches, c); break;
     }
   };
   parallel_rows(rect, body, chunks);

@@ -41,6 +41,7 @@ class Program {
   // uniforms (a uniform loop bound, e.g. the number of lights, changes the count).
   struct Analysis {
     int instructions = 0;
+    int branches = 0;  // f.branch() calls, every branch taken (what a work-masked fragment skips)
     FetchTally fetches;
   };
   Analysis analyze() const;
