@@ -67,8 +67,10 @@ std::string FrameStats::to_json(int indent) const {
     nlohmann::ordered_json e;
     e["name"] = p.name;
     e["paper_name"] = p.paper_name;
-    e["instructions"] = p.instructions;
-    for (auto& [k, v] : counters_json(p.counters).items()) e[k] = v;
+    // The static count has its own key: the counters' "instructions" (executed) follow.
+    e["static_instructions"] = p.instructions;
+    const nlohmann::ordered_json c = counters_json(p.counters);  // items() needs it alive
+    for (auto& [k, v] : c.items()) e[k] = v;
     progs.push_back(e);
   }
   j["programs"] = progs;
