@@ -25,6 +25,10 @@ const std::vector<Profile>& profiles() {
     fx.program_load_us = 50;     // model parameter (no public figure)
     fx.readback_us = 100;        // model parameter (no public figure; GPU Gems 2 ch. 6: a stall)
     fx.pass_us = 50;             // model parameter (no public figure)
+    fx.alu_lanes = 4;            // NV_fragment_program instructions are 4-component (vec4)
+    fx.alu_per_clock = 1;        // hexus.net FX 5700 Ultra review p.2: one shader unit per pipe
+    fx.fp32_rate = 0.5;          // model parameter: NV3x slow at fp32 (Tom's Hardware NV40 review)
+    fx.texels_per_clock = 1;     // hexus.net FX 5700 Ultra review p.2: one texture unit per pipe
     t.push_back(fx);
 
     Profile g6;
@@ -44,6 +48,10 @@ const std::vector<Profile>& profiles() {
     g6.program_load_us = 20;     // model parameter (no public figure)
     g6.readback_us = 50;         // model parameter (no public figure)
     g6.pass_us = 20;             // model parameter (no public figure)
+    g6.alu_lanes = 4;            // NV_fragment_program2 instructions are 4-component (vec4)
+    g6.alu_per_clock = 2;        // Tom's Hardware NV40 review: two FP32 units per pipe
+    g6.fp32_rate = 1;            // NVIDIA CineFX 3.0 brief: FP32 and FP16 equal speed
+    g6.texels_per_clock = 1;     // one texture unit per pipe (NV4x pipe, GPU Gems 2 ch. 30)
     t.push_back(g6);
 
     Profile m;
@@ -63,6 +71,10 @@ const std::vector<Profile>& profiles() {
     m.program_load_us = 2;       // model parameter
     m.readback_us = 10;          // model parameter
     m.pass_us = 3;               // model parameter
+    m.alu_lanes = 1;             // scalar CUDA cores: every scalar operation is one instruction
+    m.alu_per_clock = 1;         // one FP32 FMA per core per clock (NVIDIA Ada whitepaper)
+    m.fp32_rate = 1;
+    m.texels_per_clock = 512.0 / 16384;  // 512 texture units for 16384 cores (Ada whitepaper)
     t.push_back(m);
     return t;
   }();

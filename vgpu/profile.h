@@ -34,6 +34,11 @@ struct Profile {
   double readback_us = 0;        // occlusion-query read-back: pipeline drain + sync (model parameter)
   double pass_us = 0;            // fixed cost of one render-to-texture pass (model parameter)
   int instruction_bytes = 16;    // bytes of one encoded instruction (program upload size)
+  // Fragment-unit throughput, for the cost model (host/cost_model.h).
+  int alu_lanes = 4;             // scalar lanes one arithmetic instruction drives (4: vec4 ALU)
+  double alu_per_clock = 1;      // arithmetic instructions per pipeline per clock, fp16
+  double fp32_rate = 1;          // fp32 arithmetic throughput relative to fp16
+  double texels_per_clock = 1;   // texture fetches per pipeline per clock
 };
 
 // The built-in profiles: gf5700, gf6600, rtx4090.
