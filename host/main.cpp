@@ -16,6 +16,7 @@
 #include <unistd.h>
 
 #include "host/camera.h"
+#include "host/cost_model.h"
 #include "host/gltf_loader.h"
 #include "host/grid.h"
 #include "host/image_io.h"
@@ -41,6 +42,7 @@ struct RenderArgs {
   std::vector<std::string> aovs;
   std::string trace_pixel;
   bool quiet = false;
+  bool predict = false;
 };
 
 struct UsageError : std::runtime_error {
@@ -173,6 +175,23 @@ int run_render(const RenderArgs& a) {
     ks.push_back(k);
   }
   j["kernels"] = ks;
+  // The cost model's prediction for every built-in profile (the counters do not depend on it).
+  nlohmann::ordered_json predicted_ms, predicted_breakdown;
+  for (const vgpu::Profile& p : vgpu::profiles()) {
+    const host::CostBreakdown c = host::predict(r.stats, p);
+    predicted_ms[p.name] = c.total_ms;
+    for (const auto& [key, v] : c.items()) predicted_breakdown[p.name][key] = v;
+  }
+  j["predicted_ms"] = predicted_ms;
+  j["predicted_breakdown"] = predicted_breakdown;
+  auto what_if = nlohmann::ordered_json::array();  // MRT and resident programs (docs/table1.md)
+  for (const auto& [name, s] : host::what_ifs(r.stats)) {
+    nlohmann::ordered_json w = {{"name", name}, {"totals", counters_json(s.totals)}};
+    for (const vgpu::Profile& p : vgpu::profiles())
+      for (const auto& [key, v] : host::predict(s, p).items()) w["predicted_breakdown"][p.name][key] = v;
+    what_if.push_back(w);
+  }
+  j["predicted_what_if"] = what_if;
   if (!a.stats_json.empty()) {
     const std::string tmp = a.stats_json + ".tmp";
     std::ofstream f(tmp);
@@ -195,6 +214,10 @@ int run_render(const RenderArgs& a) {
                 a.shadows.c_str(), a.masks.c_str());
     std::printf("initialization %.1f ms (grid %.1f ms), render %.1f ms (host, emulated)\n", init_ms,
                 grid.build_ms, r.render_ms);
+  }
+  if (a.predict) {
+    const vgpu::Profile& p = vgpu::profile(opt.profile);
+    std::cout << host::describe(host::predict(r.stats, p), p);
   }
   return 0;
 }
@@ -223,6 +246,7 @@ int main(int argc, char** argv) {
   render->add_option("--aov", a.aovs, "depth=FILE.exr (distance to primary hit) or hit=FILE.exr (triangle id)");
   render->add_option("--trace-pixel", a.trace_pixel, "X,Y: print every pass this pixel took part in and its state");
   render->add_flag("--quiet,-q", a.quiet, "No progress on stderr");
+  render->add_flag("--predict", a.predict, "Print the cost model's predicted time for --profile, with its breakdown");
   auto* scenes = app.add_subcommand("scenes", "List the scenes in scenes/");
   std::string ca, cb;
   double threshold = 1.0 / 255.0;

@@ -1,0 +1,99 @@
+// The cost model: predicts how long a frame would take on a modeled GPU from the virtual GPU's
+// statistics (vgpu::FrameStats) and the profile's hardware figures (vgpu::Profile). It explains
+// the paper's Table 1; docs/table1.md lists every parameter with its source or marks it fitted.
+//
+// Per pass:  time = max(arithmetic, texture, memory) + pass_us
+//   arithmetic = ALU instructions / (pipelines x clock x alu_per_clock x precision rate)
+//   texture    = texel fetches / (pipelines x clock x texels_per_clock)
+//   memory     = (bytes read + bytes written) / bandwidth
+// Per frame:  + program loads (bytes over the bus + program_load_us each)
+//             + query read-backs (readback_us each: a pipeline drain and a CPU round trip)
+//             + clears (bytes / bandwidth, counted with memory)
+#pragma once
+
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "vgpu/profile.h"
+#include "vgpu/stats.h"
+
+namespace host {
+
+// Model parameters that are not hardware facts. The hardware figures, and the fixed costs
+// (pass_us, program_load_us, readback_us) fitted on Table 1, live in vgpu::Profile.
+struct CostParams {
+  // Counted scalar operations one vec4 instruction does. The statistics count every scalar
+  // operation of the kernel code (vgpu/lanes.h, CountingLanes); a Cg compiler packs vector code
+  // into 4-wide instructions (a dot product is one DP3, a cross product a MUL and a MAD).
+  // Assumed 3: hand count of the ray-triangle test, 62 scalar operations in about 22 fp30
+  // instructions, and of voxel_exits, 27 in about 9. Capped by the profile's alu_lanes.
+  double scalar_ops_per_instruction = 3.0;
+  // Dynamic branching (Branching::dynamic): the share of a pass's branch-idle fragments (its
+  // finished rays) that sit in batches of branch_granularity fragments idle as a whole, so the
+  // batch skips the branch. Assumed (no public figure): 0.75 for ~1000-pixel batches, 0.95 for
+  // 32-pixel warps. Zero without dynamic branching (fp30 runs both sides).
+  double branch_coherence = 0;
+  // Share of a program's operations, fetches and bytes read inside its f.branch() block, i.e.
+  // what a skipping batch saves. Assumed 0.75 from the kernels' code: intersecciones (most of
+  // every frame) keeps 132 of 135 operations but only 6 of 8 fetches (84 of 116 bytes) inside.
+  double branch_body_share = 0.75;
+  // Fixed costs, copied from the profile by defaults_for (fitted, see docs/table1.md).
+  double pass_us = 0;          // one render-to-texture pass: driver, target switch, pipeline fill
+  double program_load_us = 0;  // driver cost of binding another fragment program
+  double readback_us = 0;      // one occlusion-query read-back: pipeline drain + CPU round trip
+};
+
+// The profile's fixed costs and the assumed parameters above for its branching model.
+CostParams defaults_for(const vgpu::Profile& profile);
+
+// Predicted frame time, ms, by where it goes. The first three are the pass work attributed to
+// each pass's bottleneck (the larger of the three demands), so that
+//   total = arithmetic + texture + memory + per_pass + program_load + readback.
+// wasted_ms is part of that pass work: the share spent on fragments whose ray was finished.
+struct CostBreakdown {
+  double arithmetic_ms = 0;  // passes bounded by the ALUs
+  double texture_ms = 0;     // passes bounded by texture fetch rate
+  double memory_ms = 0;      // passes bounded by memory bandwidth, plus clears
+  double per_pass_ms = 0;    // passes x pass_us
+  double program_load_ms = 0;  // program bytes over the bus + program_load_us per load
+  double readback_ms = 0;      // query read-backs x readback_us
+  double wasted_ms = 0;        // of the pass work: fragments whose ray was finished
+  double total_ms = 0;
+  // Each unit's whole demand, overlapped or not (how close the other bottlenecks are).
+  double arithmetic_demand_ms = 0, texture_demand_ms = 0, memory_demand_ms = 0;
+
+  // (name, ms) pairs in the order above, for tables and JSON.
+  std::vector<std::pair<std::string, double>> items() const;
+};
+
+// Uses stats.passes (one record per pass) when it holds every pass, else each program's totals
+// spread evenly over its passes.
+CostBreakdown predict(const vgpu::FrameStats& stats, const vgpu::Profile& profile);
+CostBreakdown predict(const vgpu::FrameStats& stats, const vgpu::Profile& profile,
+                      const CostParams& params);
+
+// A few lines: the predicted total and its breakdown, for the CLI.
+std::string describe(const CostBreakdown& cost, const vgpu::Profile& profile);
+
+// What-if transforms of a frame's statistics, predicted by the same model (docs/table1.md).
+// Multiple render targets: two kernels that always run back to back become one pass writing
+// both targets. The merged pass shades each fragment once, does both programs' operations and
+// fetches except the inputs both read (shared_fetches own texels, shared_bytes each fragment),
+// writes both targets, and is one program load instead of two.
+struct MergedPair {
+  std::string first, second;  // kernel names, as in the statistics
+  int shared_fetches = 0;     // own-texel fetches both programs make of the same texture
+  int shared_bytes = 0;       // their bytes per fragment
+};
+// The pairs of the paper's pipeline: intersecciones + proximoTriangulo (both read the voxel
+// state), traversal + actualizarVoxel (the second reads the first's output, the traversal state).
+const std::vector<MergedPair>& mrt_pairs();
+vgpu::FrameStats with_merged_passes(const vgpu::FrameStats& stats,
+                                    const std::vector<MergedPair>& pairs);
+// Programs kept resident: each is loaded once, on first use, instead of at every switch.
+vgpu::FrameStats with_resident_programs(const vgpu::FrameStats& stats);
+// The named scenarios: "mrt", "resident programs", "mrt + resident programs".
+std::vector<std::pair<std::string, vgpu::FrameStats>> what_ifs(const vgpu::FrameStats& stats);
+
+}  // namespace host

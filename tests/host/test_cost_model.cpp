@@ -1,0 +1,166 @@
+// Tests for host/cost_model: known counters give the hand-computed time of every term; more
+// passes never predict less; masked fragments and skipped branches lower the arithmetic; the
+// what-if transforms keep the work and drop passes or loads.
+#include <doctest/doctest.h>
+
+#include "host/cost_model.h"
+
+namespace {
+
+// A small made-up card with round numbers: 4 pipes at 100 MHz, 1 GB/s, 1000 MB/s bus.
+vgpu::Profile card() {
+  vgpu::Profile p;
+  p.name = "test";
+  p.pipelines = 4;
+  p.core_mhz = 100;
+  p.mem_gbps = 1;
+  p.bus_mbps = 1000;
+  p.precision = vgpu::Format::fp32;
+  p.alu_lanes = 4;
+  p.alu_per_clock = 1;
+  p.fp32_rate = 0.5;
+  p.texels_per_clock = 1;
+  p.branching = vgpu::Branching::none;
+  return p;
+}
+
+host::CostParams params() {
+  host::CostParams c;
+  c.scalar_ops_per_instruction = 3;
+  c.branch_coherence = 0;
+  c.branch_body_share = 0.75;
+  c.pass_us = 10;
+  c.program_load_us = 20;
+  c.readback_us = 40;
+  return c;
+}
+
+// `passes` passes of one program over 4000 fragments each: 31 counted operations (one of them a
+// 16-byte fetch) and a 16-byte write per fragment; `idle` fragments a pass are finished rays.
+vgpu::Counters kernel_passes(uint64_t passes, uint64_t idle = 1000, uint64_t masked = 0) {
+  vgpu::Counters c;
+  c.passes = passes;
+  c.fragments_launched = 4000 * passes;
+  c.fragments_masked = masked * passes;
+  c.fragments_shaded = c.fragments_launched - c.fragments_masked;
+  c.lanes_idle = (idle - masked) * passes;
+  c.instructions = 31 * c.fragments_shaded;
+  c.texture_fetches = c.fragments_shaded;
+  c.bytes_read = 16 * c.fragments_shaded;
+  c.bytes_written = 16 * c.fragments_shaded;
+  c.program_loads = passes;
+  c.program_bytes = 496 * passes;  // 31 instructions x 16 bytes
+  return c;
+}
+
+vgpu::FrameStats frame(const vgpu::Counters& k, uint64_t readbacks = 1, uint64_t clear_bytes = 100000) {
+  vgpu::FrameStats s;
+  s.keep_pass_records = false;
+  s.program("kernel", "kernel", 31).counters = k;
+  s.totals = k;
+  s.totals.queries = s.totals.query_readbacks = readbacks;
+  s.totals.clears = 1;
+  s.totals.bytes_written += clear_bytes;
+  return s;
+}
+
+}  // namespace
+
+TEST_CASE("Known counters give the hand-computed time of every term") {
+  const host::CostBreakdown b = host::predict(frame(kernel_passes(2)), card(), params());
+  // Per pass: 4000 x 30 operations / 3 per instruction = 40000 instructions over
+  // 4 pipes x 1e8 Hz x 0.5 (fp32) = 200 us; texture 4000 / 4e8 = 10 us; memory 128000 B / 1e9 = 128 us.
+  CHECK(b.arithmetic_demand_ms == doctest::Approx(0.400));
+  CHECK(b.texture_demand_ms == doctest::Approx(0.020));
+  CHECK(b.memory_demand_ms == doctest::Approx(0.256 + 0.100));  // passes + the clear
+  CHECK(b.arithmetic_ms == doctest::Approx(0.400));             // both passes ALU bound
+  CHECK(b.texture_ms == doctest::Approx(0.0));
+  CHECK(b.memory_ms == doctest::Approx(0.100));                 // the clear: 100000 B / 1 GB/s
+  CHECK(b.per_pass_ms == doctest::Approx(0.020));               // 2 x 10 us
+  CHECK(b.program_load_ms == doctest::Approx(0.000992 + 0.040));  // 992 B at 1000 MB/s + 2 x 20 us
+  CHECK(b.readback_ms == doctest::Approx(0.040));
+  CHECK(b.wasted_ms == doctest::Approx(0.100));  // a quarter of the fragments were finished
+  CHECK(b.total_ms == doctest::Approx(0.400 + 0.100 + 0.020 + 0.040992 + 0.040));
+}
+
+TEST_CASE("Pass records and per-program totals predict the same for identical passes") {
+  vgpu::FrameStats s = frame(kernel_passes(2));
+  const host::CostBreakdown totals = host::predict(s, card(), params());
+  s.keep_pass_records = true;
+  for (int i = 0; i < 2; ++i) {
+    vgpu::Counters one = kernel_passes(1);
+    one.program_loads = 0;  // loads are counted by use_program, not by the pass
+    one.program_bytes = 0;
+    s.passes.push_back({"kernel", 64, 64, one, -1});
+  }
+  const host::CostBreakdown records = host::predict(s, card(), params());
+  CHECK(records.total_ms == doctest::Approx(totals.total_ms));
+  CHECK(records.wasted_ms == doctest::Approx(totals.wasted_ms));
+}
+
+TEST_CASE("More passes never predict less time") {
+  double last = 0;
+  for (uint64_t n = 1; n <= 64; n *= 2) {
+    const double t = host::predict(frame(kernel_passes(n), n), card(), params()).total_ms;
+    CHECK(t > last);
+    last = t;
+  }
+  // A pass whose every fragment is masked still costs its fixed cost.
+  const vgpu::FrameStats one = frame(kernel_passes(1));
+  vgpu::FrameStats two = one;
+  two.totals.passes += 1;
+  two.totals.fragments_launched += 4000;
+  two.totals.fragments_masked += 4000;
+  two.programs[0].counters.passes += 1;
+  two.programs[0].counters.fragments_launched += 4000;
+  two.programs[0].counters.fragments_masked += 4000;
+  CHECK(host::predict(two, card(), params()).total_ms >
+        host::predict(one, card(), params()).total_ms);
+}
+
+TEST_CASE("Masked fragments reduce the arithmetic term") {
+  const auto all = host::predict(frame(kernel_passes(4, 3000, 0)), card(), params());
+  const auto masked = host::predict(frame(kernel_passes(4, 3000, 3000)), card(), params());
+  CHECK(masked.arithmetic_demand_ms == doctest::Approx(all.arithmetic_demand_ms / 4));
+  CHECK(masked.arithmetic_ms < all.arithmetic_ms);
+  CHECK(masked.wasted_ms == doctest::Approx(0.0));  // the finished rays were all masked
+  CHECK(masked.total_ms < all.total_ms);
+}
+
+TEST_CASE("Dynamic branching skips the branch body of batches idle as a whole") {
+  vgpu::Profile fx = card();
+  vgpu::Profile nv4 = card();
+  nv4.branching = vgpu::Branching::dynamic;
+  host::CostParams p = params();
+  p.branch_coherence = 1;  // every finished ray sits in an all-idle batch
+  p.branch_body_share = 1;  // and skips the whole program
+  const vgpu::FrameStats s = frame(kernel_passes(2, 3000));
+  const auto both_sides = host::predict(s, fx, p);
+  const auto branching = host::predict(s, nv4, p);
+  CHECK(branching.arithmetic_demand_ms == doctest::Approx(both_sides.arithmetic_demand_ms / 4));
+  CHECK(branching.wasted_ms == doctest::Approx(0.0));
+  CHECK(both_sides.wasted_ms == doctest::Approx(0.75 * both_sides.arithmetic_ms));
+}
+
+TEST_CASE("Merging a pair of kernels into one MRT pass drops passes and loads, keeps the work") {
+  vgpu::FrameStats s;
+  s.keep_pass_records = false;
+  vgpu::Counters a = kernel_passes(10), b = kernel_passes(10);
+  s.program("intersections", "intersecciones", 31).counters = a;
+  s.program("next triangle", "proximoTriangulo", 31).counters = b;
+  s.totals = a;
+  s.totals += b;
+  const vgpu::FrameStats m = host::with_merged_passes(s, {{"intersections", "next triangle", 1, 16}});
+  CHECK(m.totals.passes == 10);
+  CHECK(m.totals.program_loads == 10);
+  CHECK(m.totals.fragments_shaded == a.fragments_shaded);
+  CHECK(m.totals.instructions == a.instructions + b.instructions - a.fragments_shaded);
+  CHECK(m.totals.bytes_read == a.bytes_read + b.bytes_read - 16 * a.fragments_shaded);
+  CHECK(m.totals.bytes_written == a.bytes_written + b.bytes_written);
+  CHECK(host::predict(m, card(), params()).total_ms < host::predict(s, card(), params()).total_ms);
+
+  const vgpu::FrameStats r = host::with_resident_programs(s);
+  CHECK(r.totals.program_loads == 2);
+  CHECK(r.totals.program_bytes == 2 * 496);
+  CHECK(r.totals.passes == s.totals.passes);
+}
