@@ -1,0 +1,367 @@
+#!/usr/bin/env python3
+"""Writes the small glTF files that tests/host/test_gltf_loader.cpp loads, valid and broken.
+
+Run from anywhere: python3 tests/data/gltf/make_cases.py. The output is committed next to this
+script; each case is a few triangles whose expected values the test states exactly.
+"""
+import base64
+import json
+import math
+import os
+import struct
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+
+FLOAT, BYTE, UBYTE, SHORT, USHORT, UINT = 5126, 5120, 5121, 5122, 5123, 5125
+POINTS, LINES, LINE_STRIP, TRIANGLES, STRIP, FAN = 0, 1, 3, 4, 5, 6
+INDEX_FORMAT = {UBYTE: "B", USHORT: "H", UINT: "I"}
+
+
+class Builder:
+    """Collects binary data, buffer views and accessors for one buffer."""
+
+    def __init__(self):
+        self.bin = bytearray()
+        self.views = []
+        self.accessors = []
+
+    def view(self, data, stride=None):
+        while len(self.bin) % 4:
+            self.bin.append(0)
+        v = {"buffer": 0, "byteOffset": len(self.bin), "byteLength": len(data)}
+        if stride:
+            v["byteStride"] = stride
+        self.bin += data
+        self.views.append(v)
+        return len(self.views) - 1
+
+    def accessor(self, view, comp, type_, count, normalized=False, extra=None):
+        a = {"bufferView": view, "componentType": comp, "type": type_, "count": count}
+        if normalized:
+            a["normalized"] = True
+        if extra:
+            a.update(extra)
+        self.accessors.append(a)
+        return len(self.accessors) - 1
+
+    def vec3(self, points):
+        data = b"".join(struct.pack("<3f", *p) for p in points)
+        finite = [p for p in points if all(math.isfinite(c) for c in p)] or [(0, 0, 0)]
+        mm = {"min": [min(p[i] for p in finite) for i in range(3)],
+              "max": [max(p[i] for p in finite) for i in range(3)]}
+        return self.accessor(self.view(data), FLOAT, "VEC3", len(points), extra=mm)
+
+    def vec3_quantized(self, points, comp, normalized):
+        fmt, size = {BYTE: ("b", 1), UBYTE: ("B", 1), SHORT: ("h", 2), USHORT: ("H", 2)}[comp]
+        stride = (3 * size + 3) // 4 * 4  # glTF: vertex strides are multiples of 4
+        data = b"".join(struct.pack("<3" + fmt, *p) + b"\0" * (stride - 3 * size) for p in points)
+        return self.accessor(self.view(data, stride=stride), comp, "VEC3", len(points), normalized)
+
+    def indices(self, idx, comp=USHORT):
+        data = struct.pack("<%d%s" % (len(idx), INDEX_FORMAT[comp]), *idx)
+        return self.accessor(self.view(data), comp, "SCALAR", len(idx))
+
+    def doc(self, **parts):
+        d = {"asset": {"version": "2.0", "generator": "tests/data/gltf/make_cases.py"}}
+        d.update(parts)
+        d["buffers"] = [{"byteLength": len(self.bin)}]
+        d["bufferViews"] = self.views
+        d["accessors"] = self.accessors
+        return d
+
+
+def data_uri(data):
+    return "data:application/octet-stream;base64," + base64.b64encode(bytes(data)).decode()
+
+
+def write_text(name, text):
+    with open(os.path.join(HERE, name), "w") as f:
+        f.write(text)
+
+
+def write_bytes(name, data):
+    with open(os.path.join(HERE, name), "wb") as f:
+        f.write(data)
+
+
+def write_gltf(name, doc, data, external=False):
+    doc = json.loads(json.dumps(doc))
+    if external:
+        bin_name = name.replace(".gltf", ".bin")
+        doc["buffers"][0]["uri"] = bin_name
+        write_bytes(bin_name, data)
+    else:
+        doc["buffers"][0]["uri"] = data_uri(data)
+    write_text(name, json.dumps(doc, indent=1) + "\n")
+
+
+def glb_bytes(doc, data, version=2):
+    text = json.dumps(doc, separators=(",", ":")).encode()
+    text += b" " * (-len(text) % 4)
+    data = bytes(data) + b"\0" * (-len(data) % 4)
+    out = struct.pack("<I", len(text)) + b"JSON" + text
+    if data:
+        out += struct.pack("<I", len(data)) + b"BIN\0" + data
+    return b"glTF" + struct.pack("<II", version, 12 + len(out)) + out
+
+
+def simple(points, mode=TRIANGLES, idx=None, normals=None, **doc_parts):
+    """One node, one mesh, one primitive."""
+    b = Builder()
+    prim = {"attributes": {"POSITION": b.vec3(points)}, "mode": mode}
+    if normals:
+        prim["attributes"]["NORMAL"] = b.vec3(normals)
+    if idx is not None:
+        prim["indices"] = b.indices(idx)
+    parts = {"scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+             "meshes": [{"primitives": [prim]}]}
+    parts.update(doc_parts)
+    return b, b.doc(**parts)
+
+
+TRI = [(0, 0, 0), (1, 0, 0), (0, 1, 0)]
+UP = [(0, 0, 1)] * 3
+
+
+def triangle_cases():
+    b, d = simple(TRI, idx=[0, 1, 2], normals=UP)
+    write_gltf("triangle.gltf", d, b.bin)
+    write_gltf("triangle_external.gltf", d, b.bin, external=True)
+    d_glb = json.loads(json.dumps(d))
+    write_bytes("triangle.glb", glb_bytes(d_glb, b.bin))
+
+
+def hierarchy_case():
+    b = Builder()
+    tri = {"attributes": {"POSITION": b.vec3(TRI), "NORMAL": b.vec3(UP)}, "indices": b.indices([0, 1, 2])}
+    # A triangle in the plane x + y = 1, front (1, 1, 0).
+    slanted = [(1, 0, 0), (0, 1, 0), (0, 1, 1)]
+    n = 1 / math.sqrt(2)
+    tilt = {"attributes": {"POSITION": b.vec3(slanted), "NORMAL": b.vec3([(n, n, 0)] * 3)}}
+    nodes = [
+        {"name": "trs", "mesh": 0, "children": [1], "translation": [1, 2, 3],
+         "rotation": [0, 0, 1, 0], "scale": [2, 2, 2]},  # 180 degrees about +Z
+        {"name": "matrix", "mesh": 0,
+         "matrix": [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 10, 0, 0, 1]},  # translate (10, 0, 0)
+        {"name": "mirror", "mesh": 0, "scale": [-1, 1, 1]},
+        {"name": "stretch", "mesh": 1, "scale": [1, 2, 1]},
+    ]
+    d = b.doc(scene=0, scenes=[{"nodes": [0, 2, 3]}], nodes=nodes,
+              meshes=[{"primitives": [tri]}, {"primitives": [tilt]}])
+    write_gltf("hierarchy.gltf", d, b.bin)
+
+
+def roots_case():
+    # No "scenes": every root node, in index order; node 2 is node 0's child.
+    b, d = simple(TRI, idx=[0, 1, 2])
+    del d["scene"], d["scenes"]
+    d["nodes"] = [{"mesh": 0, "children": [2]}, {"mesh": 0, "translation": [0, 0, 1]},
+                  {"mesh": 0, "translation": [0, 0, 2]}]
+    write_gltf("no_scenes.gltf", d, b.bin)
+
+
+def strip_fan_case():
+    b = Builder()
+    strip = {"attributes": {"POSITION": b.vec3([(0, 0, 0), (0, 1, 0), (1, 0, 0), (1, 1, 0), (2, 0, 0)])},
+             "indices": b.indices([0, 1, 2, 3, 4]), "mode": STRIP}
+    fan = {"attributes": {"POSITION": b.vec3([(0, 0, 1), (1, 0, 1), (1, 1, 1), (0, 1, 1)])},
+           "indices": b.indices([0, 1, 2, 3]), "mode": FAN}
+    plain_strip = {"attributes": {"POSITION": b.vec3([(0, 0, 2), (0, 1, 2), (1, 0, 2), (1, 1, 2)])},
+                   "mode": STRIP}
+    d = b.doc(scene=0, scenes=[{"nodes": [0]}], nodes=[{"mesh": 0}],
+              meshes=[{"primitives": [strip, fan, plain_strip]}])
+    write_gltf("strip_fan.gltf", d, b.bin)
+
+
+def index_types_case():
+    b = Builder()
+    pos = b.vec3([(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0)])
+    prims = [{"attributes": {"POSITION": pos}, "indices": b.indices([0, 1, 2, 0, 2, 3], comp)}
+             for comp in (UBYTE, USHORT, UINT)]
+    d = b.doc(scene=0, scenes=[{"nodes": [0]}], nodes=[{"mesh": 0}], meshes=[{"primitives": prims}])
+    write_gltf("index_types.gltf", d, b.bin)
+
+
+def non_indexed_case():
+    pts = [(0, 0, 0), (1, 0, 0), (0, 1, 0), (0, 0, 1), (1, 0, 1), (0, 1, 1)]
+    b, d = simple(pts)
+    write_gltf("non_indexed.gltf", d, b.bin)
+
+
+def quantized_case():
+    b = Builder()
+    u16 = {"attributes": {
+        "POSITION": b.vec3_quantized([(0, 0, 0), (65535, 0, 0), (0, 32768, 0)], USHORT, True),
+        "NORMAL": b.vec3_quantized([(0, 0, 127)] * 3, BYTE, True)}}
+    i8 = {"attributes": {"POSITION": b.vec3_quantized([(-128, 0, 0), (127, 0, 0), (0, 64, 0)], BYTE, True)}}
+    i16 = {"attributes": {"POSITION": b.vec3_quantized([(0, 0, 0), (300, 0, 0), (0, -200, 0)], SHORT, False)}}
+    d = b.doc(extensionsUsed=["KHR_mesh_quantization"], extensionsRequired=["KHR_mesh_quantization"],
+              scene=0, scenes=[{"nodes": [0]}], nodes=[{"mesh": 0}],
+              meshes=[{"primitives": [u16, i8, i16]}])
+    write_gltf("quantized.gltf", d, b.bin)
+
+
+def no_normals_case():
+    # Two triangles folded along the edge 1-2, plus a separate non-indexed triangle.
+    b = Builder()
+    roof = {"attributes": {"POSITION": b.vec3([(0, 0, 0), (1, 0, 0), (0, 1, 0), (1, 1, 1)])},
+            "indices": b.indices([0, 1, 2, 1, 3, 2])}
+    flat = {"attributes": {"POSITION": b.vec3([(0, 0, 5), (0, 0, 6), (0, 1, 5)])}}
+    d = b.doc(scene=0, scenes=[{"nodes": [0]}], nodes=[{"mesh": 0}], meshes=[{"primitives": [roof, flat]}])
+    write_gltf("no_normals.gltf", d, b.bin)
+
+
+def degenerate_case():
+    pts = [(0, 0, 0), (1, 0, 0), (0, 1, 0),      # id 0
+           (0, 0, 0), (1, 1, 1), (2, 2, 2),      # id 1: collinear
+           (3, 3, 3), (3, 3, 3), (4, 4, 5),      # id 2: repeated corner
+           (0, 0, 1), (1, 0, 1), (0, 1, 1)]      # id 3
+    b, d = simple(pts)
+    write_gltf("degenerate.gltf", d, b.bin)
+
+
+def cameras_case():
+    s = math.sqrt(0.5)
+    b, d = simple(TRI, idx=[0, 1, 2])
+    d["cameras"] = [{"type": "perspective", "perspective": {"yfov": y, "znear": 0.1}} for y in (0.5, 0.7, 0.9)]
+    d["nodes"] = [
+        {"name": "root", "mesh": 0, "children": [3, 1]},
+        {"name": "shallow camera", "camera": 0, "translation": [5, 5, 5]},
+        {"name": "deep camera", "camera": 1, "translation": [1, 2, 3], "rotation": [0, s, 0, s]},
+        {"name": "group", "children": [2], "translation": [0, 0, 10]},
+        {"name": "scene 0 only", "camera": 2, "mesh": 0},
+    ]
+    d["scenes"] = [{"nodes": [4]}, {"nodes": [0]}]
+    d["scene"] = 1
+    write_gltf("cameras.gltf", d, b.bin)
+
+
+def ortho_case():
+    b, d = simple(TRI, idx=[0, 1, 2])
+    d["cameras"] = [{"type": "orthographic",
+                     "orthographic": {"xmag": 1, "ymag": 1, "znear": 0.1, "zfar": 10}}]
+    d["nodes"][0]["camera"] = 0
+    write_gltf("orthographic_camera.gltf", d, b.bin)
+
+
+def lights_case():
+    b, d = simple(TRI, idx=[0, 1, 2])
+    d["extensionsUsed"] = ["KHR_lights_punctual"]
+    d["extensions"] = {"KHR_lights_punctual": {"lights": [
+        {"type": "point", "color": [1, 0.5, 0.25], "intensity": 2},
+        {"type": "point", "intensity": 4},
+        {"type": "spot", "color": [0, 1, 0], "intensity": 1, "spot": {}},
+        {"type": "directional", "intensity": 3},
+    ]}}
+    d["nodes"] = [{"mesh": 0}] + [
+        {"translation": t, "extensions": {"KHR_lights_punctual": {"light": i}}}
+        for i, t in enumerate([[1, 2, 3], [0, 5, 0], [0, 0, 5], [0, 0, 0]])]
+    d["scenes"] = [{"nodes": [0, 1, 2, 3, 4]}]
+    write_gltf("lights.gltf", d, b.bin)
+
+
+def materials_case():
+    b = Builder()
+    pos = b.vec3(TRI)
+    prims = [{"attributes": {"POSITION": pos}, "material": m} for m in range(4)]
+    prims.append({"attributes": {"POSITION": pos}})
+    materials = [
+        {"pbrMetallicRoughness": {"baseColorFactor": [0.2, 0.4, 0.6, 1], "metallicFactor": 0.25}},
+        {"pbrMetallicRoughness": {"metallicFactor": 0.1}, "extras": {"reflect": 0.75}},
+        {},
+        {"pbrMetallicRoughness": {"metallicFactor": 0}, "extras": {"reflect": 1.5}},
+    ]
+    d = b.doc(scene=0, scenes=[{"nodes": [0]}], nodes=[{"mesh": 0}],
+              meshes=[{"primitives": prims}], materials=materials)
+    write_gltf("materials.gltf", d, b.bin)
+
+
+def modes_case():
+    b = Builder()
+    pos = b.vec3(TRI)
+    prims = [{"attributes": {"POSITION": pos}, "mode": m} for m in (TRIANGLES, LINES, POINTS, LINE_STRIP)]
+    prims[1]["indices"] = b.indices([0, 1])
+    d = b.doc(scene=0, scenes=[{"nodes": [0]}], nodes=[{"mesh": 0}], meshes=[{"primitives": prims}])
+    write_gltf("modes.gltf", d, b.bin)
+
+
+def bad_cases():
+    write_text("not_gltf.txt", "This is a plain text file, not a glTF scene.\n")
+
+    b, d = simple(TRI, idx=[0, 1, 2], normals=UP)
+    glb = glb_bytes(json.loads(json.dumps(d)), b.bin)
+    write_bytes("truncated.glb", glb[:len(glb) // 2])
+    bad_chunk = bytearray(glb)
+    bad_chunk[12:16] = struct.pack("<I", 10000)
+    write_bytes("bad_chunk_length.glb", bytes(bad_chunk))
+    write_bytes("bad_version.glb", glb_bytes(json.loads(json.dumps(d)), b.bin, version=1))
+    # BIN chunk holds 8 bytes fewer than the buffer's byteLength.
+    short = json.loads(json.dumps(d))
+    short["buffers"][0]["byteLength"] = len(b.bin) + 8
+    write_bytes("short_buffer.glb", glb_bytes(short, b.bin))
+
+    write_text("json_syntax.gltf", '{\n  "asset": {"version": "2.0"}\n  "scenes": []\n}\n')
+
+    b, d = simple(TRI, idx=[0, 1, 2])
+    d["accessors"][0]["count"] = 4
+    write_gltf("accessor_past_view.gltf", d, b.bin)
+
+    b, d = simple(TRI, idx=[0, 1, 2])
+    d["bufferViews"][1]["byteLength"] = 100
+    write_gltf("view_past_buffer.gltf", d, b.bin)
+
+    b, d = simple(TRI, idx=[0, 1, 2])
+    d["buffers"][0]["byteLength"] = len(b.bin) + 8
+    d["buffers"][0]["uri"] = "short_buffer.bin"
+    write_bytes("short_buffer.bin", b.bin)
+    write_text("short_buffer.gltf", json.dumps(d, indent=1) + "\n")
+    d["buffers"][0]["uri"] = data_uri(b.bin)
+    write_text("short_buffer_embedded.gltf", json.dumps(d, indent=1) + "\n")
+
+    b, d = simple(TRI, idx=[0, 1, 5])
+    write_gltf("index_past_vertices.gltf", d, b.bin)
+
+    b, d = simple([(0, 0, 0), (float("nan"), 0, 0), (0, 1, 0)])
+    write_gltf("nan_position.gltf", d, b.bin)
+    b, d = simple([(0, 0, 0), (1, 0, 0), (0, float("inf"), 0)])
+    write_gltf("inf_position.gltf", d, b.bin)
+
+    b, d = simple(TRI, mode=LINES, idx=[0, 1, 1, 2])
+    write_gltf("only_lines.gltf", d, b.bin)
+
+    b, d = simple(TRI, idx=[0, 1, 2])
+    d["nodes"] = [{"mesh": 0, "children": [1]}, {"children": [0]}]
+    write_gltf("node_cycle.gltf", d, b.bin)
+
+    b, d = simple(TRI, idx=[0, 1, 2])
+    d["meshes"][0]["primitives"][0]["attributes"]["POSITION"] = 7
+    write_gltf("accessor_index_out_of_range.gltf", d, b.bin)
+
+    b, d = simple(TRI, idx=[0, 1, 2])
+    d["extensionsRequired"] = ["KHR_draco_mesh_compression"]
+    write_gltf("draco_required.gltf", d, b.bin)
+
+    b, d = simple(TRI, idx=[0, 1, 2])
+    nested = 0
+    for _ in range(100):
+        nested = [nested]
+    d["nodes"][0]["extras"] = {"deep": nested}
+    write_gltf("deep_json.gltf", d, b.bin)
+
+
+if __name__ == "__main__":
+    triangle_cases()
+    hierarchy_case()
+    roots_case()
+    strip_fan_case()
+    index_types_case()
+    non_indexed_case()
+    quantized_case()
+    no_normals_case()
+    degenerate_case()
+    cameras_case()
+    ortho_case()
+    lights_case()
+    materials_case()
+    modes_case()
+    bad_cases()
