@@ -16,6 +16,7 @@
 #include <unistd.h>
 
 #include "host/camera.h"
+#include "host/cpu_tracer.h"
 #include "host/cost_model.h"
 #include "host/gltf_loader.h"
 #include "host/grid.h"
@@ -43,6 +44,7 @@ struct RenderArgs {
   std::string trace_pixel;
   bool quiet = false;
   bool predict = false;
+  std::string engine = "stream";
 };
 
 struct UsageError : std::runtime_error {
@@ -118,6 +120,12 @@ int run_render(const RenderArgs& a) {
     opt.trace_out = &std::cout;
   }
 
+  if (a.engine != "stream" && a.engine != "cpu")
+    throw UsageError("--engine: expected stream or cpu, got '" + a.engine + "'");
+  const bool cpu = a.engine == "cpu";
+  if (cpu && (a.predict || !a.trace_pixel.empty()))
+    throw UsageError("--predict and --trace-pixel need --engine stream");
+
   const std::string path = host::resolve_scene(a.scene);
   const host::Scene scene = host::load_scene(path);
   const auto t0 = std::chrono::steady_clock::now();
@@ -130,10 +138,12 @@ int run_render(const RenderArgs& a) {
       std::fprintf(stderr, tty ? "\rvgpu-rt: iteration %d/%d" : "vgpu-rt: iteration %d/%d\n", it, n);
       std::fflush(stderr);
     };
-  host::StreamTracer tracer(scene, grid, opt);
+  std::optional<host::StreamTracer> tracer;
+  if (!cpu) tracer.emplace(scene, grid, opt);
   const double init_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-  const host::RenderResult r = tracer.render(cam);
+  host::CpuStats cpu_stats;
+  const host::RenderResult r = cpu ? host::render_cpu(scene, grid, cam, opt, &cpu_stats) : tracer->render(cam);
   if (tty) std::fprintf(stderr, "\n");
 
   if (!a.out.empty()) host::write_image(a.out, r.width, r.height, 3, r.rgb);
@@ -143,7 +153,7 @@ int run_render(const RenderArgs& a) {
   nlohmann::ordered_json j;
   j["scene"] = scene.name;
   j["scene_path"] = path;
-  j["engine"] = "stream";
+  j["engine"] = a.engine;
   j["triangles"] = scene.triangle_count();
   j["input_triangles"] = scene.input_triangles;
   j["dropped_degenerate"] = scene.dropped_degenerate;
@@ -161,7 +171,11 @@ int run_render(const RenderArgs& a) {
   j["init_ms"] = init_ms;
   j["grid_build_ms"] = grid.build_ms;
   j["render_ms"] = r.render_ms;
-  j["texture_bytes"] = tracer.texture_bytes();
+  if (tracer) j["texture_bytes"] = tracer->texture_bytes();
+  if (cpu)
+    j["cpu"] = {{"rays", cpu_stats.rays},
+                {"voxel_steps", cpu_stats.voxel_steps},
+                {"triangle_tests", cpu_stats.triangle_tests}};
   j["rays_traced"] = r.rays_traced;
   j["totals"] = counters_json(r.stats.totals);
   auto ks = nlohmann::ordered_json::array();
@@ -178,6 +192,7 @@ int run_render(const RenderArgs& a) {
   // The cost model's prediction for every built-in profile (the counters do not depend on it).
   nlohmann::ordered_json predicted_ms, predicted_breakdown;
   for (const vgpu::Profile& p : vgpu::profiles()) {
+    if (cpu) break;  // the CPU engine runs no passes: nothing to predict
     const host::CostBreakdown c = host::predict(r.stats, p);
     predicted_ms[p.name] = c.total_ms;
     for (const auto& [key, v] : c.items()) predicted_breakdown[p.name][key] = v;
@@ -185,7 +200,7 @@ int run_render(const RenderArgs& a) {
   j["predicted_ms"] = predicted_ms;
   j["predicted_breakdown"] = predicted_breakdown;
   auto what_if = nlohmann::ordered_json::array();  // MRT and resident programs (docs/table1.md)
-  for (const auto& [name, s] : host::what_ifs(r.stats)) {
+  for (const auto& [name, s] : cpu ? decltype(host::what_ifs(r.stats)){} : host::what_ifs(r.stats)) {
     nlohmann::ordered_json w = {{"name", name}, {"totals", counters_json(s.totals)}};
     for (const vgpu::Profile& p : vgpu::profiles())
       for (const auto& [key, v] : host::predict(s, p).items()) w["predicted_breakdown"][p.name][key] = v;
@@ -205,15 +220,21 @@ int run_render(const RenderArgs& a) {
   if (a.stats == "json") {
     std::cout << j.dump(2) << "\n";
   } else if (a.stats == "table") {
-    std::cout << r.stats.to_table();
+    if (cpu)
+      std::printf("CPU reference (double precision, recursive Whitted): %llu rays, %llu voxel steps, %llu triangle tests\n",
+                  static_cast<unsigned long long>(cpu_stats.rays),
+                  static_cast<unsigned long long>(cpu_stats.voxel_steps),
+                  static_cast<unsigned long long>(cpu_stats.triangle_tests));
+    else
+      std::cout << r.stats.to_table();
     std::printf("scene %s: %zu triangles (%u dropped as degenerate), grid %dx%dx%d (%llu references)\n",
                 scene.name.c_str(), scene.triangle_count(), scene.dropped_degenerate, grid.res.x,
                 grid.res.y, grid.res.z, static_cast<unsigned long long>(grid.references()));
-    std::printf("profile %s, %dx%d, %d iteration(s), %s shading, shadows %s, masks %s\n",
-                opt.profile.c_str(), r.width, r.height, r.iterations, a.shading.c_str(),
+    std::printf("%s %s, %dx%d, %d iteration(s), %s shading, shadows %s, masks %s\n",
+                cpu ? "engine" : "profile", cpu ? "cpu" : opt.profile.c_str(), r.width, r.height, r.iterations, a.shading.c_str(),
                 a.shadows.c_str(), a.masks.c_str());
-    std::printf("initialization %.1f ms (grid %.1f ms), render %.1f ms (host, emulated)\n", init_ms,
-                grid.build_ms, r.render_ms);
+    std::printf("initialization %.1f ms (grid %.1f ms), render %.1f ms (%s)\n", init_ms,
+                grid.build_ms, r.render_ms, cpu ? "host CPU" : "host, emulated");
   }
   if (a.predict) {
     const vgpu::Profile& p = vgpu::profile(opt.profile);
@@ -246,6 +267,7 @@ int main(int argc, char** argv) {
   render->add_option("--aov", a.aovs, "depth=FILE.exr (distance to primary hit) or hit=FILE.exr (triangle id)");
   render->add_option("--trace-pixel", a.trace_pixel, "X,Y: print every pass this pixel took part in and its state");
   render->add_flag("--quiet,-q", a.quiet, "No progress on stderr");
+  render->add_option("--engine", a.engine, "stream (the vgpu pipeline) | cpu (double-precision reference)")->capture_default_str();
   render->add_flag("--predict", a.predict, "Print the cost model's predicted time for --profile, with its breakdown");
   auto* scenes = app.add_subcommand("scenes", "List the scenes in scenes/");
   std::string ca, cb;
