@@ -19,7 +19,8 @@ CostParams defaults_for(const vgpu::Profile& profile) {
 std::vector<std::pair<std::string, double>> CostBreakdown::items() const {
   return {{"arithmetic_ms", arithmetic_ms},   {"texture_ms", texture_ms},
           {"memory_ms", memory_ms},           {"per_pass_ms", per_pass_ms},
-          {"program_load_ms", program_load_ms}, {"readback_ms", readback_ms},
+          {"program_load_ms", program_load_ms}, {"bus_ms", bus_ms},
+          {"readback_ms", readback_ms},
           {"wasted_ms", wasted_ms},           {"total_ms", total_ms},
           {"arithmetic_demand_ms", arithmetic_demand_ms},
           {"texture_demand_ms", texture_demand_ms},
@@ -97,8 +98,8 @@ CostBreakdown predict(const vgpu::FrameStats& stats, const vgpu::Profile& hw,
     b.memory_demand_ms += clear_ms;
   }
   b.per_pass_ms = 1e-3 * p.pass_us * double(t.passes);
-  b.program_load_ms = 1e3 * double(t.program_bytes) / (hw.bus_mbps * 1e6) +
-                      1e-3 * p.program_load_us * double(t.program_loads);
+  b.bus_ms = 1e3 * double(t.program_bytes) / (hw.bus_mbps * 1e6);
+  b.program_load_ms = b.bus_ms + 1e-3 * p.program_load_us * double(t.program_loads);
   b.readback_ms = 1e-3 * p.readback_us * double(t.query_readbacks);
   b.total_ms = b.arithmetic_ms + b.texture_ms + b.memory_ms + b.per_pass_ms + b.program_load_ms +
                b.readback_ms;

@@ -57,6 +57,7 @@ struct CostBreakdown {
   double memory_ms = 0;      // passes bounded by memory bandwidth, plus clears
   double per_pass_ms = 0;    // passes x pass_us
   double program_load_ms = 0;  // program bytes over the bus + program_load_us per load
+  double bus_ms = 0;           // of program_load_ms: the program bytes over the bus alone
   double readback_ms = 0;      // query read-backs x readback_us
   double wasted_ms = 0;        // of the pass work: fragments whose ray was finished
   double total_ms = 0;
