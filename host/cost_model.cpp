@@ -17,11 +17,15 @@ CostParams defaults_for(const vgpu::Profile& profile) {
 }
 
 std::vector<std::pair<std::string, double>> CostBreakdown::items() const {
-  return {{"arithmetic_ms", arithmetic_ms},   {"texture_ms", texture_ms},
-          {"memory_ms", memory_ms},           {"per_pass_ms", per_pass_ms},
-          {"program_load_ms", program_load_ms}, {"bus_ms", bus_ms},
+  return {{"arithmetic_ms", arithmetic_ms},
+          {"texture_ms", texture_ms},
+          {"memory_ms", memory_ms},
+          {"per_pass_ms", per_pass_ms},
+          {"program_load_ms", program_load_ms},
+          {"bus_ms", bus_ms},
           {"readback_ms", readback_ms},
-          {"wasted_ms", wasted_ms},           {"total_ms", total_ms},
+          {"wasted_ms", wasted_ms},
+          {"total_ms", total_ms},
           {"arithmetic_demand_ms", arithmetic_demand_ms},
           {"texture_demand_ms", texture_demand_ms},
           {"memory_demand_ms", memory_demand_ms}};
@@ -58,9 +62,12 @@ void add_passes(const vgpu::Counters& c, double n, const vgpu::Profile& hw, cons
   out.arithmetic_demand_ms += arith_s * ms;
   out.texture_demand_ms += tex_s * ms;
   out.memory_demand_ms += mem_s * ms;
-  if (work_s == arith_s) out.arithmetic_ms += work_s * ms;
-  else if (work_s == tex_s) out.texture_ms += work_s * ms;
-  else out.memory_ms += work_s * ms;
+  if (work_s == arith_s)
+    out.arithmetic_ms += work_s * ms;
+  else if (work_s == tex_s)
+    out.texture_ms += work_s * ms;
+  else
+    out.memory_ms += work_s * ms;
   // Work units: a full fragment is 1, a skipping one 1 - body share.
   const double units = shaded - p.branch_body_share * skipped;
   const double finished_units = finished - p.branch_body_share * skipped;
@@ -73,8 +80,7 @@ CostBreakdown predict(const vgpu::FrameStats& stats, const vgpu::Profile& profil
   return predict(stats, profile, defaults_for(profile));
 }
 
-CostBreakdown predict(const vgpu::FrameStats& stats, const vgpu::Profile& hw,
-                      const CostParams& p) {
+CostBreakdown predict(const vgpu::FrameStats& stats, const vgpu::Profile& hw, const CostParams& p) {
   CostBreakdown b;
   const vgpu::Counters& t = stats.totals;
   uint64_t recorded = 0;
@@ -93,7 +99,8 @@ CostBreakdown predict(const vgpu::FrameStats& stats, const vgpu::Profile& hw,
   }
   // Clears write whole textures without a program: the frame's bytes no pass wrote.
   if (t.bytes_written > pass_bytes_written) {
-    const double clear_ms = 1e3 * double(t.bytes_written - pass_bytes_written) / (hw.mem_gbps * 1e9);
+    const double clear_ms =
+        1e3 * double(t.bytes_written - pass_bytes_written) / (hw.mem_gbps * 1e9);
     b.memory_ms += clear_ms;
     b.memory_demand_ms += clear_ms;
   }
@@ -115,7 +122,7 @@ std::string describe(const CostBreakdown& c, const vgpu::Profile& profile) {
                 "memory %.1f ms (%.0f%%)\n"
                 "  fixed      per-pass %.1f ms (%.0f%%), program loads %.1f ms (%.0f%%), "
                 "read-backs %.1f ms (%.0f%%)\n"
-                "  of the pass work, on finished rays: %.1f ms (%.0f%% of the total)\n",
+                "  of the pass work, on idle fragments (finished rays): %.1f ms (%.0f%% of the total)\n",
                 profile.name.c_str(), c.total_ms, c.arithmetic_ms, pct(c.arithmetic_ms),
                 c.texture_ms, pct(c.texture_ms), c.memory_ms, pct(c.memory_ms), c.per_pass_ms,
                 pct(c.per_pass_ms), c.program_load_ms, pct(c.program_load_ms), c.readback_ms,
@@ -129,15 +136,21 @@ namespace {
 template <class Fn>
 vgpu::Counters each_counter(const vgpu::Counters& a, const vgpu::Counters& b, Fn f) {
   vgpu::Counters r;
-  uint64_t vgpu::Counters::* const fields[] = {
-      &vgpu::Counters::passes,          &vgpu::Counters::fragments_launched,
-      &vgpu::Counters::fragments_shaded, &vgpu::Counters::fragments_masked,
-      &vgpu::Counters::fragments_discarded, &vgpu::Counters::lanes_idle,
-      &vgpu::Counters::instructions,    &vgpu::Counters::texture_fetches,
-      &vgpu::Counters::bytes_read,      &vgpu::Counters::bytes_written,
-      &vgpu::Counters::program_loads,   &vgpu::Counters::program_bytes,
-      &vgpu::Counters::clears,          &vgpu::Counters::queries,
-      &vgpu::Counters::query_readbacks};
+  uint64_t vgpu::Counters::*const fields[] = {&vgpu::Counters::passes,
+                                              &vgpu::Counters::fragments_launched,
+                                              &vgpu::Counters::fragments_shaded,
+                                              &vgpu::Counters::fragments_masked,
+                                              &vgpu::Counters::fragments_discarded,
+                                              &vgpu::Counters::lanes_idle,
+                                              &vgpu::Counters::instructions,
+                                              &vgpu::Counters::texture_fetches,
+                                              &vgpu::Counters::bytes_read,
+                                              &vgpu::Counters::bytes_written,
+                                              &vgpu::Counters::program_loads,
+                                              &vgpu::Counters::program_bytes,
+                                              &vgpu::Counters::clears,
+                                              &vgpu::Counters::queries,
+                                              &vgpu::Counters::query_readbacks};
   for (auto field : fields) r.*field = f(a.*field, b.*field);
   return r;
 }

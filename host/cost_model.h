@@ -50,16 +50,18 @@ CostParams defaults_for(const vgpu::Profile& profile);
 // Predicted frame time, ms, by where it goes. The first three are the pass work attributed to
 // each pass's bottleneck (the larger of the three demands), so that
 //   total = arithmetic + texture + memory + per_pass + program_load + readback.
-// wasted_ms is part of that pass work: the share spent on fragments whose ray was finished.
+// wasted_ms is part of that pass work: the share spent on idle fragments, whose ray is finished
+// or has nothing to do in the pass (no triangle left in its voxel while other rays test theirs):
+// the fragments an early-z mask (--masks on) would skip.
 struct CostBreakdown {
-  double arithmetic_ms = 0;  // passes bounded by the ALUs
-  double texture_ms = 0;     // passes bounded by texture fetch rate
-  double memory_ms = 0;      // passes bounded by memory bandwidth, plus clears
-  double per_pass_ms = 0;    // passes x pass_us
+  double arithmetic_ms = 0;    // passes bounded by the ALUs
+  double texture_ms = 0;       // passes bounded by texture fetch rate
+  double memory_ms = 0;        // passes bounded by memory bandwidth, plus clears
+  double per_pass_ms = 0;      // passes x pass_us
   double program_load_ms = 0;  // program bytes over the bus + program_load_us per load
   double bus_ms = 0;           // of program_load_ms: the program bytes over the bus alone
   double readback_ms = 0;      // query read-backs x readback_us
-  double wasted_ms = 0;        // of the pass work: fragments whose ray was finished
+  double wasted_ms = 0;        // of the pass work: idle fragments (finished rays)
   double total_ms = 0;
   // Each unit's whole demand, overlapped or not (how close the other bottlenecks are).
   double arithmetic_demand_ms = 0, texture_demand_ms = 0, memory_demand_ms = 0;

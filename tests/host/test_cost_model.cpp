@@ -53,7 +53,8 @@ vgpu::Counters kernel_passes(uint64_t passes, uint64_t idle = 1000, uint64_t mas
   return c;
 }
 
-vgpu::FrameStats frame(const vgpu::Counters& k, uint64_t readbacks = 1, uint64_t clear_bytes = 100000) {
+vgpu::FrameStats frame(const vgpu::Counters& k, uint64_t readbacks = 1,
+                       uint64_t clear_bytes = 100000) {
   vgpu::FrameStats s;
   s.keep_pass_records = false;
   s.program("kernel", "kernel", 31).counters = k;
@@ -69,14 +70,15 @@ vgpu::FrameStats frame(const vgpu::Counters& k, uint64_t readbacks = 1, uint64_t
 TEST_CASE("Known counters give the hand-computed time of every term") {
   const host::CostBreakdown b = host::predict(frame(kernel_passes(2)), card(), params());
   // Per pass: 4000 x 30 operations / 3 per instruction = 40000 instructions over
-  // 4 pipes x 1e8 Hz x 0.5 (fp32) = 200 us; texture 4000 / 4e8 = 10 us; memory 128000 B / 1e9 = 128 us.
+  // 4 pipes x 1e8 Hz x 0.5 (fp32) = 200 us; texture 4000 / 4e8 = 10 us;
+  // memory 128000 B / 1e9 B/s = 128 us.
   CHECK(b.arithmetic_demand_ms == doctest::Approx(0.400));
   CHECK(b.texture_demand_ms == doctest::Approx(0.020));
   CHECK(b.memory_demand_ms == doctest::Approx(0.256 + 0.100));  // passes + the clear
   CHECK(b.arithmetic_ms == doctest::Approx(0.400));             // both passes ALU bound
   CHECK(b.texture_ms == doctest::Approx(0.0));
-  CHECK(b.memory_ms == doctest::Approx(0.100));                 // the clear: 100000 B / 1 GB/s
-  CHECK(b.per_pass_ms == doctest::Approx(0.020));               // 2 x 10 us
+  CHECK(b.memory_ms == doctest::Approx(0.100));                   // the clear: 100000 B / 1 GB/s
+  CHECK(b.per_pass_ms == doctest::Approx(0.020));                 // 2 x 10 us
   CHECK(b.program_load_ms == doctest::Approx(0.000992 + 0.040));  // 992 B at 1000 MB/s + 2 x 20 us
   CHECK(b.readback_ms == doctest::Approx(0.040));
   CHECK(b.wasted_ms == doctest::Approx(0.100));  // a quarter of the fragments were finished
@@ -132,7 +134,7 @@ TEST_CASE("Dynamic branching skips the branch body of batches idle as a whole") 
   vgpu::Profile nv4 = card();
   nv4.branching = vgpu::Branching::dynamic;
   host::CostParams p = params();
-  p.branch_coherence = 1;  // every finished ray sits in an all-idle batch
+  p.branch_coherence = 1;   // every finished ray sits in an all-idle batch
   p.branch_body_share = 1;  // and skips the whole program
   const vgpu::FrameStats s = frame(kernel_passes(2, 3000));
   const auto both_sides = host::predict(s, fx, p);
@@ -150,7 +152,8 @@ TEST_CASE("Merging a pair of kernels into one MRT pass drops passes and loads, k
   s.program("next triangle", "proximoTriangulo", 31).counters = b;
   s.totals = a;
   s.totals += b;
-  const vgpu::FrameStats m = host::with_merged_passes(s, {{"intersections", "next triangle", 1, 16}});
+  const vgpu::FrameStats m =
+      host::with_merged_passes(s, {{"intersections", "next triangle", 1, 16}});
   CHECK(m.totals.passes == 10);
   CHECK(m.totals.program_loads == 10);
   CHECK(m.totals.fragments_shaded == a.fragments_shaded);
