@@ -116,17 +116,18 @@ CostBreakdown predict(const vgpu::FrameStats& stats, const vgpu::Profile& hw, co
 std::string describe(const CostBreakdown& c, const vgpu::Profile& profile) {
   char buf[1024];
   auto pct = [&](double v) { return c.total_ms > 0 ? 100.0 * v / c.total_ms : 0.0; };
-  std::snprintf(buf, sizeof buf,
-                "predicted %s: %.1f ms (cost model, docs/table1.md)\n"
-                "  pass work  arithmetic %.1f ms (%.0f%%), texture %.1f ms (%.0f%%), "
-                "memory %.1f ms (%.0f%%)\n"
-                "  fixed      per-pass %.1f ms (%.0f%%), program loads %.1f ms (%.0f%%), "
-                "read-backs %.1f ms (%.0f%%)\n"
-                "  of the pass work, on idle fragments (finished rays): %.1f ms (%.0f%% of the total)\n",
-                profile.name.c_str(), c.total_ms, c.arithmetic_ms, pct(c.arithmetic_ms),
-                c.texture_ms, pct(c.texture_ms), c.memory_ms, pct(c.memory_ms), c.per_pass_ms,
-                pct(c.per_pass_ms), c.program_load_ms, pct(c.program_load_ms), c.readback_ms,
-                pct(c.readback_ms), c.wasted_ms, pct(c.wasted_ms));
+  std::snprintf(
+      buf, sizeof buf,
+      "predicted %s: %.1f ms (cost model, docs/table1.md)\n"
+      "  pass work  arithmetic %.1f ms (%.0f%%), texture %.1f ms (%.0f%%), "
+      "memory %.1f ms (%.0f%%)\n"
+      "  fixed      per-pass %.1f ms (%.0f%%), program loads %.1f ms (%.0f%%), "
+      "read-backs %.1f ms (%.0f%%)\n"
+      "  of the pass work, on idle fragments (finished rays): %.1f ms (%.0f%% of the total)\n",
+      profile.name.c_str(), c.total_ms, c.arithmetic_ms, pct(c.arithmetic_ms), c.texture_ms,
+      pct(c.texture_ms), c.memory_ms, pct(c.memory_ms), c.per_pass_ms, pct(c.per_pass_ms),
+      c.program_load_ms, pct(c.program_load_ms), c.readback_ms, pct(c.readback_ms), c.wasted_ms,
+      pct(c.wasted_ms));
   return buf;
 }
 
