@@ -992,14 +992,18 @@ class Loader {
   // -- after the walk --------------------------------------------------------------------------
 
   void finish() {
-    for (const auto& [what, count] : skipped_modes_)
-      scene_.warnings.push_back("skipped " + str(count) + " " + what + " primitive" +
-                                (count == 1 ? "" : "s") + " (only triangles are rendered)");
+    std::string skipped;
+    for (const auto& [what, count] : skipped_modes_) {
+      const std::string item = str(count) + " " + what + " primitive" + (count == 1 ? "" : "s");
+      scene_.warnings.push_back("skipped " + item + " (only triangles are rendered)");
+      skipped += (skipped.empty() ? "" : ", ") + item;
+    }
     if (invalid_file_normals_ > 0)
       scene_.warnings.push_back(str(invalid_file_normals_) +
                                 " corner normals from the file were zero or not finite and were "
                                 "replaced by face normals");
-    if (scene_.input_triangles == 0) fail(path_, "the scene has no triangles");
+    if (scene_.input_triangles == 0)
+      fail(path_, "the scene has no triangles" + (skipped.empty() ? "" : " (skipped " + skipped + ")"));
     if (scene_.triangle_count() == 0)
       fail(path_, "all " + str(uint64_t(scene_.input_triangles)) +
                       " triangles of the scene are degenerate (zero area)");
