@@ -1,0 +1,129 @@
+// Helpers shared by the kernel tests: hand-made textures, one kernel pass through a real
+// vgpu::Gpu (profile gf5700), and per-channel texel checks. Expected values always come from the
+// test itself, never from the kernels' own helpers.
+#pragma once
+
+#include <doctest/doctest.h>
+
+#include <cstdint>
+#include <glm/glm.hpp>
+#include <string>
+#include <vector>
+
+#include "kernels/kernels.h"
+#include "vgpu/vgpu.h"
+
+namespace ktest {
+
+using vgpu::Texture;
+
+inline const vgpu::Profile& gf5700() {
+  return vgpu::profile("gf5700");
+}
+
+// A w x h texture of 4-channel texels, row-major (texel (x, y) = values[y * w + x]); texels past
+// the list are zero.
+inline Texture texels(std::string name, int w, int h, const std::vector<glm::vec4>& values) {
+  Texture t(std::move(name), w, h, 4);
+  for (size_t i = 0; i < values.size(); ++i)
+    for (int c = 0; c < 4; ++c) t.set(int(i % size_t(w)), int(i / size_t(w)), c, values[i][c]);
+  return t;
+}
+
+// The same with 1-channel texels (triangle lists, voxel pointers).
+inline Texture scalars(std::string name, int w, int h, const std::vector<float>& values) {
+  Texture t(std::move(name), w, h, 1);
+  for (size_t i = 0; i < values.size(); ++i)
+    t.set(int(i % size_t(w)), int(i / size_t(w)), 0, values[i]);
+  return t;
+}
+
+// A texture holding one 3-vector per entry in xyz (vertex and normal textures), w texels wide.
+inline Texture vec3s(std::string name, int w, int h, const std::vector<glm::vec3>& values) {
+  Texture t(std::move(name), w, h, 3);
+  for (size_t i = 0; i < values.size(); ++i)
+    for (int c = 0; c < 3; ++c) t.set(int(i % size_t(w)), int(i / size_t(w)), c, values[i][c]);
+  return t;
+}
+
+inline glm::vec4 at(const Texture& t, int x, int y) {
+  glm::vec4 v(0.0f, 0.0f, 0.0f, 1.0f);
+  for (int c = 0; c < t.channels(); ++c) v[c] = t.get(x, y, c);
+  return v;
+}
+
+// One pass of program p: units[i] bound to texture unit i, rendering into target (whatever the
+// target held is kept where fragments are discarded). With `query`, the pass runs inside an
+// occlusion query and its count is stored there.
+inline vgpu::PassRecord draw(vgpu::Gpu& gpu, const vgpu::Program& p,
+                             const std::vector<const Texture*>& units, Texture& target,
+                             uint64_t* query = nullptr) {
+  gpu.use_program(p);
+  gpu.unbind_textures();
+  for (size_t i = 0; i < units.size(); ++i) gpu.bind_texture(int(i), *units[i]);
+  gpu.set_targets({&target});
+  if (query) gpu.begin_query();
+  vgpu::PassRecord rec = gpu.draw();
+  if (query) *query = gpu.end_query();
+  return rec;
+}
+
+// One pass of kernel k over a fresh w x h target of 4 channels, cleared to `fill`.
+template <class K>
+Texture run(vgpu::Gpu& gpu, const K& k, const std::vector<const Texture*>& units, int w, int h,
+            glm::vec4 fill = glm::vec4(0.0f), uint64_t* query = nullptr,
+            vgpu::PassRecord* record = nullptr) {
+  vgpu::KernelProgram<K> program(k);
+  Texture out = gpu.make_texture(std::string(K::name) + " out", w, h, 4);
+  const float f[4] = {fill.x, fill.y, fill.z, fill.w};
+  out.fill(f);
+  const vgpu::PassRecord rec = draw(gpu, program, units, out, query);
+  if (record) *record = rec;
+  return out;
+}
+
+template <class K>
+Texture run(const K& k, const std::vector<const Texture*>& units, int w, int h,
+            glm::vec4 fill = glm::vec4(0.0f), uint64_t* query = nullptr) {
+  vgpu::Gpu gpu(gf5700(), 1, 1);
+  return run(gpu, k, units, w, h, fill, query);
+}
+
+// A grid uniform block: box corner lo, voxel size cell, res voxels per axis.
+inline kernels::GridUniforms grid_uniforms(glm::vec3 lo, glm::vec3 cell, glm::vec3 res,
+                                           float list_width = 1, float t_slack = 0) {
+  kernels::GridUniforms g;
+  g.lo = lo;
+  g.cell = cell;
+  g.res = res;
+  g.list_width = list_width;
+  g.t_slack = t_slack;
+  return g;
+}
+
+}  // namespace ktest
+
+// Every channel of texel (x, y) equals the expected vec4 exactly.
+#define CHECK_TEXEL(tex, tx, ty, ...)                                \
+  do {                                                               \
+    const glm::vec4 expected_ = (__VA_ARGS__);                       \
+    const glm::vec4 got_ = ktest::at((tex), (tx), (ty));             \
+    INFO((tex).name() << " texel (" << (tx) << ", " << (ty) << ")"); \
+    CHECK(got_.x == expected_.x);                                    \
+    CHECK(got_.y == expected_.y);                                    \
+    CHECK(got_.z == expected_.z);                                    \
+    CHECK(got_.w == expected_.w);                                    \
+  } while (0)
+
+// Every channel of texel (x, y) within eps * (1 + |expected|) of the expected vec4
+// (doctest::Approx).
+#define CHECK_TEXEL_NEAR(tex, tx, ty, eps, ...)                       \
+  do {                                                                \
+    const glm::vec4 expected_ = (__VA_ARGS__);                        \
+    const glm::vec4 got_ = ktest::at((tex), (tx), (ty));              \
+    INFO((tex).name() << " texel (" << (tx) << ", " << (ty) << ")");  \
+    for (int c_ = 0; c_ < 4; ++c_) {                                  \
+      CAPTURE(c_);                                                    \
+      CHECK(got_[c_] == doctest::Approx(expected_[c_]).epsilon(eps)); \
+    }                                                                 \
+  } while (0)
