@@ -4,7 +4,9 @@
 #pragma once
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
+#include <cstring>
 
 #include "vgpu/lanes.h"
 
@@ -29,6 +31,87 @@ struct FetchTally {
   }
 };
 
+// Transposes between texels (4 channels each, contiguous) and registers (one per channel), for
+// W consecutive fragments. Width 8 and 16 use in-lane shuffles of 8-float vectors (GCC/Clang
+// vector extensions); other widths a per-lane loop. Pure data movement: bits are unchanged.
+namespace texels {
+
+using V8 = float __attribute__((vector_size(32)));
+
+inline V8 load8(const float* p) {
+  V8 v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+
+// p: 8 texels xyzw. Out: x0..x7, y0..y7, z0..z7, w0..w7.
+inline void split8(const float* p, float* x, float* y, float* z, float* w) {
+  const V8 l0 = load8(p), l1 = load8(p + 8), l2 = load8(p + 16), l3 = load8(p + 24);
+  // a0 = [texel 0 | texel 4], a1 = [1 | 5], a2 = [2 | 6], a3 = [3 | 7]: then in-lane 4x4.
+  const V8 a0 = __builtin_shufflevector(l0, l2, 0, 1, 2, 3, 8, 9, 10, 11);
+  const V8 a1 = __builtin_shufflevector(l0, l2, 4, 5, 6, 7, 12, 13, 14, 15);
+  const V8 a2 = __builtin_shufflevector(l1, l3, 0, 1, 2, 3, 8, 9, 10, 11);
+  const V8 a3 = __builtin_shufflevector(l1, l3, 4, 5, 6, 7, 12, 13, 14, 15);
+  const V8 u0 = __builtin_shufflevector(a0, a1, 0, 8, 1, 9, 4, 12, 5, 13);
+  const V8 u1 = __builtin_shufflevector(a0, a1, 2, 10, 3, 11, 6, 14, 7, 15);
+  const V8 u2 = __builtin_shufflevector(a2, a3, 0, 8, 1, 9, 4, 12, 5, 13);
+  const V8 u3 = __builtin_shufflevector(a2, a3, 2, 10, 3, 11, 6, 14, 7, 15);
+  const V8 vx = __builtin_shufflevector(u0, u2, 0, 1, 8, 9, 4, 5, 12, 13);
+  const V8 vy = __builtin_shufflevector(u0, u2, 2, 3, 10, 11, 6, 7, 14, 15);
+  const V8 vz = __builtin_shufflevector(u1, u3, 0, 1, 8, 9, 4, 5, 12, 13);
+  const V8 vw = __builtin_shufflevector(u1, u3, 2, 3, 10, 11, 6, 7, 14, 15);
+  std::memcpy(x, &vx, sizeof vx);
+  std::memcpy(y, &vy, sizeof vy);
+  std::memcpy(z, &vz, sizeof vz);
+  std::memcpy(w, &vw, sizeof vw);
+}
+
+// The inverse: x0..x7, y.., z.., w.. into 8 texels xyzw at p.
+inline void join8(const float* x, const float* y, const float* z, const float* w, float* p) {
+  const V8 vx = load8(x), vy = load8(y), vz = load8(z), vw = load8(w);
+  const V8 u0 = __builtin_shufflevector(vx, vy, 0, 8, 1, 9, 4, 12, 5, 13);
+  const V8 u1 = __builtin_shufflevector(vx, vy, 2, 10, 3, 11, 6, 14, 7, 15);
+  const V8 u2 = __builtin_shufflevector(vz, vw, 0, 8, 1, 9, 4, 12, 5, 13);
+  const V8 u3 = __builtin_shufflevector(vz, vw, 2, 10, 3, 11, 6, 14, 7, 15);
+  const V8 b0 = __builtin_shufflevector(u0, u2, 0, 1, 8, 9, 4, 5, 12, 13);  // [0 | 4]
+  const V8 b1 = __builtin_shufflevector(u0, u2, 2, 3, 10, 11, 6, 7, 14, 15);  // [1 | 5]
+  const V8 b2 = __builtin_shufflevector(u1, u3, 0, 1, 8, 9, 4, 5, 12, 13);  // [2 | 6]
+  const V8 b3 = __builtin_shufflevector(u1, u3, 2, 3, 10, 11, 6, 7, 14, 15);  // [3 | 7]
+  const V8 s0 = __builtin_shufflevector(b0, b1, 0, 1, 2, 3, 8, 9, 10, 11);
+  const V8 s1 = __builtin_shufflevector(b2, b3, 0, 1, 2, 3, 8, 9, 10, 11);
+  const V8 s2 = __builtin_shufflevector(b0, b1, 4, 5, 6, 7, 12, 13, 14, 15);
+  const V8 s3 = __builtin_shufflevector(b2, b3, 4, 5, 6, 7, 12, 13, 14, 15);
+  std::memcpy(p, &s0, sizeof s0);
+  std::memcpy(p + 8, &s1, sizeof s1);
+  std::memcpy(p + 16, &s2, sizeof s2);
+  std::memcpy(p + 24, &s3, sizeof s3);
+}
+
+// W texels xyzw at p into lanes[c][i] (channel c of fragment i).
+template <int W>
+inline void split(const float* p, float (&lanes)[4][W]) {
+  if constexpr (W % 8 == 0) {
+    for (int g = 0; g < W; g += 8)
+      split8(p + 4 * g, lanes[0] + g, lanes[1] + g, lanes[2] + g, lanes[3] + g);
+  } else {
+    for (int i = 0; i < W; ++i)
+      for (int c = 0; c < 4; ++c) lanes[c][i] = p[4 * i + c];
+  }
+}
+
+template <int W>
+inline void join(const float (&lanes)[4][W], float* p) {
+  if constexpr (W % 8 == 0) {
+    for (int g = 0; g < W; g += 8)
+      join8(lanes[0] + g, lanes[1] + g, lanes[2] + g, lanes[3] + g, p + 4 * g);
+  } else {
+    for (int i = 0; i < W; ++i)
+      for (int c = 0; c < 4; ++c) p[4 * i + c] = lanes[c][i];
+  }
+}
+
+}  // namespace texels
+
 template <class L>
 class Fragments {
  public:
@@ -40,36 +123,41 @@ class Fragments {
 
   // texRECT(unit, (u, v)): nearest texel floor(u), floor(v), clamped at the edges. Channels a
   // texture lacks read as (0, 0, 0, 1).
-  Vec4<F> fetch(int unit, const F& u, const F& v) const {
+  [[gnu::always_inline]] Vec4<F> fetch(int unit, const F& u, const F& v) const {
     const BoundTexture& t = units_[unit];
     if constexpr (L::counting) {
       ++OpCounter::ops;
       ++tally_->per_unit[unit];
       return {F(0.0f), F(0.0f), F(0.0f), F(1.0f)};
     } else {
-      // Clamp in float first (NaN goes to 0), then convert: no undefined conversions.
-      const F wmax = F(float(t.width - 1)), hmax = F(float(t.height - 1));
-      F fu = floor(u), fv = floor(v);
-      fu = select(fu >= F(0.0f), fu, F(0.0f));
-      fv = select(fv >= F(0.0f), fv, F(0.0f));
-      fu = select(fu <= wmax, fu, wmax);
-      fv = select(fv <= hmax, fv, hmax);
-      std::array<int, W> idx;
-      for (int i = 0; i < W; ++i) idx[i] = (int(fv[i]) * t.width + int(fu[i])) * t.channels;
-      const float* d = t.data;
-      Vec4<F> r{F(0.0f), F(0.0f), F(0.0f), F(1.0f)};
-      r.x = F([&](auto i) { return d[idx[i]]; });
-      if (t.channels > 1) r.y = F([&](auto i) { return d[idx[i] + 1]; });
-      if (t.channels > 2) r.z = F([&](auto i) { return d[idx[i] + 2]; });
-      if (t.channels > 3) r.w = F([&](auto i) { return d[idx[i] + 3]; });
-      return r;
+      const F fu = floor(u), fv = floor(v);
+      const float u0 = fu[0], v0 = fv[0];
+      if (t.channels == 4 && u0 >= 0.0f && u0 + float(W - 1) <= float(t.width - 1) &&
+          v0 >= 0.0f && v0 <= float(t.height - 1) &&
+          all(fu == F([](auto i) { return float(i); }) + u0) && all(fv == F(v0))) {
+        // The common case, a fragment's own texel: W consecutive fp32x4 texels inside one row.
+        // Nothing to clamp; one base address and a transpose instead of per-lane loads.
+        alignas(64) float lanes[4][W];
+        texels::split<W>(t.data + (int64_t(v0) * t.width + int64_t(u0)) * 4, lanes);
+        Vec4<F> r;
+        r.x.copy_from(lanes[0], stdx::vector_aligned);
+        r.y.copy_from(lanes[1], stdx::vector_aligned);
+        r.z.copy_from(lanes[2], stdx::vector_aligned);
+        r.w.copy_from(lanes[3], stdx::vector_aligned);
+        return r;
+      }
+      return fetch_clamped(t, fu, fv);
     }
   }
   // The texel of this fragment's own pixel in a texture the size of the render target.
-  Vec4<F> fetch_own(int unit) const { return fetch(unit, x, y); }
+  [[gnu::always_inline]] Vec4<F> fetch_own(int unit) const { return fetch(unit, x, y); }
 
   // Output register i (COLOR0..): written to render target i where the fragment survives.
-  Vec4<F>& out(int i) { return out_[i]; }
+  // Every register reads as zero until written.
+  Vec4<F>& out(int i) {
+    if (i >= cleared_) clear_outputs(kMaxOutputs);  // a register past the program's outputs
+    return out_[i];
+  }
 
   // Kills the fragments where m holds: they write nothing and an occlusion query skips them.
   void discard(const M& m) { kill_ = kill_ || m; }
@@ -93,12 +181,14 @@ class Fragments {
   // Set up by the fragment processor.
   Fragments(const BoundTexture* units, bool dynamic, uint64_t* idle, FetchTally* tally)
       : units_(units), dynamic_(dynamic), idle_(idle), tally_(tally) {}
-  void reset(const F& px, const F& py, const M& live) {
+  // outputs: registers cleared now (the program's); the rest are cleared on first use.
+  void reset(const F& px, const F& py, const M& live, int outputs = kMaxOutputs) {
     x = px;
     y = py;
     live_ = live;
     kill_ = M(false);
-    for (auto& o : out_) o = {F(0.0f), F(0.0f), F(0.0f), F(0.0f)};
+    cleared_ = 0;
+    clear_outputs(outputs);
   }
   const M& killed() const { return kill_; }
   const Vec4<F>& output(int i) const { return out_[i]; }
@@ -110,6 +200,31 @@ class Fragments {
   FetchTally* tally_;
   M live_{false}, kill_{false};
   std::array<Vec4<F>, kMaxOutputs> out_;
+  int cleared_ = 0;  // out_[0, cleared_) hold zero or what the program wrote in this batch
+
+  // Any texel coordinates: clamp in float first (NaN goes to 0), then convert (no undefined
+  // conversions), then one load per lane and channel.
+  [[gnu::noinline]] static Vec4<F> fetch_clamped(const BoundTexture& t, F fu, F fv) {
+    const F wmax = F(float(t.width - 1)), hmax = F(float(t.height - 1));
+    fu = select(fu >= F(0.0f), fu, F(0.0f));
+    fv = select(fv >= F(0.0f), fv, F(0.0f));
+    fu = select(fu <= wmax, fu, wmax);
+    fv = select(fv <= hmax, fv, hmax);
+    const float* d = t.data;
+    const int ch = t.channels;
+    std::array<int64_t, W> idx;
+    for (int i = 0; i < W; ++i) idx[i] = (int64_t(fv[i]) * t.width + int64_t(fu[i])) * ch;
+    Vec4<F> r{F(0.0f), F(0.0f), F(0.0f), F(1.0f)};
+    r.x = F([&](auto i) { return d[idx[i]]; });
+    if (ch > 1) r.y = F([&](auto i) { return d[idx[i] + 1]; });
+    if (ch > 2) r.z = F([&](auto i) { return d[idx[i] + 2]; });
+    if (ch > 3) r.w = F([&](auto i) { return d[idx[i] + 3]; });
+    return r;
+  }
+
+  void clear_outputs(int n) {
+    for (; cleared_ < n; ++cleared_) out_[cleared_] = {F(0.0f), F(0.0f), F(0.0f), F(0.0f)};
+  }
 };
 
 }  // namespace vgpu

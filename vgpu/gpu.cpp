@@ -100,7 +100,10 @@ const PassRecord& Gpu::draw() {
 
 template <int W>
 void Gpu::run_rows(const Program& p, const Rect& r, int y0, int y1, uint64_t idle_branches,
-                   Chunk& out) const {
+                   Chunk& result) const {
+  // Counted in a local and stored once: neighbouring chunks share cache lines, and other
+  // threads are counting into them.
+  Chunk out;
   using L = SimdLanes<W>;
   using F = typename L::F;
   using M = typename L::M;
@@ -142,9 +145,11 @@ void Gpu::run_rows(const Program& p, const Rect& r, int y0, int y1, uint64_t idl
       }
       M kill(false);
       if (any(run)) {
-        f.reset(iota + float(x) + 0.5f, F(float(y) + 0.5f), run);
+        f.reset(iota + float(x) + 0.5f, F(float(y) + 0.5f), run, nout);
         p.run(f);
         kill = f.killed() && run;
+        const M write = run && !kill;
+        const bool every = all(write);  // W fragments, all in the rectangle, none killed
         for (int o = 0; o < nout; ++o) {
           Texture& t = *targets_[o];
           const Vec4<F>& v = f.output(o);
@@ -154,9 +159,15 @@ void Gpu::run_rows(const Program& p, const Rect& r, int y0, int y1, uint64_t idl
           v.w.copy_to(lanes_out[3], stdx::element_aligned);
           const int ch = t.channels();
           const Format fmt = t.format();
+          float* row = t.texel_mut(x, y);
+          if (every && ch == 4 && fmt == Format::fp32) {
+            // The common case: W whole fp32x4 texels, interleaved from the four registers.
+            texels::join<W>(lanes_out, row);
+            continue;
+          }
           for (int i = 0; i < n; ++i) {
-            if (!run[i] || kill[i]) continue;
-            float* dst = t.texel_mut(x + i, y);
+            if (!write[i]) continue;
+            float* dst = row + i * ch;
             for (int c = 0; c < ch; ++c) dst[c] = round_to(fmt, lanes_out[c][i]);
           }
         }
@@ -186,6 +197,7 @@ void Gpu::run_rows(const Program& p, const Rect& r, int y0, int y1, uint64_t idl
           if (live[i]) sw[x + i] = (run[i] ? !kill[i] : !idle_kill) ? 1 : 0;
     }
   }
+  result = out;
 }
 
 void Gpu::parallel_rows(const Rect& r, const std::function<void(int, int, Chunk&)>& body,

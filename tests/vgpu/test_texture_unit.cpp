@@ -4,6 +4,7 @@
 
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <stdexcept>
 #include <utility>
@@ -161,17 +162,32 @@ TEST_CASE("channels a texture lacks read as (0, 0, 0, 1)") {
   }
 }
 
-TEST_CASE("a fragment's own texel is the texel under its pixel centre") {
-  Gpu gpu(profile("gf6600"), 1);
-  Texture src = gpu.make_texture("src", 7, 5, 4);
-  vgpu_test::fill_pattern(src, 42, false);
-  Texture dst = gpu.make_texture("dst", 7, 5, 4);
-  KernelProgram<Copy> copy;
-  gpu.use_program(copy);
-  gpu.bind_texture(0, src);
-  gpu.set_targets({&dst});
-  gpu.draw();
-  CHECK(vgpu_test::same_bits(src, dst));
+TEST_CASE("a fragment's own texel is the texel under its pixel centre, at every width") {
+  for (int channels = 1; channels <= 4; ++channels)
+    for (int lanes : {1, 4, 8, 16}) {
+      CAPTURE(channels);
+      CAPTURE(lanes);
+      Gpu gpu(profile("gf6600"), 1, lanes);
+      Texture src = gpu.make_texture("src", 37, 5, channels);
+      vgpu_test::fill_pattern(src, 42);
+      Texture dst = gpu.make_texture("dst", 37, 5, channels);
+      KernelProgram<Copy> copy;
+      gpu.use_program(copy);
+      gpu.bind_texture(0, src);
+      gpu.set_targets({&dst});
+      gpu.draw();
+      CHECK(vgpu_test::same_bits(src, dst));
+      dst.fill(std::array{9.0f, 9.0f, 9.0f, 9.0f});
+      gpu.draw(Rect{5, 1, 30, 4});  // batches that start mid-row
+      CHECK(dst.get(4, 1) == 9.0f);
+      CHECK(dst.get(30, 3) == 9.0f);
+      bool same = true;
+      for (int y = 1; y < 4; ++y)
+        for (int x = 5; x < 30; ++x)
+          same = same && std::memcmp(src.texel(x, y), dst.texel(x, y),
+                                     sizeof(float) * size_t(channels)) == 0;
+      CHECK(same);
+    }
 }
 
 TEST_CASE("textures know their size in texture memory and reject impossible shapes") {
