@@ -183,7 +183,7 @@ int run_render(const RenderArgs& a) {
     nlohmann::ordered_json k;
     k["name"] = p.name;
     k["paper_name"] = p.paper_name;
-    k["instructions"] = p.instructions;
+    k["static_instructions"] = p.instructions;
     const nlohmann::ordered_json c = counters_json(p.counters);
     for (auto& [key, v] : c.items()) k[key] = v;
     ks.push_back(k);

@@ -73,6 +73,18 @@ void Gpu::set_targets(std::initializer_list<Texture*> targets) {
   for (Texture* t : targets_) check_texture(*t);
 }
 
+void Gpu::clear(Texture& t, std::initializer_list<float> value) {
+  if (int(value.size()) != t.channels())
+    fail("clear of texture '" + t.name() + "': " + std::to_string(value.size()) +
+         " values for " + std::to_string(t.channels()) + " channels");
+  check_texture(t);
+  t.fill(std::span<const float>(value.begin(), value.size()));
+  Counters c;
+  c.clears = 1;
+  c.bytes_written = t.bytes();
+  stats_.totals += c;
+}
+
 void Gpu::begin_query() {
   if (query_active_) fail("begin_query: a query is already active");
   query_active_ = true;
@@ -177,9 +189,15 @@ void Gpu::run_rows(const Program& p, const Rect& r, int y0, int y1, uint64_t idl
         // Idle fragments: outputs keep their previous values (copied from the passthrough units).
         for (int i = 0; i < n; ++i) {
           if (!live[i] || run[i]) continue;
-          out.idle += idle_branches;  // an idle fragment takes none of the program's branches
+          if (work_masked_) {
+            // Modeled as an early-z/stencil reject: masked, not shaded, never counted.
+            --out.shaded;
+            ++out.masked;
+          } else {
+            out.idle += idle_branches;  // an idle fragment takes none of the program's branches
+          }
           if (idle_kill) {
-            ++nkill;
+            if (!work_masked_) ++nkill;
             continue;
           }
           for (int o = 0; o < nout; ++o) {
