@@ -45,6 +45,7 @@ struct RenderArgs {
   bool quiet = false;
   bool predict = false;
   std::string engine = "stream";
+  std::string precision = "fp32";
 };
 
 struct UsageError : std::runtime_error {
@@ -98,6 +99,10 @@ int run_render(const RenderArgs& a) {
   opt.profile = vgpu::profile(a.profile).name;
   opt.threads = a.threads;
   opt.lanes = a.lanes;
+  if (a.precision == "fp32") opt.precision = vgpu::Format::fp32;
+  else if (a.precision == "fp24") opt.precision = vgpu::Format::fp24;
+  else if (a.precision == "fp16") opt.precision = vgpu::Format::fp16;
+  else throw UsageError("--precision: expected fp32, fp24 or fp16, got '" + a.precision + "'");
   const host::GridSpec grid_spec = host::parse_grid_spec(a.grid);
   if (a.stats != "table" && a.stats != "json" && a.stats != "none")
     throw UsageError("--stats: expected table, json or none, got '" + a.stats + "'");
@@ -168,6 +173,7 @@ int run_render(const RenderArgs& a) {
   j["masks"] = opt.masks;
   j["threads"] = opt.threads;
   j["lanes"] = opt.lanes;
+  j["precision"] = a.precision;
   j["init_ms"] = init_ms;
   j["grid_build_ms"] = grid.build_ms;
   j["render_ms"] = r.render_ms;
@@ -177,6 +183,7 @@ int run_render(const RenderArgs& a) {
                 {"voxel_steps", cpu_stats.voxel_steps},
                 {"triangle_tests", cpu_stats.triangle_tests}};
   j["rays_traced"] = r.rays_traced;
+  j["rays_unfinished"] = r.rays_unfinished;
   j["totals"] = counters_json(r.stats.totals);
   auto ks = nlohmann::ordered_json::array();
   for (const auto& p : r.stats.programs) {
@@ -267,6 +274,7 @@ int main(int argc, char** argv) {
   render->add_option("--aov", a.aovs, "depth=FILE.exr (distance to primary hit) or hit=FILE.exr (triangle id)");
   render->add_option("--trace-pixel", a.trace_pixel, "X,Y: print every pass this pixel took part in and its state");
   render->add_flag("--quiet,-q", a.quiet, "No progress on stderr");
+  render->add_option("--precision", a.precision, "Ray-state textures and kernel arithmetic: fp32 | fp24 | fp16")->capture_default_str();
   render->add_option("--engine", a.engine, "stream (the vgpu pipeline) | cpu (double-precision reference)")->capture_default_str();
   render->add_flag("--predict", a.predict, "Print the cost model's predicted time for --profile, with its breakdown");
   auto* scenes = app.add_subcommand("scenes", "List the scenes in scenes/");

@@ -1,6 +1,7 @@
 // The stream ray tracer's host loop: which pass runs next, steered by occlusion queries.
 #include "host/stream_tracer.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -43,6 +44,8 @@ struct StreamTracer::State {
   KernelProgram<ReflectionDirection> direction;
   KernelProgram<ShadowRays> shadow;
   uint64_t rays_traced = 0;
+  uint64_t rays_unfinished = 0;
+  int max_list = 0;  // longest voxel list: a ray tests at most this many triangles per voxel
 };
 
 kernels::ShadingModel parse_shading(const std::string& name) {
@@ -59,6 +62,7 @@ StreamTracer::StreamTracer(const Scene& scene, const Grid& grid, const RenderOpt
   gpu_ = std::make_unique<vgpu::Gpu>(vgpu::profile(opt_.profile), opt_.threads, opt_.lanes);
   s_ = std::make_unique<State>();
   vgpu::Gpu& gpu = *gpu_;
+  gpu.set_precision(opt_.precision);
   const int maxs = gpu.profile().max_texture_size;
 
   // Scene textures: triangle i at texel (i mod width, i div width).
@@ -97,7 +101,11 @@ StreamTracer::StreamTracer(const Scene& scene, const Grid& grid, const RenderOpt
                       gpu.profile().name + " allows " + std::to_string(maxs) + "x" +
                       std::to_string(maxs));
   size_t nonempty = 0;
-  for (size_t vox = 0; vox < grid.voxels(); ++vox) nonempty += grid.start[vox + 1] > grid.start[vox];
+  for (size_t vox = 0; vox < grid.voxels(); ++vox) {
+    const uint32_t n = grid.start[vox + 1] - grid.start[vox];
+    nonempty += n > 0;
+    s_->max_list = std::max(s_->max_list, int(n));
+  }
   const size_t list_len = 1 + grid.tris.size() + nonempty;
   if (list_len >= (size_t(1) << 24))
     throw vgpu::Error("grid lists hold " + std::to_string(list_len) +
@@ -133,14 +141,15 @@ StreamTracer::StreamTracer(const Scene& scene, const Grid& grid, const RenderOpt
   const int W = opt_.width, H = opt_.height;
   for (int i = 0; i < 2; ++i) {
     const std::string sfx = i ? " B" : " A";
-    s_->rays[i] = gpu.make_texture("rays" + sfx, W, H, 4);
-    s_->origins[i] = gpu.make_texture("origins" + sfx, W, H, 4);
-    s_->trav[i] = gpu.make_texture("traversal" + sfx, W, H, 4);
-    s_->vs[i] = gpu.make_texture("voxel state" + sfx, W, H, 4);
-    s_->isect[i] = gpu.make_texture("intersection" + sfx, W, H, 4);
-    s_->result[i] = gpu.make_texture("result" + sfx, W, H, 4);
+    const Format fmt = opt_.precision;
+    s_->rays[i] = gpu.make_texture("rays" + sfx, W, H, 4, fmt);
+    s_->origins[i] = gpu.make_texture("origins" + sfx, W, H, 4, fmt);
+    s_->trav[i] = gpu.make_texture("traversal" + sfx, W, H, 4, fmt);
+    s_->vs[i] = gpu.make_texture("voxel state" + sfx, W, H, 4, fmt);
+    s_->isect[i] = gpu.make_texture("intersection" + sfx, W, H, 4, fmt);
+    s_->result[i] = gpu.make_texture("result" + sfx, W, H, 4, fmt);
   }
-  s_->shadow_rays = gpu.make_texture("shadow rays", W, H, 4);
+  s_->shadow_rays = gpu.make_texture("shadow rays", W, H, 4, opt_.precision);
   // Counting passes need a colour target; only their query result matters.
   s_->counter = gpu.make_texture("counter", W, H, 1, Format::fp16);
   s_->grid_mask = Stencil(W, H, 1);
@@ -255,7 +264,15 @@ void StreamTracer::trace(Texture& origins, Texture& rays, bool primary, const Ca
   s.grid_mask.fill(1);
   uint64_t walking = count(s.in_grid, s.trav[s.cur_trav], nullptr, &s.grid_mask);
   s.rays_traced += walking;
-  while (walking > 0) {
+  // In exact arithmetic a ray crosses at most nx+ny+nz voxels and tests each voxel's list once.
+  // Reduced precision can break both (fp16 cannot count past 2048): the host stops there and
+  // reports the rays left unfinished instead of looping forever.
+  const int max_steps = grid_.res.x + grid_.res.y + grid_.res.z + 2;
+  for (int step = 0; walking > 0; ++step) {
+    if (step == max_steps) {
+      s.rays_unfinished += walking;
+      break;
+    }
     // The first triangle of each ray's new voxel.
     pass(s.update, {&s.trav[s.cur_trav], &s.vs[s.cur_vs], &s.pointers, &s.lists},
          s.vs[s.cur_vs ^ 1], &s.grid_mask);
@@ -263,7 +280,8 @@ void StreamTracer::trace(Texture& origins, Texture& rays, bool primary, const Ca
     uint64_t testing =
         count(s.intersecting, s.vs[s.cur_vs], &s.grid_mask, &(s.isect_mask = s.grid_mask));
     // One triangle per pass, until no ray has a triangle left in its voxel.
-    while (testing > 0) {
+    for (int k = 0; testing > 0; ++k) {
+      if (k == s.max_list + 1) break;  // lists cannot be longer: stuck positions (fp16)
       pass(s.intersect,
            {&origins, &rays, &s.trav[s.cur_trav], &s.vs[s.cur_vs], &s.isect[s.cur_isect], &s.v[0],
             &s.v[1], &s.v[2]},
@@ -287,6 +305,7 @@ RenderResult StreamTracer::render(const Camera& cam) {
   State& s = *s_;
   gpu.stats().clear();
   s.rays_traced = 0;
+  s.rays_unfinished = 0;
   const int W = opt_.width, H = opt_.height;
   RenderResult res;
   res.width = W;
@@ -369,6 +388,7 @@ RenderResult StreamTracer::render(const Camera& cam) {
       for (int c = 0; c < 3; ++c) res.rgb[(size_t(y) * W + x) * 3 + c] = out.texel(x, y)[c];
   res.stats = gpu.stats();
   res.rays_traced = s.rays_traced;
+  res.rays_unfinished = s.rays_unfinished;
   res.render_ms = ms_since(t0);
   return res;
 }

@@ -25,6 +25,9 @@ struct RenderOptions {
   std::string profile = "gf5700";
   int threads = 0;                // 0: every host core
   int lanes = vgpu::kLanes;
+  // Precision of the ray-state textures and of the arithmetic inside kernels (--precision).
+  // The scene textures stay fp32. fp16 cannot address texels past 2048 exactly, as on NV3x.
+  vgpu::Format precision = vgpu::Format::fp32;
   // Early-z/stencil masks for finished rays (the paper's future work): masked fragments cost
   // nothing. Off: every fragment runs every pass, as on the paper's GeForce FX.
   bool masks = false;
@@ -47,6 +50,7 @@ struct RenderResult {
   double render_ms = 0;
   int iterations = 0;         // ray-tracing iterations run (primary included)
   uint64_t rays_traced = 0;   // rays entering a trace (primary, reflected, shadow)
+  uint64_t rays_unfinished = 0;  // rays stopped by the pass cap (only under reduced precision)
 };
 
 class StreamTracer {

@@ -3,6 +3,7 @@
 // address another fragment's texel (no scatter) and cannot start a pass (no recursion).
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -213,7 +214,10 @@ class Fragments {
     const float* d = t.data;
     const int ch = t.channels;
     std::array<int64_t, W> idx;
-    for (int i = 0; i < W; ++i) idx[i] = (int64_t(fv[i]) * t.width + int64_t(fu[i])) * ch;
+    // Clamped again as integers: a reduced-precision wmax may round past the last texel.
+    for (int i = 0; i < W; ++i)
+      idx[i] = (std::min<int64_t>(int64_t(fv[i]), t.height - 1) * t.width +
+                std::min<int64_t>(int64_t(fu[i]), t.width - 1)) * ch;
     Vec4<F> r{F(0.0f), F(0.0f), F(0.0f), F(1.0f)};
     r.x = F([&](auto i) { return d[idx[i]]; });
     if (ch > 1) r.y = F([&](auto i) { return d[idx[i] + 1]; });

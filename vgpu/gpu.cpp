@@ -110,13 +110,13 @@ const PassRecord& Gpu::draw() {
   return draw(Rect{0, 0, targets_[0]->width(), targets_[0]->height()});
 }
 
-template <int W>
+template <class L>
 void Gpu::run_rows(const Program& p, const Rect& r, int y0, int y1, uint64_t idle_branches,
                    Chunk& result) const {
+  constexpr int W = L::width;
   // Counted in a local and stored once: neighbouring chunks share cache lines, and other
   // threads are counting into them.
   Chunk out;
-  using L = SimdLanes<W>;
   using F = typename L::F;
   using M = typename L::M;
   BoundTexture views[kMaxTextureUnits];
@@ -325,11 +325,22 @@ const PassRecord& Gpu::draw(const Rect& rect) {
   std::vector<Chunk> chunks;
   const uint64_t idle_branches = uint64_t(a.branches);
   auto body = [&](int ya, int yb, Chunk& c) {
+    // Reduced precision runs at width 1 (the scalar reference) or 8.
+    if (precision_ == Format::fp16) {
+      if (lanes_ == 1) run_rows<RoundedLanes<1, Format::fp16>>(p, rect, ya, yb, idle_branches, c);
+      else run_rows<RoundedLanes<8, Format::fp16>>(p, rect, ya, yb, idle_branches, c);
+      return;
+    }
+    if (precision_ == Format::fp24) {
+      if (lanes_ == 1) run_rows<RoundedLanes<1, Format::fp24>>(p, rect, ya, yb, idle_branches, c);
+      else run_rows<RoundedLanes<8, Format::fp24>>(p, rect, ya, yb, idle_branches, c);
+      return;
+    }
     switch (lanes_) {
-      case 1: run_rows<1>(p, rect, ya, yb, idle_branches, c); break;
-      case 4: run_rows<4>(p, rect, ya, yb, idle_branches, c); break;
-      case 8: run_rows<8>(p, rect, ya, yb, idle_branches, c); break;
-      default: run_rows<16>(p, rect, ya, yb, idle_branches, c); break;
+      case 1: run_rows<SimdLanes<1>>(p, rect, ya, yb, idle_branches, c); break;
+      case 4: run_rows<SimdLanes<4>>(p, rect, ya, yb, idle_branches, c); break;
+      case 8: run_rows<SimdLanes<8>>(p, rect, ya, yb, idle_branches, c); break;
+      default: run_rows<SimdLanes<16>>(p, rect, ya, yb, idle_branches, c); break;
     }
   };
   parallel_rows(rect, body, chunks);

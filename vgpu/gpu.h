@@ -52,6 +52,10 @@ class Gpu {
   const Profile& profile() const { return profile_; }
   int threads() const { return int(workers_.size()) + 1; }
   int lanes() const { return lanes_; }
+  // Arithmetic precision of the fragment units: fp32, or every operation rounded to fp24 (R300)
+  // or fp16 (NV3x half). Texture formats are set per texture.
+  void set_precision(Format f) { precision_ = f; }
+  Format precision() const { return precision_; }
 
   // Video memory: a texture the profile can hold (throws Error past max_texture_size).
   Texture make_texture(std::string name, int width, int height, int channels,
@@ -96,7 +100,7 @@ class Gpu {
 
  private:
   struct Chunk;
-  template <int W>
+  template <class L>
   void run_rows(const Program& p, const Rect& r, int y0, int y1, uint64_t idle_branches,
                 Chunk& out) const;
   void parallel_rows(const Rect& r, const std::function<void(int, int, Chunk&)>& body,
@@ -106,6 +110,7 @@ class Gpu {
 
   Profile profile_;
   int lanes_;
+  Format precision_ = Format::fp32;
   const Program* program_ = nullptr;
   uint32_t loaded_program_ = 0;
   std::array<const Texture*, kMaxTextureUnits> units_{};

@@ -17,6 +17,7 @@
 #include <string>
 
 #include "vgpu/fragment.h"
+#include "vgpu/precision.h"
 
 namespace vgpu {
 
@@ -36,6 +37,10 @@ class Program {
   virtual void run(Fragments<SimdLanes<8>>& f) const = 0;
   virtual void run(Fragments<SimdLanes<16>>& f) const = 0;
   virtual void run(Fragments<CountingLanes>& f) const = 0;
+  virtual void run(Fragments<RoundedLanes<1, Format::fp24>>& f) const = 0;
+  virtual void run(Fragments<RoundedLanes<8, Format::fp24>>& f) const = 0;
+  virtual void run(Fragments<RoundedLanes<1, Format::fp16>>& f) const = 0;
+  virtual void run(Fragments<RoundedLanes<8, Format::fp16>>& f) const = 0;
 
   // The counting run: static instructions per fragment and fetches per unit, with the current
   // uniforms (a uniform loop bound, e.g. the number of lights, changes the count).
@@ -76,6 +81,10 @@ class KernelProgram final : public Program {
   void run(Fragments<SimdLanes<8>>& f) const override { kernel(f); }
   void run(Fragments<SimdLanes<16>>& f) const override { kernel(f); }
   void run(Fragments<CountingLanes>& f) const override { kernel(f); }
+  void run(Fragments<RoundedLanes<1, Format::fp24>>& f) const override { kernel(f); }
+  void run(Fragments<RoundedLanes<8, Format::fp24>>& f) const override { kernel(f); }
+  void run(Fragments<RoundedLanes<1, Format::fp16>>& f) const override { kernel(f); }
+  void run(Fragments<RoundedLanes<8, Format::fp16>>& f) const override { kernel(f); }
 };
 
 }  // namespace vgpu

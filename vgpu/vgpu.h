@@ -5,6 +5,7 @@
 #include "vgpu/fragment.h"
 #include "vgpu/gpu.h"
 #include "vgpu/lanes.h"
+#include "vgpu/precision.h"
 #include "vgpu/profile.h"
 #include "vgpu/program.h"
 #include "vgpu/stats.h"
