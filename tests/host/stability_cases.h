@@ -353,7 +353,7 @@ inline std::vector<Case> cases() {
   {  // 13. misses
     Case c;
     c.name = "rays that miss the grid miss";
-    c.probe = "rays passing beside the grid box and rays pointing away from it";
+    c.probe = "rays passing beside the grid box, parallel to its face x = 4";
     Builder b;
     b.quad({0.5f, 0.5f, 2}, {3.5f, 0.5f, 2}, {3.5f, 3.5f, 2}, {0.5f, 3.5f, 2});
     c.scene = b.s;
@@ -361,6 +361,7 @@ inline std::vector<Case> cases() {
     c.expected = expect_analytic(c);
     out.push_back(c);
     c.name = "rays pointing away from the grid miss";
+    c.probe = "rays starting outside the grid and pointing away from it";
     c.camera = look({2, 2, 10}, {0, 0.1f, 1}, 0.8f);
     c.expected = expect_analytic(c);
     out.push_back(c);
