@@ -64,8 +64,9 @@ struct Run {
 };
 
 void bench(const std::string& label, const host::Scene& scene, int bounces, int threads, int reps) {
-  const host::Grid grid = host::build_grid(scene, host::GridSpec{});
   host::RenderOptions opt;
+  const host::Grid grid =
+      host::build_grid(scene, host::grid_spec_for(host::GridSpec{}, scene, vgpu::profile(opt.profile)));
   opt.bounces = bounces;
   opt.threads = threads;
   host::StreamTracer tracer(scene, grid, opt);

@@ -134,7 +134,8 @@ int run_render(const RenderArgs& a) {
   const std::string path = host::resolve_scene(a.scene);
   const host::Scene scene = host::load_scene(path);
   const auto t0 = std::chrono::steady_clock::now();
-  const host::Grid grid = host::build_grid(scene, grid_spec);
+  const host::Grid grid =
+      host::build_grid(scene, host::grid_spec_for(grid_spec, scene, vgpu::profile(opt.profile)));
   const float aspect = float(opt.width) / float(opt.height);
   const host::Camera cam = scene.camera ? *scene.camera : host::frame_bounds(scene.bounds(), aspect);
   const bool tty = ::isatty(2) && !a.quiet;

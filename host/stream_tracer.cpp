@@ -48,6 +48,19 @@ struct StreamTracer::State {
   int max_list = 0;  // longest voxel list: a ray tests at most this many triangles per voxel
 };
 
+GridSpec grid_spec_for(const GridSpec& spec, const Scene& scene, const vgpu::Profile& profile) {
+  if (!spec.automatic()) return spec;
+  glm::ivec3 r = auto_resolution(scene.bounds(), scene.triangle_count());
+  const double maxs = profile.max_texture_size;
+  while (double(r.x) * r.y > maxs) {
+    const double f = std::sqrt(maxs / (double(r.x) * r.y));
+    r.x = std::max(1, int(r.x * f));
+    r.y = std::max(1, int(r.y * f));
+  }
+  r.z = std::min(r.z, profile.max_texture_size);
+  return GridSpec{r};
+}
+
 kernels::ShadingModel parse_shading(const std::string& name) {
   if (name == "diffuse") return ShadingModel::diffuse;
   if (name == "phong") return ShadingModel::phong;

@@ -79,6 +79,11 @@ class StreamTracer {
   double init_ms_ = 0;
 };
 
+// The grid spec to build for a profile: an automatic resolution is shrunk in x and y until the
+// voxel pointer texture (sizeX*sizeY by sizeZ texels) fits the profile's largest texture; an
+// explicit one is kept (and refused at initialization if it does not fit).
+GridSpec grid_spec_for(const GridSpec& spec, const Scene& scene, const vgpu::Profile& profile);
+
 // Names of the shading models as the CLI spells them.
 kernels::ShadingModel parse_shading(const std::string& name);
 
