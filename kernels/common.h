@@ -60,6 +60,8 @@ inline Vec3<F> voxel_exits(const Vec3<F>& o, const Vec3<F>& d, const Vec3<F>& vo
 template <class F>
 inline F min3(const Vec3<F>& v) { return min(min(v.x, v.y), v.z); }
 
+inline constexpr float kEdgeEps = 1.0f / (1 << 20);
+
 // Moller-Trumbore, two-sided. Returns t (kFar where the ray misses) and barycentrics u, v.
 template <class F>
 inline F intersect_triangle(const Vec3<F>& o, const Vec3<F>& d, const Vec3<F>& p0,
@@ -73,8 +75,11 @@ inline F intersect_triangle(const Vec3<F>& o, const Vec3<F>& d, const Vec3<F>& p
   const Vec3<F> q = cross(s, e1);
   v = dot(d, q) * inv;
   const F t = dot(e2, q) * inv;
-  const auto hit = (det != F(0.0f)) && (u >= F(0.0f)) && (v >= F(0.0f)) && (u + v <= F(1.0f)) &&
-                   (t > F(0.0f));
+  // Edges are widened by kEdgeEps (in barycentric units) so that a ray through an edge shared
+  // by two triangles cannot be refused by both through rounding (a crack): found by the
+  // stability suite's octahedron case, where both faces computed u + v = 1 + 2^-23.
+  const F lo = F(-kEdgeEps), hi = F(1.0f + kEdgeEps);
+  const auto hit = (det != F(0.0f)) && (u >= lo) && (v >= lo) && (u + v <= hi) && (t > F(0.0f));
   return select(hit, t, F(kFar));
 }
 

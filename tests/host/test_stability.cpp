@@ -89,13 +89,9 @@ TEST_CASE("a triangle spanning the whole grid is hit everywhere it is seen") {
 TEST_CASE("a hit just outside the current voxel is not taken before a nearer one") {
   check_case("a hit just outside the current voxel is not taken before a nearer one");
 }
-// Known defect (found by these cases, kept visible with may_fail): rays exactly in the plane
-// x = 2 through the octahedron's shared edges (pixels (8, 7) and (8, 9)) miss at fp32. The
-// kernel's Moller-Trumbore (kernels/common.h, intersect_triangle) is not watertight: both
-// triangles sharing the edge compute u + v = 1.0000001 > 1 and reject the ray (checked by
-// emulating the kernel's float arithmetic), so the closed mesh has a one-pixel crack. A fix
-// belongs in the kernel (e.g. an edge test with consistent tie-breaking or a tiny epsilon).
-TEST_CASE("a closed octahedron has no cracks along its shared edges and vertices" * doctest::may_fail()) {
+// These cases found a crack: both triangles sharing an edge computed u + v = 1 + 2^-23 and
+// refused the ray; intersect_triangle now widens edges by kEdgeEps (kernels/common.h).
+TEST_CASE("a closed octahedron has no cracks along its shared edges and vertices") {
   check_case("a closed octahedron has no cracks along its shared edges and vertices");
 }
 TEST_CASE("a triangle fan has no cracks at its spokes and centre") {
@@ -113,13 +109,13 @@ TEST_CASE("rays pointing away from the grid miss") { check_case("rays pointing a
 TEST_CASE("a scene far from the origin: a quad in a voxel face at 1e4") {
   check_case("a quad lying exactly in a voxel face is hit at 1e4");
 }
-TEST_CASE("a scene far from the origin: a closed octahedron at 1e4" * doctest::may_fail()) {
+TEST_CASE("a scene far from the origin: a closed octahedron at 1e4") {
   check_case("a closed octahedron has no cracks along its shared edges and vertices at 1e4");
 }
 TEST_CASE("a scene far from the origin: a quad in a voxel face at 1e5") {
   check_case("a quad lying exactly in a voxel face is hit at 1e5");
 }
-TEST_CASE("a scene far from the origin: a closed octahedron at 1e5" * doctest::may_fail()) {
+TEST_CASE("a scene far from the origin: a closed octahedron at 1e5") {
   check_case("a closed octahedron has no cracks along its shared edges and vertices at 1e5");
 }
 TEST_CASE("a very thin triangle is hit across its width") { check_case("a very thin triangle is hit across its width"); }
