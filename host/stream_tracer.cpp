@@ -220,9 +220,8 @@ const vgpu::PassRecord& StreamTracer::pass(const vgpu::Program& p,
   // The same finished-ray mask either skips fragments on the modeled hardware (masks on) or
   // only saves the emulator's host work (masks off: every fragment is charged).
   gpu.set_stencil_test(nullptr);
-  gpu.set_work_mask(work && opt_.host_shortcut ? work : nullptr);
+  gpu.set_work_mask(opt_.masks || opt_.host_shortcut ? work : nullptr);
   gpu.set_work_mask_counts_as_masked(opt_.masks);
-  if (work && opt_.masks) gpu.set_work_mask(work);
   // The traced pixel takes part unless the finished-ray mask says its ray is done.
   const bool traced = opt_.trace_pixel && opt_.trace_out &&
                       (!work || work->get(opt_.trace_pixel->x, opt_.trace_pixel->y) != 0);
