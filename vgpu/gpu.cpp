@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cstring>
 
 namespace vgpu {
 
@@ -27,7 +28,9 @@ Gpu::~Gpu() {
   for (auto& w : workers_) w.join();
 }
 
-void Gpu::fail(const std::string& what) const { throw Error(what); }
+void Gpu::fail(const std::string& what) const {
+  throw Error(what);
+}
 
 Texture Gpu::make_texture(std::string name, int width, int height, int channels,
                           Format format) const {
@@ -46,7 +49,8 @@ void Gpu::check_texture(const Texture& t) const {
 }
 
 void Gpu::use_program(const Program& program) {
-  if (in_draw_) fail(std::string("program '") + program.name() + "': no recursion (bind inside a pass)");
+  if (in_draw_)
+    fail(std::string("program '") + program.name() + "': no recursion (bind inside a pass)");
   program_ = &program;
   if (program.id() == loaded_program_) return;
   loaded_program_ = program.id();
@@ -66,7 +70,9 @@ void Gpu::bind_texture(int unit, const Texture& texture) {
   units_[unit] = &texture;
 }
 
-void Gpu::unbind_textures() { units_.fill(nullptr); }
+void Gpu::unbind_textures() {
+  units_.fill(nullptr);
+}
 
 void Gpu::set_targets(std::initializer_list<Texture*> targets) {
   targets_.assign(targets.begin(), targets.end());
@@ -75,8 +81,8 @@ void Gpu::set_targets(std::initializer_list<Texture*> targets) {
 
 void Gpu::clear(Texture& t, std::initializer_list<float> value) {
   if (int(value.size()) != t.channels())
-    fail("clear of texture '" + t.name() + "': " + std::to_string(value.size()) +
-         " values for " + std::to_string(t.channels()) + " channels");
+    fail("clear of texture '" + t.name() + "': " + std::to_string(value.size()) + " values for " +
+         std::to_string(t.channels()) + " channels");
   check_texture(t);
   t.fill(std::span<const float>(value.begin(), value.size()));
   Counters c;
@@ -105,8 +111,9 @@ uint64_t Gpu::end_query() {
 
 const PassRecord& Gpu::draw() {
   if (targets_.empty())
-    fail(program_ ? "program '" + std::string(program_->name()) + "': draw with no render target set"
-                  : std::string("draw: no render target set"));
+    fail(program_
+             ? "program '" + std::string(program_->name()) + "': draw with no render target set"
+             : std::string("draw: no render target set"));
   return draw(Rect{0, 0, targets_[0]->width(), targets_[0]->height()});
 }
 
@@ -132,12 +139,59 @@ void Gpu::run_rows(const Program& p, const Rect& r, int y0, int y1, uint64_t idl
   alignas(64) float lanes_out[4][W];
   bool bools[W] = {};
 
+  // Where idle fragments' outputs come from: the passthrough unit's texel at the same place.
+  struct CopyPlan {
+    const float* src = nullptr;
+    float* dst = nullptr;
+    int width = 0, ch = 0;
+    Format fmt = Format::fp32;
+    bool exact = false;  // same format: already rounded, a plain copy
+  };
+  CopyPlan copies[kMaxOutputs];
+  if (work_mask_ && !idle_kill)  // draw() checked that each passthrough is shaped like its target
+    for (int o = 0; o < nout; ++o) {
+      const Texture& src = *units_[p.passthrough(o)];
+      Texture& dst = *targets_[o];
+      copies[o] = {src.data().data(), dst.texel_mut(0, 0),
+                   dst.width(),       dst.channels(),
+                   dst.format(),      src.format() == dst.format() || dst.format() == Format::fp32};
+    }
+
   for (int y = y0; y < y1; ++y) {
     const uint8_t* st = stencil_test_ ? stencil_test_->row(y) : nullptr;
     const uint8_t* wk = work_mask_ ? work_mask_->row(y) : nullptr;
     uint8_t* sw = stencil_write_ ? stencil_write_->row_mut(y) : nullptr;
-    for (int x = r.x0; x < r.x1; x += W) {
-      const int n = std::min(W, r.x1 - x);
+    for (int x = r.x0, n = 0; x < r.x1; x += n) {
+      if (wk && !st && wk[x] == 0) {
+        // A stretch of idle fragments (the usual case late in a loop): counted and copied at
+        // once, exactly as the per-block path below would (fragments are independent).
+        int e = x + 1;
+        while (e < r.x1 && wk[e] == 0) ++e;
+        n = e - x;
+        const uint64_t k = uint64_t(n);
+        out.launched += k;
+        if (work_masked_) {
+          out.masked += k;
+        } else {
+          out.shaded += k;
+          out.idle += idle_branches * k;
+          if (idle_kill) out.discarded += k;
+        }
+        if (!idle_kill)
+          for (int o = 0; o < nout; ++o) {
+            const CopyPlan& cp = copies[o];
+            const size_t off = (size_t(y) * size_t(cp.width) + size_t(x)) * size_t(cp.ch);
+            const size_t count = k * size_t(cp.ch);
+            if (cp.exact)
+              std::memcpy(cp.dst + off, cp.src + off, count * sizeof(float));
+            else
+              for (size_t i = 0; i < count; ++i)
+                cp.dst[off + i] = round_to(cp.fmt, cp.src[off + i]);
+          }
+        if (sw) std::memset(sw + x, idle_kill ? 0 : 1, size_t(n));
+        continue;
+      }
+      n = std::min(W, r.x1 - x);
       out.launched += uint64_t(n);
       // live: fragments in the quad that pass the stencil test.
       M live = iota < float(n);
@@ -187,25 +241,38 @@ void Gpu::run_rows(const Program& p, const Rect& r, int y0, int y1, uint64_t idl
       int nkill = lanes_on(kill);
       if (wk) {
         // Idle fragments: outputs keep their previous values (copied from the passthrough units).
-        for (int i = 0; i < n; ++i) {
-          if (!live[i] || run[i]) continue;
-          if (work_masked_) {
-            // Modeled as an early-z/stencil reject: masked, not shaded, never counted.
-            --out.shaded;
-            ++out.masked;
-          } else {
-            out.idle += idle_branches;  // an idle fragment takes none of the program's branches
-          }
-          if (idle_kill) {
-            if (!work_masked_) ++nkill;
-            continue;
-          }
+        int nidle = 0;
+        for (int i = 0; i < n; ++i) nidle += (live[i] && !run[i]) ? 1 : 0;
+        if (work_masked_) {
+          // Modeled as an early-z/stencil reject: masked, not shaded, never counted.
+          out.shaded -= uint64_t(nidle);
+          out.masked += uint64_t(nidle);
+        } else {
+          out.idle += idle_branches * uint64_t(nidle);  // an idle fragment takes no branch
+          if (idle_kill) nkill += nidle;
+        }
+        if (!idle_kill && nidle > 0) {
           for (int o = 0; o < nout; ++o) {
-            Texture& t = *targets_[o];
-            const float* s = units_[p.passthrough(o)]->texel(x + i, y);
-            float* d = t.texel_mut(x + i, y);
-            // Rounded as the program's own store would be: the source may have a wider format.
-            for (int c = 0; c < t.channels(); ++c) d[c] = round_to(t.format(), s[c]);
+            const CopyPlan& cp = copies[o];
+            // Contiguous runs of idle fragments are copied in one go.
+            for (int i = 0; i < n;) {
+              if (!live[i] || run[i]) {
+                ++i;
+                continue;
+              }
+              int j = i + 1;
+              while (j < n && live[j] && !run[j]) ++j;
+              const size_t off = (size_t(y) * size_t(cp.width) + size_t(x + i)) * size_t(cp.ch);
+              const size_t count = size_t(j - i) * size_t(cp.ch);
+              if (cp.exact) {
+                std::memcpy(cp.dst + off, cp.src + off, count * sizeof(float));
+              } else {
+                // Rounded as the program's own store would be: the source is a wider format.
+                for (size_t k = 0; k < count; ++k)
+                  cp.dst[off + k] = round_to(cp.fmt, cp.src[off + k]);
+              }
+              i = j;
+            }
           }
         }
       }
@@ -275,9 +342,9 @@ const PassRecord& Gpu::draw(const Rect& rect) {
 
   // The profile's limits.
   if (p.outputs() > profile_.max_outputs)
-    fail("program '" + pname + "' writes " + std::to_string(p.outputs()) +
-         " outputs; profile " + profile_.name + " allows " +
-         std::to_string(profile_.max_outputs) + " (no multiple render targets)");
+    fail("program '" + pname + "' writes " + std::to_string(p.outputs()) + " outputs; profile " +
+         profile_.name + " allows " + std::to_string(profile_.max_outputs) +
+         " (no multiple render targets)");
   if (int(targets_.size()) != p.outputs())
     fail("program '" + pname + "' writes " + std::to_string(p.outputs()) + " outputs but " +
          std::to_string(targets_.size()) + " render targets are set");
@@ -327,20 +394,32 @@ const PassRecord& Gpu::draw(const Rect& rect) {
   auto body = [&](int ya, int yb, Chunk& c) {
     // Reduced precision runs at width 1 (the scalar reference) or 8.
     if (precision_ == Format::fp16) {
-      if (lanes_ == 1) run_rows<RoundedLanes<1, Format::fp16>>(p, rect, ya, yb, idle_branches, c);
-      else run_rows<RoundedLanes<8, Format::fp16>>(p, rect, ya, yb, idle_branches, c);
+      if (lanes_ == 1)
+        run_rows<RoundedLanes<1, Format::fp16>>(p, rect, ya, yb, idle_branches, c);
+      else
+        run_rows<RoundedLanes<8, Format::fp16>>(p, rect, ya, yb, idle_branches, c);
       return;
     }
     if (precision_ == Format::fp24) {
-      if (lanes_ == 1) run_rows<RoundedLanes<1, Format::fp24>>(p, rect, ya, yb, idle_branches, c);
-      else run_rows<RoundedLanes<8, Format::fp24>>(p, rect, ya, yb, idle_branches, c);
+      if (lanes_ == 1)
+        run_rows<RoundedLanes<1, Format::fp24>>(p, rect, ya, yb, idle_branches, c);
+      else
+        run_rows<RoundedLanes<8, Format::fp24>>(p, rect, ya, yb, idle_branches, c);
       return;
     }
     switch (lanes_) {
-      case 1: run_rows<SimdLanes<1>>(p, rect, ya, yb, idle_branches, c); break;
-      case 4: run_rows<SimdLanes<4>>(p, rect, ya, yb, idle_branches, c); break;
-      case 8: run_rows<SimdLanes<8>>(p, rect, ya, yb, idle_branches, c); break;
-      default: run_rows<SimdLanes<16>>(p, rect, ya, yb, idle_branches, c); break;
+      case 1:
+        run_rows<SimdLanes<1>>(p, rect, ya, yb, idle_branches, c);
+        break;
+      case 4:
+        run_rows<SimdLanes<4>>(p, rect, ya, yb, idle_branches, c);
+        break;
+      case 8:
+        run_rows<SimdLanes<8>>(p, rect, ya, yb, idle_branches, c);
+        break;
+      default:
+        run_rows<SimdLanes<16>>(p, rect, ya, yb, idle_branches, c);
+        break;
     }
   };
   parallel_rows(rect, body, chunks);
@@ -373,7 +452,8 @@ const PassRecord& Gpu::draw(const Rect& rect) {
   for (Texture* t : targets_) write_per_frag += uint64_t(t->bytes_per_texel());
   c.bytes_written = (sum.shaded - sum.discarded) * write_per_frag;
   if (query_active_) query_count_ += sum.shaded - sum.discarded;
-  c.host_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  c.host_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 
   FrameStats::ProgramTotals& totals = stats_.program(pname, p.paper_name(), a.instructions);
   totals.counters += c;

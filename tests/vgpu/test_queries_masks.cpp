@@ -17,7 +17,9 @@ using vgpu_test::same_bits;
 namespace {
 
 // Known pattern: the fragment at pixel (x, y) is discarded where (x + 2y) mod 3 == 0.
-bool killed_at(int x, int y) { return (x + 2 * y) % 3 == 0; }
+bool killed_at(int x, int y) {
+  return (x + 2 * y) % 3 == 0;
+}
 
 struct KillPattern {
   static constexpr const char* name = "kill pattern";
@@ -197,7 +199,7 @@ struct Walk {
 // Three ping-pong passes of K over a 75x61 state, with or without the work mask.
 template <class K>
 Walk walk(const std::string& prof, int threads, int lanes, bool work_mask,
-          Format target_format = Format::fp32) {
+          Format target_format = Format::fp32, bool stencil_test = true) {
   Gpu gpu(profile(prof), threads, lanes);
   Texture a = gpu.make_texture("a", 75, 61, 4), b = gpu.make_texture("b", 75, 61, 4, target_format);
   Texture g = gpu.make_texture("g", 75, 61, 4);
@@ -213,7 +215,7 @@ Walk walk(const std::string& prof, int threads, int lanes, bool work_mask,
   KernelProgram<K> k;
   gpu.use_program(k);
   gpu.bind_texture(1, g);
-  gpu.set_stencil_test(&test);
+  if (stencil_test) gpu.set_stencil_test(&test);
   gpu.set_stencil_write(&written);
   Walk r;
   Texture* src = &a;
@@ -276,4 +278,28 @@ TEST_CASE("passthrough copies round to the render target's format, as the progra
     CHECK(same_bits(fast.state, full.state));
     CHECK(fast.totals.same_counts(full.totals));
   }
+}
+
+TEST_CASE("without a stencil test, stretches of idle fragments give the same images and counters") {
+  // The emulator copies whole idle stretches of a row at once when no stencil test is bound.
+  for (Format target : {Format::fp32, Format::fp16})
+    for (int lanes : {1, 8, 16})
+      for (int threads : {1, 3}) {
+        CAPTURE(lanes);
+        CAPTURE(threads);
+        const Walk full = walk<Step>("gf5700", threads, lanes, false, target, false);
+        const Walk fast = walk<Step>("gf5700", threads, lanes, true, target, false);
+        CHECK(full.totals.lanes_idle > 0);
+        CHECK(same_bits(fast.state, full.state));
+        CHECK(same_bits(fast.written, full.written));
+        CHECK(fast.last_query == full.last_query);
+        CHECK(fast.totals.same_counts(full.totals));
+        const Walk kfull = walk<StepOrKill>("gf6600", threads, lanes, false, target, false);
+        const Walk kfast = walk<StepOrKill>("gf6600", threads, lanes, true, target, false);
+        CHECK(kfull.totals.fragments_discarded > 0);
+        CHECK(same_bits(kfast.state, kfull.state));
+        CHECK(same_bits(kfast.written, kfull.written));
+        CHECK(kfast.last_query == kfull.last_query);
+        CHECK(kfast.totals.same_counts(kfull.totals));
+      }
 }
