@@ -1,18 +1,23 @@
 #!/usr/bin/python3
 """Speed vs accuracy sweep of the stream tracer.
 
-For each scene (sphere, bunny, bunny-refl, classic), grid resolution (auto, 8, 32 by default; 16 is left out to keep
-the sweep near 10 minutes on 2 cores, since fp16 runs hit the pass cap and take 30-60 s each at one
-thread; add it with --grids auto,8,16,32) and bounce
-count (0, 2): one CPU reference render (--engine cpu, double precision) and one stream render per
-precision (fp32, fp24, fp16), all at 128x128. Per run it records render_ms (--stats-json), the
-share of pixels whose primary hit id differs from the CPU reference at the same grid and bounces
-(`vgpu-rt compare` of the hit AOVs, threshold 0.5) and the PSNR of the colour image against the
-reference (`vgpu-rt compare` of linear EXRs). A grid the profile refuses (the render fails) is
-recorded with its message and left out of the chart; a run over --timeout seconds likewise.
+For each scene (sphere, bunny, bunny-refl, classic), grid resolution (auto, 8, 16, 32 by default)
+and bounce count (0, 2): one CPU reference render (--engine cpu, double precision) and one stream
+render per precision (fp32, fp24, fp16), all at 128x128, one host thread each. Per run it records
+render_ms (--stats-json) and, against the CPU reference at the same grid and bounces, the pixels
+rendered wrong by three criteria (all through `vgpu-rt compare`, i.e. OpenImageIO):
 
-Writes docs/sweep.csv and docs/speed_vs_accuracy.png.
-Usage: /usr/bin/python3 scripts/sweep.py [--grids auto,8,32] [--jobs 2] [--timeout 60]
+  hit:    the primary hit's triangle id differs (hit AOVs, threshold 0.5);
+  depth:  the distance to the primary hit differs by more than DEPTH_TOL scene units (depth AOVs;
+          a hit against a miss always counts);
+  colour: some channel of the linear colour differs by more than COLOUR_TOL (one 8-bit step);
+
+plus the PSNR of the colour image. A grid the profile refuses (the render fails) is recorded with
+its message and left out of the chart; a run over --timeout seconds likewise.
+
+Writes docs/sweep.csv, docs/speed_vs_accuracy.png and docs/accuracy.md.
+Usage: /usr/bin/python3 scripts/sweep.py [--grids auto,8,16,32] [--jobs 2] [--timeout 300]
+       /usr/bin/python3 scripts/sweep.py --plot-only   (chart and report from docs/sweep.csv)
 """
 import argparse
 import concurrent.futures as cf
@@ -30,14 +35,19 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SCENES = ["sphere", "bunny", "bunny-refl", "classic"]
 PRECISIONS = ["fp32", "fp24", "fp16"]
 BOUNCES = [0, 2]
+# Stated tolerances of the wrong-pixel counts (see the docstring).
+DEPTH_TOL = 1e-3  # scene units: the scenes span 3 to 16 units, cameras stand 7 to 9 units away
+COLOUR_TOL = 1.0 / 255.0
+CRITERIA = [("hit", "wrong primary hit id"), ("depth", f"depth error > {DEPTH_TOL:g}"),
+            ("colour", "colour difference > 1/255")]
 
 
 def render(exe, work, scene, grid, engine, precision, bounces, size, timeout):
     tag = f"{scene}_{grid}_{engine}_{precision}_b{bounces}"
     out = {k: os.path.join(work, tag + s) for k, s in
-           [("rgb", ".exr"), ("hit", "_hit.exr"), ("json", ".json")]}
+           [("rgb", ".exr"), ("hit", "_hit.exr"), ("depth", "_depth.exr"), ("json", ".json")]}
     cmd = [exe, "render", scene, "--engine", engine, "--grid", grid, "--bounces", str(bounces),
-           "--size", size, "--out", out["rgb"], "--aov", "hit=" + out["hit"],
+           "--size", size, "--out", out["rgb"], "--aov", "hit=" + out["hit"], "depth=" + out["depth"],
            "--stats-json", out["json"], "--quiet", "--stats", "none", "--threads", "1"]
     if engine == "stream":
         cmd += ["--precision", precision]
@@ -68,17 +78,22 @@ def compare(exe, a, b, threshold=None):
 
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("--grids", default="auto,8,32")
+    ap.add_argument("--scenes", default=",".join(SCENES))
+    ap.add_argument("--grids", default="auto,8,16,32")
+    ap.add_argument("--out-dir", default=os.path.join(ROOT, "docs"),
+                    help="where sweep.csv, speed_vs_accuracy.png and accuracy.md go")
     ap.add_argument("--jobs", type=int, default=2)
-    ap.add_argument("--timeout", type=float, default=60)
+    ap.add_argument("--timeout", type=float, default=300)
     ap.add_argument("--size", default="128x128")
     ap.add_argument("--build", default=os.path.join(ROOT, "build-stab"))
     ap.add_argument("--plot-only", action="store_true", help="redraw the chart from docs/sweep.csv")
     args = ap.parse_args()
+    SCENES[:] = args.scenes.split(",")
     if args.plot_only:
-        with open(os.path.join(ROOT, "docs", "sweep.csv")) as f:
+        with open(os.path.join(args.out_dir, "sweep.csv")) as f:
             rows = [dict(r, bounces=int(r["bounces"])) for r in csv.DictReader(f)]
-        plot(rows, os.path.join(ROOT, "docs", "speed_vs_accuracy.png"), args.size)
+        plot(rows, os.path.join(args.out_dir, "speed_vs_accuracy.png"), args.size)
+        report(rows, os.path.join(args.out_dir, "accuracy.md"), args.size)
         return 0
     exe = os.path.join(args.build, "host", "vgpu-rt")
     grids = args.grids.split(",")
@@ -109,33 +124,46 @@ def main():
     rows = []
     for (scene, grid, engine, prec, b), (tag, out, stats, err) in sorted(results.items()):
         row = {"scene": scene, "grid": grid, "engine": engine, "precision": prec, "bounces": b,
-               "grid_res": "", "render_ms": "", "wrong_hit_share": "", "psnr_db": "",
+               "grid_res": "", "render_ms": "", "pixels": "", "wrong_hit_px": "",
+               "wrong_depth_px": "", "wrong_colour_px": "", "wrong_hit_share": "", "psnr_db": "",
                "rays_unfinished": "", "status": err or "ok"}
         if stats:
             row["grid_res"] = "x".join(map(str, stats.get("grid", [])))
             row["render_ms"] = f"{stats['render_ms']:.3f}"
             row["rays_unfinished"] = stats.get("rays_unfinished", 0)
+            pixels = stats["size"][0] * stats["size"][1]
+            row["pixels"] = pixels
             ref = results.get((scene, grid, "cpu", "fp64", b))
             if ref and ref[2]:
                 if engine == "cpu":
-                    row["wrong_hit_share"], row["psnr_db"] = "0", "inf"
+                    row.update(wrong_hit_px=0, wrong_depth_px=0, wrong_colour_px=0,
+                               wrong_hit_share="0", psnr_db="inf")
                 else:
-                    share, _ = compare(exe, out["hit"], ref[1]["hit"], 0.5)
-                    _, psnr = compare(exe, out["rgb"], ref[1]["rgb"])
-                    row["wrong_hit_share"] = f"{share:.6f}"
+                    hit, _ = compare(exe, out["hit"], ref[1]["hit"], 0.5)
+                    depth, _ = compare(exe, out["depth"], ref[1]["depth"], DEPTH_TOL)
+                    colour, psnr = compare(exe, out["rgb"], ref[1]["rgb"], COLOUR_TOL)
+                    row["wrong_hit_px"] = round(hit * pixels)
+                    row["wrong_depth_px"] = round(depth * pixels)
+                    row["wrong_colour_px"] = round(colour * pixels)
+                    row["wrong_hit_share"] = f"{hit:.6f}"
                     row["psnr_db"] = "inf" if math.isinf(psnr) else f"{psnr:.2f}"
             elif engine != "cpu":
                 row["status"] += " (no cpu reference)"
         rows.append(row)
 
-    os.makedirs(os.path.join(ROOT, "docs"), exist_ok=True)
-    csv_path = os.path.join(ROOT, "docs", "sweep.csv")
+    os.makedirs(args.out_dir, exist_ok=True)
+    csv_path = os.path.join(args.out_dir, "sweep.csv")
     with open(csv_path, "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=list(rows[0].keys()))
         w.writeheader()
         w.writerows(rows)
     print(f"wrote {csv_path} ({len(rows)} runs, {time.time() - t0:.0f} s)")
-    plot(rows, os.path.join(ROOT, "docs", "speed_vs_accuracy.png"), args.size)
+    plot(rows, os.path.join(args.out_dir, "speed_vs_accuracy.png"), args.size)
+    report(rows, os.path.join(args.out_dir, "accuracy.md"), args.size)
+
+
+def num(r, key):
+    return float(r[key]) if r.get(key, "") not in ("", None) else None
 
 
 def plot(rows, path, size):
@@ -146,38 +174,123 @@ def plot(rows, path, size):
     colours = {"fp64": "black", "fp32": "tab:blue", "fp24": "tab:green", "fp16": "tab:red"}
     markers = {0: "o", 2: "^"}
     psnr_cap = 120.0
-    fig, axes = plt.subplots(2, len(SCENES), figsize=(4.2 * len(SCENES), 7.5), squeeze=False)
+    panels = [("psnr", f"PSNR vs CPU fp64 [dB]\n(inf drawn at {psnr_cap:.0f})")] + [
+        (key, f"{label}\n[% of pixels, symlog]") for key, label in CRITERIA]
+    fig, axes = plt.subplots(len(panels), len(SCENES), figsize=(4.2 * len(SCENES), 12.5),
+                             squeeze=False, sharex="col")
     for c, scene in enumerate(SCENES):
-        top, bot = axes[0][c], axes[1][c]
         for r in rows:
             if r["scene"] != scene or r["render_ms"] == "" or r["psnr_db"] == "":
                 continue
             x = float(r["render_ms"])
-            psnr = min(float(r["psnr_db"]), psnr_cap)
-            share = 100 * float(r["wrong_hit_share"])
+            pixels = float(r["pixels"])
             kw = dict(color=colours[r["precision"]], marker=markers[r["bounces"]], s=36,
                       alpha=0.85, edgecolors="none")
-            top.scatter(x, psnr, **kw)
-            bot.scatter(x, share, **kw)
-            for ax, y in ((top, psnr), (bot, share)):
+            for k, (key, _) in enumerate(panels):
+                if key == "psnr":
+                    y = min(float(r["psnr_db"]), psnr_cap)
+                else:
+                    y = 100.0 * float(r[f"wrong_{key}_px"]) / pixels
+                ax = axes[k][c]
+                ax.scatter(x, y, **kw)
                 ax.annotate(r["grid"], (x, y), fontsize=6, xytext=(3, 2), textcoords="offset points")
-        top.set_title(scene)
-        for ax in (top, bot):
+        axes[0][c].set_title(scene)
+        for k, (key, label) in enumerate(panels):
+            ax = axes[k][c]
             ax.set_xscale("log")
+            if key != "psnr":
+                ax.set_yscale("symlog", linthresh=0.01)
+                ax.set_ylim(-0.002, 100)
             ax.grid(True, which="both", alpha=0.3)
-        top.set_ylabel(f"PSNR vs CPU fp64 [dB] (inf drawn at {psnr_cap:.0f})")
-        bot.set_ylabel("wrong primary hit ids [% of pixels]")
-        bot.set_xlabel(f"render time [ms], {size}, 1 host thread (log)")
+            if c == 0:
+                ax.set_ylabel(label)
+        axes[-1][c].set_xlabel(f"render time [ms], {size}, 1 host thread (log)")
     handles = [plt.Line2D([], [], color=colours[p], marker="s", linestyle="", label=p)
                for p in ["fp64", "fp32", "fp24", "fp16"]]
     handles += [plt.Line2D([], [], color="gray", marker=markers[b], linestyle="",
                            label=f"{b} bounces") for b in BOUNCES]
     fig.suptitle("Stream tracer: render time vs accuracy against the CPU fp64 reference "
-                 "(labels = grid; timed-out runs omitted)", y=0.99, fontsize=11)
+                 "(labels = grid; timed-out runs omitted)", y=0.995, fontsize=11)
     fig.legend(handles=handles, loc="upper center", ncol=6, frameon=False,
-               bbox_to_anchor=(0.5, 0.955))
-    fig.tight_layout(rect=(0, 0, 1, 0.91))
-    fig.savefig(path, dpi=110)
+               bbox_to_anchor=(0.5, 0.975))
+    fig.tight_layout(rect=(0, 0, 1, 0.95))
+    fig.savefig(path, dpi=100)
+    print(f"wrote {path}")
+
+
+def median(xs):
+    xs = sorted(xs)
+    n = len(xs)
+    return (xs[n // 2] + xs[(n - 1) // 2]) / 2 if n else None
+
+
+def report(rows, path, size):
+    """docs/accuracy.md: wrong pixels per precision mode, by criterion."""
+    ok = [r for r in rows if r["render_ms"] != "" and r["wrong_hit_px"] != ""]
+    grids = sorted({r["grid"] for r in rows}, key=lambda g: (g != "auto", g.zfill(4)))
+    pixels = int(ok[0]["pixels"]) if ok else 0
+    L = []
+    L.append("# Accuracy per precision mode: wrong pixels against the CPU reference\n")
+    L.append("Written by `/usr/bin/python3 scripts/sweep.py` (do not edit by hand; the same runs "
+             "as `docs/sweep.csv` and `docs/speed_vs_accuracy.png`).\n")
+    L.append(f"Every stream render (`--engine stream --precision P`) is compared with the CPU "
+             f"tracer (`--engine cpu`, double precision) at the same scene, grid and bounce "
+             f"count, {size} ({pixels} pixels), through `vgpu-rt compare` (OpenImageIO). A pixel "
+             f"is wrong by:\n")
+    L.append("- **hit**: its primary hit's triangle id differs (a hit against a miss included);")
+    L.append(f"- **depth**: its distance to the primary hit differs by more than "
+             f"**{DEPTH_TOL:g} scene units** (the scenes span 3 to 16 units and the cameras "
+             f"stand 7 to 9 units from their targets, so about 1e-4 of the viewing distance; "
+             f"a hit against a miss counts);")
+    L.append(f"- **colour**: some channel of the linear colour differs by more than "
+             f"**1/255** (one 8-bit step of the PNG output).\n")
+    L.append("## Per precision mode, all scenes and grids\n")
+    L.append("Sums over every run that finished (scenes x grids x bounces); *runs* counts them, "
+             "*timed out / refused* the ones left out.\n")
+    L.append("| precision | runs | timed out / refused | pixels compared | wrong hit | wrong depth "
+             "| wrong colour | median PSNR [dB] |")
+    L.append("|---|---:|---:|---:|---:|---:|---:|---:|")
+    for prec in PRECISIONS:
+        rs = [r for r in ok if r["precision"] == prec]
+        bad = [r for r in rows if r["precision"] == prec and r["render_ms"] == ""]
+        tot = sum(int(r["pixels"]) for r in rs)
+        cells = []
+        for key, _ in CRITERIA:
+            n = sum(int(r[f"wrong_{key}_px"]) for r in rs)
+            cells.append(f"{n} ({100.0 * n / tot:.3g}%)" if tot else "")
+        ps = [float(r["psnr_db"]) for r in rs]
+        med = median(ps)
+        L.append(f"| {prec} | {len(rs)} | {len(bad)} | {tot} | " + " | ".join(cells) +
+                 f" | {'inf' if med == math.inf else f'{med:.1f}'} |")
+    L.append("")
+    L.append("## Per scene and grid\n")
+    L.append("Wrong pixels as *hit / depth / colour* (of " + str(pixels) + "), for 0 and 2 "
+             "bounces; *t/o*: over the time limit (fp16 rays that never leave the grid run the "
+             "pass loop to its cap).\n")
+    head = "| scene | grid | bounces | " + " | ".join(PRECISIONS) + " |"
+    L.append(head)
+    L.append("|---|---|---:|" + "---:|" * len(PRECISIONS))
+    index = {(r["scene"], r["grid"], r["precision"], int(r["bounces"])): r for r in rows}
+    for scene in [s for s in SCENES if any(r["scene"] == s for r in rows)]:
+        for grid in grids:
+            for b in BOUNCES:
+                cells = []
+                for prec in PRECISIONS:
+                    r = index.get((scene, grid, prec, b))
+                    if not r:
+                        cells.append("")
+                    elif r["wrong_hit_px"] == "":
+                        cells.append("t/o" if "timeout" in r["status"] else "refused")
+                    else:
+                        cells.append(f"{r['wrong_hit_px']} / {r['wrong_depth_px']} / "
+                                     f"{r['wrong_colour_px']}")
+                res = next((r["grid_res"] for p in ["fp64"] + PRECISIONS
+                            for r in [index.get((scene, grid, p, b))] if r and r["grid_res"]), "")
+                L.append(f"| {scene} | {grid}" + (f" ({res})" if grid == "auto" and res else "") +
+                         f" | {b} | " + " | ".join(cells) + " |")
+    L.append("")
+    with open(path, "w") as f:
+        f.write("\n".join(L))
     print(f"wrote {path}")
 
 
