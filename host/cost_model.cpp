@@ -8,8 +8,6 @@ namespace host {
 
 CostParams defaults_for(const vgpu::Profile& profile) {
   CostParams p;
-  if (profile.branching == vgpu::Branching::dynamic)
-    p.branch_coherence = profile.branch_granularity >= 256 ? 0.75 : 0.95;
   p.pass_us = profile.pass_us;
   p.program_load_us = profile.program_load_us;
   p.readback_us = profile.readback_us;
@@ -45,9 +43,13 @@ void add_passes(const vgpu::Counters& c, double n, const vgpu::Profile& hw, cons
   // (one branch per program, as every kernel has; a second branch would count them twice).
   const double idle = std::min(shaded, double(c.lanes_idle) / n);
   const double finished = std::min(shaded, idle + double(c.fragments_discarded) / n);
-  // Dynamic branching: batches idle as a whole skip the branch body.
+  // Dynamic branching: batches idle as a whole skip the branch body (counted by the vgpu per
+  // 8x4 and 32x32 tile; the profile's granularity picks the tile).
   double skipped = 0;
-  if (hw.branching == vgpu::Branching::dynamic) skipped = p.branch_coherence * idle;
+  if (hw.branching == vgpu::Branching::dynamic) {
+    const uint64_t batch = hw.branch_granularity >= 256 ? c.idle_in_batch1024 : c.idle_in_batch32;
+    skipped = std::min(idle, double(batch) / n);
+  }
   const double keep = 1.0 - p.branch_body_share * skipped / shaded;  // share of work still done
 
   const double packing = std::clamp(p.scalar_ops_per_instruction, 1.0, double(hw.alu_lanes));
@@ -143,6 +145,8 @@ vgpu::Counters each_counter(const vgpu::Counters& a, const vgpu::Counters& b, Fn
                                               &vgpu::Counters::fragments_masked,
                                               &vgpu::Counters::fragments_discarded,
                                               &vgpu::Counters::lanes_idle,
+                                              &vgpu::Counters::idle_in_batch32,
+                                              &vgpu::Counters::idle_in_batch1024,
                                               &vgpu::Counters::instructions,
                                               &vgpu::Counters::texture_fetches,
                                               &vgpu::Counters::bytes_read,
@@ -196,7 +200,9 @@ vgpu::FrameStats with_merged_passes(const vgpu::FrameStats& in,
     c.fragments_launched = ma.fragments_launched;  // the same fragments, shaded once
     c.fragments_shaded = ma.fragments_shaded;
     c.fragments_masked = ma.fragments_masked;
-    c.lanes_idle = std::max(ma.lanes_idle, mb.lanes_idle);  // the same finished rays
+    c.lanes_idle = std::max(ma.lanes_idle, mb.lanes_idle);                 // the same finished rays
+    c.idle_in_batch32 = std::min(ma.idle_in_batch32, mb.idle_in_batch32);  // idle in both
+    c.idle_in_batch1024 = std::min(ma.idle_in_batch1024, mb.idle_in_batch1024);
     const uint64_t shared = uint64_t(m.shared_fetches) * c.fragments_shaded;
     c.instructions -= std::min(c.instructions, shared);  // a fetch is one counted operation
     c.texture_fetches -= std::min(c.texture_fetches, shared);

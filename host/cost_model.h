@@ -29,11 +29,10 @@ struct CostParams {
   // Assumed 3: hand count of the ray-triangle test, 62 scalar operations in about 22 fp30
   // instructions, and of voxel_exits, 27 in about 9. Capped by the profile's alu_lanes.
   double scalar_ops_per_instruction = 3.0;
-  // Dynamic branching (Branching::dynamic): the share of a pass's branch-idle fragments (its
-  // finished rays) that sit in batches of branch_granularity fragments idle as a whole, so the
-  // batch skips the branch. Assumed (no public figure): 0.75 for ~1000-pixel batches, 0.95 for
-  // 32-pixel warps. Zero without dynamic branching (fp30 runs both sides).
-  double branch_coherence = 0;
+  // Dynamic branching (Branching::dynamic) is not a parameter: the virtual GPU counts the
+  // branch-idle fragments that sit in batches idle as a whole (Counters::idle_in_batch32 and
+  // idle_in_batch1024, 8x4 and 32x32 pixel tiles); the profile's branch_granularity picks one
+  // (1024 for >= 256, else 32). Without dynamic branching (fp30) nothing is skipped.
   // Share of a program's operations, fetches and bytes read inside its f.branch() block, i.e.
   // what a skipping batch saves. Assumed 0.75 from the kernels' code: intersecciones (most of
   // every frame) keeps 132 of 135 operations but only 6 of 8 fetches (84 of 116 bytes) inside.

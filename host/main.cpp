@@ -4,8 +4,9 @@
 // GCC 12 reports false positives inside nlohmann_json's templates.
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #pragma GCC diagnostic ignored "-Wrestrict"
-#include <CLI/CLI.hpp>
+#include <unistd.h>
 
+#include <CLI/CLI.hpp>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -13,11 +14,10 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <regex>
-#include <unistd.h>
 
 #include "host/camera.h"
-#include "host/cpu_tracer.h"
 #include "host/cost_model.h"
+#include "host/cpu_tracer.h"
 #include "host/gltf_loader.h"
 #include "host/grid.h"
 #include "host/image_io.h"
@@ -71,6 +71,8 @@ nlohmann::ordered_json counters_json(const vgpu::Counters& c) {
           {"fragments_masked", c.fragments_masked},
           {"fragments_discarded", c.fragments_discarded},
           {"lanes_idle", c.lanes_idle},
+          {"idle_in_batch32", c.idle_in_batch32},
+          {"idle_in_batch1024", c.idle_in_batch1024},
           {"instructions", c.instructions},
           {"texture_fetches", c.texture_fetches},
           {"bytes_read", c.bytes_read},
@@ -99,21 +101,30 @@ int run_render(const RenderArgs& a) {
   opt.profile = vgpu::profile(a.profile).name;
   opt.threads = a.threads;
   opt.lanes = a.lanes;
-  if (a.precision == "fp32") opt.precision = vgpu::Format::fp32;
-  else if (a.precision == "fp24") opt.precision = vgpu::Format::fp24;
-  else if (a.precision == "fp16") opt.precision = vgpu::Format::fp16;
-  else throw UsageError("--precision: expected fp32, fp24 or fp16, got '" + a.precision + "'");
+  if (a.precision == "fp32")
+    opt.precision = vgpu::Format::fp32;
+  else if (a.precision == "fp24")
+    opt.precision = vgpu::Format::fp24;
+  else if (a.precision == "fp16")
+    opt.precision = vgpu::Format::fp16;
+  else
+    throw UsageError("--precision: expected fp32, fp24 or fp16, got '" + a.precision + "'");
   const host::GridSpec grid_spec = host::parse_grid_spec(a.grid);
   if (a.stats != "table" && a.stats != "json" && a.stats != "none")
     throw UsageError("--stats: expected table, json or none, got '" + a.stats + "'");
   std::string aov_depth, aov_hit;
   for (const std::string& aov : a.aovs) {
     const auto eq = aov.find('=');
-    const std::string kind = aov.substr(0, eq), file = eq == std::string::npos ? "" : aov.substr(eq + 1);
-    if (file.empty()) throw UsageError("--aov: expected depth=FILE.exr or hit=FILE.exr, got '" + aov + "'");
-    if (kind == "depth") aov_depth = file;
-    else if (kind == "hit") aov_hit = file;
-    else throw UsageError("--aov: unknown AOV '" + kind + "' (known: depth, hit)");
+    const std::string kind = aov.substr(0, eq),
+                      file = eq == std::string::npos ? "" : aov.substr(eq + 1);
+    if (file.empty())
+      throw UsageError("--aov: expected depth=FILE.exr or hit=FILE.exr, got '" + aov + "'");
+    if (kind == "depth")
+      aov_depth = file;
+    else if (kind == "hit")
+      aov_hit = file;
+    else
+      throw UsageError("--aov: unknown AOV '" + kind + "' (known: depth, hit)");
     host::check_image_path(file);
   }
   if (!a.out.empty()) host::check_image_path(a.out);
@@ -137,11 +148,13 @@ int run_render(const RenderArgs& a) {
   const host::Grid grid =
       host::build_grid(scene, host::grid_spec_for(grid_spec, scene, vgpu::profile(opt.profile)));
   const float aspect = float(opt.width) / float(opt.height);
-  const host::Camera cam = scene.camera ? *scene.camera : host::frame_bounds(scene.bounds(), aspect);
+  const host::Camera cam =
+      scene.camera ? *scene.camera : host::frame_bounds(scene.bounds(), aspect);
   const bool tty = ::isatty(2) && !a.quiet;
   if (!a.quiet)
     opt.progress = [&](int it, int n) {
-      std::fprintf(stderr, tty ? "\rvgpu-rt: iteration %d/%d" : "vgpu-rt: iteration %d/%d\n", it, n);
+      std::fprintf(stderr, tty ? "\rvgpu-rt: iteration %d/%d" : "vgpu-rt: iteration %d/%d\n", it,
+                   n);
       std::fflush(stderr);
     };
   std::optional<host::StreamTracer> tracer;
@@ -149,7 +162,8 @@ int run_render(const RenderArgs& a) {
   const double init_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   host::CpuStats cpu_stats;
-  const host::RenderResult r = cpu ? host::render_cpu(scene, grid, cam, opt, &cpu_stats) : tracer->render(cam);
+  const host::RenderResult r =
+      cpu ? host::render_cpu(scene, grid, cam, opt, &cpu_stats) : tracer->render(cam);
   if (tty) std::fprintf(stderr, "\n");
 
   if (!a.out.empty()) host::write_image(a.out, r.width, r.height, 3, r.rgb);
@@ -208,10 +222,12 @@ int run_render(const RenderArgs& a) {
   j["predicted_ms"] = predicted_ms;
   j["predicted_breakdown"] = predicted_breakdown;
   auto what_if = nlohmann::ordered_json::array();  // MRT and resident programs (docs/table1.md)
-  for (const auto& [name, s] : cpu ? decltype(host::what_ifs(r.stats)){} : host::what_ifs(r.stats)) {
+  for (const auto& [name, s] :
+       cpu ? decltype(host::what_ifs(r.stats)){} : host::what_ifs(r.stats)) {
     nlohmann::ordered_json w = {{"name", name}, {"totals", counters_json(s.totals)}};
     for (const vgpu::Profile& p : vgpu::profiles())
-      for (const auto& [key, v] : host::predict(s, p).items()) w["predicted_breakdown"][p.name][key] = v;
+      for (const auto& [key, v] : host::predict(s, p).items())
+        w["predicted_breakdown"][p.name][key] = v;
     what_if.push_back(w);
   }
   j["predicted_what_if"] = what_if;
@@ -229,18 +245,21 @@ int run_render(const RenderArgs& a) {
     std::cout << j.dump(2) << "\n";
   } else if (a.stats == "table") {
     if (cpu)
-      std::printf("CPU reference (double precision, recursive Whitted): %llu rays, %llu voxel steps, %llu triangle tests\n",
-                  static_cast<unsigned long long>(cpu_stats.rays),
-                  static_cast<unsigned long long>(cpu_stats.voxel_steps),
-                  static_cast<unsigned long long>(cpu_stats.triangle_tests));
+      std::printf(
+          "CPU reference (double precision, recursive Whitted): %llu rays, %llu voxel steps, %llu "
+          "triangle tests\n",
+          static_cast<unsigned long long>(cpu_stats.rays),
+          static_cast<unsigned long long>(cpu_stats.voxel_steps),
+          static_cast<unsigned long long>(cpu_stats.triangle_tests));
     else
       std::cout << r.stats.to_table();
-    std::printf("scene %s: %zu triangles (%u dropped as degenerate), grid %dx%dx%d (%llu references)\n",
-                scene.name.c_str(), scene.triangle_count(), scene.dropped_degenerate, grid.res.x,
-                grid.res.y, grid.res.z, static_cast<unsigned long long>(grid.references()));
+    std::printf(
+        "scene %s: %zu triangles (%u dropped as degenerate), grid %dx%dx%d (%llu references)\n",
+        scene.name.c_str(), scene.triangle_count(), scene.dropped_degenerate, grid.res.x,
+        grid.res.y, grid.res.z, static_cast<unsigned long long>(grid.references()));
     std::printf("%s %s, %dx%d, %d iteration(s), %s shading, shadows %s, masks %s\n",
-                cpu ? "engine" : "profile", cpu ? "cpu" : opt.profile.c_str(), r.width, r.height, r.iterations, a.shading.c_str(),
-                a.shadows.c_str(), a.masks.c_str());
+                cpu ? "engine" : "profile", cpu ? "cpu" : opt.profile.c_str(), r.width, r.height,
+                r.iterations, a.shading.c_str(), a.shadows.c_str(), a.masks.c_str());
     std::printf("initialization %.1f ms (grid %.1f ms), render %.1f ms (%s)\n", init_ms,
                 grid.build_ms, r.render_ms, cpu ? "host CPU" : "host, emulated");
   }
@@ -254,37 +273,58 @@ int run_render(const RenderArgs& a) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"vgpu-rt: a virtual 2004 GPU and the stream ray tracer of Fal, Vasconcelos & "
-               "Delrieux (after Purcell et al. 2002)"};
+  CLI::App app{
+      "vgpu-rt: a virtual 2004 GPU and the stream ray tracer of Fal, Vasconcelos & "
+      "Delrieux (after Purcell et al. 2002)"};
   app.require_subcommand(1);
   RenderArgs a;
-  auto* render = app.add_subcommand("render", "Render a scene on the virtual GPU and print the pass statistics");
-  render->add_option("scene", a.scene, "glTF file (.gltf/.glb) or a scene name from scenes/")->capture_default_str();
+  auto* render = app.add_subcommand(
+      "render", "Render a scene on the virtual GPU and print the pass statistics");
+  render->add_option("scene", a.scene, "glTF file (.gltf/.glb) or a scene name from scenes/")
+      ->capture_default_str();
   render->add_option("--size", a.size, "Image size WxH")->capture_default_str();
   render->add_option("--out", a.out, "Write the image (.png or .exr)");
-  render->add_option("--bounces", a.bounces, "Reflection iterations after the primary one")->capture_default_str();
-  render->add_option("--shading", a.shading, "diffuse | phong | phong-atten")->capture_default_str();
+  render->add_option("--bounces", a.bounces, "Reflection iterations after the primary one")
+      ->capture_default_str();
+  render->add_option("--shading", a.shading, "diffuse | phong | phong-atten")
+      ->capture_default_str();
   render->add_option("--shadows", a.shadows, "on | off")->capture_default_str();
   render->add_option("--grid", a.grid, "auto | N | AxBxC voxels")->capture_default_str();
   render->add_option("--profile", a.profile, "gf5700 | gf6600 | rtx4090")->capture_default_str();
   render->add_option("--threads", a.threads, "Host threads (0: all cores)")->capture_default_str();
-  render->add_option("--lanes", a.lanes, "SIMD lanes per batch: 1 (scalar reference), 4, 8, 16")->capture_default_str();
-  render->add_option("--masks", a.masks, "Early-z masks for finished rays (paper's future work): on | off")->capture_default_str();
+  render->add_option("--lanes", a.lanes, "SIMD lanes per batch: 1 (scalar reference), 4, 8, 16")
+      ->capture_default_str();
+  render
+      ->add_option("--masks", a.masks,
+                   "Early-z masks for finished rays (paper's future work): on | off")
+      ->capture_default_str();
   render->add_option("--stats", a.stats, "table | json | none")->capture_default_str();
-  render->add_option("--stats-json", a.stats_json, "Also write the statistics as JSON to this file");
-  render->add_option("--aov", a.aovs, "depth=FILE.exr (distance to primary hit) or hit=FILE.exr (triangle id)");
-  render->add_option("--trace-pixel", a.trace_pixel, "X,Y: print every pass this pixel took part in and its state");
+  render->add_option("--stats-json", a.stats_json,
+                     "Also write the statistics as JSON to this file");
+  render->add_option("--aov", a.aovs,
+                     "depth=FILE.exr (distance to primary hit) or hit=FILE.exr (triangle id)");
+  render->add_option("--trace-pixel", a.trace_pixel,
+                     "X,Y: print every pass this pixel took part in and its state");
   render->add_flag("--quiet,-q", a.quiet, "No progress on stderr");
-  render->add_option("--precision", a.precision, "Ray-state textures and kernel arithmetic: fp32 | fp24 | fp16")->capture_default_str();
-  render->add_option("--engine", a.engine, "stream (the vgpu pipeline) | cpu (double-precision reference)")->capture_default_str();
-  render->add_flag("--predict", a.predict, "Print the cost model's predicted time for --profile, with its breakdown");
+  render
+      ->add_option("--precision", a.precision,
+                   "Ray-state textures and kernel arithmetic: fp32 | fp24 | fp16")
+      ->capture_default_str();
+  render
+      ->add_option("--engine", a.engine,
+                   "stream (the vgpu pipeline) | cpu (double-precision reference)")
+      ->capture_default_str();
+  render->add_flag("--predict", a.predict,
+                   "Print the cost model's predicted time for --profile, with its breakdown");
   auto* scenes = app.add_subcommand("scenes", "List the scenes in scenes/");
   std::string ca, cb;
   double threshold = 1.0 / 255.0;
-  auto* compare = app.add_subcommand("compare", "Compare two images (OpenImageIO): differing pixels, RMS, PSNR");
+  auto* compare = app.add_subcommand(
+      "compare", "Compare two images (OpenImageIO): differing pixels, RMS, PSNR");
   compare->add_option("a", ca, "First image")->required();
   compare->add_option("b", cb, "Second image")->required();
-  compare->add_option("--threshold", threshold, "Per-channel difference that makes a pixel differ")->capture_default_str();
+  compare->add_option("--threshold", threshold, "Per-channel difference that makes a pixel differ")
+      ->capture_default_str();
 
   try {
     app.parse(argc, argv);
@@ -311,9 +351,11 @@ int main(int argc, char** argv) {
     }
     if (*compare) {
       const host::ImageComparison c = host::compare_images(ca, cb, threshold);
-      std::printf("%dx%d, %d channels: %.4f%% of pixels differ by more than %g; RMS %.6g, PSNR %.2f dB, max %.6g\n",
-                  c.width, c.height, c.channels, 100.0 * c.differing_share, c.threshold,
-                  c.rms_error, c.psnr, c.max_error);
+      std::printf(
+          "%dx%d, %d channels: %.4f%% of pixels differ by more than %g; RMS %.6g, PSNR %.2f dB, "
+          "max %.6g\n",
+          c.width, c.height, c.channels, 100.0 * c.differing_share, c.threshold, c.rms_error,
+          c.psnr, c.max_error);
       return 0;
     }
   } catch (const UsageError& e) {

@@ -18,7 +18,9 @@ enum class Format : uint8_t {
 
 // Bytes one channel of this format occupies in texture memory. R300 had no fp24 texture
 // format: fp24 values live in 32-bit texels, only the arithmetic is 24-bit.
-constexpr int bytes_per_channel(Format f) { return f == Format::fp16 ? 2 : 4; }
+constexpr int bytes_per_channel(Format f) {
+  return f == Format::fp16 ? 2 : 4;
+}
 
 constexpr std::string_view format_name(Format f) {
   return f == Format::fp32 ? "fp32" : f == Format::fp24 ? "fp24" : "fp16";
@@ -62,9 +64,12 @@ inline float round_fp24(float v) {
 
 inline float round_to(Format f, float v) {
   switch (f) {
-    case Format::fp16: return round_fp16(v);
-    case Format::fp24: return round_fp24(v);
-    default: return v;
+    case Format::fp16:
+      return round_fp16(v);
+    case Format::fp24:
+      return round_fp24(v);
+    default:
+      return v;
   }
 }
 

@@ -74,9 +74,9 @@ inline void join8(const float* x, const float* y, const float* z, const float* w
   const V8 u1 = __builtin_shufflevector(vx, vy, 2, 10, 3, 11, 6, 14, 7, 15);
   const V8 u2 = __builtin_shufflevector(vz, vw, 0, 8, 1, 9, 4, 12, 5, 13);
   const V8 u3 = __builtin_shufflevector(vz, vw, 2, 10, 3, 11, 6, 14, 7, 15);
-  const V8 b0 = __builtin_shufflevector(u0, u2, 0, 1, 8, 9, 4, 5, 12, 13);  // [0 | 4]
+  const V8 b0 = __builtin_shufflevector(u0, u2, 0, 1, 8, 9, 4, 5, 12, 13);    // [0 | 4]
   const V8 b1 = __builtin_shufflevector(u0, u2, 2, 3, 10, 11, 6, 7, 14, 15);  // [1 | 5]
-  const V8 b2 = __builtin_shufflevector(u1, u3, 0, 1, 8, 9, 4, 5, 12, 13);  // [2 | 6]
+  const V8 b2 = __builtin_shufflevector(u1, u3, 0, 1, 8, 9, 4, 5, 12, 13);    // [2 | 6]
   const V8 b3 = __builtin_shufflevector(u1, u3, 2, 3, 10, 11, 6, 7, 14, 15);  // [3 | 7]
   const V8 s0 = __builtin_shufflevector(b0, b1, 0, 1, 2, 3, 8, 9, 10, 11);
   const V8 s1 = __builtin_shufflevector(b2, b3, 0, 1, 2, 3, 8, 9, 10, 11);
@@ -133,9 +133,9 @@ class Fragments {
     } else {
       const F fu = floor(u), fv = floor(v);
       const float u0 = fu[0], v0 = fv[0];
-      if (t.channels == 4 && u0 >= 0.0f && u0 + float(W - 1) <= float(t.width - 1) &&
-          v0 >= 0.0f && v0 <= float(t.height - 1) &&
-          all(fu == F([](auto i) { return float(i); }) + u0) && all(fv == F(v0))) {
+      if (t.channels == 4 && u0 >= 0.0f && u0 + float(W - 1) <= float(t.width - 1) && v0 >= 0.0f &&
+          v0 <= float(t.height - 1) && all(fu == F([](auto i) { return float(i); }) + u0) &&
+          all(fv == F(v0))) {
         // The common case, a fragment's own texel: W consecutive fp32x4 texels inside one row.
         // Nothing to clamp; one base address and a transpose instead of per-lane loads.
         alignas(64) float lanes[4][W];
@@ -173,11 +173,14 @@ class Fragments {
       return true;
     } else {
       *idle_ += uint64_t(lanes_on(live_ && !m));
+      idle_any_ = idle_any_ || (live_ && !m);
       return !dynamic_ || any(live_ && m);
     }
   }
 
   const M& live() const { return live_; }
+  // Live fragments idle in some branch of this batch (for the batch-coherence counters).
+  const M& idle_lanes() const { return idle_any_; }
 
   // Set up by the fragment processor.
   Fragments(const BoundTexture* units, bool dynamic, uint64_t* idle, FetchTally* tally)
@@ -188,6 +191,7 @@ class Fragments {
     y = py;
     live_ = live;
     kill_ = M(false);
+    idle_any_ = M(false);
     cleared_ = 0;
     clear_outputs(outputs);
   }
@@ -199,7 +203,7 @@ class Fragments {
   bool dynamic_;
   uint64_t* idle_;
   FetchTally* tally_;
-  M live_{false}, kill_{false};
+  M live_{false}, kill_{false}, idle_any_{false};
   std::array<Vec4<F>, kMaxOutputs> out_;
   int cleared_ = 0;  // out_[0, cleared_) hold zero or what the program wrote in this batch
 
@@ -217,7 +221,8 @@ class Fragments {
     // Clamped again as integers: a reduced-precision wmax may round past the last texel.
     for (int i = 0; i < W; ++i)
       idx[i] = (std::min<int64_t>(int64_t(fv[i]), t.height - 1) * t.width +
-                std::min<int64_t>(int64_t(fu[i]), t.width - 1)) * ch;
+                std::min<int64_t>(int64_t(fu[i]), t.width - 1)) *
+               ch;
     Vec4<F> r{F(0.0f), F(0.0f), F(0.0f), F(1.0f)};
     r.x = F([&](auto i) { return d[idx[i]]; });
     if (ch > 1) r.y = F([&](auto i) { return d[idx[i] + 1]; });

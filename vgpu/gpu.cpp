@@ -2,11 +2,56 @@
 #include "vgpu/gpu.h"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
+#include <bit>
 #include <chrono>
 #include <cstring>
 
 namespace vgpu {
+
+namespace {
+
+// Batch flags per fragment: kTook took the branch, kIdle sat idle in it, 0 not shaded.
+constexpr uint8_t kTook = 1, kIdle = 2;
+
+// Idle fragments in the 8x4 and the 32x32 tiles of a w x h flag map where no fragment took the
+// branch: {in 8x4 tiles, in 32x32 tiles}. Eight flags are tested at once as one 64-bit word.
+std::array<uint64_t, 2> idle_in_batches(const std::vector<uint8_t>& flags, int w, int h) {
+  constexpr uint64_t took_bits = 0x0101010101010101ull * kTook;
+  constexpr uint64_t idle_bits = 0x0101010101010101ull * kIdle;
+  const int cols8 = (w + 7) / 8, cols32 = (w + 31) / 32;
+  std::vector<uint64_t> idle8(static_cast<size_t>(cols8)), idle32(static_cast<size_t>(cols32));
+  std::vector<uint8_t> busy8(static_cast<size_t>(cols8)), busy32(static_cast<size_t>(cols32));
+  std::array<uint64_t, 2> total{0, 0};
+  for (int y = 0; y < h; ++y) {
+    const uint8_t* row = flags.data() + size_t(y) * size_t(w);
+    for (int c = 0; c < cols8; ++c) {
+      uint64_t v = 0;
+      std::memcpy(&v, row + 8 * c, size_t(std::min(8, w - 8 * c)));  // the tail reads 0s
+      busy8[size_t(c)] |= (v & took_bits) != 0;
+      idle8[size_t(c)] += uint64_t(std::popcount(v & idle_bits));
+    }
+    const bool band8_end = y % 4 == 3 || y == h - 1;
+    if (band8_end)
+      for (int c = 0; c < cols8; ++c) {
+        if (!busy8[size_t(c)]) total[0] += idle8[size_t(c)];
+        busy32[size_t(c / 4)] |= busy8[size_t(c)];
+        idle32[size_t(c / 4)] += idle8[size_t(c)];
+        busy8[size_t(c)] = 0;
+        idle8[size_t(c)] = 0;
+      }
+    if (y % 32 == 31 || y == h - 1)
+      for (int c = 0; c < cols32; ++c) {
+        if (!busy32[size_t(c)]) total[1] += idle32[size_t(c)];
+        busy32[size_t(c)] = 0;
+        idle32[size_t(c)] = 0;
+      }
+  }
+  return total;
+}
+
+}  // namespace
 
 struct Gpu::Chunk {
   uint64_t launched = 0, shaded = 0, masked = 0, discarded = 0, idle = 0;
@@ -119,7 +164,7 @@ const PassRecord& Gpu::draw() {
 
 template <class L>
 void Gpu::run_rows(const Program& p, const Rect& r, int y0, int y1, uint64_t idle_branches,
-                   Chunk& result) const {
+                   uint8_t* flags, Chunk& result) const {
   constexpr int W = L::width;
   // Counted in a local and stored once: neighbouring chunks share cache lines, and other
   // threads are counting into them.
@@ -161,6 +206,7 @@ void Gpu::run_rows(const Program& p, const Rect& r, int y0, int y1, uint64_t idl
     const uint8_t* st = stencil_test_ ? stencil_test_->row(y) : nullptr;
     const uint8_t* wk = work_mask_ ? work_mask_->row(y) : nullptr;
     uint8_t* sw = stencil_write_ ? stencil_write_->row_mut(y) : nullptr;
+    uint8_t* fl = flags ? flags + size_t(y - r.y0) * size_t(r.width()) - size_t(r.x0) : nullptr;
     for (int x = r.x0, n = 0; x < r.x1; x += n) {
       if (wk && !st && wk[x] == 0) {
         // A stretch of idle fragments (the usual case late in a loop): counted and copied at
@@ -189,6 +235,7 @@ void Gpu::run_rows(const Program& p, const Rect& r, int y0, int y1, uint64_t idl
                 cp.dst[off + i] = round_to(cp.fmt, cp.src[off + i]);
           }
         if (sw) std::memset(sw + x, idle_kill ? 0 : 1, size_t(n));
+        if (fl && !work_masked_) std::memset(fl + x, kIdle, size_t(n));
         continue;
       }
       n = std::min(W, r.x1 - x);
@@ -275,6 +322,13 @@ void Gpu::run_rows(const Program& p, const Rect& r, int y0, int y1, uint64_t idl
             }
           }
         }
+      }
+      if (fl) {
+        const M idle = f.idle_lanes();
+        for (int i = 0; i < n; ++i)
+          fl[x + i] = !live[i] ? 0
+                      : run[i] ? (idle[i] ? kIdle : kTook)
+                               : (work_masked_ ? 0 : kIdle);
       }
       out.discarded += uint64_t(nkill);
       if (sw)
@@ -391,34 +445,39 @@ const PassRecord& Gpu::draw(const Rect& rect) {
   in_draw_ = true;
   std::vector<Chunk> chunks;
   const uint64_t idle_branches = uint64_t(a.branches);
+  uint8_t* flags = nullptr;
+  if (a.branches > 0) {
+    batch_flags_.assign(size_t(rect.width()) * size_t(rect.height()), 0);
+    flags = batch_flags_.data();
+  }
   auto body = [&](int ya, int yb, Chunk& c) {
     // Reduced precision runs at width 1 (the scalar reference) or 8.
     if (precision_ == Format::fp16) {
       if (lanes_ == 1)
-        run_rows<RoundedLanes<1, Format::fp16>>(p, rect, ya, yb, idle_branches, c);
+        run_rows<RoundedLanes<1, Format::fp16>>(p, rect, ya, yb, idle_branches, flags, c);
       else
-        run_rows<RoundedLanes<8, Format::fp16>>(p, rect, ya, yb, idle_branches, c);
+        run_rows<RoundedLanes<8, Format::fp16>>(p, rect, ya, yb, idle_branches, flags, c);
       return;
     }
     if (precision_ == Format::fp24) {
       if (lanes_ == 1)
-        run_rows<RoundedLanes<1, Format::fp24>>(p, rect, ya, yb, idle_branches, c);
+        run_rows<RoundedLanes<1, Format::fp24>>(p, rect, ya, yb, idle_branches, flags, c);
       else
-        run_rows<RoundedLanes<8, Format::fp24>>(p, rect, ya, yb, idle_branches, c);
+        run_rows<RoundedLanes<8, Format::fp24>>(p, rect, ya, yb, idle_branches, flags, c);
       return;
     }
     switch (lanes_) {
       case 1:
-        run_rows<SimdLanes<1>>(p, rect, ya, yb, idle_branches, c);
+        run_rows<SimdLanes<1>>(p, rect, ya, yb, idle_branches, flags, c);
         break;
       case 4:
-        run_rows<SimdLanes<4>>(p, rect, ya, yb, idle_branches, c);
+        run_rows<SimdLanes<4>>(p, rect, ya, yb, idle_branches, flags, c);
         break;
       case 8:
-        run_rows<SimdLanes<8>>(p, rect, ya, yb, idle_branches, c);
+        run_rows<SimdLanes<8>>(p, rect, ya, yb, idle_branches, flags, c);
         break;
       default:
-        run_rows<SimdLanes<16>>(p, rect, ya, yb, idle_branches, c);
+        run_rows<SimdLanes<16>>(p, rect, ya, yb, idle_branches, flags, c);
         break;
     }
   };
@@ -441,6 +500,12 @@ const PassRecord& Gpu::draw(const Rect& rect) {
   c.fragments_masked = sum.masked;
   c.fragments_discarded = sum.discarded;
   c.lanes_idle = sum.idle;
+  if (flags) {
+    const std::array<uint64_t, 2> batch =
+        idle_in_batches(batch_flags_, rect.width(), rect.height());
+    c.idle_in_batch32 = batch[0];
+    c.idle_in_batch1024 = batch[1];
+  }
   c.instructions = sum.shaded * uint64_t(a.instructions);
   uint64_t read_per_frag = 0;
   for (int u = 0; u < kMaxTextureUnits; ++u)

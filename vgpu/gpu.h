@@ -102,7 +102,7 @@ class Gpu {
   struct Chunk;
   template <class L>
   void run_rows(const Program& p, const Rect& r, int y0, int y1, uint64_t idle_branches,
-                Chunk& out) const;
+                uint8_t* flags, Chunk& out) const;
   void parallel_rows(const Rect& r, const std::function<void(int, int, Chunk&)>& body,
                      std::vector<Chunk>& chunks);
   void worker_loop();
@@ -120,6 +120,9 @@ class Gpu {
   const Stencil* work_mask_ = nullptr;
   bool work_masked_ = false;
   bool in_draw_ = false;
+  // Per fragment of the drawn rectangle, for the batch counters: took the branch, idle in it, or
+  // not shaded (gpu.cpp). Rebuilt by every draw of a program that branches.
+  std::vector<uint8_t> batch_flags_;
   bool query_active_ = false;
   uint64_t query_count_ = 0;
   FrameStats stats_;

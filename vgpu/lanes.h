@@ -4,10 +4,9 @@
 // Vectors are one register per component (Vec3<F>{x, y, z}), as in SwiftShader.
 #pragma once
 
-#include <experimental/simd>
-
 #include <cmath>
 #include <cstdint>
+#include <experimental/simd>
 
 namespace vgpu {
 
@@ -33,13 +32,21 @@ inline stdx::simd<T, A> select(const stdx::simd_mask<T, A>& m, const stdx::simd<
   return r;
 }
 template <class T, class A>
-inline bool any(const stdx::simd_mask<T, A>& m) { return stdx::any_of(m); }
+inline bool any(const stdx::simd_mask<T, A>& m) {
+  return stdx::any_of(m);
+}
 template <class T, class A>
-inline bool all(const stdx::simd_mask<T, A>& m) { return stdx::all_of(m); }
+inline bool all(const stdx::simd_mask<T, A>& m) {
+  return stdx::all_of(m);
+}
 template <class T, class A>
-inline int lanes_on(const stdx::simd_mask<T, A>& m) { return stdx::popcount(m); }
+inline int lanes_on(const stdx::simd_mask<T, A>& m) {
+  return stdx::popcount(m);
+}
 template <class T, class A>
-inline stdx::simd<T, A> rsqrt(const stdx::simd<T, A>& v) { return T(1) / stdx::sqrt(v); }
+inline stdx::simd<T, A> rsqrt(const stdx::simd<T, A>& v) {
+  return T(1) / stdx::sqrt(v);
+}
 using stdx::abs;
 using stdx::floor;
 using stdx::max;
@@ -49,14 +56,14 @@ using stdx::sqrt;
 // MAX = a > b ? a : b), so a NaN or a signed zero gives the same result at every width:
 // stdx::min is std::min at width 1 but minps at wider widths, and those disagree on NaN and
 // +-0. Non-templates, so overload resolution prefers them to stdx::min found by ADL.
-#define VGPU_LANE_MIN_MAX(W)                                                                  \
-  inline stdx::fixed_size_simd<float, W> min(const stdx::fixed_size_simd<float, W>& a,       \
-                                             const stdx::fixed_size_simd<float, W>& b) {     \
-    return select(a < b, a, b);                                                             \
-  }                                                                                         \
-  inline stdx::fixed_size_simd<float, W> max(const stdx::fixed_size_simd<float, W>& a,       \
-                                             const stdx::fixed_size_simd<float, W>& b) {     \
-    return select(a > b, a, b);                                                             \
+#define VGPU_LANE_MIN_MAX(W)                                                             \
+  inline stdx::fixed_size_simd<float, W> min(const stdx::fixed_size_simd<float, W>& a,   \
+                                             const stdx::fixed_size_simd<float, W>& b) { \
+    return select(a < b, a, b);                                                          \
+  }                                                                                      \
+  inline stdx::fixed_size_simd<float, W> max(const stdx::fixed_size_simd<float, W>& a,   \
+                                             const stdx::fixed_size_simd<float, W>& b) { \
+    return select(a > b, a, b);                                                          \
   }
 VGPU_LANE_MIN_MAX(1)
 VGPU_LANE_MIN_MAX(4)
@@ -75,28 +82,45 @@ struct OpCounter {
 struct CFloat;
 struct CMask {
   bool v;
-  friend CMask operator&&(CMask a, CMask b) { ++OpCounter::ops; return {a.v && b.v}; }
-  friend CMask operator||(CMask a, CMask b) { ++OpCounter::ops; return {a.v || b.v}; }
-  friend CMask operator!(CMask a) { ++OpCounter::ops; return {!a.v}; }
+  friend CMask operator&&(CMask a, CMask b) {
+    ++OpCounter::ops;
+    return {a.v && b.v};
+  }
+  friend CMask operator||(CMask a, CMask b) {
+    ++OpCounter::ops;
+    return {a.v || b.v};
+  }
+  friend CMask operator!(CMask a) {
+    ++OpCounter::ops;
+    return {!a.v};
+  }
 };
 struct CFloat {
   float v = 0;
   CFloat() = default;
   CFloat(float f) : v(f) {}  // constants are free (literal registers)
-#define VGPU_COUNTED_BINOP(op)                                   \
-  friend CFloat operator op(CFloat a, CFloat b) {                \
-    ++OpCounter::ops;                                            \
-    return CFloat(a.v op b.v);                                   \
-  }                                                              \
-  CFloat& operator op##=(CFloat b) { return *this = *this op b; }
+#define VGPU_COUNTED_BINOP(op)                    \
+  friend CFloat operator op(CFloat a, CFloat b) { \
+    ++OpCounter::ops;                             \
+    return CFloat(a.v op b.v);                    \
+  }                                               \
+  CFloat& operator op##=(CFloat b) {              \
+    return *this = *this op b;                    \
+  }
   VGPU_COUNTED_BINOP(+)
   VGPU_COUNTED_BINOP(-)
   VGPU_COUNTED_BINOP(*)
   VGPU_COUNTED_BINOP(/)
 #undef VGPU_COUNTED_BINOP
-  friend CFloat operator-(CFloat a) { ++OpCounter::ops; return CFloat(-a.v); }
-#define VGPU_COUNTED_CMP(op) \
-  friend CMask operator op(CFloat a, CFloat b) { ++OpCounter::ops; return {a.v op b.v}; }
+  friend CFloat operator-(CFloat a) {
+    ++OpCounter::ops;
+    return CFloat(-a.v);
+  }
+#define VGPU_COUNTED_CMP(op)                     \
+  friend CMask operator op(CFloat a, CFloat b) { \
+    ++OpCounter::ops;                            \
+    return {a.v op b.v};                         \
+  }
   VGPU_COUNTED_CMP(<)
   VGPU_COUNTED_CMP(<=)
   VGPU_COUNTED_CMP(>)
@@ -105,16 +129,43 @@ struct CFloat {
   VGPU_COUNTED_CMP(!=)
 #undef VGPU_COUNTED_CMP
 };
-inline CFloat select(CMask m, CFloat a, CFloat b) { ++OpCounter::ops; return m.v ? a : b; }
-inline bool any(CMask m) { return m.v; }
-inline bool all(CMask m) { return m.v; }
-inline int lanes_on(CMask m) { return m.v ? 1 : 0; }
-inline CFloat min(CFloat a, CFloat b) { ++OpCounter::ops; return a.v < b.v ? a : b; }
-inline CFloat max(CFloat a, CFloat b) { ++OpCounter::ops; return a.v > b.v ? a : b; }
-inline CFloat abs(CFloat a) { ++OpCounter::ops; return CFloat(std::fabs(a.v)); }
-inline CFloat floor(CFloat a) { ++OpCounter::ops; return CFloat(std::floor(a.v)); }
-inline CFloat sqrt(CFloat a) { ++OpCounter::ops; return CFloat(std::sqrt(a.v)); }
-inline CFloat rsqrt(CFloat a) { ++OpCounter::ops; return CFloat(1.0f / std::sqrt(a.v)); }
+inline CFloat select(CMask m, CFloat a, CFloat b) {
+  ++OpCounter::ops;
+  return m.v ? a : b;
+}
+inline bool any(CMask m) {
+  return m.v;
+}
+inline bool all(CMask m) {
+  return m.v;
+}
+inline int lanes_on(CMask m) {
+  return m.v ? 1 : 0;
+}
+inline CFloat min(CFloat a, CFloat b) {
+  ++OpCounter::ops;
+  return a.v < b.v ? a : b;
+}
+inline CFloat max(CFloat a, CFloat b) {
+  ++OpCounter::ops;
+  return a.v > b.v ? a : b;
+}
+inline CFloat abs(CFloat a) {
+  ++OpCounter::ops;
+  return CFloat(std::fabs(a.v));
+}
+inline CFloat floor(CFloat a) {
+  ++OpCounter::ops;
+  return CFloat(std::floor(a.v));
+}
+inline CFloat sqrt(CFloat a) {
+  ++OpCounter::ops;
+  return CFloat(std::sqrt(a.v));
+}
+inline CFloat rsqrt(CFloat a) {
+  ++OpCounter::ops;
+  return CFloat(1.0f / std::sqrt(a.v));
+}
 
 struct CountingLanes {
   static constexpr int width = 1;
@@ -125,11 +176,19 @@ struct CountingLanes {
 
 // Lane i of a value, for host code and tests.
 template <class T, class A>
-inline T lane(const stdx::simd<T, A>& v, int i) { return v[i]; }
+inline T lane(const stdx::simd<T, A>& v, int i) {
+  return v[i];
+}
 template <class T, class A>
-inline bool lane(const stdx::simd_mask<T, A>& m, int i) { return m[i]; }
-inline float lane(CFloat v, int) { return v.v; }
-inline bool lane(CMask m, int) { return m.v; }
+inline bool lane(const stdx::simd_mask<T, A>& m, int i) {
+  return m[i];
+}
+inline float lane(CFloat v, int) {
+  return v.v;
+}
+inline bool lane(CMask m, int) {
+  return m.v;
+}
 
 // ---------------------------------------------------------------------------------------------
 // Vectors of lanes, one register per component.
@@ -149,13 +208,17 @@ struct Vec4 {
   Vec3<F> xyz() const { return {x, y, z}; }
 };
 template <class F>
-inline F dot(const Vec3<F>& a, const Vec3<F>& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+inline F dot(const Vec3<F>& a, const Vec3<F>& b) {
+  return a.x * b.x + a.y * b.y + a.z * b.z;
+}
 template <class F>
 inline Vec3<F> cross(const Vec3<F>& a, const Vec3<F>& b) {
   return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
 }
 template <class F>
-inline Vec3<F> normalize(const Vec3<F>& a) { return a * rsqrt(dot(a, a)); }
+inline Vec3<F> normalize(const Vec3<F>& a) {
+  return a * rsqrt(dot(a, a));
+}
 template <class M, class F>
 inline Vec3<F> select(const M& m, const Vec3<F>& a, const Vec3<F>& b) {
   return {select(m, a.x, b.x), select(m, a.y, b.y), select(m, a.z, b.z)};

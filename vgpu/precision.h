@@ -26,31 +26,41 @@ struct RFloat {
   RFloat(float f) : v(round_to(Fm, f)) {}  // constants are rounded too
   explicit RFloat(const S& s) : v(round(s)) {}
   template <class G>
-    requires std::is_invocable_r_v<float, G, std::integral_constant<size_t, 0>>
+  requires std::is_invocable_r_v<float, G, std::integral_constant<size_t, 0>>
   explicit RFloat(G&& gen) : v(round(S(std::forward<G>(gen)))) {}
 
   float operator[](size_t i) const { return v[i]; }
   template <class Tag>
-  void copy_to(float* p, Tag t) const { v.copy_to(p, t); }
+  void copy_to(float* p, Tag t) const {
+    v.copy_to(p, t);
+  }
   template <class Tag>
   void copy_from(const float* p, Tag t) {
     v.copy_from(p, t);
     v = round(v);
   }
 
-#define VGPU_ROUNDED_BINOP(op)                                                  \
-  friend RFloat operator op(const RFloat& a, const RFloat& b) {                 \
-    return RFloat(S(a.v op b.v));                                               \
-  }                                                                             \
-  RFloat& operator op##=(const RFloat& b) { return *this = *this op b; }
+#define VGPU_ROUNDED_BINOP(op)                                  \
+  friend RFloat operator op(const RFloat& a, const RFloat& b) { \
+    return RFloat(S(a.v op b.v));                               \
+  }                                                             \
+  RFloat& operator op##=(const RFloat& b) {                     \
+    return *this = *this op b;                                  \
+  }
   VGPU_ROUNDED_BINOP(+)
   VGPU_ROUNDED_BINOP(-)
   VGPU_ROUNDED_BINOP(*)
   VGPU_ROUNDED_BINOP(/)
 #undef VGPU_ROUNDED_BINOP
-  friend RFloat operator-(const RFloat& a) { RFloat r; r.v = -a.v; return r; }  // exact
-#define VGPU_ROUNDED_CMP(op) \
-  friend mask_type operator op(const RFloat& a, const RFloat& b) { return a.v op b.v; }
+  friend RFloat operator-(const RFloat& a) {
+    RFloat r;
+    r.v = -a.v;
+    return r;
+  }  // exact
+#define VGPU_ROUNDED_CMP(op)                                       \
+  friend mask_type operator op(const RFloat& a, const RFloat& b) { \
+    return a.v op b.v;                                             \
+  }
   VGPU_ROUNDED_CMP(<)
   VGPU_ROUNDED_CMP(<=)
   VGPU_ROUNDED_CMP(>)
@@ -68,15 +78,27 @@ inline RFloat<W, Fm> select(const typename RFloat<W, Fm>::mask_type& m, const RF
   return r;
 }
 template <int W, Format Fm>
-inline RFloat<W, Fm> min(const RFloat<W, Fm>& a, const RFloat<W, Fm>& b) { return select(a < b, a, b); }
+inline RFloat<W, Fm> min(const RFloat<W, Fm>& a, const RFloat<W, Fm>& b) {
+  return select(a < b, a, b);
+}
 template <int W, Format Fm>
-inline RFloat<W, Fm> max(const RFloat<W, Fm>& a, const RFloat<W, Fm>& b) { return select(a > b, a, b); }
+inline RFloat<W, Fm> max(const RFloat<W, Fm>& a, const RFloat<W, Fm>& b) {
+  return select(a > b, a, b);
+}
 template <int W, Format Fm>
-inline RFloat<W, Fm> abs(const RFloat<W, Fm>& a) { RFloat<W, Fm> r; r.v = stdx::abs(a.v); return r; }
+inline RFloat<W, Fm> abs(const RFloat<W, Fm>& a) {
+  RFloat<W, Fm> r;
+  r.v = stdx::abs(a.v);
+  return r;
+}
 template <int W, Format Fm>
-inline RFloat<W, Fm> floor(const RFloat<W, Fm>& a) { return RFloat<W, Fm>(stdx::floor(a.v)); }
+inline RFloat<W, Fm> floor(const RFloat<W, Fm>& a) {
+  return RFloat<W, Fm>(stdx::floor(a.v));
+}
 template <int W, Format Fm>
-inline RFloat<W, Fm> sqrt(const RFloat<W, Fm>& a) { return RFloat<W, Fm>(stdx::sqrt(a.v)); }
+inline RFloat<W, Fm> sqrt(const RFloat<W, Fm>& a) {
+  return RFloat<W, Fm>(stdx::sqrt(a.v));
+}
 // RSQ is one instruction: one rounding.
 template <int W, Format Fm>
 inline RFloat<W, Fm> rsqrt(const RFloat<W, Fm>& a) {

@@ -67,14 +67,22 @@ class KernelProgram final : public Program {
   const char* name() const override { return K::name; }
   const char* paper_name() const override { return K::paper_name; }
   int outputs() const override { return K::outputs; }
-  bool has_passthrough() const override { return requires { K::passthrough; }; }
+  bool has_passthrough() const override {
+    return requires {
+      K::passthrough;
+    };
+  }
   int passthrough(int output) const override {
-    if constexpr (requires { K::passthrough; }) return K::passthrough[output];
-    else return -1;
+    if constexpr (requires { K::passthrough; })
+      return K::passthrough[output];
+    else
+      return -1;
   }
   bool idle_discards() const override {
-    if constexpr (requires { K::idle_discards; }) return K::idle_discards;
-    else return false;
+    if constexpr (requires { K::idle_discards; })
+      return K::idle_discards;
+    else
+      return false;
   }
   void run(Fragments<SimdLanes<1>>& f) const override { kernel(f); }
   void run(Fragments<SimdLanes<4>>& f) const override { kernel(f); }

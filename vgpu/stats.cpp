@@ -10,10 +10,12 @@
 
 namespace vgpu {
 
-#define VGPU_COUNTER_FIELDS(X)                                                               \
-  X(passes) X(fragments_launched) X(fragments_shaded) X(fragments_masked)                   \
-  X(fragments_discarded) X(lanes_idle) X(instructions) X(texture_fetches) X(bytes_read)     \
-  X(bytes_written) X(program_loads) X(program_bytes) X(clears) X(queries) X(query_readbacks)
+#define VGPU_COUNTER_FIELDS(X)                                                                  \
+  X(passes)                                                                                     \
+  X(fragments_launched) X(fragments_shaded) X(fragments_masked) X(fragments_discarded)          \
+      X(lanes_idle) X(idle_in_batch32) X(idle_in_batch1024) X(instructions) X(texture_fetches)  \
+          X(bytes_read) X(bytes_written) X(program_loads) X(program_bytes) X(clears) X(queries) \
+              X(query_readbacks)
 
 Counters& Counters::operator+=(const Counters& o) {
 #define X(f) f += o.f;
@@ -24,7 +26,8 @@ Counters& Counters::operator+=(const Counters& o) {
 }
 
 bool Counters::same_counts(const Counters& o) const {
-#define X(f) if (f != o.f) return false;
+#define X(f) \
+  if (f != o.f) return false;
   VGPU_COUNTER_FIELDS(X)
 #undef X
   return true;
@@ -79,10 +82,14 @@ std::string FrameStats::to_json(int indent) const {
 
 static std::string human(uint64_t v) {
   char buf[32];
-  if (v >= 10'000'000'000ull) std::snprintf(buf, sizeof buf, "%.1fG", v / 1e9);
-  else if (v >= 10'000'000ull) std::snprintf(buf, sizeof buf, "%.1fM", v / 1e6);
-  else if (v >= 100'000ull) std::snprintf(buf, sizeof buf, "%.1fk", v / 1e3);
-  else std::snprintf(buf, sizeof buf, "%llu", static_cast<unsigned long long>(v));
+  if (v >= 10'000'000'000ull)
+    std::snprintf(buf, sizeof buf, "%.1fG", v / 1e9);
+  else if (v >= 10'000'000ull)
+    std::snprintf(buf, sizeof buf, "%.1fM", v / 1e6);
+  else if (v >= 100'000ull)
+    std::snprintf(buf, sizeof buf, "%.1fk", v / 1e3);
+  else
+    std::snprintf(buf, sizeof buf, "%llu", static_cast<unsigned long long>(v));
   return buf;
 }
 

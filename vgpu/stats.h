@@ -14,17 +14,22 @@ struct Counters {
   uint64_t fragments_shaded = 0;     // fragments the program ran on (launched minus masked)
   uint64_t fragments_masked = 0;     // skipped by the early-z/stencil mask before shading
   uint64_t fragments_discarded = 0;  // shaded, then killed (no write, not counted by a query)
-  uint64_t lanes_idle = 0;           // SIMD lanes issued without a live fragment, or idle in a branch
-  uint64_t instructions = 0;         // fragment-program instructions executed (shaded x static count)
-  uint64_t texture_fetches = 0;      // texels fetched through texture units
-  uint64_t bytes_read = 0;           // bytes fetched through texture units
-  uint64_t bytes_written = 0;        // bytes written to render targets
-  uint64_t program_loads = 0;        // binds of a program different from the last one
-  uint64_t program_bytes = 0;        // bytes of program code uploaded by those loads
-  uint64_t clears = 0;               // render-target clears (glClear: no fragment program)
-  uint64_t queries = 0;              // occlusion queries issued
-  uint64_t query_readbacks = 0;      // query results read back by the host (a CPU-GPU sync)
-  double host_ms = 0;                // host wall time (the only counter that varies run to run)
+  uint64_t lanes_idle = 0;  // SIMD lanes issued without a live fragment, or idle in a branch
+  // Shaded fragments idle in the program's branch that sit in a batch with no shaded fragment
+  // taking it: what dynamic branching skips at a granularity of 32 (8x4 pixel tiles, a warp) or
+  // 1024 (32x32 tiles, NV4x) fragments. Tiles are aligned to the drawn rectangle's corner.
+  uint64_t idle_in_batch32 = 0;
+  uint64_t idle_in_batch1024 = 0;
+  uint64_t instructions = 0;     // fragment-program instructions executed (shaded x static count)
+  uint64_t texture_fetches = 0;  // texels fetched through texture units
+  uint64_t bytes_read = 0;       // bytes fetched through texture units
+  uint64_t bytes_written = 0;    // bytes written to render targets
+  uint64_t program_loads = 0;    // binds of a program different from the last one
+  uint64_t program_bytes = 0;    // bytes of program code uploaded by those loads
+  uint64_t clears = 0;           // render-target clears (glClear: no fragment program)
+  uint64_t queries = 0;          // occlusion queries issued
+  uint64_t query_readbacks = 0;  // query results read back by the host (a CPU-GPU sync)
+  double host_ms = 0;            // host wall time (the only counter that varies run to run)
 
   Counters& operator+=(const Counters& o);
   // Every integer counter equal (host_ms excluded).

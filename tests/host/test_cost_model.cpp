@@ -27,7 +27,6 @@ vgpu::Profile card() {
 host::CostParams params() {
   host::CostParams c;
   c.scalar_ops_per_instruction = 3;
-  c.branch_coherence = 0;
   c.branch_body_share = 0.75;
   c.pass_us = 10;
   c.program_load_us = 20;
@@ -133,10 +132,13 @@ TEST_CASE("Dynamic branching skips the branch body of batches idle as a whole") 
   vgpu::Profile fx = card();
   vgpu::Profile nv4 = card();
   nv4.branching = vgpu::Branching::dynamic;
+  nv4.branch_granularity = 1024;
   host::CostParams p = params();
-  p.branch_coherence = 1;   // every finished ray sits in an all-idle batch
-  p.branch_body_share = 1;  // and skips the whole program
-  const vgpu::FrameStats s = frame(kernel_passes(2, 3000));
+  p.branch_body_share = 1;  // a skipping batch skips the whole program
+  vgpu::Counters k = kernel_passes(2, 3000);
+  k.idle_in_batch1024 = k.lanes_idle;  // every finished ray sits in an all-idle batch
+  k.idle_in_batch32 = 0;               // (the warp-sized count is not the 6600's)
+  const vgpu::FrameStats s = frame(k);
   const auto both_sides = host::predict(s, fx, p);
   const auto branching = host::predict(s, nv4, p);
   CHECK(branching.arithmetic_demand_ms == doctest::Approx(both_sides.arithmetic_demand_ms / 4));

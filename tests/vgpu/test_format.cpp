@@ -19,16 +19,18 @@ const float kInf = std::numeric_limits<float>::infinity();
 const float kNaN = std::numeric_limits<float>::quiet_NaN();
 
 // Exact equality of bits: tells +0 from -0, which == does not.
-bool same_bits(float a, float b) { return std::bit_cast<uint32_t>(a) == std::bit_cast<uint32_t>(b); }
+bool same_bits(float a, float b) {
+  return std::bit_cast<uint32_t>(a) == std::bit_cast<uint32_t>(b);
+}
 
 }  // namespace
 
 TEST_CASE("fp16 stores round to the nearest binary16, ties to even") {
   CHECK(round_fp16(1.0f / 3.0f) == 0.333251953125f);  // 0x3555
-  CHECK(round_fp16(0.1f) == 0.0999755859375f);          // 0x2e66
+  CHECK(round_fp16(0.1f) == 0.0999755859375f);        // 0x2e66
   CHECK(round_fp16(1.0f) == 1.0f);
-  CHECK(round_fp16(2048.0f + 1.0f) == 2048.0f);         // tie: 2048 is even, 2050 odd
-  CHECK(round_fp16(2048.0f + 3.0f) == 2052.0f);         // tie: 2052 is even
+  CHECK(round_fp16(2048.0f + 1.0f) == 2048.0f);  // tie: 2048 is even, 2050 odd
+  CHECK(round_fp16(2048.0f + 3.0f) == 2052.0f);  // tie: 2052 is even
   SUBCASE("a tie one half-ulp above 1 goes down to the even 1") {
     CHECK(round_fp16(1.0f + 0x1p-11f) == 1.0f);
   }
@@ -50,16 +52,16 @@ TEST_CASE("fp16 holds 65504 at most and rounds 65520 and above to infinity") {
 }
 
 TEST_CASE("fp16 underflows gradually to subnormals in steps of 2^-24") {
-  CHECK(round_fp16(0x1p-14f) == 0x1p-14f);                 // smallest normal
-  CHECK(round_fp16(1023 * 0x1p-24f) == 1023 * 0x1p-24f);   // largest subnormal
-  CHECK(round_fp16(0x1p-24f) == 0x1p-24f);                 // smallest subnormal
-  CHECK(round_fp16(0x1.8p-24f) == 0x1p-23f);               // 1.5 ulp: tie to the even 2 ulps
-  CHECK(round_fp16(3 * 0x1p-25f) == 0x1p-23f);             // the same tie, written as 3 * 2^-25
-  CHECK(round_fp16(0x1.4p-24f) == 0x1p-24f);               // 1.25 ulp rounds down
-  CHECK(same_bits(round_fp16(0x1p-25f), 0.0f));            // half an ulp: tie to the even 0
+  CHECK(round_fp16(0x1p-14f) == 0x1p-14f);                // smallest normal
+  CHECK(round_fp16(1023 * 0x1p-24f) == 1023 * 0x1p-24f);  // largest subnormal
+  CHECK(round_fp16(0x1p-24f) == 0x1p-24f);                // smallest subnormal
+  CHECK(round_fp16(0x1.8p-24f) == 0x1p-23f);              // 1.5 ulp: tie to the even 2 ulps
+  CHECK(round_fp16(3 * 0x1p-25f) == 0x1p-23f);            // the same tie, written as 3 * 2^-25
+  CHECK(round_fp16(0x1.4p-24f) == 0x1p-24f);              // 1.25 ulp rounds down
+  CHECK(same_bits(round_fp16(0x1p-25f), 0.0f));           // half an ulp: tie to the even 0
   CHECK(round_fp16(std::nextafter(0x1p-25f, 1.0f)) == 0x1p-24f);
   CHECK(same_bits(round_fp16(1e-10f), 0.0f));
-  CHECK(round_fp16(1e-40f) == 0.0f);                       // binary32 subnormal
+  CHECK(round_fp16(1e-40f) == 0.0f);  // binary32 subnormal
 }
 
 TEST_CASE("fp16 rounding is symmetric in the sign and keeps the sign of zero") {
@@ -84,7 +86,8 @@ TEST_CASE("fp16 rounding leaves every binary16 value unchanged") {
   for (uint32_t h = 0; h < 0x10000u; ++h) {
     const uint32_t e = (h >> 10) & 31, m = h & 1023;
     if (e == 31) continue;
-    const float mag = e == 0 ? float(m) * 0x1p-24f : std::ldexp(1.0f + float(m) / 1024.0f, int(e) - 15);
+    const float mag =
+        e == 0 ? float(m) * 0x1p-24f : std::ldexp(1.0f + float(m) / 1024.0f, int(e) - 15);
     const float v = (h & 0x8000u) ? -mag : mag;
     if (!same_bits(round_fp16(v), v)) {
       FAIL_CHECK("binary16 0x" << std::hex << h << " changed");
@@ -96,13 +99,13 @@ TEST_CASE("fp16 rounding leaves every binary16 value unchanged") {
 }
 
 TEST_CASE("fp24 stores keep 16 mantissa bits, ties to even") {
-  CHECK(round_fp24(1.0f + 0x1p-17f) == 1.0f);                  // tie down to even
-  CHECK(round_fp24(1.0f + 3 * 0x1p-17f) == 1.0f + 0x1p-15f);   // tie up to even
-  CHECK(round_fp24(1.0f + 0x1p-16f) == 1.0f + 0x1p-16f);       // representable
+  CHECK(round_fp24(1.0f + 0x1p-17f) == 1.0f);                 // tie down to even
+  CHECK(round_fp24(1.0f + 3 * 0x1p-17f) == 1.0f + 0x1p-15f);  // tie up to even
+  CHECK(round_fp24(1.0f + 0x1p-16f) == 1.0f + 0x1p-16f);      // representable
   CHECK(round_fp24(std::nextafter(1.0f + 0x1p-17f, 2.0f)) == 1.0f + 0x1p-16f);
-  CHECK(round_fp24(1.0f / 3.0f) == 0x1.5555p-2f);              // 0.0101...01 (17 bits) x 2^-1
+  CHECK(round_fp24(1.0f / 3.0f) == 0x1.5555p-2f);  // 0.0101...01 (17 bits) x 2^-1
   CHECK(round_fp24(2.0f / 3.0f) == 0x1.5555p-1f);
-  CHECK(round_fp24(0.1f) == 0x1.999ap-4f);                     // 0x1.99999ap-4 rounds up
+  CHECK(round_fp24(0.1f) == 0x1.999ap-4f);  // 0x1.99999ap-4 rounds up
   CHECK(round_fp24(-1.0f / 3.0f) == -0x1.5555p-2f);
 }
 

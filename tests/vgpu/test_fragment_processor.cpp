@@ -242,6 +242,37 @@ TEST_CASE("f.branch counts the live fragments idle in the block at every width")
     }
 }
 
+TEST_CASE("the batch counters count idle fragments only in 8x4 and 32x32 tiles idle as a whole") {
+  // 64 x 40 target, branch taken where x < 10. 8x4 tiles: x 0..7 and 8..15 hold takers, the
+  // other 6 tile columns are idle (48 x 40 = 1920 fragments). 32x32 tiles: x 32..63 is idle,
+  // rows 0..31 and the partial tile of rows 32..39 (32 x 40 = 1280).
+  for (int lanes : {1, 8, 16})
+    for (int threads : {1, 3}) {
+      CAPTURE(lanes);
+      CAPTURE(threads);
+      Gpu gpu(profile("gf6600"), threads, lanes);
+      Texture out = gpu.make_texture("out", 64, 40, 4);
+      int runs = 0;
+      KernelProgram<LeftBranch> k;
+      k.kernel.runs = &runs;
+      gpu.use_program(k);
+      gpu.set_targets({&out});
+      const Counters c = gpu.draw().counters;
+      CHECK(c.lanes_idle == 54 * 40);
+      CHECK(c.idle_in_batch32 == 1920);
+      CHECK(c.idle_in_batch1024 == 1280);
+      // Masked fragments (stencil 0) neither take the branch nor count as idle.
+      Stencil test(64, 40, 1);
+      for (int y = 0; y < 40; ++y)
+        for (int x = 56; x < 64; ++x) test.set(x, y, 0);  // tile column x 56..63 all masked
+      gpu.set_stencil_test(&test);
+      const Counters m = gpu.draw().counters;
+      CHECK(m.lanes_idle == 46 * 40);
+      CHECK(m.idle_in_batch32 == 1600);   // 5 idle tile columns (x 16..55) x 40 rows x 8
+      CHECK(m.idle_in_batch1024 == 960);  // x 32..55 in both row tiles: 24 x 40
+    }
+}
+
 TEST_CASE("with dynamic branching a batch where no live fragment takes a branch skips it") {
   for (int lanes : {1, 4, 8, 16}) {
     CAPTURE(lanes);

@@ -213,9 +213,8 @@ TEST_CASE("a rectangle outside the render target is rejected") {
     CAPTURE(r.y0);
     CAPTURE(r.x1);
     CAPTURE(r.y1);
-    CHECK_THROWS_WITH_AS(gpu.draw(r),
-                         Contains("program 'copy': drawn rectangle outside the render target"),
-                         Error);
+    CHECK_THROWS_WITH_AS(
+        gpu.draw(r), Contains("program 'copy': drawn rectangle outside the render target"), Error);
   }
   CHECK(gpu.draw(Rect{8, 8, 8, 8}).counters.fragments_launched == 0);  // empty, not outside
   CHECK(gpu.draw(Rect{0, 0, 8, 8}).counters.fragments_launched == 64);

@@ -96,8 +96,10 @@ TEST_CASE("render-target stores round to the target's format") {
     for (int x = 0; x < 3; ++x)
       for (int c = 0; c < 4; ++c) {
         const float want = round_to(fmt, values[x][c]);
-        if (std::isnan(want)) CHECK(std::isnan(dst.get(x, 0, c)));
-        else CHECK(dst.get(x, 0, c) == want);
+        if (std::isnan(want))
+          CHECK(std::isnan(dst.get(x, 0, c)));
+        else
+          CHECK(dst.get(x, 0, c) == want);
       }
   }
   Texture h = gpu.make_texture("h", 3, 1, 4, Format::fp16);
@@ -120,9 +122,10 @@ TEST_CASE("texRECT samples the nearest texel: floor of each integer-texel coordi
   const Texture t = numbered();
   for (int lanes : {1, 8}) {
     CAPTURE(lanes);
-    const auto r = sample(t, {{0.5f, 0.5f}, {2.0f, 1.0f}, {2.999f, 1.999f}, {3.0f, 0.0f},
-                              {4.5f, 2.5f}, {1.25f, 2.75f}},
-                          lanes);
+    const auto r = sample(
+        t,
+        {{0.5f, 0.5f}, {2.0f, 1.0f}, {2.999f, 1.999f}, {3.0f, 0.0f}, {4.5f, 2.5f}, {1.25f, 2.75f}},
+        lanes);
     const int want[6][2] = {{0, 0}, {2, 1}, {2, 1}, {3, 0}, {4, 2}, {1, 2}};
     for (int i = 0; i < 6; ++i) {
       CAPTURE(i);
@@ -138,12 +141,18 @@ TEST_CASE("texRECT clamps coordinates outside the texture, NaN and infinities to
   const Texture t = numbered();
   for (int lanes : {1, 4, 8, 16}) {
     CAPTURE(lanes);
-    const auto r = sample(t, {{-0.5f, 1.5f}, {-100.0f, -100.0f}, {5.0f, 1.0f}, {1e9f, 3.0f},
-                              {kNaN, 1.5f}, {2.5f, kNaN}, {kInf, -kInf}, {-kInf, kInf},
-                              {4.999f, 2.999f}},
+    const auto r = sample(t,
+                          {{-0.5f, 1.5f},
+                           {-100.0f, -100.0f},
+                           {5.0f, 1.0f},
+                           {1e9f, 3.0f},
+                           {kNaN, 1.5f},
+                           {2.5f, kNaN},
+                           {kInf, -kInf},
+                           {-kInf, kInf},
+                           {4.999f, 2.999f}},
                           lanes);
-    const int want[9][2] = {{0, 1}, {0, 0}, {4, 1}, {4, 2}, {0, 1},
-                            {2, 0}, {4, 0}, {0, 2}, {4, 2}};
+    const int want[9][2] = {{0, 1}, {0, 0}, {4, 1}, {4, 2}, {0, 1}, {2, 0}, {4, 0}, {0, 2}, {4, 2}};
     for (int i = 0; i < 9; ++i) {
       CAPTURE(i);
       CHECK(r[size_t(i)][0] == float(want[i][0]));
