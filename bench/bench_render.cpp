@@ -44,7 +44,8 @@ host::Scene sphere_scene(size_t target) {
       return;
     }
     s.p0.push_back(a), s.p1.push_back(b), s.p2.push_back(c);
-    s.n0.push_back(glm::normalize(a)), s.n1.push_back(glm::normalize(b)), s.n2.push_back(glm::normalize(c));
+    s.n0.push_back(glm::normalize(a)), s.n1.push_back(glm::normalize(b)),
+        s.n2.push_back(glm::normalize(c));
     s.material.push_back(0);
     s.id.push_back(this_id);
   };
@@ -65,8 +66,8 @@ struct Run {
 
 void bench(const std::string& label, const host::Scene& scene, int bounces, int threads, int reps) {
   host::RenderOptions opt;
-  const host::Grid grid =
-      host::build_grid(scene, host::grid_spec_for(host::GridSpec{}, scene, vgpu::profile(opt.profile)));
+  const host::Grid grid = host::build_grid(
+      scene, host::grid_spec_for(host::GridSpec{}, scene, vgpu::profile(opt.profile)));
   opt.bounces = bounces;
   opt.threads = threads;
   host::StreamTracer tracer(scene, grid, opt);
@@ -93,15 +94,16 @@ void bench(const std::string& label, const host::Scene& scene, int bounces, int 
 int main(int argc, char** argv) {
   const int reps = 3;
   const int ncores = int(std::max(1u, std::thread::hardware_concurrency()));
-  std::printf("%-26s %7s %3s %7s %10s %8s %8s %12s %12s %10s %9s\n", "scene", "tris", "bnc", "threads",
-              "render ms", "init ms", "passes", "fragments", "rays", "tex MB", "peak MB");
+  std::printf("%-26s %7s %3s %7s %10s %8s %8s %12s %12s %10s %9s\n", "scene", "tris", "bnc",
+              "threads", "render ms", "init ms", "passes", "fragments", "rays", "tex MB",
+              "peak MB");
   if (argc > 1 && std::strcmp(argv[1], "million") == 0) {
     const host::Scene s = sphere_scene(1'000'000);
     bench("sphere 1M, primary", s, 0, ncores, 1);
     return 0;
   }
   const std::vector<std::string> names = argc > 1 ? std::vector<std::string>(argv + 1, argv + argc)
-                                                   : std::vector<std::string>{"bunny"};
+                                                  : std::vector<std::string>{"bunny"};
   for (const std::string& name : names) {
     const host::Scene s = host::load_scene(host::resolve_scene(name));
     for (int threads : {1, ncores}) {

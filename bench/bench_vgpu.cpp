@@ -25,7 +25,9 @@ constexpr double kFragments = double(kSize) * kSize;
 // Bytes one fragment moves: three fp32x4 texels read, one written.
 constexpr double kBytesPerFragment = 3 * 16 + 16;
 
-int all_cores() { return int(std::max(1u, std::thread::hardware_concurrency())); }
+int all_cores() {
+  return int(std::max(1u, std::thread::hardware_concurrency()));
+}
 
 // The pass: 3 fetches + 14 ops = 17 instructions per fragment.
 struct Blend3 {
@@ -164,7 +166,8 @@ void BM_plain_loop(benchmark::State& state) {
       plain_rows(a, b, c, o, 0, n);
     } else {
       pool.run([&](int t) {
-        plain_rows(a, b, c, o, n * size_t(t) / size_t(threads), n * size_t(t + 1) / size_t(threads));
+        plain_rows(a, b, c, o, n * size_t(t) / size_t(threads),
+                   n * size_t(t + 1) / size_t(threads));
       });
     }
     benchmark::DoNotOptimize(o);
@@ -182,8 +185,12 @@ BENCHMARK(BM_vgpu_pass)
     ->Args({8, 0})
     ->UseRealTime()
     ->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_plain_loop)->ArgNames({"threads"})->Arg(1)->Arg(0)->UseRealTime()->Unit(
-    benchmark::kMillisecond);
+BENCHMARK(BM_plain_loop)
+    ->ArgNames({"threads"})
+    ->Arg(1)
+    ->Arg(0)
+    ->UseRealTime()
+    ->Unit(benchmark::kMillisecond);
 
 // Console output as usual, plus the fragments/s of each run kept for the ratios. With
 // repetitions the median aggregate is kept; without, the single run.
@@ -210,8 +217,8 @@ class RatioReporter : public benchmark::ConsoleReporter {
       const auto plain = rate_.find(std::string("BM_plain_loop/threads:") + threads + "/real_time");
       if (plain == rate_.end()) continue;
       for (const char* lanes : {"1", "8"}) {
-        const auto v = rate_.find(std::string("BM_vgpu_pass/lanes:") + lanes + "/threads:" +
-                                  threads + "/real_time");
+        const auto v = rate_.find(std::string("BM_vgpu_pass/lanes:") + lanes +
+                                  "/threads:" + threads + "/real_time");
         if (v == rate_.end()) continue;
         std::printf("  lanes %-2s threads %-3s  vgpu %8.1f M/s  plain %8.1f M/s  ratio %.2f\n",
                     lanes, threads[0] == '0' ? cores.c_str() : threads, v->second / 1e6,

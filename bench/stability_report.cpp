@@ -19,7 +19,8 @@ int main() {
   for (const auto& c : all) {
     int checked = 0;
     for (int e : c.expected) checked += e != stability::kDontCare;
-    std::printf("| %s | %s | %d of %zu |", c.name.c_str(), c.probe.c_str(), checked, c.expected.size());
+    std::printf("| %s | %s | %d of %zu |", c.name.c_str(), c.probe.c_str(), checked,
+                c.expected.size());
     for (auto& p : precisions) {
       const stability::Outcome o = stability::run(c, p.first);
       std::string cell;
@@ -28,7 +29,8 @@ int main() {
       } else if (o.wrong == 0 && o.colour_wrong == 0 && o.unfinished == 0) {
         cell = "pass";
       } else {
-        cell = std::to_string(o.wrong) + " of " + std::to_string(o.checked) + " pixels wrong (hit id)";
+        cell =
+            std::to_string(o.wrong) + " of " + std::to_string(o.checked) + " pixels wrong (hit id)";
         if (c.dominant_channel >= 0)
           cell += ", " + std::to_string(o.colour_wrong) + " wrong colour";
         cell += ", " + std::to_string(o.unfinished) + " unfinished rays";

@@ -22,8 +22,7 @@ Camera frame_bounds(const Bounds& b, float aspect) {
   cam.yfov = 45.0f * std::numbers::pi_v<float> / 180.0f;
   const float tan_half_y = std::tan(cam.yfov * 0.5f);
   const float half_x = std::atan(tan_half_y * aspect);
-  const float distance =
-      std::max(radius / std::sin(cam.yfov * 0.5f), radius / std::sin(half_x));
+  const float distance = std::max(radius / std::sin(cam.yfov * 0.5f), radius / std::sin(half_x));
   const glm::vec3 d = glm::normalize(glm::vec3(0.0f, 0.35f, 1.0f));
   cam.position = centre + distance * d;
   cam.forward = -d;

@@ -12,14 +12,13 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <glm/gtc/quaternion.hpp>
 #include <map>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <numbers>
 #include <set>
 #include <string_view>
-
-#include <glm/gtc/quaternion.hpp>
-#include <nlohmann/json.hpp>
 
 // The one translation unit that holds tinygltf and stb. Images are never decoded: the image
 // loader is a no-op, external images are not read and the JSON handed to tinygltf has no images.
@@ -74,8 +73,12 @@ std::string one_line(std::string_view text, size_t max_chars) {
   throw InputError(one_line(path, 1000) + ": " + one_line(problem, kMaxProblemChars));
 }
 
-std::string str(uint64_t v) { return std::to_string(v); }
-std::string str(int v) { return std::to_string(v); }
+std::string str(uint64_t v) {
+  return std::to_string(v);
+}
+std::string str(int v) {
+  return std::to_string(v);
+}
 
 uint32_t le32(const unsigned char* p) {
   return uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24;
@@ -122,8 +125,8 @@ GlbParts split_glb(const std::string& path, const std::vector<unsigned char>& by
     fail(path, "truncated .glb: the header announces " + str(length) + " bytes but the file has " +
                    str(size));
   if (length < size)
-    fail(path, "corrupt .glb: the header announces " + str(length) +
-                   " bytes but the file has " + str(size));
+    fail(path, "corrupt .glb: the header announces " + str(length) + " bytes but the file has " +
+                   str(size));
   GlbParts parts;
   uint64_t pos = 12;
   int chunk = 0;
@@ -183,9 +186,12 @@ size_t json_depth(std::string_view text) {
   bool in_string = false, escaped = false;
   for (char c : text) {
     if (in_string) {
-      if (escaped) escaped = false;
-      else if (c == '\\') escaped = true;
-      else if (c == '"') in_string = false;
+      if (escaped)
+        escaped = false;
+      else if (c == '\\')
+        escaped = true;
+      else if (c == '"')
+        in_string = false;
     } else if (c == '"') {
       in_string = true;
     } else if (c == '{' || c == '[') {
@@ -285,8 +291,9 @@ std::vector<uint64_t> precheck_json(const std::string& path, const std::string& 
       if (!glb) fail(path, name + " has no uri (only a .glb may omit it)");
       if (!glb->has_bin) fail(path, name + " has no uri and the .glb has no BIN chunk");
       if (byte_length > glb->bin.size())
-        fail(path, name + ": byteLength " + str(byte_length) + " is larger than the .glb BIN chunk (" +
-                       str(uint64_t(glb->bin.size())) + " bytes)");
+        fail(path, name + ": byteLength " + str(byte_length) +
+                       " is larger than the .glb BIN chunk (" + str(uint64_t(glb->bin.size())) +
+                       " bytes)");
     } else if (uri.starts_with("data:")) {
       const size_t comma = uri.find(',');
       if (comma == uri.npos || !std::string_view(uri).substr(0, comma).ends_with(";base64"))
@@ -320,7 +327,9 @@ bool fs_file_exists(const std::string& p, void*) {
   std::error_code ec;
   return fs::is_regular_file(p, ec);
 }
-std::string fs_expand(const std::string& p, void*) { return p; }
+std::string fs_expand(const std::string& p, void*) {
+  return p;
+}
 bool fs_read(std::vector<unsigned char>* out, std::string* err, const std::string& p, void*) {
   std::error_code ec;
   const uintmax_t size = fs::file_size(p, ec);
@@ -368,14 +377,22 @@ struct PendingLight {
 
 const char* mode_name(int mode) {
   switch (mode) {
-    case TINYGLTF_MODE_POINTS: return "POINTS";
-    case TINYGLTF_MODE_LINE: return "LINES";
-    case TINYGLTF_MODE_LINE_LOOP: return "LINE_LOOP";
-    case TINYGLTF_MODE_LINE_STRIP: return "LINE_STRIP";
-    case TINYGLTF_MODE_TRIANGLES: return "TRIANGLES";
-    case TINYGLTF_MODE_TRIANGLE_STRIP: return "TRIANGLE_STRIP";
-    case TINYGLTF_MODE_TRIANGLE_FAN: return "TRIANGLE_FAN";
-    default: return "unknown";
+    case TINYGLTF_MODE_POINTS:
+      return "POINTS";
+    case TINYGLTF_MODE_LINE:
+      return "LINES";
+    case TINYGLTF_MODE_LINE_LOOP:
+      return "LINE_LOOP";
+    case TINYGLTF_MODE_LINE_STRIP:
+      return "LINE_STRIP";
+    case TINYGLTF_MODE_TRIANGLES:
+      return "TRIANGLES";
+    case TINYGLTF_MODE_TRIANGLE_STRIP:
+      return "TRIANGLE_STRIP";
+    case TINYGLTF_MODE_TRIANGLE_FAN:
+      return "TRIANGLE_FAN";
+    default:
+      return "unknown";
   }
 }
 
@@ -455,7 +472,8 @@ class Loader {
     json doc;
     declared_lengths_ = precheck_json(path_, text, is_glb ? &glb : nullptr, doc);
     // Never needed, and tinygltf reads image buffer views without checking their range.
-    for (const char* key : {"images", "textures", "samplers", "animations", "skins"}) doc.erase(key);
+    for (const char* key : {"images", "textures", "samplers", "animations", "skins"})
+      doc.erase(key);
     const std::string clean = doc.dump();
     if (clean.size() > kMaxFileBytes - 64) fail(path_, "the JSON is larger than 4 GiB");
 
@@ -479,7 +497,8 @@ class Loader {
     }
     if (!ok) {
       const std::string reason = first_line(err);
-      fail(path_, "glTF error: " + (reason.empty() ? std::string("tinygltf rejected the file") : reason));
+      fail(path_,
+           "glTF error: " + (reason.empty() ? std::string("tinygltf rejected the file") : reason));
     }
     for (const std::string& text_block : {err, warn}) {
       size_t start = 0;
@@ -497,8 +516,8 @@ class Loader {
 
   void check_buffers_and_views() {
     if (model_.buffers.size() != declared_lengths_.size())
-      fail(path_, "the file declares " + str(uint64_t(declared_lengths_.size())) +
-                      " buffers but " + str(uint64_t(model_.buffers.size())) + " were loaded");
+      fail(path_, "the file declares " + str(uint64_t(declared_lengths_.size())) + " buffers but " +
+                      str(uint64_t(model_.buffers.size())) + " were loaded");
     for (size_t i = 0; i < model_.buffers.size(); ++i)
       if (model_.buffers[i].data.size() != declared_lengths_[i])
         fail(path_, "buffer " + str(uint64_t(i)) + " holds " +
@@ -585,8 +604,8 @@ class Loader {
         ct == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE || ct == TINYGLTF_COMPONENT_TYPE_SHORT ||
         ct == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT;
     if (acc.type != TINYGLTF_TYPE_VEC3 || !ok_component)
-      fail(path_, use + ": accessor " + str(index) +
-                      " must be VEC3 of float, byte or short components");
+      fail(path_,
+           use + ": accessor " + str(index) + " must be VEC3 of float, byte or short components");
     const int comp = tinygltf::GetComponentSizeInBytes(uint32_t(ct));
     auto out = std::make_shared<std::vector<glm::vec3>>(acc.count);
     for (size_t i = 0; i < acc.count; ++i) {
@@ -607,18 +626,21 @@ class Loader {
     if (auto it = index_cache_.find(index); it != index_cache_.end()) return it->second;
     const tinygltf::Accessor& acc = accessor_for(index, use);
     const int ct = acc.componentType;
-    if (acc.type != TINYGLTF_TYPE_SCALAR ||
-        (ct != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
-         ct != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT && ct != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT))
+    if (acc.type != TINYGLTF_TYPE_SCALAR || (ct != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
+                                             ct != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+                                             ct != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT))
       fail(path_, use + ": accessor " + str(index) +
                       " must be SCALAR of unsigned byte, short or int components");
     auto out = std::make_shared<std::vector<uint32_t>>(acc.count);
     for (size_t i = 0; i < acc.count; ++i) {
       const unsigned char* p = element_ptr(acc, i);
       uint32_t v = 0;
-      if (ct == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE) v = p[0];
-      else if (ct == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT) v = uint32_t(p[0]) | uint32_t(p[1]) << 8;
-      else v = le32(p);
+      if (ct == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE)
+        v = p[0];
+      else if (ct == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT)
+        v = uint32_t(p[0]) | uint32_t(p[1]) << 8;
+      else
+        v = le32(p);
       (*out)[i] = v;
     }
     index_cache_[index] = out;
@@ -732,14 +754,15 @@ class Loader {
     };
     std::vector<char> seen(model_.nodes.size(), 0);
     std::vector<Item> stack;
-    for (auto it = roots.rbegin(); it != roots.rend(); ++it) stack.push_back({*it, glm::dmat4(1.0)});
+    for (auto it = roots.rbegin(); it != roots.rend(); ++it)
+      stack.push_back({*it, glm::dmat4(1.0)});
     while (!stack.empty()) {
       const Item item = stack.back();
       stack.pop_back();
       const size_t n = size_t(item.node);
       if (seen[n])
-        fail(path_, "node " + str(item.node) +
-                        " is reached twice; the node hierarchy must be a tree");
+        fail(path_,
+             "node " + str(item.node) + " is reached twice; the node hierarchy must be a tree");
       seen[n] = 1;
       const tinygltf::Node& node = model_.nodes[n];
       const glm::dmat4 world = item.parent * local_matrix(node, n);
@@ -839,8 +862,8 @@ class Loader {
     if (auto it = primitives_.find(key); it != primitives_.end()) return it->second;
     PrimitiveGeometry& g = primitives_[key];
     const tinygltf::Primitive& prim = model_.meshes[mesh_index].primitives[prim_index];
-    const std::string name = "mesh " + str(uint64_t(mesh_index)) + " primitive " +
-                             str(uint64_t(prim_index));
+    const std::string name =
+        "mesh " + str(uint64_t(mesh_index)) + " primitive " + str(uint64_t(prim_index));
 
     const int mode = prim.mode;
     if (mode < TINYGLTF_MODE_POINTS || mode > TINYGLTF_MODE_TRIANGLE_FAN)
@@ -959,8 +982,9 @@ class Loader {
       for (int c = 0; c < 3; ++c) {
         p[c] = glm::vec3(world * glm::dvec4(glm::dvec3(pos[v[c]]), 1.0));
         if (!std::isfinite(p[c].x + p[c].y + p[c].z))
-          fail(path_, node_name + ": a world-space position is not finite (the node transforms "
-                                  "overflow float)");
+          fail(path_, node_name +
+                          ": a world-space position is not finite (the node transforms "
+                          "overflow float)");
       }
       const glm::vec3 cross_f = glm::cross(p[1] - p[0], p[2] - p[0]);
       const glm::dvec3 cross_d =
@@ -1003,7 +1027,8 @@ class Loader {
                                 " corner normals from the file were zero or not finite and were "
                                 "replaced by face normals");
     if (scene_.input_triangles == 0)
-      fail(path_, "the scene has no triangles" + (skipped.empty() ? "" : " (skipped " + skipped + ")"));
+      fail(path_,
+           "the scene has no triangles" + (skipped.empty() ? "" : " (skipped " + skipped + ")"));
     if (scene_.triangle_count() == 0)
       fail(path_, "all " + str(uint64_t(scene_.input_triangles)) +
                       " triangles of the scene are degenerate (zero area)");

@@ -4,10 +4,10 @@
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>
 #include <OpenImageIO/imageio.h>
+#include <unistd.h>
 
 #include <cstdio>
 #include <filesystem>
-#include <unistd.h>
 
 #include "host/scene.h"
 
@@ -37,13 +37,14 @@ void write_image(const std::string& path, int width, int height, int channels,
                  const std::vector<float>& pixels) {
   check_image_path(path);
   const bool png = lower_ext(path) == ".png";
-  OIIO::ImageSpec spec(width, height, channels, png ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::FLOAT);
+  OIIO::ImageSpec spec(width, height, channels,
+                       png ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::FLOAT);
   // Same extension, so OpenImageIO picks the right writer for the temporary file.
   const fs::path p(path);
-  const std::string tmp =
-      (p.parent_path() / ("." + p.stem().string() + ".tmp" + std::to_string(::getpid()) +
-                          p.extension().string()))
-          .string();
+  std::string name = p.stem().string();
+  name.insert(0, 1, '.');
+  name += ".tmp" + std::to_string(::getpid()) + p.extension().string();
+  const std::string tmp = (p.parent_path() / name).string();
   auto out = OIIO::ImageOutput::create(tmp);
   if (!out) throw InputError(path + ": cannot create an image writer: " + OIIO::geterror());
   bool ok = out->open(tmp, spec);

@@ -4,13 +4,12 @@
 #pragma once
 
 #include <cstdint>
+#include <glm/glm.hpp>
 #include <limits>
 #include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
-
-#include <glm/glm.hpp>
 
 namespace host {
 
@@ -26,7 +25,7 @@ struct Material {
 
 // glTF conventions: looks down local -Z, +Y up, yfov vertical (radians).
 struct Camera {
-  glm::vec3 position{0.0f};   // world space
+  glm::vec3 position{0.0f};     // world space
   glm::vec3 forward{0, 0, -1};  // unit, world space
   glm::vec3 up{0, 1, 0};        // unit, orthogonal to forward
   float yfov = 0.8f;            // radians
@@ -40,7 +39,10 @@ struct PointLight {
 struct Bounds {
   glm::vec3 lo{std::numeric_limits<float>::max()};
   glm::vec3 hi{-std::numeric_limits<float>::max()};
-  void extend(glm::vec3 p) { lo = glm::min(lo, p); hi = glm::max(hi, p); }
+  void extend(glm::vec3 p) {
+    lo = glm::min(lo, p);
+    hi = glm::max(hi, p);
+  }
   bool empty() const { return lo.x > hi.x; }
 };
 
@@ -49,8 +51,8 @@ struct Bounds {
 // depth-first pre-order, a mesh's primitives in order, triangles in index order, strips and fans
 // expanded), kept even when degenerate triangles are dropped.
 struct Scene {
-  std::string source;  // file path, for messages
-  std::string name;    // short name (file stem)
+  std::string source;                 // file path, for messages
+  std::string name;                   // short name (file stem)
   std::vector<glm::vec3> p0, p1, p2;  // corners, world space
   std::vector<glm::vec3> n0, n1, n2;  // corner normals, world space, unit length
   std::vector<uint32_t> material;     // index into materials, per triangle
@@ -66,7 +68,11 @@ struct Scene {
   size_t triangle_count() const { return p0.size(); }
   Bounds bounds() const {
     Bounds b;
-    for (size_t i = 0; i < p0.size(); ++i) { b.extend(p0[i]); b.extend(p1[i]); b.extend(p2[i]); }
+    for (size_t i = 0; i < p0.size(); ++i) {
+      b.extend(p0[i]);
+      b.extend(p1[i]);
+      b.extend(p2[i]);
+    }
     return b;
   }
 };

@@ -202,8 +202,8 @@ uint64_t StreamTracer::texture_bytes() const {
                            &s_->colors, &s_->lists, &s_->pointers, &s_->shadow_rays, &s_->counter})
     b += t->bytes();
   for (int i = 0; i < 2; ++i)
-    for (const Texture* t : {&s_->rays[i], &s_->origins[i], &s_->trav[i], &s_->vs[i],
-                             &s_->isect[i], &s_->result[i]})
+    for (const Texture* t :
+         {&s_->rays[i], &s_->origins[i], &s_->trav[i], &s_->vs[i], &s_->isect[i], &s_->result[i]})
       b += t->bytes();
   return b;
 }
@@ -251,7 +251,9 @@ uint64_t StreamTracer::count(const vgpu::Program& p, const Texture& in, const St
   gpu.set_stencil_write(nullptr);
   if (traced) {
     char line[160];
-    const char* mine = !write ? "" : write->get(opt_.trace_pixel->x, opt_.trace_pixel->y) ? "counted" : "discarded";
+    const char* mine = !write                                                 ? ""
+                       : write->get(opt_.trace_pixel->x, opt_.trace_pixel->y) ? "counted"
+                                                                              : "discarded";
     std::snprintf(line, sizeof line, "  %-22s %-24s    query: %llu rays; this one %s\n",
                   p.paper_name(), p.name(), static_cast<unsigned long long>(n), mine);
     *opt_.trace_out << line;

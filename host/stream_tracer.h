@@ -23,7 +23,7 @@ struct RenderOptions {
   kernels::ShadingModel shading = kernels::ShadingModel::phong;
   bool shadows = true;
   std::string profile = "gf5700";
-  int threads = 0;                // 0: every host core
+  int threads = 0;  // 0: every host core
   int lanes = vgpu::kLanes;
   // Precision of the ray-state textures and of the arithmetic inside kernels (--precision).
   // The scene textures stay fp32. fp16 cannot address texels past 2048 exactly, as on NV3x.
@@ -48,8 +48,8 @@ struct RenderResult {
   std::vector<float> hit_id;  // input triangle id of the primary hit, -1 where it misses
   vgpu::FrameStats stats;
   double render_ms = 0;
-  int iterations = 0;         // ray-tracing iterations run (primary included)
-  uint64_t rays_traced = 0;   // rays entering a trace (primary, reflected, shadow)
+  int iterations = 0;            // ray-tracing iterations run (primary included)
+  uint64_t rays_traced = 0;      // rays entering a trace (primary, reflected, shadow)
   uint64_t rays_unfinished = 0;  // rays stopped by the pass cap (only under reduced precision)
 };
 
@@ -66,8 +66,9 @@ class StreamTracer {
  private:
   struct State;
   void trace(vgpu::Texture& origins, vgpu::Texture& rays, bool primary, const Camera& cam);
-  const vgpu::PassRecord& pass(const vgpu::Program& p, std::initializer_list<const vgpu::Texture*> in,
-                               vgpu::Texture& out, const vgpu::Stencil* work = nullptr);
+  const vgpu::PassRecord& pass(const vgpu::Program& p,
+                               std::initializer_list<const vgpu::Texture*> in, vgpu::Texture& out,
+                               const vgpu::Stencil* work = nullptr);
   uint64_t count(const vgpu::Program& p, const vgpu::Texture& in, const vgpu::Stencil* work,
                  vgpu::Stencil* write);
 

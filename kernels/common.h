@@ -25,7 +25,9 @@ using vgpu::select;
 using vgpu::sqrt;
 
 template <class F>
-inline Vec3<F> splat(const glm::vec3& v) { return {F(v.x), F(v.y), F(v.z)}; }
+inline Vec3<F> splat(const glm::vec3& v) {
+  return {F(v.x), F(v.y), F(v.z)};
+}
 
 // Texel coordinates (centre) of entry `id` of a texture `width` texels wide.
 template <class F>
@@ -58,7 +60,9 @@ inline Vec3<F> voxel_exits(const Vec3<F>& o, const Vec3<F>& d, const Vec3<F>& vo
 }
 
 template <class F>
-inline F min3(const Vec3<F>& v) { return min(min(v.x, v.y), v.z); }
+inline F min3(const Vec3<F>& v) {
+  return min(min(v.x, v.y), v.z);
+}
 
 inline constexpr float kEdgeEps = 1.0f / (1 << 20);
 
@@ -92,15 +96,14 @@ namespace kernels {
 // side the incoming direction d comes from.
 template <class F>
 struct Surface {
-  Vec3<F> n;        // shading normal
-  Vec3<F> ng;       // geometric normal
+  Vec3<F> n;   // shading normal
+  Vec3<F> ng;  // geometric normal
 };
 
 template <class L>
 inline Surface<typename L::F> surface_at(const Fragments<L>& f, const typename L::F& tri,
-                                         const Vec3<typename L::F>& p,
-                                         const Vec3<typename L::F>& d, int unit_v0, int unit_n0,
-                                         const SceneUniforms& scene) {
+                                         const Vec3<typename L::F>& p, const Vec3<typename L::F>& d,
+                                         int unit_v0, int unit_n0, const SceneUniforms& scene) {
   using F = typename L::F;
   const Vec3<F> p0 = fetch_id(f, unit_v0, tri, scene.width).xyz();
   const Vec3<F> p1 = fetch_id(f, unit_v0 + 1, tri, scene.width).xyz();

@@ -30,7 +30,8 @@ inline Vec4<typename L::F> grid_entry(const Vec3<typename L::F>& o, const Vec3<t
   auto cell_of = [&](const F& pa, float lo, float cell, float res) {
     return min(max(floor((pa - F(lo)) / F(cell)), F(0.0f)), F(res - 1.0f));
   };
-  const Vec4<F> entry{cell_of(p.x, g.lo.x, g.cell.x, g.res.x), cell_of(p.y, g.lo.y, g.cell.y, g.res.y),
+  const Vec4<F> entry{cell_of(p.x, g.lo.x, g.cell.x, g.res.x),
+                      cell_of(p.y, g.lo.y, g.cell.y, g.res.y),
                       cell_of(p.z, g.lo.z, g.cell.z, g.res.z), tnear};
   const Vec4<F> done{F(kNone), F(0.0f), F(0.0f), F(0.0f)};
   return select(enters, entry, done);

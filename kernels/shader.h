@@ -23,11 +23,11 @@ struct Shader {
   ShadingModel model = ShadingModel::diffuse;
   glm::vec3 light{0.0f}, light_color{1.0f};  // world space; rgb x intensity
   bool first_light = true, last_light = true;
-  bool shadows = false;            // kShadow holds this light's shadow-ray intersections
+  bool shadows = false;  // kShadow holds this light's shadow-ray intersections
   glm::vec3 ambient{0.1f};
   glm::vec3 background{0.0f};
-  float specular = 0.5f;           // ks
-  float atten_dist = 10.0f;        // world units: distance at which a light falls to half
+  float specular = 0.5f;     // ks
+  float atten_dist = 10.0f;  // world units: distance at which a light falls to half
 
   template <class L>
   void operator()(Fragments<L>& f) const {
@@ -49,8 +49,8 @@ struct Shader {
       Vec3<F> lit = kd * max(dot(s.n, l), F(0.0f));
       if (model != ShadingModel::diffuse) {
         const Vec3<F> r = l - s.n * (F(2.0f) * dot(l, s.n));  // mirror of l, pointing away
-        F c = max(dot(r, d), F(0.0f));                       // = max(r'.v, 0), v = -d
-        for (int i = 0; i < 5; ++i) c = c * c;               // ^32, unrolled: no loop on fp30
+        F c = max(dot(r, d), F(0.0f));                        // = max(r'.v, 0), v = -d
+        for (int i = 0; i < 5; ++i) c = c * c;                // ^32, unrolled: no loop on fp30
         lit = lit + splat<F>(glm::vec3(1.0f)) * (F(specular) * c);
       }
       if (model == ShadingModel::phong_atten) {

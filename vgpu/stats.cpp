@@ -10,12 +10,12 @@
 
 namespace vgpu {
 
-#define VGPU_COUNTER_FIELDS(X)                                                                  \
-  X(passes)                                                                                     \
-  X(fragments_launched) X(fragments_shaded) X(fragments_masked) X(fragments_discarded)          \
-      X(lanes_idle) X(idle_in_batch32) X(idle_in_batch1024) X(instructions) X(texture_fetches)  \
-          X(bytes_read) X(bytes_written) X(program_loads) X(program_bytes) X(clears) X(queries) \
-              X(query_readbacks)
+#define VGPU_COUNTER_FIELDS(X)                                                                    \
+  X(passes)                                                                                       \
+  X(fragments_launched)                                                                           \
+  X(fragments_shaded) X(fragments_masked) X(fragments_discarded) X(lanes_idle) X(idle_in_batch32) \
+      X(idle_in_batch1024) X(instructions) X(texture_fetches) X(bytes_read) X(bytes_written)      \
+          X(program_loads) X(program_bytes) X(clears) X(queries) X(query_readbacks)
 
 Counters& Counters::operator+=(const Counters& o) {
 #define X(f) f += o.f;

@@ -1,13 +1,13 @@
 // libFuzzer target: every input is written to a file and loaded with host::load_scene. InputError
 // is the only acceptable failure; any other exception, crash, sanitizer report, hang or runaway
 // allocation is a loader bug. Build and run with scripts/fuzz.sh.
+#include <unistd.h>
+
 #include <cctype>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
-
-#include <unistd.h>
 
 #include "host/gltf_loader.h"
 

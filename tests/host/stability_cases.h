@@ -16,11 +16,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <glm/glm.hpp>
 #include <limits>
 #include <string>
 #include <vector>
-
-#include <glm/glm.hpp>
 
 #include "host/camera.h"
 #include "host/cpu_tracer.h"
@@ -41,13 +40,14 @@ struct Case {
   host::Scene scene;
   host::Camera camera;
   int width = 9, height = 9;
-  std::vector<int> expected;  // input id per pixel (row-major, y = 0 top), or kMiss/kAnyMesh/kDontCare
+  std::vector<int>
+      expected;  // input id per pixel (row-major, y = 0 top), or kMiss/kAnyMesh/kDontCare
   glm::vec3 lo{0.0f}, hi{4.0f};  // grid box (build_grid_in_box): voxel planes at known places
   glm::ivec3 res{4};
   int bounces = 0;
-  std::vector<int> mesh_ids;      // for kAnyMesh
-  int dominant_channel = -1;      // >= 0: every pixel must have this colour channel dominant
-                                  // (the reflected wall's), never the mirror's own colour
+  std::vector<int> mesh_ids;  // for kAnyMesh
+  int dominant_channel = -1;  // >= 0: every pixel must have this colour channel dominant
+                              // (the reflected wall's), never the mirror's own colour
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -60,8 +60,12 @@ struct Builder {
   int tri(glm::vec3 a, glm::vec3 b, glm::vec3 c, uint32_t material = 0) {
     glm::vec3 n = glm::cross(b - a, c - a);
     n = glm::length(n) > 0 ? glm::normalize(n) : glm::vec3(0, 0, 1);
-    s.p0.push_back(a); s.p1.push_back(b); s.p2.push_back(c);
-    s.n0.push_back(n); s.n1.push_back(n); s.n2.push_back(n);
+    s.p0.push_back(a);
+    s.p1.push_back(b);
+    s.p2.push_back(c);
+    s.n0.push_back(n);
+    s.n1.push_back(n);
+    s.n2.push_back(n);
     s.material.push_back(material);
     s.id.push_back(next_id);
     s.input_triangles = next_id + 1;
@@ -87,7 +91,11 @@ inline host::Camera look(glm::vec3 pos, glm::vec3 fwd, float yfov, glm::vec3 up 
 // inside it); a hit within 1e-6 of the box (relative to its size) is uncertain.
 inline int analytic_hit(const host::Scene& s, glm::dvec3 o, glm::dvec3 d, double margin,
                         glm::dvec3 lo, glm::dvec3 hi) {
-  struct Cand { double t; int id; bool sure; };
+  struct Cand {
+    double t;
+    int id;
+    bool sure;
+  };
   std::vector<Cand> c;
   for (size_t i = 0; i < s.triangle_count(); ++i) {
     const glm::dvec3 a(s.p0[i]), b(s.p1[i]), e(s.p2[i]);
@@ -121,9 +129,10 @@ inline std::vector<int> expect_analytic(const Case& c, double margin = 1e-4) {
   std::vector<int> e(size_t(c.width) * c.height);
   for (int y = 0; y < c.height; ++y)
     for (int x = 0; x < c.width; ++x)
-      e[size_t(y) * c.width + x] = analytic_hit(c.scene, glm::dvec3(c.camera.position),
-                                                host::cpu_primary_dir(c.camera, c.width, c.height, x, y),
-                                                margin, glm::dvec3(c.lo), glm::dvec3(c.hi));
+      e[size_t(y) * c.width + x] =
+          analytic_hit(c.scene, glm::dvec3(c.camera.position),
+                       host::cpu_primary_dir(c.camera, c.width, c.height, x, y), margin,
+                       glm::dvec3(c.lo), glm::dvec3(c.hi));
   return e;
 }
 
@@ -144,14 +153,16 @@ inline Case translated(Case c, float offset, const std::string& suffix) {
 inline Case octahedron_case() {
   Case c;
   c.name = "a closed octahedron has no cracks along its shared edges and vertices";
-  c.probe = "closed mesh (octahedron, edges and apex on voxel planes; the centre ray hits the apex)";
+  c.probe =
+      "closed mesh (octahedron, edges and apex on voxel planes; the centre ray hits the apex)";
   Builder b;
   const glm::vec3 ct(2, 2, 2);
   const float r = 1.5f;
   const glm::vec3 X(r, 0, 0), Y(0, r, 0), Z(0, 0, r);
   for (int sx : {-1, 1})
     for (int sy : {-1, 1})
-      for (int sz : {-1, 1}) c.mesh_ids.push_back(b.tri(ct + float(sx) * X, ct + float(sy) * Y, ct + float(sz) * Z));
+      for (int sz : {-1, 1})
+        c.mesh_ids.push_back(b.tri(ct + float(sx) * X, ct + float(sy) * Y, ct + float(sz) * Z));
   c.scene = b.s;
   c.camera = look({2, 2, 8}, {0, 0, -1}, 0.5f);
   c.width = c.height = 17;
@@ -169,8 +180,9 @@ inline Case octahedron_case() {
             best = std::min(best, std::abs(p.x) + std::abs(p.y) + std::abs(p.z));
           }
         }
-      c.expected[size_t(y) * c.width + x] =
-          best < r * (1 - 1e-3) ? kAnyMesh : best > r * (1 + 1e-3) ? kMiss : kDontCare;
+      c.expected[size_t(y) * c.width + x] = best < r * (1 - 1e-3)   ? kAnyMesh
+                                            : best > r * (1 + 1e-3) ? kMiss
+                                                                    : kDontCare;
     }
   return c;
 }
@@ -257,7 +269,8 @@ inline std::vector<Case> cases() {
   {  // 7. hit just outside the current voxel
     Case c;
     c.name = "a hit just outside the current voxel is not taken before a nearer one";
-    c.probe = "slanted triangle listed in the first voxels, hit at z = 1.9; a nearer one at z = 1.95";
+    c.probe =
+        "slanted triangle listed in the first voxels, hit at z = 1.9; a nearer one at z = 1.95";
     Builder b;
     // plane z = 1.9 + 2 (x - 2.3)
     auto z = [](float x) { return 1.9f + 2 * (x - 2.3f); };
@@ -280,8 +293,9 @@ inline std::vector<Case> cases() {
     const glm::vec3 ct(2, 2, 1.5f);
     for (int k = 0; k < n; ++k) {
       const double a0 = 2 * pi * k / n, a1 = 2 * pi * (k + 1) / n;
-      c.mesh_ids.push_back(b.tri(ct, ct + glm::vec3(float(r * std::cos(a0)), float(r * std::sin(a0)), 0),
-                                 ct + glm::vec3(float(r * std::cos(a1)), float(r * std::sin(a1)), 0)));
+      c.mesh_ids.push_back(
+          b.tri(ct, ct + glm::vec3(float(r * std::cos(a0)), float(r * std::sin(a0)), 0),
+                ct + glm::vec3(float(r * std::cos(a1)), float(r * std::sin(a1)), 0)));
     }
     c.scene = b.s;
     c.camera = look({2, 2, 9}, {0, 0, -1}, 0.5f);
@@ -322,7 +336,8 @@ inline std::vector<Case> cases() {
     Builder b;
     b.s.materials = {{{0, 1, 0}, 1.0f}, {{1, 0, 0}, 0.0f}};
     b.quad({0.2f, 0.2f, 1}, {3.8f, 0.2f, 1}, {3.8f, 3.8f, 1}, {0.2f, 3.8f, 1}, 0);  // mirror
-    b.quad({0.1f, 0.1f, 3.8f}, {0.1f, 3.9f, 3.8f}, {3.9f, 3.9f, 3.8f}, {3.9f, 0.1f, 3.8f}, 1);  // wall
+    b.quad({0.1f, 0.1f, 3.8f}, {0.1f, 3.9f, 3.8f}, {3.9f, 3.9f, 3.8f}, {3.9f, 0.1f, 3.8f},
+           1);  // wall
     b.s.lights = {{{2, 3.5f, 3.4f}, {1, 1, 1}}};
     c.scene = b.s;
     c.camera = look({2.3f, 2.2f, 3.0f}, {0.05f, -0.05f, -1}, 0.35f);
@@ -339,7 +354,8 @@ inline std::vector<Case> cases() {
     const float l = 0.5f, h = 3.5f;
     const glm::vec3 v[8] = {{l, l, l}, {h, l, l}, {h, h, l}, {l, h, l},
                             {l, l, h}, {h, l, h}, {h, h, h}, {l, h, h}};
-    const int f[6][4] = {{0, 1, 2, 3}, {4, 7, 6, 5}, {0, 4, 5, 1}, {3, 2, 6, 7}, {0, 3, 7, 4}, {1, 5, 6, 2}};
+    const int f[6][4] = {{0, 1, 2, 3}, {4, 7, 6, 5}, {0, 4, 5, 1},
+                         {3, 2, 6, 7}, {0, 3, 7, 4}, {1, 5, 6, 2}};
     for (auto& q : f) {
       c.mesh_ids.push_back(b.tri(v[q[0]], v[q[1]], v[q[2]]));
       c.mesh_ids.push_back(b.tri(v[q[0]], v[q[2]], v[q[3]]));
@@ -407,15 +423,17 @@ inline std::vector<Case> cases() {
 // Running a case.
 
 struct Outcome {
-  int checked = 0;         // pixels with a demanded answer (not kDontCare)
-  int wrong = 0;           // of those, wrong hit id
-  int colour_wrong = 0;    // dominant-channel failures
+  int checked = 0;       // pixels with a demanded answer (not kDontCare)
+  int wrong = 0;         // of those, wrong hit id
+  int colour_wrong = 0;  // dominant-channel failures
   uint64_t unfinished = 0;
-  std::vector<int> got;    // input id per pixel
-  std::string error;       // non-empty if the tracer threw (e.g. a profile limit)
+  std::vector<int> got;  // input id per pixel
+  std::string error;     // non-empty if the tracer threw (e.g. a profile limit)
 };
 
-inline host::Grid grid_of(const Case& c) { return host::build_grid_in_box(c.scene, c.lo, c.hi, c.res, 1); }
+inline host::Grid grid_of(const Case& c) {
+  return host::build_grid_in_box(c.scene, c.lo, c.hi, c.res, 1);
+}
 
 inline host::RenderOptions options_of(const Case& c, vgpu::Format precision) {
   host::RenderOptions opt;
@@ -431,7 +449,8 @@ inline host::RenderOptions options_of(const Case& c, vgpu::Format precision) {
 
 inline bool accepts(const Case& c, int expected, int got) {
   if (expected == kDontCare) return true;
-  if (expected == kAnyMesh) return std::find(c.mesh_ids.begin(), c.mesh_ids.end(), got) != c.mesh_ids.end();
+  if (expected == kAnyMesh)
+    return std::find(c.mesh_ids.begin(), c.mesh_ids.end(), got) != c.mesh_ids.end();
   return expected == got;
 }
 
@@ -451,7 +470,8 @@ inline Outcome run(const Case& c, vgpu::Format precision) {
       if (c.dominant_channel >= 0 && got >= 0) {
         const float* p = &r.rgb[3 * i];
         for (int ch = 0; ch < 3; ++ch)
-          if (ch != c.dominant_channel && !(p[c.dominant_channel] > 4 * p[ch] && p[c.dominant_channel] > 0)) {
+          if (ch != c.dominant_channel &&
+              !(p[c.dominant_channel] > 4 * p[ch] && p[c.dominant_channel] > 0)) {
             ++o.colour_wrong;
             break;
           }

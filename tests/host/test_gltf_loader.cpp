@@ -4,10 +4,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <glm/gtc/epsilon.hpp>
 #include <sstream>
 #include <string>
-
-#include <glm/gtc/epsilon.hpp>
 
 #include "host/camera.h"
 #include "host/gltf_loader.h"
@@ -60,9 +59,11 @@ bool has_warning(const host::Scene& s, const std::string& text) {
 
 }  // namespace
 
-// ---- valid files ---------------------------------------------------------------------------------
+// ---- valid files
+// ---------------------------------------------------------------------------------
 
-TEST_CASE("A minimal triangle loads with its positions, normals, default material and default light") {
+TEST_CASE(
+    "A minimal triangle loads with its positions, normals, default material and default light") {
   const host::Scene s = load("triangle.gltf");
   REQUIRE(s.triangle_count() == 1);
   CHECK(s.name == "triangle");
@@ -85,11 +86,14 @@ TEST_CASE("A minimal triangle loads with its positions, normals, default materia
   REQUIRE(s.lights.size() == 1);
   CHECK(s.default_light);
   const float diagonal = glm::length(glm::vec3(1, 1, 0));
-  CHECK_VEC(s.lights[0].position, glm::vec3(0.5f, 0.5f, 0.0f) + glm::vec3(0.3f, 1.0f, 0.6f) * diagonal);
+  CHECK_VEC(s.lights[0].position,
+            glm::vec3(0.5f, 0.5f, 0.0f) + glm::vec3(0.3f, 1.0f, 0.6f) * diagonal);
   CHECK_VEC(s.lights[0].color, glm::vec3(1.0f));
 }
 
-TEST_CASE("The glb and external-buffer versions of the triangle load the same scene as the embedded gltf") {
+TEST_CASE(
+    "The glb and external-buffer versions of the triangle load the same scene as the embedded "
+    "gltf") {
   const host::Scene a = load("triangle.gltf");
   for (const char* name : {"triangle.glb", "triangle_external.gltf"}) {
     INFO(name);
@@ -130,7 +134,8 @@ TEST_CASE("Normals are transformed by the inverse transpose of the world matrix"
   CHECK_VEC_NEAR(s.n2[3], expected);
 }
 
-TEST_CASE("A mirroring node transform keeps stored triangles counter-clockwise around their normals") {
+TEST_CASE(
+    "A mirroring node transform keeps stored triangles counter-clockwise around their normals") {
   const host::Scene s = load("hierarchy.gltf");
   REQUIRE(s.triangle_count() == 4);
   // Node 2 scales x by -1: corners 1 and 2 are swapped, the normal still points to +Z.
@@ -156,17 +161,31 @@ TEST_CASE("Triangle strips and fans expand in the glTF order and ids follow that
   CHECK(s.id == std::vector<uint32_t>{0, 1, 2, 3, 4, 5, 6});
   const glm::vec3 v[5] = {{0, 0, 0}, {0, 1, 0}, {1, 0, 0}, {1, 1, 0}, {2, 0, 0}};
   // Strip: (0,1,2), (1,3,2), (2,3,4).
-  CHECK_VEC(s.p0[0], v[0]); CHECK_VEC(s.p1[0], v[1]); CHECK_VEC(s.p2[0], v[2]);
-  CHECK_VEC(s.p0[1], v[1]); CHECK_VEC(s.p1[1], v[3]); CHECK_VEC(s.p2[1], v[2]);
-  CHECK_VEC(s.p0[2], v[2]); CHECK_VEC(s.p1[2], v[3]); CHECK_VEC(s.p2[2], v[4]);
+  CHECK_VEC(s.p0[0], v[0]);
+  CHECK_VEC(s.p1[0], v[1]);
+  CHECK_VEC(s.p2[0], v[2]);
+  CHECK_VEC(s.p0[1], v[1]);
+  CHECK_VEC(s.p1[1], v[3]);
+  CHECK_VEC(s.p2[1], v[2]);
+  CHECK_VEC(s.p0[2], v[2]);
+  CHECK_VEC(s.p1[2], v[3]);
+  CHECK_VEC(s.p2[2], v[4]);
   // Fan around f[0]: (1,2,0), (2,3,0).
   const glm::vec3 f[4] = {{0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
-  CHECK_VEC(s.p0[3], f[1]); CHECK_VEC(s.p1[3], f[2]); CHECK_VEC(s.p2[3], f[0]);
-  CHECK_VEC(s.p0[4], f[2]); CHECK_VEC(s.p1[4], f[3]); CHECK_VEC(s.p2[4], f[0]);
+  CHECK_VEC(s.p0[3], f[1]);
+  CHECK_VEC(s.p1[3], f[2]);
+  CHECK_VEC(s.p2[3], f[0]);
+  CHECK_VEC(s.p0[4], f[2]);
+  CHECK_VEC(s.p1[4], f[3]);
+  CHECK_VEC(s.p2[4], f[0]);
   // Non-indexed strip.
   const glm::vec3 w[4] = {{0, 0, 2}, {0, 1, 2}, {1, 0, 2}, {1, 1, 2}};
-  CHECK_VEC(s.p0[5], w[0]); CHECK_VEC(s.p1[5], w[1]); CHECK_VEC(s.p2[5], w[2]);
-  CHECK_VEC(s.p0[6], w[1]); CHECK_VEC(s.p1[6], w[3]); CHECK_VEC(s.p2[6], w[2]);
+  CHECK_VEC(s.p0[5], w[0]);
+  CHECK_VEC(s.p1[5], w[1]);
+  CHECK_VEC(s.p2[5], w[2]);
+  CHECK_VEC(s.p0[6], w[1]);
+  CHECK_VEC(s.p1[6], w[3]);
+  CHECK_VEC(s.p2[6], w[2]);
 }
 
 TEST_CASE("Unsigned byte, short and int indices give the same triangles") {
@@ -248,7 +267,9 @@ TEST_CASE("An orthographic camera is rejected") {
   check_rejected("orthographic_camera.gltf", "orthographic");
 }
 
-TEST_CASE("Point lights are scaled by the brightest light; spot lights count as point lights; directional lights are skipped") {
+TEST_CASE(
+    "Point lights are scaled by the brightest light; spot lights count as point lights; "
+    "directional lights are skipped") {
   // color = rgb * intensity / max(1, I_max); here I_max = 4.
   const host::Scene s = load("lights.gltf");
   CHECK_FALSE(s.default_light);
@@ -263,7 +284,9 @@ TEST_CASE("Point lights are scaled by the brightest light; spot lights count as 
   CHECK(has_warning(s, "directional lights are not supported"));
 }
 
-TEST_CASE("Materials take color and reflection from the file, extras.reflect overrides, and a missing material is grey") {
+TEST_CASE(
+    "Materials take color and reflection from the file, extras.reflect overrides, and a missing "
+    "material is grey") {
   const host::Scene s = load("materials.gltf");
   REQUIRE(s.triangle_count() == 5);
   REQUIRE(s.materials.size() == 5);
@@ -288,7 +311,8 @@ TEST_CASE("Points and lines primitives are skipped with a warning") {
   CHECK(has_warning(s, "skipped 1 LINE_STRIP primitive"));
 }
 
-// ---- broken files --------------------------------------------------------------------------------
+// ---- broken files
+// --------------------------------------------------------------------------------
 
 TEST_CASE("A missing file is rejected with the file name") {
   check_rejected("does_not_exist.gltf", "no such file");
@@ -323,13 +347,16 @@ TEST_CASE("A buffer view outside its buffer is rejected") {
 }
 
 TEST_CASE("A buffer shorter than its byteLength is rejected, external, embedded or in a glb") {
-  check_rejected("short_buffer.gltf", "buffer 0: file 'short_buffer.bin' holds 42 bytes but its byteLength is 50");
-  check_rejected("short_buffer_embedded.gltf", "buffer 0: its data URI holds 42 bytes but its byteLength is 50");
+  check_rejected("short_buffer.gltf",
+                 "buffer 0: file 'short_buffer.bin' holds 42 bytes but its byteLength is 50");
+  check_rejected("short_buffer_embedded.gltf",
+                 "buffer 0: its data URI holds 42 bytes but its byteLength is 50");
   check_rejected("short_buffer.glb", "byteLength 86 is larger than the .glb BIN chunk (80 bytes)");
 }
 
 TEST_CASE("An index past the vertex count is rejected") {
-  check_rejected("index_past_vertices.gltf", "index 5 (element 2 of accessor 1) is past the vertex count 3");
+  check_rejected("index_past_vertices.gltf",
+                 "index 5 (element 2 of accessor 1) is past the vertex count 3");
 }
 
 TEST_CASE("A NaN position is rejected") {
@@ -354,7 +381,8 @@ TEST_CASE("A node hierarchy with a cycle is rejected") {
 }
 
 TEST_CASE("An accessor index out of range is rejected") {
-  check_rejected("accessor_index_out_of_range.gltf", "refers to accessor 7, but the file has 2 accessors");
+  check_rejected("accessor_index_out_of_range.gltf",
+                 "refers to accessor 7, but the file has 2 accessors");
 }
 
 TEST_CASE("A required extension the loader cannot read is rejected") {
@@ -365,9 +393,11 @@ TEST_CASE("JSON nested too deeply is rejected before tinygltf recurses into it")
   check_rejected("deep_json.gltf", "nested deeper than 64 levels");
 }
 
-// ---- scene lookup --------------------------------------------------------------------------------
+// ---- scene lookup
+// --------------------------------------------------------------------------------
 
-TEST_CASE("resolve_scene returns an existing path unchanged and names unknown scenes in its error") {
+TEST_CASE(
+    "resolve_scene returns an existing path unchanged and names unknown scenes in its error") {
   CHECK(host::resolve_scene(data_path("triangle.gltf")) == data_path("triangle.gltf"));
   try {
     host::resolve_scene("no-such-scene-anywhere");
@@ -387,10 +417,11 @@ TEST_CASE("list_scenes returns gltf and glb files sorted by name") {
   }
 }
 
-// ---- camera contract -----------------------------------------------------------------------------
+// ---- camera contract
+// -----------------------------------------------------------------------------
 
 TEST_CASE("primary_dir follows the documented pixel-to-ray contract") {
-  host::Camera cam;  // at the origin, looking down -Z, +Y up
+  host::Camera cam;                    // at the origin, looking down -Z, +Y up
   cam.yfov = std::acos(-1.0f) / 2.0f;  // tan(yfov/2) = 1
   // Top-left pixel of a 4x2 image: x' = (2*0.5/4 - 1) * 1 * 2 = -1.5, y' = 1 - 2*0.5/2 = 0.5.
   CHECK_VEC_NEAR(host::primary_dir(cam, 4, 2, 0, 0), glm::normalize(glm::vec3(-1.5f, 0.5f, -1.0f)));
@@ -421,7 +452,8 @@ TEST_CASE("frame_bounds sees the whole bounding box with a margin, at any aspect
     // Every box corner projects inside the image.
     const glm::vec3 right = glm::normalize(glm::cross(cam.forward, cam.up));
     for (int i = 0; i < 8; ++i) {
-      const glm::vec3 corner(i & 1 ? b.hi.x : b.lo.x, i & 2 ? b.hi.y : b.lo.y, i & 4 ? b.hi.z : b.lo.z);
+      const glm::vec3 corner(i & 1 ? b.hi.x : b.lo.x, i & 2 ? b.hi.y : b.lo.y,
+                             i & 4 ? b.hi.z : b.lo.z);
       const glm::vec3 v = corner - cam.position;
       const float depth = glm::dot(v, cam.forward);
       CHECK(std::abs(glm::dot(v, right) / depth) < t * aspect);

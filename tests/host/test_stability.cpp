@@ -32,8 +32,9 @@ void check_case(const std::string& name) {
       const int e = c.expected[size_t(y) * c.width + x];
       if (e == stability::kDontCare) continue;
       ++demanded;
-      const host::RefHit h = host::brute_force_hit(c.scene, glm::dvec3(c.camera.position),
-                                                   host::cpu_primary_dir(c.camera, c.width, c.height, x, y));
+      const host::RefHit h =
+          host::brute_force_hit(c.scene, glm::dvec3(c.camera.position),
+                                host::cpu_primary_dir(c.camera, c.width, c.height, x, y));
       const int bf = h.tri < 0 ? -1 : int(c.scene.id[size_t(h.tri)]);
       INFO(name << ": brute force at pixel (" << x << ", " << y << ")");
       CHECK(stability::accepts(c, e, bf));
@@ -82,7 +83,9 @@ TEST_CASE("a ray running along a voxel edge hits the triangle below it") {
 TEST_CASE("a diagonal ray through voxel corners hits the triangle behind them") {
   check_case("a diagonal ray through voxel corners hits the triangle behind them");
 }
-TEST_CASE("a quad lying exactly in a voxel face is hit") { check_case("a quad lying exactly in a voxel face is hit"); }
+TEST_CASE("a quad lying exactly in a voxel face is hit") {
+  check_case("a quad lying exactly in a voxel face is hit");
+}
 TEST_CASE("a triangle spanning the whole grid is hit everywhere it is seen") {
   check_case("a triangle spanning the whole grid is hit everywhere it is seen");
 }
@@ -97,15 +100,21 @@ TEST_CASE("a closed octahedron has no cracks along its shared edges and vertices
 TEST_CASE("a triangle fan has no cracks at its spokes and centre") {
   check_case("a triangle fan has no cracks at its spokes and centre");
 }
-TEST_CASE("grazing rays hit the floor they skim") { check_case("grazing rays hit the floor they skim"); }
+TEST_CASE("grazing rays hit the floor they skim") {
+  check_case("grazing rays hit the floor they skim");
+}
 TEST_CASE("a mirror facing a red wall shows the wall, never itself") {
   check_case("a mirror facing a red wall shows the wall, never itself");
 }
 TEST_CASE("a camera inside a closed cube sees a wall in every pixel") {
   check_case("a camera inside a closed cube sees a wall in every pixel");
 }
-TEST_CASE("rays that miss the grid miss") { check_case("rays that miss the grid miss"); }
-TEST_CASE("rays pointing away from the grid miss") { check_case("rays pointing away from the grid miss"); }
+TEST_CASE("rays that miss the grid miss") {
+  check_case("rays that miss the grid miss");
+}
+TEST_CASE("rays pointing away from the grid miss") {
+  check_case("rays pointing away from the grid miss");
+}
 TEST_CASE("a scene far from the origin: a quad in a voxel face at 1e4") {
   check_case("a quad lying exactly in a voxel face is hit at 1e4");
 }
@@ -118,7 +127,9 @@ TEST_CASE("a scene far from the origin: a quad in a voxel face at 1e5") {
 TEST_CASE("a scene far from the origin: a closed octahedron at 1e5") {
   check_case("a closed octahedron has no cracks along its shared edges and vertices at 1e5");
 }
-TEST_CASE("a very thin triangle is hit across its width") { check_case("a very thin triangle is hit across its width"); }
+TEST_CASE("a very thin triangle is hit across its width") {
+  check_case("a very thin triangle is hit across its width");
+}
 TEST_CASE("a very large triangle behind a small one is hit around it") {
   check_case("a very large triangle behind a small one is hit around it");
 }

@@ -23,8 +23,8 @@ inline uint64_t mix(uint64_t& state) {
 // a binary32 subnormal instead, to reach the NaN and signed-zero corners of every operation.
 inline void fill_pattern(vgpu::Texture& t, uint64_t seed, bool specials = true) {
   const float inf = std::numeric_limits<float>::infinity();
-  const float special[] = {std::numeric_limits<float>::quiet_NaN(), inf, -inf, 0.0f, -0.0f,
-                           1e30f, -1e30f, 1e-40f};
+  const float special[] = {
+      std::numeric_limits<float>::quiet_NaN(), inf, -inf, 0.0f, -0.0f, 1e30f, -1e30f, 1e-40f};
   uint64_t s = seed;
   for (int y = 0; y < t.height(); ++y)
     for (int x = 0; x < t.width(); ++x)
