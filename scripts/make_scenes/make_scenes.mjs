@@ -557,6 +557,33 @@ for (const [file, mesh, what, src] of [
 }
 
 // ---------------------------------------------------------------------------------------------
+// 4b. sphere-alone.gltf, bunny-mirror.gltf — the lighter readings of Table 1's "Sphere" and
+// "BunnyRefl" (docs/table1.md): the object alone, and the bunny on a mirror floor only.
+// ---------------------------------------------------------------------------------------------
+{
+  const g = new Gltf('sphere-alone', 'Table 1 "Sphere" (the reading scripts/table1.py uses): the UV sphere of sphere.gltf alone, no floor; same camera and light', SRC_PROC);
+  const mSphere = g.material('red', [0.8, 0.12, 0.08], 0.3, 0.2);
+  const sphere = uvSphere(1.5, 32, 24); // 1472 faces
+  const c = [0, 2.0, 0];
+  g.instance('sphere', g.mesh('sphere', [{ mesh: sphere, material: mSphere }]), { t: c });
+  g.camera([0, 3.2, 7.5], [0, 1.7, 0], placed(sphere, 1, c), 0.6);
+  g.light('light', [-4, 8, 5], WHITE);
+  summary.push(g.write('sphere-alone.gltf'));
+}
+{
+  const g = new Gltf('bunny-mirror', 'Table 1 "BunnyRefl" (the reading scripts/table1.py uses): the full bunny of bunny-refl.gltf on a reflective 6 x 6 floor (about twice its footprint), no walls; same camera and light', `${SRC_BUNNY}; floor procedural`);
+  const mBunny = g.material('bunny', [0.85, 0.72, 0.55], 0.0, 0.6);
+  const mFloor = g.material('floor', [0.55, 0.6, 0.7], 0.5, 0.3);
+  const t = [-0.4, bunnyBase, 0];
+  const r = quatAxisAngle([0, 1, 0], deg(30));
+  g.instance('bunny', g.mesh('bunny', [{ mesh: bunnyMesh, material: mBunny }]), { s: BUNNY_SCALE, t, r });
+  g.instance('floor', g.mesh('floor', [{ mesh: quadXZ(6, 6), material: mFloor }]));
+  g.camera([0, 3.2, 8.5], [0, 1.6, -1.0], placed(bunnyMesh, BUNNY_SCALE, t, r), 0.7);
+  g.light('light', [3.5, 7, 5], WHITE);
+  summary.push(g.write('bunny-mirror.gltf'));
+}
+
+// ---------------------------------------------------------------------------------------------
 // 5. classic.gltf — Fig. 1 (Whitted-style test scene, 848 faces)
 // ---------------------------------------------------------------------------------------------
 {
