@@ -24,9 +24,9 @@ const std::vector<Profile>& profiles() {
     fx.bus_mbps = 2112;           // AGP 8x: 264 MB/s x 8 (GPU Gems 2, ch. 30)
     // Fixed costs: no public figure; one unit u fitted on Table 1 Bunny3 on this card (5075 ms,
     // scripts/table1.py --fit), split pass : load : read-back = u : u : 2u (docs/table1.md).
-    fx.program_load_us = 535;  // fitted (Table 1 Bunny3), driver cost of a program switch
-    fx.readback_us = 1069;     // fitted (Table 1 Bunny3); GPU Gems 2 ch. 6: a stall
-    fx.pass_us = 535;          // fitted (Table 1 Bunny3)
+    fx.program_load_us = 651;  // fitted (Table 1 Bunny3), driver cost of a program switch
+    fx.readback_us = 1301;     // fitted (Table 1 Bunny3); GPU Gems 2 ch. 6: a stall
+    fx.pass_us = 651;          // fitted (Table 1 Bunny3)
     fx.alu_lanes = 4;          // NV_fragment_program instructions are 4-component (vec4)
     fx.alu_per_clock = 1;      // hexus.net FX 5700 Ultra review p.2: one shader unit per pipe
     fx.fp32_rate = 0.5;        // model parameter: NV3x slow at fp32 (Tom's Hardware NV40 review)
@@ -48,9 +48,9 @@ const std::vector<Profile>& profiles() {
     g6.precision = Format::fp32;        // FP32 and FP16 equal speed on GeForce 6 (CineFX 3.0 brief)
     g6.bus_mbps = 4000;  // PCI Express x16, one direction (PCI-SIG 1.0a: 250 MB/s/lane)
     // Fixed costs: fitted as on the FX 5700, on Table 1 Bunny3 on this card (1079 ms).
-    g6.program_load_us = 128;  // fitted (Table 1 Bunny3), driver cost of a program switch
-    g6.readback_us = 255;      // fitted (Table 1 Bunny3)
-    g6.pass_us = 128;          // fitted (Table 1 Bunny3)
+    g6.program_load_us = 160;  // fitted (Table 1 Bunny3), driver cost of a program switch
+    g6.readback_us = 320;      // fitted (Table 1 Bunny3)
+    g6.pass_us = 160;          // fitted (Table 1 Bunny3)
     g6.alu_lanes = 4;          // NV_fragment_program2 instructions are 4-component (vec4)
     g6.alu_per_clock = 2;      // Tom's Hardware NV40 review: two FP32 units per pipe
     g6.fp32_rate = 1;          // NVIDIA CineFX 3.0 brief: FP32 and FP16 equal speed

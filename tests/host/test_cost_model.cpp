@@ -4,6 +4,9 @@
 #include <doctest/doctest.h>
 
 #include "host/cost_model.h"
+#include "host/gltf_loader.h"
+#include "host/grid.h"
+#include "host/stream_tracer.h"
 
 namespace {
 
@@ -168,4 +171,24 @@ TEST_CASE("Merging a pair of kernels into one MRT pass drops passes and loads, k
   CHECK(r.totals.program_loads == 2);
   CHECK(r.totals.program_bytes == 2 * 496);
   CHECK(r.totals.passes == s.totals.passes);
+}
+
+TEST_CASE(
+    "the fitted fixed costs reproduce Table 1's Bunny3 on both cards at the Table 1 settings") {
+  // scripts/table1.py's settings: 256x256, 2 bounces, phong, no shadow rays, a 15^3 grid. If the
+  // kernels or the host loop change their counts, this fails: refit (table1.py --fit).
+  const host::Scene scene = host::load_scene(VGPU_SCENES_DIR "/bunny.gltf");
+  REQUIRE(scene.camera.has_value());
+  const host::Grid grid = host::build_grid(scene, host::parse_grid_spec("15"));
+  host::RenderOptions opt;
+  opt.shadows = false;
+  opt.threads = 2;
+  host::StreamTracer tracer(scene, grid, opt);
+  const host::RenderResult r = tracer.render(*scene.camera);
+  const double fx = host::predict(r.stats, vgpu::profile("gf5700")).total_ms;
+  const double g6 = host::predict(r.stats, vgpu::profile("gf6600")).total_ms;
+  MESSAGE("Bunny3 predicted: GeForce FX 5700 " << fx << " ms (paper 5075), GeForce 6600 " << g6
+                                               << " ms (paper 1079)");
+  CHECK(fx == doctest::Approx(5075).epsilon(0.01));
+  CHECK(g6 == doctest::Approx(1079).epsilon(0.01));
 }
