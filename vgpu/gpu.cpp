@@ -206,7 +206,8 @@ void Gpu::run_rows(const Program& p, const Rect& r, int y0, int y1, uint64_t idl
     const uint8_t* st = stencil_test_ ? stencil_test_->row(y) : nullptr;
     const uint8_t* wk = work_mask_ ? work_mask_->row(y) : nullptr;
     uint8_t* sw = stencil_write_ ? stencil_write_->row_mut(y) : nullptr;
-    uint8_t* fl = flags ? flags + size_t(y - r.y0) * size_t(r.width()) - size_t(r.x0) : nullptr;
+    // This row's flags; fragment x sits at fl[x - r.x0].
+    uint8_t* fl = flags ? flags + size_t(y - r.y0) * size_t(r.width()) : nullptr;
     for (int x = r.x0, n = 0; x < r.x1; x += n) {
       if (wk && !st && wk[x] == 0) {
         // A stretch of idle fragments (the usual case late in a loop): counted and copied at
@@ -235,7 +236,7 @@ void Gpu::run_rows(const Program& p, const Rect& r, int y0, int y1, uint64_t idl
                 cp.dst[off + i] = round_to(cp.fmt, cp.src[off + i]);
           }
         if (sw) std::memset(sw + x, idle_kill ? 0 : 1, size_t(n));
-        if (fl && !work_masked_) std::memset(fl + x, kIdle, size_t(n));
+        if (fl && !work_masked_) std::memset(fl + (x - r.x0), kIdle, size_t(n));
         continue;
       }
       n = std::min(W, r.x1 - x);
@@ -326,9 +327,9 @@ void Gpu::run_rows(const Program& p, const Rect& r, int y0, int y1, uint64_t idl
       if (fl) {
         const M idle = f.idle_lanes();
         for (int i = 0; i < n; ++i)
-          fl[x + i] = !live[i] ? 0
-                      : run[i] ? (idle[i] ? kIdle : kTook)
-                               : (work_masked_ ? 0 : kIdle);
+          fl[x - r.x0 + i] = !live[i] ? 0
+                             : run[i] ? (idle[i] ? kIdle : kTook)
+                                      : (work_masked_ ? 0 : kIdle);
       }
       out.discarded += uint64_t(nkill);
       if (sw)

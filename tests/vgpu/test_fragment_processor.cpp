@@ -270,6 +270,13 @@ TEST_CASE("the batch counters count idle fragments only in 8x4 and 32x32 tiles i
       CHECK(m.lanes_idle == 46 * 40);
       CHECK(m.idle_in_batch32 == 1600);   // 5 idle tile columns (x 16..55) x 40 rows x 8
       CHECK(m.idle_in_batch1024 == 960);  // x 32..55 in both row tiles: 24 x 40
+      // Tiles start at the drawn rectangle's corner: x 8..63 gives 8x4 tiles from x 8 (x 8..15
+      // busy) and 32x32 tiles from x 8 (x 8..39 busy).
+      gpu.set_stencil_test(nullptr);
+      const Counters part = gpu.draw(Rect{8, 0, 64, 40}).counters;
+      CHECK(part.lanes_idle == 54 * 40);
+      CHECK(part.idle_in_batch32 == 48 * 40);
+      CHECK(part.idle_in_batch1024 == 24 * 40);
     }
 }
 
