@@ -51,6 +51,21 @@ std::array<uint64_t, 2> idle_in_batches(const std::vector<uint8_t>& flags, int w
   return total;
 }
 
+// End of a stretch of live idle fragments from `from`: the first i < to with wk[i] != 0 or, when
+// there is a stencil test, st[i] == 0. Eight bytes at a time, the row's hottest loop.
+int stretch_end(const uint8_t* wk, const uint8_t* st, int from, int to) {
+  constexpr uint64_t ones = 0x0101010101010101ull, highs = 0x8080808080808080ull;
+  int i = from;
+  for (; i + 8 <= to; i += 8) {
+    uint64_t w = 0, s = ~0ull;
+    std::memcpy(&w, wk + i, 8);
+    if (st) std::memcpy(&s, st + i, 8);
+    if (w != 0 || ((s - ones) & ~s & highs) != 0) break;  // a set work byte or a zero stencil byte
+  }
+  while (i < to && wk[i] == 0 && (!st || st[i] != 0)) ++i;
+  return i;
+}
+
 }  // namespace
 
 struct Gpu::Chunk {
@@ -201,6 +216,30 @@ void Gpu::run_rows(const Program& p, const Rect& r, int y0, int y1, uint64_t idl
                    dst.width(),       dst.channels(),
                    dst.format(),      src.format() == dst.format() || dst.format() == Format::fp32};
     }
+  // k live fragments from (x, y) on that skip the program: their outputs keep their previous
+  // values, copied from the passthrough units (or nothing, for a program that discards them).
+  // Returns how many are discarded.
+  auto idle_run = [&](int x, int y, int k) -> uint64_t {
+    const uint64_t n = uint64_t(k);
+    if (work_masked_) {
+      // Modeled as an early-z/stencil reject: masked, not shaded, never counted.
+      out.shaded -= n;
+      out.masked += n;
+    } else {
+      out.idle += idle_branches * n;  // an idle fragment takes none of the program's branches
+    }
+    if (idle_kill) return work_masked_ ? 0 : n;
+    for (int o = 0; o < nout; ++o) {
+      const CopyPlan& cp = copies[o];
+      const size_t off = (size_t(y) * size_t(cp.width) + size_t(x)) * size_t(cp.ch);
+      const size_t count = n * size_t(cp.ch);
+      if (cp.exact)
+        std::memcpy(cp.dst + off, cp.src + off, count * sizeof(float));
+      else  // rounded as the program's own store would be: the source is a wider format
+        for (size_t i = 0; i < count; ++i) cp.dst[off + i] = round_to(cp.fmt, cp.src[off + i]);
+    }
+    return 0;
+  };
 
   for (int y = y0; y < y1; ++y) {
     const uint8_t* st = stencil_test_ ? stencil_test_->row(y) : nullptr;
@@ -209,32 +248,13 @@ void Gpu::run_rows(const Program& p, const Rect& r, int y0, int y1, uint64_t idl
     // This row's flags; fragment x sits at fl[x - r.x0].
     uint8_t* fl = flags ? flags + size_t(y - r.y0) * size_t(r.width()) : nullptr;
     for (int x = r.x0, n = 0; x < r.x1; x += n) {
-      if (wk && !st && wk[x] == 0) {
-        // A stretch of idle fragments (the usual case late in a loop): counted and copied at
-        // once, exactly as the per-block path below would (fragments are independent).
-        int e = x + 1;
-        while (e < r.x1 && wk[e] == 0) ++e;
-        n = e - x;
-        const uint64_t k = uint64_t(n);
-        out.launched += k;
-        if (work_masked_) {
-          out.masked += k;
-        } else {
-          out.shaded += k;
-          out.idle += idle_branches * k;
-          if (idle_kill) out.discarded += k;
-        }
-        if (!idle_kill)
-          for (int o = 0; o < nout; ++o) {
-            const CopyPlan& cp = copies[o];
-            const size_t off = (size_t(y) * size_t(cp.width) + size_t(x)) * size_t(cp.ch);
-            const size_t count = k * size_t(cp.ch);
-            if (cp.exact)
-              std::memcpy(cp.dst + off, cp.src + off, count * sizeof(float));
-            else
-              for (size_t i = 0; i < count; ++i)
-                cp.dst[off + i] = round_to(cp.fmt, cp.src[off + i]);
-          }
+      // A stretch of live idle fragments (the usual case late in a loop) is handled at once,
+      // exactly as the per-block path below would (fragments are independent).
+      if (wk && wk[x] == 0 && (!st || st[x] != 0)) {
+        n = stretch_end(wk, st, x, r.x1) - x;
+        out.launched += uint64_t(n);
+        out.shaded += uint64_t(n);
+        out.discarded += idle_run(x, y, n);
         if (sw) std::memset(sw + x, idle_kill ? 0 : 1, size_t(n));
         if (fl && !work_masked_) std::memset(fl + (x - r.x0), kIdle, size_t(n));
         continue;
@@ -287,43 +307,17 @@ void Gpu::run_rows(const Program& p, const Rect& r, int y0, int y1, uint64_t idl
         }
       }
       int nkill = lanes_on(kill);
-      if (wk) {
-        // Idle fragments: outputs keep their previous values (copied from the passthrough units).
-        int nidle = 0;
-        for (int i = 0; i < n; ++i) nidle += (live[i] && !run[i]) ? 1 : 0;
-        if (work_masked_) {
-          // Modeled as an early-z/stencil reject: masked, not shaded, never counted.
-          out.shaded -= uint64_t(nidle);
-          out.masked += uint64_t(nidle);
-        } else {
-          out.idle += idle_branches * uint64_t(nidle);  // an idle fragment takes no branch
-          if (idle_kill) nkill += nidle;
-        }
-        if (!idle_kill && nidle > 0) {
-          for (int o = 0; o < nout; ++o) {
-            const CopyPlan& cp = copies[o];
-            // Contiguous runs of idle fragments are copied in one go.
-            for (int i = 0; i < n;) {
-              if (!live[i] || run[i]) {
-                ++i;
-                continue;
-              }
-              int j = i + 1;
-              while (j < n && live[j] && !run[j]) ++j;
-              const size_t off = (size_t(y) * size_t(cp.width) + size_t(x + i)) * size_t(cp.ch);
-              const size_t count = size_t(j - i) * size_t(cp.ch);
-              if (cp.exact) {
-                std::memcpy(cp.dst + off, cp.src + off, count * sizeof(float));
-              } else {
-                // Rounded as the program's own store would be: the source is a wider format.
-                for (size_t k = 0; k < count; ++k)
-                  cp.dst[off + k] = round_to(cp.fmt, cp.src[off + k]);
-              }
-              i = j;
-            }
+      if (wk)  // contiguous runs of live fragments the work mask leaves idle
+        for (int i = 0; i < n;) {
+          if (!live[i] || run[i]) {
+            ++i;
+            continue;
           }
+          int j = i + 1;
+          while (j < n && live[j] && !run[j]) ++j;
+          nkill += int(idle_run(x + i, y, j - i));
+          i = j;
         }
-      }
       if (fl) {
         const M idle = f.idle_lanes();
         for (int i = 0; i < n; ++i)
