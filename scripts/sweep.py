@@ -26,6 +26,7 @@ import json
 import math
 import os
 import re
+import statistics
 import subprocess
 import sys
 import tempfile
@@ -218,12 +219,6 @@ def plot(rows, path, size):
     print(f"wrote {path}")
 
 
-def median(xs):
-    xs = sorted(xs)
-    n = len(xs)
-    return (xs[n // 2] + xs[(n - 1) // 2]) / 2 if n else None
-
-
 def report(rows, path, size):
     """docs/accuracy.md: wrong pixels per precision mode, by criterion."""
     ok = [r for r in rows if r["render_ms"] != "" and r["wrong_hit_px"] != ""]
@@ -258,10 +253,9 @@ def report(rows, path, size):
         for key, _ in CRITERIA:
             n = sum(int(r[f"wrong_{key}_px"]) for r in rs)
             cells.append(f"{n} ({100.0 * n / tot:.3g}%)" if tot else "")
-        ps = [float(r["psnr_db"]) for r in rs]
-        med = median(ps)
+        med = statistics.median(float(r["psnr_db"]) for r in rs) if rs else None
         L.append(f"| {prec} | {len(rs)} | {len(bad)} | {tot} | " + " | ".join(cells) +
-                 f" | {'inf' if med == math.inf else f'{med:.1f}'} |")
+                 f" | {'' if med is None else 'inf' if med == math.inf else f'{med:.1f}'} |")
     L.append("")
     L.append("## Per scene and grid\n")
     L.append("Wrong pixels as *hit / depth / colour* (of " + str(pixels) + "), for 0 and 2 "

@@ -85,17 +85,25 @@ def span(values):
     return f"about {lo}" if lo == hi else f"{lo}-{hi}"
 
 
+def fixed_units(t):
+    """A frame's fixed costs in units of u (SPLIT), from its totals."""
+    return (SPLIT["pass"] * t["passes"] + SPLIT["load"] * t["program_loads"] +
+            SPLIT["readback"] * t["query_readbacks"])
+
+
+def split(j, gpu):
+    """A prediction as (ms that do not depend on u, units of u): total = rest + u * units."""
+    b = j["predicted_breakdown"][gpu]
+    fixed = b["per_pass_ms"] + b["program_load_ms"] - b["bus_ms"] + b["readback_ms"]
+    return b["total_ms"] - fixed, fixed_units(j["totals"])
+
+
 def fit(data):
     """u (us) that makes each calibration cell's prediction equal the paper's time."""
     out = {}
     for scene, gpu in CALIBRATION:
-        j = data[(scene, gpu)]
-        b = j["predicted_breakdown"][gpu]
-        t = j["totals"]
-        work = b["arithmetic_ms"] + b["texture_ms"] + b["memory_ms"]
-        units = (SPLIT["pass"] * t["passes"] + SPLIT["load"] * t["program_loads"] +
-                 SPLIT["readback"] * t["query_readbacks"])
-        out[gpu] = 1e3 * (PAPER[scene][gpu] - work - b["bus_ms"]) / units
+        rest, units = split(data[(scene, gpu)], gpu)
+        out[gpu] = 1e3 * (PAPER[scene][gpu] - rest) / units
     return out
 
 
@@ -477,8 +485,7 @@ def explain_what_if(data, masks):
     v0 = [data[(sc, "gf5700")]["predicted_ms"]["gf5700"] / data[(sc, "gf6600")]["predicted_ms"]["gf6600"]
           for sc, _ in SCENES]
     t = data[("BunnyRefl", "gf5700")]["totals"]
-    per_pass = (SPLIT["pass"] * t["passes"] + SPLIT["load"] * t["program_loads"] +
-                SPLIT["readback"] * t["query_readbacks"]) / t["passes"]
+    per_pass = fixed_units(t) / t["passes"]
     return ("**Reading the what-ifs (FX 5700).** " + "; ".join(out) + ". Masks remove the largest "
             "term, the work on idle fragments, and almost all memory traffic. MRT removes about a "
             "third of the passes and program loads, but none of the arithmetic: the merged pass "
@@ -495,12 +502,6 @@ def refit(cells):
 
     cells: scene -> --stats-json of that scene (rendered once; the JSON predicts every profile).
     Returns ({gpu: u_us}, {(scene, gpu): predicted ms})."""
-    def split(j, gpu):
-        b, t = j["predicted_breakdown"][gpu], j["totals"]
-        units = (SPLIT["pass"] * t["passes"] + SPLIT["load"] * t["program_loads"] +
-                 SPLIT["readback"] * t["query_readbacks"])
-        fixed = b["per_pass_ms"] + b["program_load_ms"] - b["bus_ms"] + b["readback_ms"]
-        return b["total_ms"] - fixed, units
     us, pred = {}, {}
     for gpu in GPUS:
         rest, units = split(cells["Bunny3"], gpu)
