@@ -43,11 +43,7 @@ host::Scene sphere_scene(size_t target) {
       ++s.dropped_degenerate;
       return;
     }
-    s.p0.push_back(a), s.p1.push_back(b), s.p2.push_back(c);
-    s.n0.push_back(glm::normalize(a)), s.n1.push_back(glm::normalize(b)),
-        s.n2.push_back(glm::normalize(c));
-    s.material.push_back(0);
-    s.id.push_back(this_id);
+    s.add_triangle(a, b, c, glm::normalize(a), glm::normalize(b), glm::normalize(c), 0, this_id);
   };
   for (int i = 0; i < rings; ++i)
     for (int j = 0; j < segs; ++j) {

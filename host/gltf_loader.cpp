@@ -1006,10 +1006,7 @@ class Loader {
           if (g.normals_from_file) ++invalid_file_normals_;
         }
       }
-      scene_.p0.push_back(p[0]), scene_.p1.push_back(p[1]), scene_.p2.push_back(p[2]);
-      scene_.n0.push_back(n[0]), scene_.n1.push_back(n[1]), scene_.n2.push_back(n[2]);
-      scene_.material.push_back(g.material);
-      scene_.id.push_back(id);
+      scene_.add_triangle(p[0], p[1], p[2], n[0], n[1], n[2], g.material, id);
     }
   }
 

@@ -66,6 +66,20 @@ struct Scene {
   std::vector<std::string> warnings;  // e.g. "skipped 2 LINES primitives"
 
   size_t triangle_count() const { return p0.size(); }
+  // Appends a triangle: corners, corner normals (unit), material index and input id.
+  void add_triangle(glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 na, glm::vec3 nb, glm::vec3 nc,
+                    uint32_t mat, uint32_t input_id) {
+    p0.push_back(a), p1.push_back(b), p2.push_back(c);
+    n0.push_back(na), n1.push_back(nb), n2.push_back(nc);
+    material.push_back(mat);
+    id.push_back(input_id);
+  }
+  // The same with the face normal at every corner (+z for a zero-area triangle).
+  void add_flat_triangle(glm::vec3 a, glm::vec3 b, glm::vec3 c, uint32_t mat, uint32_t input_id) {
+    const glm::vec3 n = glm::cross(b - a, c - a);
+    const glm::vec3 u = glm::length(n) > 0 ? glm::normalize(n) : glm::vec3(0, 0, 1);
+    add_triangle(a, b, c, u, u, u, mat, input_id);
+  }
   Bounds bounds() const {
     Bounds b;
     for (size_t i = 0; i < p0.size(); ++i) {

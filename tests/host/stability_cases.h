@@ -58,16 +58,7 @@ struct Builder {
   uint32_t next_id = 100;
   Builder() { s.materials = {{{0.8f, 0.8f, 0.8f}, 0.0f}}; }
   int tri(glm::vec3 a, glm::vec3 b, glm::vec3 c, uint32_t material = 0) {
-    glm::vec3 n = glm::cross(b - a, c - a);
-    n = glm::length(n) > 0 ? glm::normalize(n) : glm::vec3(0, 0, 1);
-    s.p0.push_back(a);
-    s.p1.push_back(b);
-    s.p2.push_back(c);
-    s.n0.push_back(n);
-    s.n1.push_back(n);
-    s.n2.push_back(n);
-    s.material.push_back(material);
-    s.id.push_back(next_id);
+    s.add_flat_triangle(a, b, c, material, next_id);
     s.input_triangles = next_id + 1;
     return int(next_id++);
   }

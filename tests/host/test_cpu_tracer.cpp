@@ -34,15 +34,7 @@ Scene make_scene(const std::vector<Tri>& tris, std::vector<host::Material> mater
                  std::vector<host::PointLight> lights) {
   Scene s;
   for (const Tri& t : tris) {
-    s.p0.push_back(t.a);
-    s.p1.push_back(t.b);
-    s.p2.push_back(t.c);
-    const glm::vec3 n = glm::normalize(glm::cross(t.b - t.a, t.c - t.a));
-    s.n0.push_back(n);
-    s.n1.push_back(n);
-    s.n2.push_back(n);
-    s.material.push_back(t.material);
-    s.id.push_back(uint32_t(s.id.size()));
+    s.add_flat_triangle(t.a, t.b, t.c, t.material, uint32_t(s.id.size()));
   }
   s.materials = std::move(materials);
   s.lights = std::move(lights);

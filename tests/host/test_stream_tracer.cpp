@@ -30,15 +30,7 @@ namespace {
 struct SceneBuilder {
   Scene s;
   void tri(glm::vec3 a, glm::vec3 b, glm::vec3 c, uint32_t material) {
-    const glm::vec3 n = glm::normalize(glm::cross(b - a, c - a));
-    s.p0.push_back(a);
-    s.p1.push_back(b);
-    s.p2.push_back(c);
-    s.n0.push_back(n);
-    s.n1.push_back(n);
-    s.n2.push_back(n);
-    s.material.push_back(material);
-    s.id.push_back(10 + 3 * uint32_t(s.id.size()));
+    s.add_flat_triangle(a, b, c, material, 10 + 3 * uint32_t(s.id.size()));
     s.input_triangles = 10 + 3 * uint32_t(s.id.size());
   }
   void quad(glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d, uint32_t material) {
