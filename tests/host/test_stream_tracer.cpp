@@ -85,6 +85,17 @@ RenderOptions primary_only(int w, int h) {
   return opt;
 }
 
+// The whole pipeline: 2 bounces, shadow rays, phong, one thread.
+RenderOptions full_pipeline(int w, int h) {
+  RenderOptions opt;
+  opt.width = w;
+  opt.height = h;
+  opt.bounces = 2;
+  opt.shadows = true;
+  opt.threads = 1;
+  return opt;
+}
+
 // How close the ray passes to a triangle edge where that matters: the smallest |barycentric
 // margin| min(u, v, 1 - u - v) over the triangles whose plane the ray crosses at 0 < t <= the
 // brute-force hit (every t for a miss). Small for a hit near its triangle's edge (the hit lies in
@@ -215,12 +226,8 @@ TEST_CASE("on the bunny the stream tracer's primary hits match brute force away 
 TEST_CASE("images and statistics are bit-identical for 1 and 3 threads and 1 and 8 lanes") {
   const Scene scene = test_scene();
   const host::Grid grid = host::build_grid(scene, host::GridSpec{});
-  RenderOptions opt;
-  opt.width = 72;  // 72x64 = 4608 fragments: passes are split over threads from 4096 on
-  opt.height = 64;
-  opt.bounces = 2;
-  opt.shadows = true;
-  opt.threads = 1;
+  // 72x64 = 4608 fragments: passes are split over threads from 4096 on.
+  RenderOptions opt = full_pipeline(72, 64);
   opt.lanes = 1;
   const RenderResult ref = render(scene, grid, test_camera(), opt);
   CHECK(ref.iterations == 3);
@@ -236,12 +243,7 @@ TEST_CASE("images and statistics are bit-identical for 1 and 3 threads and 1 and
 TEST_CASE("the emulator's host shortcut changes neither the image nor any statistic") {
   const Scene scene = test_scene();
   const host::Grid grid = host::build_grid(scene, host::GridSpec{});
-  RenderOptions opt;
-  opt.width = 40;
-  opt.height = 30;
-  opt.bounces = 2;
-  opt.shadows = true;
-  opt.threads = 1;
+  RenderOptions opt = full_pipeline(40, 30);
   opt.host_shortcut = true;
   const RenderResult with = render(scene, grid, test_camera(), opt);
   opt.host_shortcut = false;
@@ -251,12 +253,7 @@ TEST_CASE("the emulator's host shortcut changes neither the image nor any statis
 TEST_CASE("early-z masks give the same image while masking fragments that would have been shaded") {
   const Scene scene = test_scene();
   const host::Grid grid = host::build_grid(scene, host::GridSpec{});
-  RenderOptions opt;
-  opt.width = 40;
-  opt.height = 30;
-  opt.bounces = 2;
-  opt.shadows = true;
-  opt.threads = 1;
+  RenderOptions opt = full_pipeline(40, 30);
   opt.masks = false;
   const RenderResult plain = render(scene, grid, test_camera(), opt);
   opt.masks = true;
