@@ -139,24 +139,7 @@ namespace {
 template <class Fn>
 vgpu::Counters each_counter(const vgpu::Counters& a, const vgpu::Counters& b, Fn f) {
   vgpu::Counters r;
-  uint64_t vgpu::Counters::*const fields[] = {&vgpu::Counters::passes,
-                                              &vgpu::Counters::fragments_launched,
-                                              &vgpu::Counters::fragments_shaded,
-                                              &vgpu::Counters::fragments_masked,
-                                              &vgpu::Counters::fragments_discarded,
-                                              &vgpu::Counters::lanes_idle,
-                                              &vgpu::Counters::idle_in_batch32,
-                                              &vgpu::Counters::idle_in_batch1024,
-                                              &vgpu::Counters::instructions,
-                                              &vgpu::Counters::texture_fetches,
-                                              &vgpu::Counters::bytes_read,
-                                              &vgpu::Counters::bytes_written,
-                                              &vgpu::Counters::program_loads,
-                                              &vgpu::Counters::program_bytes,
-                                              &vgpu::Counters::clears,
-                                              &vgpu::Counters::queries,
-                                              &vgpu::Counters::query_readbacks};
-  for (auto field : fields) r.*field = f(a.*field, b.*field);
+  for (const auto& [name, field] : vgpu::kCounterFields) r.*field = f(a.*field, b.*field);
   return r;
 }
 vgpu::Counters scaled(const vgpu::Counters& c, double f) {

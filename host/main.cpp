@@ -64,27 +64,6 @@ bool parse_on_off(const std::string& v, const std::string& what) {
   throw UsageError(what + ": expected on or off, got '" + v + "'");
 }
 
-nlohmann::ordered_json counters_json(const vgpu::Counters& c) {
-  return {{"passes", c.passes},
-          {"fragments_launched", c.fragments_launched},
-          {"fragments_shaded", c.fragments_shaded},
-          {"fragments_masked", c.fragments_masked},
-          {"fragments_discarded", c.fragments_discarded},
-          {"lanes_idle", c.lanes_idle},
-          {"idle_in_batch32", c.idle_in_batch32},
-          {"idle_in_batch1024", c.idle_in_batch1024},
-          {"instructions", c.instructions},
-          {"texture_fetches", c.texture_fetches},
-          {"bytes_read", c.bytes_read},
-          {"bytes_written", c.bytes_written},
-          {"program_loads", c.program_loads},
-          {"program_bytes", c.program_bytes},
-          {"clears", c.clears},
-          {"queries", c.queries},
-          {"query_readbacks", c.query_readbacks},
-          {"host_ms", c.host_ms}};
-}
-
 int run_render(const RenderArgs& a) {
   // Validate everything before any work, so a bad argument costs nothing and writes nothing.
   host::RenderOptions opt;
@@ -199,18 +178,11 @@ int run_render(const RenderArgs& a) {
                 {"triangle_tests", cpu_stats.triangle_tests}};
   j["rays_traced"] = r.rays_traced;
   j["rays_unfinished"] = r.rays_unfinished;
-  j["totals"] = counters_json(r.stats.totals);
-  auto ks = nlohmann::ordered_json::array();
-  for (const auto& p : r.stats.programs) {
-    nlohmann::ordered_json k;
-    k["name"] = p.name;
-    k["paper_name"] = p.paper_name;
-    k["static_instructions"] = p.instructions;
-    const nlohmann::ordered_json c = counters_json(p.counters);
-    for (auto& [key, v] : c.items()) k[key] = v;
-    ks.push_back(k);
+  {
+    nlohmann::ordered_json stats = r.stats.json();
+    j["totals"] = std::move(stats["totals"]);
+    j["kernels"] = std::move(stats["programs"]);
   }
-  j["kernels"] = ks;
   // The cost model's prediction for every built-in profile (the counters do not depend on it).
   nlohmann::ordered_json predicted_ms, predicted_breakdown;
   for (const vgpu::Profile& p : vgpu::profiles()) {
@@ -224,7 +196,7 @@ int run_render(const RenderArgs& a) {
   auto what_if = nlohmann::ordered_json::array();  // MRT and resident programs (docs/table1.md)
   for (const auto& [name, s] :
        cpu ? decltype(host::what_ifs(r.stats)){} : host::what_ifs(r.stats)) {
-    nlohmann::ordered_json w = {{"name", name}, {"totals", counters_json(s.totals)}};
+    nlohmann::ordered_json w = {{"name", name}, {"totals", vgpu::to_json(s.totals)}};
     for (const vgpu::Profile& p : vgpu::profiles())
       for (const auto& [key, v] : host::predict(s, p).items())
         w["predicted_breakdown"][p.name][key] = v;

@@ -10,34 +10,21 @@
 
 namespace vgpu {
 
-#define VGPU_COUNTER_FIELDS(X)                                                                    \
-  X(passes)                                                                                       \
-  X(fragments_launched)                                                                           \
-  X(fragments_shaded) X(fragments_masked) X(fragments_discarded) X(lanes_idle) X(idle_in_batch32) \
-      X(idle_in_batch1024) X(instructions) X(texture_fetches) X(bytes_read) X(bytes_written)      \
-          X(program_loads) X(program_bytes) X(clears) X(queries) X(query_readbacks)
-
 Counters& Counters::operator+=(const Counters& o) {
-#define X(f) f += o.f;
-  VGPU_COUNTER_FIELDS(X)
-#undef X
+  for (const auto& [name, field] : kCounterFields) this->*field += o.*field;
   host_ms += o.host_ms;
   return *this;
 }
 
 bool Counters::same_counts(const Counters& o) const {
-#define X(f) \
-  if (f != o.f) return false;
-  VGPU_COUNTER_FIELDS(X)
-#undef X
+  for (const auto& [name, field] : kCounterFields)
+    if (this->*field != o.*field) return false;
   return true;
 }
 
-static nlohmann::ordered_json counters_json(const Counters& c) {
+nlohmann::ordered_json to_json(const Counters& c) {
   nlohmann::ordered_json j;
-#define X(f) j[#f] = c.f;
-  VGPU_COUNTER_FIELDS(X)
-#undef X
+  for (const auto& [name, field] : kCounterFields) j[name] = c.*field;
   j["host_ms"] = c.host_ms;
   return j;
 }
@@ -62,9 +49,9 @@ void FrameStats::clear() {
   totals = {};
 }
 
-std::string FrameStats::to_json(int indent) const {
+nlohmann::ordered_json FrameStats::json() const {
   nlohmann::ordered_json j;
-  j["totals"] = counters_json(totals);
+  j["totals"] = vgpu::to_json(totals);
   auto progs = nlohmann::ordered_json::array();
   for (const ProgramTotals& p : programs) {
     nlohmann::ordered_json e;
@@ -72,12 +59,16 @@ std::string FrameStats::to_json(int indent) const {
     e["paper_name"] = p.paper_name;
     // The static count has its own key: the counters' "instructions" (executed) follow.
     e["static_instructions"] = p.instructions;
-    const nlohmann::ordered_json c = counters_json(p.counters);  // items() needs it alive
+    const nlohmann::ordered_json c = vgpu::to_json(p.counters);  // items() needs it alive
     for (auto& [k, v] : c.items()) e[k] = v;
     progs.push_back(e);
   }
   j["programs"] = progs;
-  return j.dump(indent);
+  return j;
+}
+
+std::string FrameStats::to_json(int indent) const {
+  return json().dump(indent);
 }
 
 static std::string human(uint64_t v) {

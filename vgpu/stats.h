@@ -3,7 +3,9 @@
 #pragma once
 
 #include <cstdint>
+#include <nlohmann/json_fwd.hpp>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace vgpu {
@@ -36,6 +38,30 @@ struct Counters {
   bool same_counts(const Counters& o) const;
 };
 
+// Every integer counter and its name, in the JSON's order: the one list that sums, comparisons,
+// the JSON forms and the cost model's transforms walk (host_ms is not a count).
+inline constexpr std::pair<const char*, uint64_t Counters::*> kCounterFields[] = {
+    {"passes", &Counters::passes},
+    {"fragments_launched", &Counters::fragments_launched},
+    {"fragments_shaded", &Counters::fragments_shaded},
+    {"fragments_masked", &Counters::fragments_masked},
+    {"fragments_discarded", &Counters::fragments_discarded},
+    {"lanes_idle", &Counters::lanes_idle},
+    {"idle_in_batch32", &Counters::idle_in_batch32},
+    {"idle_in_batch1024", &Counters::idle_in_batch1024},
+    {"instructions", &Counters::instructions},
+    {"texture_fetches", &Counters::texture_fetches},
+    {"bytes_read", &Counters::bytes_read},
+    {"bytes_written", &Counters::bytes_written},
+    {"program_loads", &Counters::program_loads},
+    {"program_bytes", &Counters::program_bytes},
+    {"clears", &Counters::clears},
+    {"queries", &Counters::queries},
+    {"query_readbacks", &Counters::query_readbacks}};
+
+// The counters as a JSON object: every field of kCounterFields, then host_ms.
+nlohmann::ordered_json to_json(const Counters& c);
+
 // One pass as recorded: which program, what it drew, what it cost.
 struct PassRecord {
   std::string program;
@@ -61,7 +87,9 @@ struct FrameStats {
   const ProgramTotals* find(const std::string& name) const;
   void clear();
 
-  std::string to_json(int indent = 2) const;  // {"totals": {...}, "programs": [...]}
+  // {"totals": {...}, "programs": [{"name", "paper_name", "static_instructions", counters...}]}
+  nlohmann::ordered_json json() const;
+  std::string to_json(int indent = 2) const;  // json(), as text
   std::string to_table() const;               // human-readable, one row per program
 };
 
