@@ -18,10 +18,6 @@ namespace host {
 
 namespace {
 
-// Fractions of the grid diagonal, as host/stream_tracer.cpp derives its uniforms.
-constexpr double kSlackOfDiagonal = 1e-5;   // in-voxel rule tolerance (GridUniforms::t_slack)
-constexpr double kOffsetOfDiagonal = 1e-4;  // origin lift (ReflectionOrigin::offset)
-constexpr double kAttenOfDiagonal = 0.5;    // Shader::atten_dist
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
 // A triangle as the intersection test wants it, world space.

@@ -175,7 +175,7 @@ StreamTracer::StreamTracer(const Scene& scene, const Grid& grid, const RenderOpt
   g.res = glm::vec3(r);
   g.list_width = float(lw);
   const float diag = glm::length(grid.hi - grid.lo);
-  g.t_slack = 1e-5f * diag;
+  g.t_slack = float(kSlackOfDiagonal) * diag;
   SceneUniforms su{float(sw)};
   s_->init.kernel.grid = g;
   s_->reset.kernel.grid = g;
@@ -186,9 +186,9 @@ StreamTracer::StreamTracer(const Scene& scene, const Grid& grid, const RenderOpt
   s_->next.kernel.grid = g;
   s_->shader.kernel.scene = su;
   s_->shader.kernel.model = opt_.shading;
-  s_->shader.kernel.atten_dist = 0.5f * diag;
+  s_->shader.kernel.atten_dist = float(kAttenOfDiagonal) * diag;
   s_->origin.kernel.scene = su;
-  s_->origin.kernel.offset = 1e-4f * diag;
+  s_->origin.kernel.offset = float(kOffsetOfDiagonal) * diag;
   s_->direction.kernel.scene = su;
   gpu.stats().keep_pass_records = opt_.keep_pass_records;
   init_ms_ = ms_since(t0);

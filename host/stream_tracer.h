@@ -17,6 +17,12 @@
 
 namespace host {
 
+// Lengths both tracers derive from the grid diagonal, as fractions of it (the stream tracer's
+// uniforms take float(k) * diagonal in float, the CPU tracer k * diagonal in double).
+inline constexpr double kSlackOfDiagonal = 1e-5;   // GridUniforms::t_slack (in-voxel rule)
+inline constexpr double kOffsetOfDiagonal = 1e-4;  // ReflectionOrigin::offset (origin lift)
+inline constexpr double kAttenOfDiagonal = 0.5;    // Shader::atten_dist
+
 struct RenderOptions {
   int width = 256, height = 256;  // the paper's image size
   int bounces = 2;                // reflection iterations after the primary one (Fig. 1: 3 in all)
