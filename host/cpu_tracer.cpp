@@ -195,8 +195,8 @@ class Tracer {
       const glm::dvec3 l = to / dist;
       glm::dvec3 lit = kd * std::max(glm::dot(n, l), 0.0);
       if (opt_.shading != kernels::ShadingModel::diffuse) {
-        const glm::dvec3 r = l - n * (2.0 * glm::dot(l, n));  // mirror of l, pointing away
-        const double rv = std::max(glm::dot(r, d), 0.0);      // = max(r'.v, 0), v = -d
+        const glm::dvec3 r = glm::reflect(l, n);          // mirror of l, pointing away
+        const double rv = std::max(glm::dot(r, d), 0.0);  // = max(r'.v, 0), v = -d
         lit += glm::dvec3(specular_ * std::pow(rv, 32.0));
       }
       if (opt_.shading == kernels::ShadingModel::phong_atten) {
@@ -209,7 +209,7 @@ class Tracer {
     const double a = mat.reflect;
     glm::dvec3 colour = local * (1.0 - a);
     if (w * a >= min_weight_ && depth + 1 < iterations_) {
-      const glm::dvec3 r = glm::normalize(d - n * (2.0 * glm::dot(d, n)));
+      const glm::dvec3 r = glm::normalize(glm::reflect(d, n));
       colour += a * radiance(lifted, r, depth + 1, w * a, nullptr, c);
     }
     return colour;
