@@ -3,15 +3,14 @@
 #include "host/cpu_tracer.h"
 
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cmath>
-#include <exception>
 #include <limits>
 #include <stdexcept>
 #include <thread>
 #include <vector>
 
+#include "host/parallel.h"
 #include "kernels/kernels.h"
 
 namespace host {
@@ -30,8 +29,9 @@ struct Hit {
   double t = kInf, u = 0, v = 0;  // ray parameter (unit direction: world distance), barycentrics
 };
 
-// Per-thread counters, summed at the end.
-struct Counters {
+// Per-thread counters, summed at the end; each on its own cache line, so the workers do not
+// share one.
+struct alignas(64) Counters {
   uint64_t rays = 0, entered = 0, voxel_steps = 0, triangle_tests = 0;
   int iterations = 0;
 };
@@ -260,26 +260,10 @@ RenderResult render_cpu(const Scene& scene, const Grid& grid, const Camera& came
   const unsigned workers = std::clamp<unsigned>(
       options.threads > 0 ? unsigned(options.threads) : cores, 1u, unsigned(std::max(H, 1)));
   std::vector<Counters> counters(workers);
-  // Rows handed out one at a time; every pixel is independent, so the order does not matter.
-  std::atomic<int> next_row{0};
-  std::atomic<bool> failed{false};
-  std::exception_ptr error;
-  auto work = [&](unsigned id) {
-    try {
-      Counters mine;  // on this thread's stack: no cache line shared with the other workers
-      for (int y; !failed && (y = next_row++) < H;)
-        for (int x = 0; x < W; ++x) tracer.pixel(x, y, res, mine);
-      counters[id] = mine;
-    } catch (...) {
-      if (!failed.exchange(true)) error = std::current_exception();
-    }
-  };
-  {
-    std::vector<std::jthread> pool;
-    for (unsigned k = 1; k < workers; ++k) pool.emplace_back(work, k);
-    work(0);
-  }
-  if (error) std::rethrow_exception(error);
+  // Every pixel is independent, so the order in which rows are handed out does not matter.
+  for_each_row(H, workers, [&](unsigned worker, int y) {
+    for (int x = 0; x < W; ++x) tracer.pixel(x, y, res, counters[worker]);
+  });
 
   CpuStats total;
   for (const Counters& c : counters) {

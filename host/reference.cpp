@@ -3,11 +3,11 @@
 #include "host/reference.h"
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
-#include <exception>
 #include <limits>
 #include <thread>
+
+#include "host/parallel.h"
 
 namespace host {
 
@@ -76,27 +76,11 @@ std::vector<RefHit> brute_force_image(const Scene& scene,
                                       glm::dvec3 origin, int W, int H) {
   std::vector<RefHit> image(size_t(std::max(W, 0)) * size_t(std::max(H, 0)));
   if (image.empty()) return image;
-  // Rows handed out one at a time; every pixel is independent, so the order does not matter.
-  std::atomic<int> next_row{0};
-  std::exception_ptr error;
-  std::atomic<bool> failed{false};
-  auto work = [&] {
-    try {
-      for (int y; !failed && (y = next_row++) < H;)
-        for (int x = 0; x < W; ++x)
-          image[size_t(y) * W + x] = brute_force_hit(scene, origin, dir_of_pixel(x, y));
-    } catch (...) {
-      if (!failed.exchange(true)) error = std::current_exception();
-    }
-  };
-  const unsigned workers =
-      std::min<unsigned>(std::max(1u, std::thread::hardware_concurrency()), unsigned(H));
-  {
-    std::vector<std::jthread> pool;
-    for (unsigned k = 1; k < workers; ++k) pool.emplace_back(work);
-    work();
-  }
-  if (error) std::rethrow_exception(error);
+  // Every pixel is independent, so the order in which rows are handed out does not matter.
+  for_each_row(H, std::max(1u, std::thread::hardware_concurrency()), [&](unsigned, int y) {
+    for (int x = 0; x < W; ++x)
+      image[size_t(y) * W + x] = brute_force_hit(scene, origin, dir_of_pixel(x, y));
+  });
   return image;
 }
 
