@@ -73,13 +73,6 @@ std::string one_line(std::string_view text, size_t max_chars) {
   throw InputError(one_line(path, 1000) + ": " + one_line(problem, kMaxProblemChars));
 }
 
-std::string str(uint64_t v) {
-  return std::to_string(v);
-}
-std::string str(int v) {
-  return std::to_string(v);
-}
-
 uint32_t le32(const unsigned char* p) {
   return uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24;
 }
@@ -117,28 +110,30 @@ struct GlbParts {
 GlbParts split_glb(const std::string& path, const std::vector<unsigned char>& bytes) {
   const uint64_t size = bytes.size();
   if (size < 12)
-    fail(path, "truncated .glb: " + str(size) + " bytes, shorter than the 12-byte header");
+    fail(path,
+         "truncated .glb: " + std::to_string(size) + " bytes, shorter than the 12-byte header");
   const uint32_t version = le32(&bytes[4]);
-  if (version != 2) fail(path, "unsupported .glb version " + str(uint64_t(version)) + " (need 2)");
+  if (version != 2) fail(path, "unsupported .glb version " + std::to_string(version) + " (need 2)");
   const uint64_t length = le32(&bytes[8]);
   if (length > size)
-    fail(path, "truncated .glb: the header announces " + str(length) + " bytes but the file has " +
-                   str(size));
+    fail(path, "truncated .glb: the header announces " + std::to_string(length) +
+                   " bytes but the file has " + std::to_string(size));
   if (length < size)
-    fail(path, "corrupt .glb: the header announces " + str(length) + " bytes but the file has " +
-                   str(size));
+    fail(path, "corrupt .glb: the header announces " + std::to_string(length) +
+                   " bytes but the file has " + std::to_string(size));
   GlbParts parts;
   uint64_t pos = 12;
   int chunk = 0;
   for (; pos < length; ++chunk) {
     if (length - pos < 8)
-      fail(path, "corrupt .glb: the header of chunk " + str(chunk) + " at byte " + str(pos) +
-                     " is cut off by the end of the file");
+      fail(path, "corrupt .glb: the header of chunk " + std::to_string(chunk) + " at byte " +
+                     std::to_string(pos) + " is cut off by the end of the file");
     const uint64_t chunk_length = le32(&bytes[pos]);
     const uint32_t chunk_type = le32(&bytes[pos + 4]);
     if (chunk_length > length - pos - 8)
-      fail(path, "corrupt .glb: chunk " + str(chunk) + " announces " + str(chunk_length) +
-                     " bytes but only " + str(length - pos - 8) + " remain in the file");
+      fail(path, "corrupt .glb: chunk " + std::to_string(chunk) + " announces " +
+                     std::to_string(chunk_length) + " bytes but only " +
+                     std::to_string(length - pos - 8) + " remain in the file");
     const unsigned char* data = &bytes[pos + 8];
     if (chunk == 0) {
       if (chunk_type != kGlbChunkJson) fail(path, "corrupt .glb: the first chunk is not JSON");
@@ -246,7 +241,7 @@ bool required_extension_supported(const std::string& name) {
 std::vector<uint64_t> precheck_json(const std::string& path, const std::string& text,
                                     const GlbParts* glb, json& doc) {
   if (json_depth(text) > kMaxJsonDepth)
-    fail(path, "the JSON is nested deeper than " + str(uint64_t(kMaxJsonDepth)) + " levels");
+    fail(path, "the JSON is nested deeper than " + std::to_string(kMaxJsonDepth) + " levels");
   try {
     doc = json::parse(text);
   } catch (const json::exception& e) {
@@ -277,7 +272,7 @@ std::vector<uint64_t> precheck_json(const std::string& path, const std::string& 
   const fs::path dir = fs::path(path).parent_path();
   for (size_t i = 0; i < buffers->size(); ++i) {
     const json& b = (*buffers)[i];
-    const std::string name = "buffer " + str(uint64_t(i));
+    const std::string name = "buffer " + std::to_string(i);
     if (!b.is_object()) fail(path, name + " is not an object");
     const auto bl = b.find("byteLength");
     if (bl == b.end() || !bl->is_number_unsigned() || bl->get<uint64_t>() == 0)
@@ -291,8 +286,8 @@ std::vector<uint64_t> precheck_json(const std::string& path, const std::string& 
       if (!glb) fail(path, name + " has no uri (only a .glb may omit it)");
       if (!glb->has_bin) fail(path, name + " has no uri and the .glb has no BIN chunk");
       if (byte_length > glb->bin.size())
-        fail(path, name + ": byteLength " + str(byte_length) +
-                       " is larger than the .glb BIN chunk (" + str(uint64_t(glb->bin.size())) +
+        fail(path, name + ": byteLength " + std::to_string(byte_length) +
+                       " is larger than the .glb BIN chunk (" + std::to_string(glb->bin.size()) +
                        " bytes)");
     } else if (uri.starts_with("data:")) {
       const size_t comma = uri.find(',');
@@ -300,8 +295,8 @@ std::vector<uint64_t> precheck_json(const std::string& path, const std::string& 
         fail(path, name + ": only base64 data URIs are supported");
       const uint64_t held = base64_decoded_size(std::string_view(uri).substr(comma + 1));
       if (held != byte_length)
-        fail(path, name + ": its data URI holds " + str(held) + " bytes but its byteLength is " +
-                       str(byte_length));
+        fail(path, name + ": its data URI holds " + std::to_string(held) +
+                       " bytes but its byteLength is " + std::to_string(byte_length));
     } else {
       if (uri.find("://") != uri.npos)
         fail(path, name + ": URI scheme not supported (only relative paths and data: URIs)");
@@ -313,8 +308,8 @@ std::vector<uint64_t> precheck_json(const std::string& path, const std::string& 
       const uintmax_t held = fs::file_size(file, ec);
       if (ec) fail(path, name + ": cannot read '" + uri + "': " + ec.message());
       if (held != byte_length)
-        fail(path, name + ": file '" + uri + "' holds " + str(uint64_t(held)) +
-                       " bytes but its byteLength is " + str(byte_length));
+        fail(path, name + ": file '" + uri + "' holds " + std::to_string(held) +
+                       " bytes but its byteLength is " + std::to_string(byte_length));
     }
   }
   return lengths;
@@ -516,24 +511,24 @@ class Loader {
 
   void check_buffers_and_views() {
     if (model_.buffers.size() != declared_lengths_.size())
-      fail(path_, "the file declares " + str(uint64_t(declared_lengths_.size())) + " buffers but " +
-                      str(uint64_t(model_.buffers.size())) + " were loaded");
+      fail(path_, "the file declares " + std::to_string(declared_lengths_.size()) +
+                      " buffers but " + std::to_string(model_.buffers.size()) + " were loaded");
     for (size_t i = 0; i < model_.buffers.size(); ++i)
       if (model_.buffers[i].data.size() != declared_lengths_[i])
-        fail(path_, "buffer " + str(uint64_t(i)) + " holds " +
-                        str(uint64_t(model_.buffers[i].data.size())) +
-                        " bytes but its byteLength is " + str(declared_lengths_[i]));
+        fail(path_, "buffer " + std::to_string(i) + " holds " +
+                        std::to_string(model_.buffers[i].data.size()) +
+                        " bytes but its byteLength is " + std::to_string(declared_lengths_[i]));
     for (size_t v = 0; v < model_.bufferViews.size(); ++v) {
       const tinygltf::BufferView& view = model_.bufferViews[v];
-      const std::string name = "buffer view " + str(uint64_t(v));
+      const std::string name = "buffer view " + std::to_string(v);
       if (view.buffer < 0 || size_t(view.buffer) >= model_.buffers.size())
-        fail(path_, name + " refers to buffer " + str(view.buffer) + ", but the file has " +
-                        str(uint64_t(model_.buffers.size())) + " buffers");
+        fail(path_, name + " refers to buffer " + std::to_string(view.buffer) +
+                        ", but the file has " + std::to_string(model_.buffers.size()) + " buffers");
       const uint64_t size = model_.buffers[size_t(view.buffer)].data.size();
       if (view.byteOffset > size || view.byteLength > size - view.byteOffset)
-        fail(path_, name + " (bytes " + str(uint64_t(view.byteOffset)) + " + " +
-                        str(uint64_t(view.byteLength)) + ") lies outside buffer " +
-                        str(view.buffer) + " (" + str(size) + " bytes)");
+        fail(path_, name + " (bytes " + std::to_string(view.byteOffset) + " + " +
+                        std::to_string(view.byteLength) + ") lies outside buffer " +
+                        std::to_string(view.buffer) + " (" + std::to_string(size) + " bytes)");
     }
   }
 
@@ -542,27 +537,31 @@ class Loader {
   void check_accessors() {
     for (size_t a = 0; a < model_.accessors.size(); ++a) {
       const tinygltf::Accessor& acc = model_.accessors[a];
-      const std::string name = "accessor " + str(uint64_t(a));
+      const std::string name = "accessor " + std::to_string(a);
       if (acc.bufferView < 0) continue;  // rejected when used
       if (size_t(acc.bufferView) >= model_.bufferViews.size())
-        fail(path_, name + " refers to buffer view " + str(acc.bufferView) + ", but the file has " +
-                        str(uint64_t(model_.bufferViews.size())) + " buffer views");
+        fail(path_, name + " refers to buffer view " + std::to_string(acc.bufferView) +
+                        ", but the file has " + std::to_string(model_.bufferViews.size()) +
+                        " buffer views");
       const int comp = tinygltf::GetComponentSizeInBytes(uint32_t(acc.componentType));
       const int n = tinygltf::GetNumComponentsInType(uint32_t(acc.type));
-      if (comp <= 0) fail(path_, name + " has an invalid componentType " + str(acc.componentType));
+      if (comp <= 0)
+        fail(path_, name + " has an invalid componentType " + std::to_string(acc.componentType));
       if (n <= 0) fail(path_, name + " has an invalid type");
       const tinygltf::BufferView& view = model_.bufferViews[size_t(acc.bufferView)];
       const uint64_t element = uint64_t(comp) * uint64_t(n);
       const uint64_t stride = view.byteStride ? view.byteStride : element;
       if (stride < element)
-        fail(path_, name + ": buffer view " + str(acc.bufferView) + " has byteStride " +
-                        str(stride) + ", smaller than the element size " + str(element));
+        fail(path_, name + ": buffer view " + std::to_string(acc.bufferView) + " has byteStride " +
+                        std::to_string(stride) + ", smaller than the element size " +
+                        std::to_string(element));
       if (acc.count == 0) continue;
       const uint64_t len = view.byteLength, off = acc.byteOffset, count = acc.count;
       if (off > len || element > len - off || count - 1 > (len - off - element) / stride)
-        fail(path_, name + " reads past the end of buffer view " + str(acc.bufferView) +
-                        " (byteOffset " + str(off) + ", count " + str(count) + ", stride " +
-                        str(stride) + ", view byteLength " + str(len) + ")");
+        fail(path_, name + " reads past the end of buffer view " + std::to_string(acc.bufferView) +
+                        " (byteOffset " + std::to_string(off) + ", count " + std::to_string(count) +
+                        ", stride " + std::to_string(stride) + ", view byteLength " +
+                        std::to_string(len) + ")");
     }
   }
 
@@ -579,16 +578,17 @@ class Loader {
   // The accessor, checked for a use: in range, with data, not sparse.
   const tinygltf::Accessor& accessor_for(int index, const std::string& use) const {
     if (index < 0 || size_t(index) >= model_.accessors.size())
-      fail(path_, use + " refers to accessor " + str(index) + ", but the file has " +
-                      str(uint64_t(model_.accessors.size())) + " accessors");
+      fail(path_, use + " refers to accessor " + std::to_string(index) + ", but the file has " +
+                      std::to_string(model_.accessors.size()) + " accessors");
     const tinygltf::Accessor& acc = model_.accessors[size_t(index)];
     if (acc.sparse.isSparse)
-      fail(path_, use + ": accessor " + str(index) + " is sparse, which is not supported");
+      fail(path_,
+           use + ": accessor " + std::to_string(index) + " is sparse, which is not supported");
     if (acc.bufferView < 0)
-      fail(path_, use + ": accessor " + str(index) +
+      fail(path_, use + ": accessor " + std::to_string(index) +
                       " has no buffer view (zero-filled accessors are not supported)");
     if (acc.count > 0xFFFFFFFFull)
-      fail(path_, use + ": accessor " + str(index) + " has more than 2^32 - 1 elements");
+      fail(path_, use + ": accessor " + std::to_string(index) + " has more than 2^32 - 1 elements");
     return acc;
   }
 
@@ -604,8 +604,8 @@ class Loader {
         ct == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE || ct == TINYGLTF_COMPONENT_TYPE_SHORT ||
         ct == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT;
     if (acc.type != TINYGLTF_TYPE_VEC3 || !ok_component)
-      fail(path_,
-           use + ": accessor " + str(index) + " must be VEC3 of float, byte or short components");
+      fail(path_, use + ": accessor " + std::to_string(index) +
+                      " must be VEC3 of float, byte or short components");
     const int comp = tinygltf::GetComponentSizeInBytes(uint32_t(ct));
     auto out = std::make_shared<std::vector<glm::vec3>>(acc.count);
     for (size_t i = 0; i < acc.count; ++i) {
@@ -614,8 +614,8 @@ class Loader {
       for (int c = 0; c < 3; ++c) v[c] = read_component(p + c * comp, ct, acc.normalized);
       if (positions && !std::isfinite(v.x + v.y + v.z)) {
         const bool nan = std::isnan(v.x) || std::isnan(v.y) || std::isnan(v.z);
-        fail(path_, use + ": accessor " + str(index) + " element " + str(uint64_t(i)) + " has " +
-                        (nan ? "a NaN coordinate" : "an infinite coordinate"));
+        fail(path_, use + ": accessor " + std::to_string(index) + " element " + std::to_string(i) +
+                        " has " + (nan ? "a NaN coordinate" : "an infinite coordinate"));
       }
     }
     cache[index] = out;
@@ -629,7 +629,7 @@ class Loader {
     if (acc.type != TINYGLTF_TYPE_SCALAR || (ct != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
                                              ct != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
                                              ct != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT))
-      fail(path_, use + ": accessor " + str(index) +
+      fail(path_, use + ": accessor " + std::to_string(index) +
                       " must be SCALAR of unsigned byte, short or int components");
     auto out = std::make_shared<std::vector<uint32_t>>(acc.count);
     for (size_t i = 0; i < acc.count; ++i) {
@@ -652,7 +652,7 @@ class Loader {
   void convert_materials() {
     for (size_t m = 0; m < model_.materials.size(); ++m) {
       const tinygltf::Material& src = model_.materials[m];
-      const std::string name = "material " + str(uint64_t(m));
+      const std::string name = "material " + std::to_string(m);
       Material out;
       const auto& pbr = src.pbrMetallicRoughness;
       if (pbr.baseColorFactor.size() != 4)
@@ -690,17 +690,17 @@ class Loader {
     auto check = [&](const std::vector<int>& list, const std::string& owner) {
       for (int n : list)
         if (n < 0 || size_t(n) >= node_count)
-          fail(path_, owner + " lists node " + str(n) + ", but the file has " +
-                          str(uint64_t(node_count)) + " nodes");
+          fail(path_, owner + " lists node " + std::to_string(n) + ", but the file has " +
+                          std::to_string(node_count) + " nodes");
     };
     for (size_t n = 0; n < node_count; ++n)
-      check(model_.nodes[n].children, "node " + str(uint64_t(n)));
+      check(model_.nodes[n].children, "node " + std::to_string(n));
     if (model_.defaultScene >= 0 || !model_.scenes.empty()) {
       const int s = std::max(model_.defaultScene, 0);
       if (size_t(s) >= model_.scenes.size())
-        fail(path_, "the default scene " + str(s) + " does not exist (the file has " +
-                        str(uint64_t(model_.scenes.size())) + " scenes)");
-      check(model_.scenes[size_t(s)].nodes, "scene " + str(s));
+        fail(path_, "the default scene " + std::to_string(s) + " does not exist (the file has " +
+                        std::to_string(model_.scenes.size()) + " scenes)");
+      check(model_.scenes[size_t(s)].nodes, "scene " + std::to_string(s));
       return model_.scenes[size_t(s)].nodes;
     }
     std::vector<char> is_child(node_count, 0);
@@ -713,10 +713,10 @@ class Loader {
   }
 
   glm::dmat4 local_matrix(const tinygltf::Node& node, size_t index) const {
-    const std::string name = "node " + str(uint64_t(index));
+    const std::string name = "node " + std::to_string(index);
     auto check_size = [&](const std::vector<double>& v, size_t want, const char* what) {
       if (!v.empty() && v.size() != want)
-        fail(path_, name + ": " + what + " must have " + str(uint64_t(want)) + " numbers");
+        fail(path_, name + ": " + what + " must have " + std::to_string(want) + " numbers");
     };
     check_size(node.matrix, 16, "matrix");
     check_size(node.translation, 3, "translation");
@@ -761,8 +761,8 @@ class Loader {
       stack.pop_back();
       const size_t n = size_t(item.node);
       if (seen[n])
-        fail(path_,
-             "node " + str(item.node) + " is reached twice; the node hierarchy must be a tree");
+        fail(path_, "node " + std::to_string(item.node) +
+                        " is reached twice; the node hierarchy must be a tree");
       seen[n] = 1;
       const tinygltf::Node& node = model_.nodes[n];
       const glm::dmat4 world = item.parent * local_matrix(node, n);
@@ -773,11 +773,11 @@ class Loader {
   }
 
   void visit(const tinygltf::Node& node, size_t index, const glm::dmat4& world) {
-    const std::string name = "node " + str(uint64_t(index));
+    const std::string name = "node " + std::to_string(index);
     if (node.camera >= 0) {
       if (size_t(node.camera) >= model_.cameras.size())
-        fail(path_, name + " refers to camera " + str(node.camera) + ", but the file has " +
-                        str(uint64_t(model_.cameras.size())) + " cameras");
+        fail(path_, name + " refers to camera " + std::to_string(node.camera) +
+                        ", but the file has " + std::to_string(model_.cameras.size()) + " cameras");
       if (!scene_.camera) take_camera(size_t(node.camera), name, world);
     }
     if (auto ext = node.extensions.find("KHR_lights_punctual"); ext != node.extensions.end()) {
@@ -787,15 +787,15 @@ class Loader {
         if (!l.IsInt()) fail(path_, name + ": KHR_lights_punctual.light is not an integer");
         const int li = l.GetNumberAsInt();
         if (li < 0 || size_t(li) >= model_.lights.size())
-          fail(path_, name + " refers to light " + str(li) + ", but the file has " +
-                          str(uint64_t(model_.lights.size())) + " lights");
+          fail(path_, name + " refers to light " + std::to_string(li) + ", but the file has " +
+                          std::to_string(model_.lights.size()) + " lights");
         take_light(size_t(li), world);
       }
     }
     if (node.mesh >= 0) {
       if (size_t(node.mesh) >= model_.meshes.size())
-        fail(path_, name + " refers to mesh " + str(node.mesh) + ", but the file has " +
-                        str(uint64_t(model_.meshes.size())) + " meshes");
+        fail(path_, name + " refers to mesh " + std::to_string(node.mesh) + ", but the file has " +
+                        std::to_string(model_.meshes.size()) + " meshes");
       const tinygltf::Mesh& mesh = model_.meshes[size_t(node.mesh)];
       for (size_t p = 0; p < mesh.primitives.size(); ++p)
         emit(primitive(size_t(node.mesh), p), world, name);
@@ -804,7 +804,7 @@ class Loader {
 
   void take_camera(size_t index, const std::string& node_name, const glm::dmat4& world) {
     const tinygltf::Camera& cam = model_.cameras[index];
-    const std::string name = "camera " + str(uint64_t(index)) + " (" + node_name + ")";
+    const std::string name = "camera " + std::to_string(index) + " (" + node_name + ")";
     if (cam.type == "orthographic")
       fail(path_, name + " is orthographic; only perspective cameras are supported");
     if (cam.type != "perspective") fail(path_, name + " has unknown type '" + cam.type + "'");
@@ -828,7 +828,7 @@ class Loader {
 
   void take_light(size_t index, const glm::dmat4& world) {
     const tinygltf::Light& light = model_.lights[index];
-    const std::string name = "light " + str(uint64_t(index));
+    const std::string name = "light " + std::to_string(index);
     if (light.type == "directional") {
       warn_once(name + ": directional lights are not supported; skipped");
       return;
@@ -863,11 +863,11 @@ class Loader {
     PrimitiveGeometry& g = primitives_[key];
     const tinygltf::Primitive& prim = model_.meshes[mesh_index].primitives[prim_index];
     const std::string name =
-        "mesh " + str(uint64_t(mesh_index)) + " primitive " + str(uint64_t(prim_index));
+        "mesh " + std::to_string(mesh_index) + " primitive " + std::to_string(prim_index);
 
     const int mode = prim.mode;
     if (mode < TINYGLTF_MODE_POINTS || mode > TINYGLTF_MODE_TRIANGLE_FAN)
-      fail(path_, name + " has an unknown mode " + str(mode));
+      fail(path_, name + " has an unknown mode " + std::to_string(mode));
     if (mode < TINYGLTF_MODE_TRIANGLES) {
       ++skipped_modes_[mode_name(mode)];
       g.skipped = true;
@@ -884,8 +884,9 @@ class Loader {
 
     if (prim.material >= 0) {
       if (size_t(prim.material) >= model_.materials.size())
-        fail(path_, name + " refers to material " + str(prim.material) + ", but the file has " +
-                        str(uint64_t(model_.materials.size())) + " materials");
+        fail(path_, name + " refers to material " + std::to_string(prim.material) +
+                        ", but the file has " + std::to_string(model_.materials.size()) +
+                        " materials");
       g.material = uint32_t(prim.material);
     } else {
       g.material = default_material();
@@ -896,9 +897,9 @@ class Loader {
       indices = read_indices(prim.indices, name + " indices");
       for (size_t i = 0; i < indices->size(); ++i)
         if ((*indices)[i] >= vertex_count)
-          fail(path_, name + ": index " + str(uint64_t((*indices)[i])) + " (element " +
-                          str(uint64_t(i)) + " of accessor " + str(prim.indices) +
-                          ") is past the vertex count " + str(uint64_t(vertex_count)));
+          fail(path_, name + ": index " + std::to_string((*indices)[i]) + " (element " +
+                          std::to_string(i) + " of accessor " + std::to_string(prim.indices) +
+                          ") is past the vertex count " + std::to_string(vertex_count));
     }
     const size_t n = indices ? indices->size() : vertex_count;
     const auto vertex = [&](size_t k) { return indices ? (*indices)[k] : uint32_t(k); };
@@ -928,8 +929,8 @@ class Loader {
       g.normals = read_vec3(nrm->second, name + " NORMAL", false);
       g.normals_from_file = true;
       if (g.normals->size() != vertex_count)
-        fail(path_, name + ": NORMAL has " + str(uint64_t(g.normals->size())) +
-                        " elements but POSITION has " + str(uint64_t(vertex_count)));
+        fail(path_, name + ": NORMAL has " + std::to_string(g.normals->size()) +
+                        " elements but POSITION has " + std::to_string(vertex_count));
     } else {
       g.normals = smooth_normals(*g.positions, g.corners);
     }
@@ -954,7 +955,7 @@ class Loader {
   }
 
   [[noreturn]] void too_many() const {
-    fail(path_, "the scene has more triangles than the limit of " + str(max_triangles_) +
+    fail(path_, "the scene has more triangles than the limit of " + std::to_string(max_triangles_) +
                     " (LoadOptions::max_triangles)");
   }
 
@@ -1015,19 +1016,20 @@ class Loader {
   void finish() {
     std::string skipped;
     for (const auto& [what, count] : skipped_modes_) {
-      const std::string item = str(count) + " " + what + " primitive" + (count == 1 ? "" : "s");
+      const std::string item =
+          std::to_string(count) + " " + what + " primitive" + (count == 1 ? "" : "s");
       scene_.warnings.push_back("skipped " + item + " (only triangles are rendered)");
       skipped += (skipped.empty() ? "" : ", ") + item;
     }
     if (invalid_file_normals_ > 0)
-      scene_.warnings.push_back(str(invalid_file_normals_) +
+      scene_.warnings.push_back(std::to_string(invalid_file_normals_) +
                                 " corner normals from the file were zero or not finite and were "
                                 "replaced by face normals");
     if (scene_.input_triangles == 0)
       fail(path_,
            "the scene has no triangles" + (skipped.empty() ? "" : " (skipped " + skipped + ")"));
     if (scene_.triangle_count() == 0)
-      fail(path_, "all " + str(uint64_t(scene_.input_triangles)) +
+      fail(path_, "all " + std::to_string(scene_.input_triangles) +
                       " triangles of the scene are degenerate (zero area)");
 
     double brightest = 1.0;
