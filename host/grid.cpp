@@ -35,6 +35,14 @@ int parse_positive(std::string_view part, const std::string& text) {
   return int(value);
 }
 
+// First guess of the voxel holding coordinate x along `axis`: floor((x - lo) / cell), clamped to
+// [0, res - 1] (NaN gives 0). The division may round across a plane, so callers settle the guess
+// against the exact boundaries, each with its own rule for points on a plane.
+int voxel_guess(const Grid& g, int axis, double x) {
+  const double f = std::floor((x - double(g.lo[axis])) / double(g.cell[axis]));
+  return std::isnan(f) ? 0 : int(std::clamp(f, 0.0, double(g.res[axis] - 1)));
+}
+
 }  // namespace
 
 GridSpec parse_grid_spec(const std::string& text) {
@@ -96,9 +104,8 @@ glm::ivec3 Grid::voxel_of(glm::dvec3 p) const {
   glm::ivec3 v;
   for (int a = 0; a < 3; ++a) {
     const int last = res[a] - 1;
-    double f = std::floor((p[a] - double(lo[a])) / double(cell[a]));
-    int i = std::isnan(f) ? 0 : int(std::clamp(f, 0.0, double(last)));
-    // The division may round across a plane; settle against the exact boundaries.
+    int i = voxel_guess(*this, a, p[a]);
+    // Settle against the exact boundaries: half-open slabs.
     while (i > 0 && p[a] < boundary(a, i)) --i;
     while (i < last && p[a] >= boundary(a, i + 1)) ++i;
     v[a] = i;
@@ -146,15 +153,11 @@ namespace {
 // first = smallest i with boundary(i+1) >= a, last = largest i with boundary(i) <= b, clamped.
 void voxel_span(const Grid& g, int axis, double a, double b, int& first, int& last) {
   const int top = g.res[axis] - 1;
-  auto guess = [&](double x) {
-    double f = std::floor((x - double(g.lo[axis])) / double(g.cell[axis]));
-    return std::isnan(f) ? 0 : int(std::clamp(f, 0.0, double(top)));
-  };
-  int i = guess(a);
+  int i = voxel_guess(g, axis, a);
   while (i > 0 && g.boundary(axis, i) >= a) --i;
   while (i < top && g.boundary(axis, i + 1) < a) ++i;
   first = i;
-  i = guess(b);
+  i = voxel_guess(g, axis, b);
   while (i < top && g.boundary(axis, i + 1) <= b) ++i;
   while (i > 0 && g.boundary(axis, i) > b) --i;
   last = i;
