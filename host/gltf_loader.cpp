@@ -509,6 +509,15 @@ class Loader {
 
   // -- validation of buffers, views and accessors, independent of tinygltf ---------------------
 
+  // Fails unless 0 <= index < count: "OWNER refers to WHAT INDEX, but the file has COUNT PLURAL",
+  // with `verb` in place of "refers to" where the owner holds a list.
+  void check_index(const std::string& owner, const char* what, int index, size_t count,
+                   const char* plural, const char* verb = "refers to") const {
+    if (index < 0 || size_t(index) >= count)
+      fail(path_, owner + " " + verb + " " + what + " " + std::to_string(index) +
+                      ", but the file has " + std::to_string(count) + " " + plural);
+  }
+
   void check_buffers_and_views() {
     if (model_.buffers.size() != declared_lengths_.size())
       fail(path_, "the file declares " + std::to_string(declared_lengths_.size()) +
@@ -521,9 +530,7 @@ class Loader {
     for (size_t v = 0; v < model_.bufferViews.size(); ++v) {
       const tinygltf::BufferView& view = model_.bufferViews[v];
       const std::string name = "buffer view " + std::to_string(v);
-      if (view.buffer < 0 || size_t(view.buffer) >= model_.buffers.size())
-        fail(path_, name + " refers to buffer " + std::to_string(view.buffer) +
-                        ", but the file has " + std::to_string(model_.buffers.size()) + " buffers");
+      check_index(name, "buffer", view.buffer, model_.buffers.size(), "buffers");
       const uint64_t size = model_.buffers[size_t(view.buffer)].data.size();
       if (view.byteOffset > size || view.byteLength > size - view.byteOffset)
         fail(path_, name + " (bytes " + std::to_string(view.byteOffset) + " + " +
@@ -539,10 +546,7 @@ class Loader {
       const tinygltf::Accessor& acc = model_.accessors[a];
       const std::string name = "accessor " + std::to_string(a);
       if (acc.bufferView < 0) continue;  // rejected when used
-      if (size_t(acc.bufferView) >= model_.bufferViews.size())
-        fail(path_, name + " refers to buffer view " + std::to_string(acc.bufferView) +
-                        ", but the file has " + std::to_string(model_.bufferViews.size()) +
-                        " buffer views");
+      check_index(name, "buffer view", acc.bufferView, model_.bufferViews.size(), "buffer views");
       const int comp = tinygltf::GetComponentSizeInBytes(uint32_t(acc.componentType));
       const int n = tinygltf::GetNumComponentsInType(uint32_t(acc.type));
       if (comp <= 0)
@@ -577,9 +581,7 @@ class Loader {
 
   // The accessor, checked for a use: in range, with data, not sparse.
   const tinygltf::Accessor& accessor_for(int index, const std::string& use) const {
-    if (index < 0 || size_t(index) >= model_.accessors.size())
-      fail(path_, use + " refers to accessor " + std::to_string(index) + ", but the file has " +
-                      std::to_string(model_.accessors.size()) + " accessors");
+    check_index(use, "accessor", index, model_.accessors.size(), "accessors");
     const tinygltf::Accessor& acc = model_.accessors[size_t(index)];
     if (acc.sparse.isSparse)
       fail(path_,
@@ -688,10 +690,7 @@ class Loader {
   std::vector<int> root_nodes() const {
     const size_t node_count = model_.nodes.size();
     auto check = [&](const std::vector<int>& list, const std::string& owner) {
-      for (int n : list)
-        if (n < 0 || size_t(n) >= node_count)
-          fail(path_, owner + " lists node " + std::to_string(n) + ", but the file has " +
-                          std::to_string(node_count) + " nodes");
+      for (int n : list) check_index(owner, "node", n, node_count, "nodes", "lists");
     };
     for (size_t n = 0; n < node_count; ++n)
       check(model_.nodes[n].children, "node " + std::to_string(n));
@@ -775,9 +774,7 @@ class Loader {
   void visit(const tinygltf::Node& node, size_t index, const glm::dmat4& world) {
     const std::string name = "node " + std::to_string(index);
     if (node.camera >= 0) {
-      if (size_t(node.camera) >= model_.cameras.size())
-        fail(path_, name + " refers to camera " + std::to_string(node.camera) +
-                        ", but the file has " + std::to_string(model_.cameras.size()) + " cameras");
+      check_index(name, "camera", node.camera, model_.cameras.size(), "cameras");
       if (!scene_.camera) take_camera(size_t(node.camera), name, world);
     }
     if (auto ext = node.extensions.find("KHR_lights_punctual"); ext != node.extensions.end()) {
@@ -786,16 +783,12 @@ class Loader {
         const tinygltf::Value& l = v.Get("light");
         if (!l.IsInt()) fail(path_, name + ": KHR_lights_punctual.light is not an integer");
         const int li = l.GetNumberAsInt();
-        if (li < 0 || size_t(li) >= model_.lights.size())
-          fail(path_, name + " refers to light " + std::to_string(li) + ", but the file has " +
-                          std::to_string(model_.lights.size()) + " lights");
+        check_index(name, "light", li, model_.lights.size(), "lights");
         take_light(size_t(li), world);
       }
     }
     if (node.mesh >= 0) {
-      if (size_t(node.mesh) >= model_.meshes.size())
-        fail(path_, name + " refers to mesh " + std::to_string(node.mesh) + ", but the file has " +
-                        std::to_string(model_.meshes.size()) + " meshes");
+      check_index(name, "mesh", node.mesh, model_.meshes.size(), "meshes");
       const tinygltf::Mesh& mesh = model_.meshes[size_t(node.mesh)];
       for (size_t p = 0; p < mesh.primitives.size(); ++p)
         emit(primitive(size_t(node.mesh), p), world, name);
@@ -883,10 +876,7 @@ class Loader {
     const size_t vertex_count = g.positions->size();
 
     if (prim.material >= 0) {
-      if (size_t(prim.material) >= model_.materials.size())
-        fail(path_, name + " refers to material " + std::to_string(prim.material) +
-                        ", but the file has " + std::to_string(model_.materials.size()) +
-                        " materials");
+      check_index(name, "material", prim.material, model_.materials.size(), "materials");
       g.material = uint32_t(prim.material);
     } else {
       g.material = default_material();
