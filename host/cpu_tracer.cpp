@@ -274,8 +274,7 @@ RenderResult render_cpu(const Scene& scene, const Grid& grid, const Camera& came
     res.iterations = std::max(res.iterations, c.iterations);
   }
   if (stats) *stats = total;
-  res.render_ms =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  res.render_ms = ms_since(t0);
   return res;
 }
 

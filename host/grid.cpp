@@ -11,6 +11,8 @@
 #include <string_view>
 #include <thread>
 
+#include "host/parallel.h"
+
 namespace host {
 
 namespace {
@@ -254,8 +256,7 @@ Grid build_grid(const Scene& scene, const GridSpec& spec, unsigned threads) {
     }
   }
   Grid g = build_grid_in_box(scene, lo, hi, res, threads);
-  g.build_ms =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t_begin).count();
+  g.build_ms = ms_since(t_begin);
   return g;
 }
 
@@ -321,8 +322,7 @@ Grid build_grid_in_box(const Scene& scene, glm::vec3 lo, glm::vec3 hi, glm::ivec
     for (size_t k = 0; k < r.voxel.size(); ++k) g.tris[g.start[r.voxel[k] + 1]++] = r.tri[k];
     r = References{};  // release as we go
   }
-  g.build_ms =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t_begin).count();
+  g.build_ms = ms_since(t_begin);
   return g;
 }
 

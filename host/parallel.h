@@ -1,13 +1,20 @@
-// A row-parallel worker pool shared by the CPU tracer and the test references.
+// Small host-side helpers: a row-parallel worker pool (the CPU tracer, the test references) and
+// the wall-clock milliseconds the tracers and the grid builder report.
 #pragma once
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <exception>
 #include <thread>
 #include <vector>
 
 namespace host {
+
+// Milliseconds of wall time since t0 (std::chrono::steady_clock).
+inline double ms_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
 
 // Calls body(worker, y) once for every row y in [0, rows), on `workers` threads (clamped to
 // [1, rows]; the calling thread is worker 0, the others are std::jthreads joined before the

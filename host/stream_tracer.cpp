@@ -7,6 +7,8 @@
 #include <cstdio>
 #include <stdexcept>
 
+#include "host/parallel.h"
+
 namespace host {
 
 using namespace kernels;
@@ -14,12 +16,6 @@ using vgpu::Format;
 using vgpu::KernelProgram;
 using vgpu::Stencil;
 using vgpu::Texture;
-
-namespace {
-double ms_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
-}  // namespace
 
 struct StreamTracer::State {
   // Static textures.
