@@ -834,7 +834,7 @@ class Loader {
     }
     glm::vec3 rgb(1.0f);
     if (light.color.size() == 3) {
-      for (int c = 0; c < 3; ++c) rgb[c] = float(std::clamp(light.color[size_t(c)], 0.0, 1.0));
+      rgb = clamp01(light.color);
     } else if (!light.color.empty()) {
       fail(path_, name + ": color must have 3 numbers");
     }
