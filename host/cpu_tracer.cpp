@@ -53,14 +53,44 @@ bool intersect(const glm::dvec3& o, const glm::dvec3& d, const Tri& tri, double&
   return t > 0.0;
 }
 
+// cpu_primary_dir, with the part that is the same for every pixel (camera basis, tan(yfov / 2),
+// aspect) evaluated once per image.
+struct PrimaryRays {
+  PrimaryRays(const Camera& camera, int width, int height)
+      : forward(camera.forward),
+        up(camera.up),
+        right(glm::normalize(glm::cross(forward, up))),
+        t(std::tan(double(camera.yfov) / 2.0)),
+        a(double(width) / double(height)),
+        W(width),
+        H(height) {}
+
+  glm::dvec3 dir(int x, int y) const {
+    const double sx = (2.0 * (x + 0.5) / double(W) - 1.0) * t * a;
+    const double sy = (1.0 - 2.0 * (y + 0.5) / double(H)) * t;
+    return glm::normalize(forward + sx * right + sy * up);
+  }
+
+  glm::dvec3 forward, up, right;
+  double t, a;  // tan(yfov / 2), W / H
+  int W, H;
+};
+
 class Tracer {
  public:
   Tracer(const Scene& scene, const Grid& grid, const Camera& camera, const RenderOptions& opt)
-      : scene_(scene), grid_(grid), cam_(camera), opt_(opt) {
+      : scene_(scene),
+        grid_(grid),
+        cam_(camera),
+        opt_(opt),
+        primary_(camera, opt.width, opt.height) {
     tris_.reserve(scene.triangle_count());
+    geo_normals_.reserve(scene.triangle_count());
     for (size_t i = 0; i < scene.triangle_count(); ++i) {
       const glm::dvec3 p0(scene.p0[i]);
-      tris_.push_back({p0, glm::dvec3(scene.p1[i]) - p0, glm::dvec3(scene.p2[i]) - p0});
+      const Tri& tri =
+          tris_.emplace_back(Tri{p0, glm::dvec3(scene.p1[i]) - p0, glm::dvec3(scene.p2[i]) - p0});
+      geo_normals_.push_back(glm::normalize(glm::cross(tri.e1, tri.e2)));
     }
     const double diag = glm::length(glm::dvec3(grid.hi) - glm::dvec3(grid.lo));
     slack_ = kSlackOfDiagonal * diag;
@@ -149,8 +179,7 @@ class Tracer {
     const size_t idx = size_t(y) * size_t(opt_.width) + size_t(x);
     Hit primary;
     const glm::dvec3 colour =
-        radiance(glm::dvec3(cam_.position), cpu_primary_dir(cam_, opt_.width, opt_.height, x, y), 0,
-                 1.0, &primary, c);
+        radiance(glm::dvec3(cam_.position), primary_.dir(x, y), 0, 1.0, &primary, c);
     if (primary.tri >= 0) {
       out.depth[idx] = float(primary.t);
       out.hit_id[idx] = float(scene_.id[size_t(primary.tri)]);
@@ -169,9 +198,8 @@ class Tracer {
     if (hit_out) *hit_out = h;
     if (h.tri < 0) return background_;
     const size_t k = size_t(h.tri);
-    const Tri& tri = tris_[k];
     const glm::dvec3 p = o + d * h.t;  // world space, on the surface
-    glm::dvec3 ng = glm::normalize(glm::cross(tri.e1, tri.e2));
+    glm::dvec3 ng = geo_normals_[k];
     if (glm::dot(ng, d) > 0.0) ng = -ng;
     const glm::dvec3 lifted = p + ng * offset_;  // origin of the shadow and reflected rays
     glm::dvec3 n = glm::dvec3(scene_.n0[k]) * (1.0 - h.u - h.v) + glm::dvec3(scene_.n1[k]) * h.u +
@@ -220,7 +248,9 @@ class Tracer {
   const Grid& grid_;
   const Camera& cam_;
   const RenderOptions& opt_;
+  const PrimaryRays primary_;
   std::vector<Tri> tris_;
+  std::vector<glm::dvec3> geo_normals_;  // unit geometric normal per triangle: e1 x e2 normalized
   double slack_ = 0, offset_ = 0, atten_dist_ = 0;
   glm::dvec3 box_lo_{0.0}, box_hi_{0.0};
   int iterations_ = 1;  // surfaces per chain at most: 1 + bounces
@@ -232,13 +262,7 @@ class Tracer {
 }  // namespace
 
 glm::dvec3 cpu_primary_dir(const Camera& camera, int W, int H, int x, int y) {
-  const glm::dvec3 forward(camera.forward), up(camera.up);
-  const glm::dvec3 right = glm::normalize(glm::cross(forward, up));
-  const double t = std::tan(double(camera.yfov) / 2.0);
-  const double a = double(W) / double(H);
-  const double sx = (2.0 * (x + 0.5) / double(W) - 1.0) * t * a;
-  const double sy = (1.0 - 2.0 * (y + 0.5) / double(H)) * t;
-  return glm::normalize(forward + sx * right + sy * up);
+  return PrimaryRays(camera, W, H).dir(x, y);
 }
 
 RenderResult render_cpu(const Scene& scene, const Grid& grid, const Camera& camera,
