@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <fstream>
 #include <glm/gtc/quaternion.hpp>
+#include <glm/gtc/type_ptr.hpp>
 #include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -721,12 +722,7 @@ class Loader {
     check_size(node.translation, 3, "translation");
     check_size(node.rotation, 4, "rotation");
     check_size(node.scale, 3, "scale");
-    if (!node.matrix.empty()) {
-      glm::dmat4 m;
-      for (int c = 0; c < 4; ++c)
-        for (int r = 0; r < 4; ++r) m[c][r] = node.matrix[size_t(c * 4 + r)];  // column-major
-      return m;
-    }
+    if (!node.matrix.empty()) return glm::make_mat4(node.matrix.data());  // column-major
     glm::dmat4 t(1.0), r(1.0), s(1.0);
     if (!node.translation.empty())
       t[3] = glm::dvec4(node.translation[0], node.translation[1], node.translation[2], 1.0);
