@@ -428,6 +428,12 @@ glm::vec3 clamp01(const std::vector<double>& v) {
           float(std::clamp(v[2], 0.0, 1.0))};
 }
 
+// Whether the float sum of the coordinates is finite: false for a NaN or infinite coordinate, and
+// also when finite coordinates overflow the sum (the loader's checks have always meant this).
+bool all_finite(glm::vec3 v) {
+  return std::isfinite(v.x + v.y + v.z);
+}
+
 class Loader {
  public:
   Loader(std::string path, const LoadOptions& options)
@@ -615,7 +621,7 @@ class Loader {
       const unsigned char* p = element_ptr(acc, i);
       glm::vec3& v = (*out)[i];
       for (int c = 0; c < 3; ++c) v[c] = read_component(p + c * comp, ct, acc.normalized);
-      if (positions && !std::isfinite(v.x + v.y + v.z)) {
+      if (positions && !all_finite(v)) {
         const bool nan = std::isnan(v.x) || std::isnan(v.y) || std::isnan(v.z);
         fail(path_, use + ": accessor " + std::to_string(index) + " element " + std::to_string(i) +
                         " has " + (nan ? "a NaN coordinate" : "an infinite coordinate"));
@@ -809,8 +815,7 @@ class Loader {
     out.forward = glm::vec3(f);
     out.up = glm::vec3(u);
     out.yfov = float(yfov);
-    const auto finite = [](glm::vec3 v) { return std::isfinite(v.x + v.y + v.z); };
-    if (!finite(out.position) || !finite(out.forward) || !finite(out.up))
+    if (!all_finite(out.position) || !all_finite(out.forward) || !all_finite(out.up))
       fail(path_, name + ": the node transform is degenerate");
     scene_.camera = out;
   }
@@ -835,8 +840,7 @@ class Loader {
       fail(path_, name + ": color must have 3 numbers");
     }
     const glm::vec3 position(world[3]);
-    if (!std::isfinite(position.x + position.y + position.z))
-      fail(path_, name + ": the world position is not finite");
+    if (!all_finite(position)) fail(path_, name + ": the world position is not finite");
     lights_.push_back({position, rgb, std::clamp(light.intensity, 0.0, 1e30)});
   }
 
@@ -968,7 +972,7 @@ class Loader {
       glm::vec3 p[3];
       for (int c = 0; c < 3; ++c) {
         p[c] = glm::vec3(world * glm::dvec4(glm::dvec3(pos[v[c]]), 1.0));
-        if (!std::isfinite(p[c].x + p[c].y + p[c].z))
+        if (!all_finite(p[c]))
           fail(path_, node_name +
                           ": a world-space position is not finite (the node transforms "
                           "overflow float)");
