@@ -182,6 +182,7 @@ StreamTracer::StreamTracer(const Scene& scene, const Grid& grid, const RenderOpt
   s_->next.kernel.grid = g;
   s_->shader.kernel.scene = su;
   s_->shader.kernel.model = opt_.shading;
+  s_->shader.kernel.shadows = opt_.shadows;
   s_->shader.kernel.atten_dist = float(kAttenOfDiagonal) * diag;
   s_->origin.kernel.scene = su;
   s_->origin.kernel.offset = float(kOffsetOfDiagonal) * diag;
@@ -218,9 +219,7 @@ const vgpu::PassRecord& StreamTracer::pass(const vgpu::Program& p,
   gpu.set_stencil_test(nullptr);
   gpu.set_work_mask(opt_.masks || opt_.host_shortcut ? work : nullptr);
   gpu.set_work_mask_counts_as_masked(opt_.masks);
-  // The traced pixel takes part unless the finished-ray mask says its ray is done.
-  const bool traced = opt_.trace_pixel && opt_.trace_out &&
-                      (!work || work->get(opt_.trace_pixel->x, opt_.trace_pixel->y) != 0);
+  const bool traced = traces_pixel(work);
   const vgpu::PassRecord& rec = gpu.draw();
   if (traced && !p.idle_discards()) {
     const int x = opt_.trace_pixel->x, y = opt_.trace_pixel->y;
@@ -235,11 +234,15 @@ const vgpu::PassRecord& StreamTracer::pass(const vgpu::Program& p,
   return rec;
 }
 
+bool StreamTracer::traces_pixel(const Stencil* work) const {
+  return opt_.trace_pixel && opt_.trace_out &&
+         (!work || work->get(opt_.trace_pixel->x, opt_.trace_pixel->y) != 0);
+}
+
 uint64_t StreamTracer::count(const vgpu::Program& p, const Texture& in, const Stencil* work,
                              Stencil* write) {
   vgpu::Gpu& gpu = *gpu_;
-  const bool traced = opt_.trace_pixel && opt_.trace_out &&
-                      (!work || work->get(opt_.trace_pixel->x, opt_.trace_pixel->y) != 0);
+  const bool traced = traces_pixel(work);
   gpu.set_stencil_write(write);
   gpu.begin_query();
   pass(p, {&in}, s_->counter, work);
@@ -368,7 +371,6 @@ RenderResult StreamTracer::render(const Camera& cam) {
       sh.light_color = lights[li].color;
       sh.first_light = li == 0;
       sh.last_light = li + 1 == lights.size();
-      sh.shadows = opt_.shadows;
       if (opt_.shadows) {
         s.shadow.kernel.light = lights[li].position;
         pass(s.shadow, {&surface, &s.result[s.cur_result]}, s.shadow_rays);
@@ -394,8 +396,10 @@ RenderResult StreamTracer::render(const Camera& cam) {
   const Texture& out = s.result[s.cur_result];
   res.rgb.resize(size_t(W) * H * 3);
   for (int y = 0; y < H; ++y)
-    for (int x = 0; x < W; ++x)
-      for (int c = 0; c < 3; ++c) res.rgb[(size_t(y) * W + x) * 3 + c] = out.texel(x, y)[c];
+    for (int x = 0; x < W; ++x) {
+      const float* t = out.texel(x, y);
+      for (int c = 0; c < 3; ++c) res.rgb[(size_t(y) * W + x) * 3 + c] = t[c];
+    }
   res.stats = gpu.stats();
   res.rays_traced = s.rays_traced;
   res.rays_unfinished = s.rays_unfinished;

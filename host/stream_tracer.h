@@ -77,6 +77,9 @@ class StreamTracer {
                                const vgpu::Stencil* work = nullptr);
   uint64_t count(const vgpu::Program& p, const vgpu::Texture& in, const vgpu::Stencil* work,
                  vgpu::Stencil* write);
+  // Whether --trace-pixel output is on and the traced pixel takes part in a pass under `work`
+  // (no mask, or the finished-ray mask says its ray is not done).
+  bool traces_pixel(const vgpu::Stencil* work) const;
 
   const Scene& scene_;
   const Grid& grid_;
