@@ -199,29 +199,8 @@ size_t json_depth(std::string_view text) {
   return deepest;
 }
 
-// The same decoding tinygltf applies to buffer URIs (dlib::urldecode).
-std::string url_decode(const std::string& s) {
-  auto hex = [](char c) -> int {
-    if (c >= '0' && c <= '9') return c - '0';
-    if (c >= 'a' && c <= 'f') return c - 'a' + 10;
-    if (c >= 'A' && c <= 'F') return c - 'A' + 10;
-    return 0;
-  };
-  std::string out;
-  for (size_t i = 0; i < s.size(); ++i) {
-    if (s[i] == '+') {
-      out += ' ';
-    } else if (s[i] == '%' && s.size() > i + 2) {
-      out += static_cast<char>(hex(s[i + 1]) << 4 | hex(s[i + 2]));
-      i += 2;
-    } else {
-      out += s[i];
-    }
-  }
-  return out;
-}
-
-// Bytes tinygltf's base64 decoder yields: it stops at the first '=' or non-base64 character.
+// Bytes tinygltf's base64_decode (tiny_gltf.h) yields: it stops at the first '=' or non-base64
+// character. Counted rather than decoded, since tinygltf decodes the URI itself afterwards.
 uint64_t base64_decoded_size(std::string_view payload) {
   uint64_t n = 0;
   for (char c : payload) {
@@ -301,7 +280,8 @@ std::vector<uint64_t> precheck_json(const std::string& path, const std::string& 
     } else {
       if (uri.find("://") != uri.npos)
         fail(path, name + ": URI scheme not supported (only relative paths and data: URIs)");
-      const std::string decoded = url_decode(uri);
+      // The decoding tinygltf applies to buffer URIs (this file holds its implementation).
+      const std::string decoded = tinygltf::dlib::urldecode(uri);
       if (decoded.find('\0') != decoded.npos) fail(path, name + ": the uri holds a NUL character");
       const fs::path file = dir / decoded;
       std::error_code ec;
