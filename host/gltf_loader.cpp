@@ -84,19 +84,51 @@ void put_le32(std::vector<unsigned char>& out, uint32_t v) {
 // ---------------------------------------------------------------------------------------------
 // Reading the file and splitting a .glb
 
-std::vector<unsigned char> read_bytes(const std::string& path) {
+// Why read_file() failed: missing to too_large before opening the file, the others after.
+enum class ReadError { none, missing, not_regular, no_size, too_large, no_open, short_read };
+
+// Reads the whole regular file `path`, at most kMaxFileBytes, into `out`. `detail` gets the
+// system's reason for no_size and no_open.
+ReadError read_file(const std::string& path, std::vector<unsigned char>& out, std::string& detail) {
   std::error_code ec;
   const fs::file_status st = fs::status(path, ec);
-  if (!fs::exists(st)) fail(path, "no such file");
-  if (!fs::is_regular_file(st)) fail(path, "not a regular file");
+  if (!fs::exists(st)) return ReadError::missing;
+  if (!fs::is_regular_file(st)) return ReadError::not_regular;
   const uintmax_t size = fs::file_size(path, ec);
-  if (ec) fail(path, "cannot read the file: " + ec.message());
-  if (size > kMaxFileBytes) fail(path, "the file is larger than 4 GiB");
+  if (ec) {
+    detail = ec.message();
+    return ReadError::no_size;
+  }
+  if (size > kMaxFileBytes) return ReadError::too_large;
   std::ifstream in(path, std::ios::binary);
-  if (!in) fail(path, std::string("cannot open the file: ") + std::strerror(errno));
-  std::vector<unsigned char> bytes(static_cast<size_t>(size));
-  in.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(size));
-  if (static_cast<uintmax_t>(in.gcount()) != size) fail(path, "cannot read the whole file");
+  if (!in) {
+    detail = std::strerror(errno);
+    return ReadError::no_open;
+  }
+  out.resize(static_cast<size_t>(size));
+  in.read(reinterpret_cast<char*>(out.data()), static_cast<std::streamsize>(size));
+  return static_cast<uintmax_t>(in.gcount()) == size ? ReadError::none : ReadError::short_read;
+}
+
+std::vector<unsigned char> read_bytes(const std::string& path) {
+  std::vector<unsigned char> bytes;
+  std::string detail;
+  switch (read_file(path, bytes, detail)) {
+    case ReadError::none:
+      break;
+    case ReadError::missing:
+      fail(path, "no such file");
+    case ReadError::not_regular:
+      fail(path, "not a regular file");
+    case ReadError::no_size:
+      fail(path, "cannot read the file: " + detail);
+    case ReadError::too_large:
+      fail(path, "the file is larger than 4 GiB");
+    case ReadError::no_open:
+      fail(path, "cannot open the file: " + detail);
+    case ReadError::short_read:
+      fail(path, "cannot read the whole file");
+  }
   return bytes;
 }
 
@@ -306,17 +338,13 @@ bool fs_file_exists(const std::string& p, void*) {
 std::string fs_expand(const std::string& p, void*) {
   return p;
 }
+// Only failures before the file is opened add a reason; tinygltf reports the rest.
 bool fs_read(std::vector<unsigned char>* out, std::string* err, const std::string& p, void*) {
-  std::error_code ec;
-  const uintmax_t size = fs::file_size(p, ec);
-  if (ec || !fs::is_regular_file(p, ec) || size > kMaxFileBytes) {
-    if (err) *err += "cannot read " + p;
-    return false;
-  }
-  std::ifstream in(p, std::ios::binary);
-  out->resize(static_cast<size_t>(size));
-  in.read(reinterpret_cast<char*>(out->data()), static_cast<std::streamsize>(size));
-  return in.gcount() == static_cast<std::streamsize>(size);
+  std::string detail;
+  const ReadError e = read_file(p, *out, detail);
+  if (e == ReadError::none) return true;
+  if (err && e != ReadError::no_open && e != ReadError::short_read) *err += "cannot read " + p;
+  return false;
 }
 bool fs_write(std::string*, const std::string&, const std::vector<unsigned char>&, void*) {
   return false;
