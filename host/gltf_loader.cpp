@@ -19,6 +19,7 @@
 #include <nlohmann/json.hpp>
 #include <numbers>
 #include <set>
+#include <span>
 #include <string_view>
 
 // The one translation unit that holds tinygltf and stb. Images are never decoded: the image
@@ -134,7 +135,7 @@ std::vector<unsigned char> read_bytes(const std::string& path) {
 
 struct GlbParts {
   std::string json;
-  std::vector<unsigned char> bin;
+  std::span<const unsigned char> bin;  // inside the file's bytes
   bool has_bin = false;
 };
 
@@ -172,7 +173,7 @@ GlbParts split_glb(const std::string& path, const std::vector<unsigned char>& by
       if (chunk_type != kGlbChunkJson) fail(path, "corrupt .glb: the first chunk is not JSON");
       parts.json.assign(reinterpret_cast<const char*>(data), chunk_length);
     } else if (chunk == 1 && chunk_type == kGlbChunkBin) {
-      parts.bin.assign(data, data + chunk_length);
+      parts.bin = {data, size_t(chunk_length)};
       parts.has_bin = true;
     }
     pos += 8 + chunk_length;
@@ -181,26 +182,27 @@ GlbParts split_glb(const std::string& path, const std::vector<unsigned char>& by
   return parts;
 }
 
-// A well-formed .glb (4-byte aligned chunks) around `json_text` and the BIN chunk, for tinygltf.
+// A well-formed .glb (4-byte aligned chunks) around `json_text` and the BIN chunk, for tinygltf:
+// the JSON padded with spaces, the BIN chunk with zeros.
 std::vector<unsigned char> make_glb(const std::string& json_text, const GlbParts& parts) {
-  std::string padded_json = json_text;
-  while (padded_json.size() % 4 != 0) padded_json += ' ';
-  std::vector<unsigned char> bin = parts.bin;
-  while (bin.size() % 4 != 0) bin.push_back(0);
-  const bool with_bin = parts.has_bin && !bin.empty();
-  const uint64_t total = 12 + 8 + padded_json.size() + (with_bin ? 8 + bin.size() : 0);
+  const auto padded = [](uint64_t n) { return (n + 3) / 4 * 4; };
+  const uint64_t json_size = padded(json_text.size()), bin_size = padded(parts.bin.size());
+  const bool with_bin = parts.has_bin && bin_size > 0;
+  const uint64_t total = 12 + 8 + json_size + (with_bin ? 8 + bin_size : 0);
   std::vector<unsigned char> out;
   out.reserve(total);
   put_le32(out, kGlbMagic);
   put_le32(out, 2);
   put_le32(out, static_cast<uint32_t>(total));
-  put_le32(out, static_cast<uint32_t>(padded_json.size()));
+  put_le32(out, static_cast<uint32_t>(json_size));
   put_le32(out, kGlbChunkJson);
-  out.insert(out.end(), padded_json.begin(), padded_json.end());
+  out.insert(out.end(), json_text.begin(), json_text.end());
+  out.resize(out.size() + (json_size - json_text.size()), ' ');
   if (with_bin) {
-    put_le32(out, static_cast<uint32_t>(bin.size()));
+    put_le32(out, static_cast<uint32_t>(bin_size));
     put_le32(out, kGlbChunkBin);
-    out.insert(out.end(), bin.begin(), bin.end());
+    out.insert(out.end(), parts.bin.begin(), parts.bin.end());
+    out.resize(out.size() + (bin_size - parts.bin.size()), 0);
   }
   return out;
 }
@@ -449,8 +451,7 @@ class Loader {
         max_triangles_(std::min<uint64_t>(options.max_triangles, 0xFFFFFFFFull)) {}
 
   Scene load() {
-    const std::vector<unsigned char> bytes = read_bytes(path_);
-    parse(bytes);
+    parse(read_bytes(path_));  // the file's bytes are freed once parsed
     check_buffers_and_views();
     check_accessors();
     convert_materials();
@@ -469,7 +470,7 @@ class Loader {
     std::string text;
     if (is_glb) {
       glb = split_glb(path_, bytes);
-      text = glb.json;
+      text = std::move(glb.json);
     } else {
       size_t i = 0;
       if (bytes.size() >= 3 && bytes[0] == 0xEF && bytes[1] == 0xBB && bytes[2] == 0xBF) i = 3;
