@@ -444,6 +444,12 @@ bool all_finite(glm::vec3 v) {
   return std::isfinite(v.x + v.y + v.z);
 }
 
+// The distance between an accessor's elements: the view's byteStride, or `element` (the element
+// size) when the view has none.
+uint64_t element_stride(const tinygltf::BufferView& view, uint64_t element) {
+  return view.byteStride ? view.byteStride : element;
+}
+
 class Loader {
  public:
   Loader(std::string path, const LoadOptions& options)
@@ -570,7 +576,7 @@ class Loader {
       if (n <= 0) fail(path_, name + " has an invalid type");
       const tinygltf::BufferView& view = model_.bufferViews[size_t(acc.bufferView)];
       const uint64_t element = uint64_t(comp) * uint64_t(n);
-      const uint64_t stride = view.byteStride ? view.byteStride : element;
+      const uint64_t stride = element_stride(view, element);
       if (stride < element)
         fail(path_, name + ": buffer view " + std::to_string(acc.bufferView) + " has byteStride " +
                         std::to_string(stride) + ", smaller than the element size " +
@@ -585,14 +591,20 @@ class Loader {
     }
   }
 
-  // The accessor's bytes for element i; check_accessors() proved the range.
-  const unsigned char* element_ptr(const tinygltf::Accessor& acc, size_t i) const {
+  // Where an accessor's elements lie in its buffer: element i at byte start + i * stride.
+  // check_accessors() proved the range of every element (with no element, start may lie past
+  // the buffer, so it stays an offset).
+  struct Elements {
+    const unsigned char* buffer;
+    size_t start, stride;
+    const unsigned char* operator[](size_t i) const { return buffer + (start + i * stride); }
+  };
+  Elements elements(const tinygltf::Accessor& acc) const {
     const tinygltf::BufferView& view = model_.bufferViews[size_t(acc.bufferView)];
     const int comp = tinygltf::GetComponentSizeInBytes(uint32_t(acc.componentType));
     const int n = tinygltf::GetNumComponentsInType(uint32_t(acc.type));
-    const size_t stride = view.byteStride ? view.byteStride : size_t(comp) * size_t(n);
-    return model_.buffers[size_t(view.buffer)].data.data() + view.byteOffset + acc.byteOffset +
-           i * stride;
+    return {model_.buffers[size_t(view.buffer)].data.data(), view.byteOffset + acc.byteOffset,
+            size_t(element_stride(view, uint64_t(comp) * uint64_t(n)))};
   }
 
   // The accessor, checked for a use: in range, with data, not sparse.
@@ -626,8 +638,9 @@ class Loader {
                       " must be VEC3 of float, byte or short components");
     const int comp = tinygltf::GetComponentSizeInBytes(uint32_t(ct));
     auto out = std::make_shared<std::vector<glm::vec3>>(acc.count);
+    const Elements element = elements(acc);
     for (size_t i = 0; i < acc.count; ++i) {
-      const unsigned char* p = element_ptr(acc, i);
+      const unsigned char* p = element[i];
       glm::vec3& v = (*out)[i];
       for (int c = 0; c < 3; ++c) v[c] = read_component(p + c * comp, ct, acc.normalized);
       if (positions && !all_finite(v)) {
@@ -650,8 +663,9 @@ class Loader {
       fail(path_, use + ": accessor " + std::to_string(index) +
                       " must be SCALAR of unsigned byte, short or int components");
     auto out = std::make_shared<std::vector<uint32_t>>(acc.count);
+    const Elements element = elements(acc);
     for (size_t i = 0; i < acc.count; ++i) {
-      const unsigned char* p = element_ptr(acc, i);
+      const unsigned char* p = element[i];
       uint32_t v = 0;
       if (ct == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE)
         v = p[0];
