@@ -988,18 +988,33 @@ class Loader {
     const std::vector<glm::vec3>& pos = *g.positions;
     const std::vector<glm::vec3>& nrm = *g.normals;
 
+    // Every vertex the triangles use, transformed once.
+    struct WorldVertex {
+      bool done = false;
+      bool has_normal = false;  // false: the normal is zero or not finite, use the face normal
+      glm::vec3 position, normal;
+    };
+    std::vector<WorldVertex> wv(pos.size());
+    for (const uint32_t i : g.corners) {
+      WorldVertex& out = wv[i];
+      if (out.done) continue;
+      out.done = true;
+      out.position = glm::vec3(world * glm::dvec4(glm::dvec3(pos[i]), 1.0));
+      if (!all_finite(out.position))
+        fail(path_, node_name +
+                        ": a world-space position is not finite (the node transforms "
+                        "overflow float)");
+      const glm::dvec3 w = normal_matrix * glm::dvec3(nrm[i]);
+      const double len = glm::length(w);
+      out.has_normal = len > 0.0 && std::isfinite(len);
+      if (out.has_normal) out.normal = glm::vec3(w / len);
+    }
+
     for (size_t t = 0; t < triangles; ++t) {
       const uint32_t id = scene_.input_triangles++;
       uint32_t v[3] = {g.corners[3 * t], g.corners[3 * t + 1], g.corners[3 * t + 2]};
       if (mirror) std::swap(v[1], v[2]);
-      glm::vec3 p[3];
-      for (int c = 0; c < 3; ++c) {
-        p[c] = glm::vec3(world * glm::dvec4(glm::dvec3(pos[v[c]]), 1.0));
-        if (!all_finite(p[c]))
-          fail(path_, node_name +
-                          ": a world-space position is not finite (the node transforms "
-                          "overflow float)");
-      }
+      const glm::vec3 p[3] = {wv[v[0]].position, wv[v[1]].position, wv[v[2]].position};
       const glm::vec3 cross_f = glm::cross(p[1] - p[0], p[2] - p[0]);
       const glm::dvec3 cross_d =
           glm::cross(glm::dvec3(p[1]) - glm::dvec3(p[0]), glm::dvec3(p[2]) - glm::dvec3(p[0]));
@@ -1011,13 +1026,11 @@ class Loader {
       const glm::vec3 face(cross_d / area2);
       glm::vec3 n[3];
       for (int c = 0; c < 3; ++c) {
-        const glm::dvec3 w = normal_matrix * glm::dvec3(nrm[v[c]]);
-        const double len = glm::length(w);
-        if (len > 0.0 && std::isfinite(len)) {
-          n[c] = glm::vec3(w / len);
+        if (wv[v[c]].has_normal) {
+          n[c] = wv[v[c]].normal;
         } else {
           n[c] = face;
-          if (g.normals_from_file) ++invalid_file_normals_;
+          if (g.normals_from_file) ++invalid_file_normals_;  // per corner
         }
       }
       scene_.add_triangle(p[0], p[1], p[2], n[0], n[1], n[2], g.material, id);
