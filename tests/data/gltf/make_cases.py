@@ -127,8 +127,7 @@ def triangle_cases():
     b, d = simple(TRI, idx=[0, 1, 2], normals=UP)
     write_gltf("triangle.gltf", d, b.bin)
     write_gltf("triangle_external.gltf", d, b.bin, external=True)
-    d_glb = json.loads(json.dumps(d))
-    write_bytes("triangle.glb", glb_bytes(d_glb, b.bin))
+    write_bytes("triangle.glb", glb_bytes(d, b.bin))
 
 
 def hierarchy_case():
@@ -289,12 +288,12 @@ def bad_cases():
     write_text("not_gltf.txt", "This is a plain text file, not a glTF scene.\n")
 
     b, d = simple(TRI, idx=[0, 1, 2], normals=UP)
-    glb = glb_bytes(json.loads(json.dumps(d)), b.bin)
+    glb = glb_bytes(d, b.bin)
     write_bytes("truncated.glb", glb[:len(glb) // 2])
     bad_chunk = bytearray(glb)
     bad_chunk[12:16] = struct.pack("<I", 10000)
     write_bytes("bad_chunk_length.glb", bytes(bad_chunk))
-    write_bytes("bad_version.glb", glb_bytes(json.loads(json.dumps(d)), b.bin, version=1))
+    write_bytes("bad_version.glb", glb_bytes(d, b.bin, version=1))
     # BIN chunk holds 8 bytes fewer than the buffer's byteLength.
     short = json.loads(json.dumps(d))
     short["buffers"][0]["byteLength"] = len(b.bin) + 8
@@ -312,11 +311,8 @@ def bad_cases():
 
     b, d = simple(TRI, idx=[0, 1, 2])
     d["buffers"][0]["byteLength"] = len(b.bin) + 8
-    d["buffers"][0]["uri"] = "short_buffer.bin"
-    write_bytes("short_buffer.bin", b.bin)
-    write_text("short_buffer.gltf", json.dumps(d, indent=1) + "\n")
-    d["buffers"][0]["uri"] = data_uri(b.bin)
-    write_text("short_buffer_embedded.gltf", json.dumps(d, indent=1) + "\n")
+    write_gltf("short_buffer.gltf", d, b.bin, external=True)
+    write_gltf("short_buffer_embedded.gltf", d, b.bin)
 
     b, d = simple(TRI, idx=[0, 1, 5])
     write_gltf("index_past_vertices.gltf", d, b.bin)
