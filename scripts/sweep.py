@@ -19,6 +19,7 @@ its message and left out of the chart; a run over --timeout seconds likewise.
 
 Writes docs/sweep.csv, docs/speed_vs_accuracy.png and docs/accuracy.md.
 Usage: /usr/bin/python3 scripts/sweep.py [--grids auto,8,16,32] [--jobs 2] [--timeout 300]
+                                         [--reuse WORKDIR]
        /usr/bin/python3 scripts/sweep.py --plot-only   (chart and report from docs/sweep.csv)
 """
 import argparse
@@ -46,10 +47,13 @@ CRITERIA = [("hit", "wrong primary hit id"), ("depth", f"depth error > {DEPTH_TO
             ("colour", "colour difference > 1/255")]
 
 
-def render(exe, work, scene, grid, engine, precision, bounces, size, timeout):
+def render(exe, work, scene, grid, engine, precision, bounces, size, timeout, reuse=False):
     tag = f"{scene}_{grid}_{engine}_{precision}_b{bounces}"
     out = {k: os.path.join(work, tag + s) for k, s in
            [("rgb", ".exr"), ("hit", "_hit.exr"), ("depth", "_depth.exr"), ("json", ".json")]}
+    if reuse and all(os.path.exists(p) for p in out.values()):
+        with open(out["json"]) as f:
+            return tag, out, json.load(f), ""
     cmd = [exe, "render", scene, "--engine", engine, "--grid", grid, "--bounces", str(bounces),
            "--size", size, "--out", out["rgb"], "--aov", "hit=" + out["hit"], "depth=" + out["depth"],
            "--stats-json", out["json"], "--quiet", "--stats", "none", "--threads", "1"]
@@ -91,6 +95,8 @@ def main():
     ap.add_argument("--size", default="128x128")
     ap.add_argument("--build", default=os.path.join(ROOT, "build-stab"))
     ap.add_argument("--plot-only", action="store_true", help="redraw the chart from docs/sweep.csv")
+    ap.add_argument("--reuse", metavar="DIR",
+                    help="work directory of an earlier sweep: keep the renders it finished")
     args = ap.parse_args()
     SCENES[:] = args.scenes.split(",")
     if args.plot_only:
@@ -101,7 +107,7 @@ def main():
         return 0
     exe = os.path.join(args.build, "host", "vgpu-rt")
     grids = args.grids.split(",")
-    work = tempfile.mkdtemp(prefix="vgpu-sweep-")
+    work = args.reuse or tempfile.mkdtemp(prefix="vgpu-sweep-")
     jobs = []
     for scene in SCENES:
         for grid in grids:
@@ -116,7 +122,7 @@ def main():
     t0 = time.time()
     with cf.ThreadPoolExecutor(args.jobs) as pool:
         futs = {pool.submit(render, exe, work, j[0], j[1], j[2], j[3], j[4], args.size,
-                            args.timeout): j for j in jobs}
+                            args.timeout, bool(args.reuse)): j for j in jobs}
         for n, fut in enumerate(cf.as_completed(futs), 1):
             j = futs[fut]
             results[j] = fut.result()
@@ -139,7 +145,7 @@ def main():
             row["render_ms"] = f"{stats['render_ms']:.3f}"
             row["rays_unfinished"] = stats.get("rays_unfinished", 0)
             for part in PARTS:
-                if part in stats.get("predicted_ms", {}):
+                if part in (stats.get("predicted_ms") or {}):
                     row[f"modeled_{part}_ms"] = f"{stats['predicted_ms'][part]:.3f}"
             if "formats" in stats:
                 row["voxel_format"] = stats["formats"]["voxel"]["texels"]
