@@ -5,6 +5,7 @@
 #include <EGL/eglext.h>
 
 #include <cstring>
+#include <map>
 #include <sstream>
 
 #include "gl/gl.h"
@@ -63,6 +64,19 @@ struct DeviceEnum {
     return d;
   }
 };
+
+// EGL hands out one display per device and process: every Context on it shares it, so it is
+// terminated only when the last one lets it go.
+std::map<EGLDisplay, int>& display_users() {
+  static std::map<EGLDisplay, int> users;
+  return users;
+}
+void release_display(EGLDisplay d) {
+  auto it = display_users().find(d);
+  if (it != display_users().end() && --it->second > 0) return;
+  if (it != display_users().end()) display_users().erase(it);
+  eglTerminate(d);
+}
 
 }  // namespace
 
@@ -132,9 +146,10 @@ Context::Context(const std::string& device) {
       note("eglInitialize failed (" + egl_error() + ")");
       continue;
     }
+    ++display_users()[c.display];
     if (!eglBindAPI(EGL_OPENGL_API)) {
       note("no desktop OpenGL API");
-      eglTerminate(c.display);
+      release_display(c.display);
       continue;
     }
     const EGLint config_attribs[] = {EGL_SURFACE_TYPE,
@@ -152,7 +167,7 @@ Context::Context(const std::string& device) {
     EGLint nconfig = 0;
     if (!eglChooseConfig(c.display, config_attribs, &config, 1, &nconfig) || nconfig < 1) {
       note("no EGL config with a pbuffer and OpenGL");
-      eglTerminate(c.display);
+      release_display(c.display);
       continue;
     }
     const EGLint ctx_attribs[] = {EGL_CONTEXT_MAJOR_VERSION,
@@ -165,7 +180,7 @@ Context::Context(const std::string& device) {
     EGLContext ctx = eglCreateContext(c.display, config, EGL_NO_CONTEXT, ctx_attribs);
     if (ctx == EGL_NO_CONTEXT) {
       note("no OpenGL 3.3 core context (" + egl_error() + ")");
-      eglTerminate(c.display);
+      release_display(c.display);
       continue;
     }
     const EGLint pb_attribs[] = {EGL_WIDTH, 1, EGL_HEIGHT, 1, EGL_NONE};
@@ -174,7 +189,7 @@ Context::Context(const std::string& device) {
       note("eglMakeCurrent failed (" + egl_error() + ")");
       if (surf != EGL_NO_SURFACE) eglDestroySurface(c.display, surf);
       eglDestroyContext(c.display, ctx);
-      eglTerminate(c.display);
+      release_display(c.display);
       continue;
     }
     GLint gl_major = 0, gl_minor = 0;
@@ -185,7 +200,7 @@ Context::Context(const std::string& device) {
       eglMakeCurrent(c.display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
       if (surf != EGL_NO_SURFACE) eglDestroySurface(c.display, surf);
       eglDestroyContext(c.display, ctx);
-      eglTerminate(c.display);
+      release_display(c.display);
       continue;
     }
     display_ = c.display;
@@ -209,7 +224,13 @@ Context::~Context() {
   eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
   if (surface_ != EGL_NO_SURFACE) eglDestroySurface(display_, surface_);
   eglDestroyContext(display_, context_);
-  eglTerminate(display_);
+  release_display(display_);
+}
+
+void Context::make_current() const {
+  if (eglGetCurrentContext() == context_) return;
+  if (!eglMakeCurrent(display_, surface_, surface_, context_))
+    throw Unavailable("cannot make the GL context current (" + egl_error() + ")");
 }
 
 bool Context::has_extension(const std::string& name) const {

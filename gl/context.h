@@ -32,6 +32,9 @@ class Context {
   const std::string& version() const { return version_; }    // GL_VERSION
   const std::string& platform() const { return platform_; }  // how the display was opened
   bool has_extension(const std::string& name) const;
+  // Makes this context current on the calling thread if it is not (several devices in one
+  // process each have their own context).
+  void make_current() const;
 
   static std::vector<EglDeviceInfo> list_devices();
 

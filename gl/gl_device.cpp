@@ -93,6 +93,7 @@ GlDevice::GlDevice(const vgpu::Profile& profile, const std::string& device)
 }
 
 GlDevice::~GlDevice() {
+  ctx_->make_current();
   for (auto& [id, t] : textures_) glDeleteTextures(1, &t->name);
   for (auto& [src, p] : compiled_) glDeleteProgram(p->name);
   for (auto& [key, fbo] : fbos_) glDeleteFramebuffers(1, &fbo);
@@ -142,6 +143,7 @@ GlDevice::GlTexture& GlDevice::texture(const Texture& t) {
 }
 
 void GlDevice::upload(const Texture& t) {
+  ctx_->make_current();
   const bool fresh = !textures_.count(t.id());
   GlTexture& g = texture(t);
   if (fresh) return;  // created from the host's texels just now
@@ -152,6 +154,7 @@ void GlDevice::upload(const Texture& t) {
 }
 
 void GlDevice::download(Texture& t) {
+  ctx_->make_current();
   GlTexture& g = texture(t);
   glActiveTexture(kScratchUnit);
   glBindTexture(GL_TEXTURE_2D, g.name);
@@ -201,6 +204,7 @@ void GlDevice::set_work_mask(const vgpu::Stencil*) {
 }
 
 void GlDevice::clear(Texture& t, std::initializer_list<float> value) {
+  ctx_->make_current();
   if (int(value.size()) != t.channels())
     throw Error("clear of texture '" + t.name() + "': " + std::to_string(value.size()) +
                 " values for " + std::to_string(t.channels()) + " channels");
@@ -288,6 +292,7 @@ const vgpu::PassRecord& GlDevice::draw() {
 }
 
 const vgpu::PassRecord& GlDevice::draw(const vgpu::Rect& rect) {
+  ctx_->make_current();
   const auto t0 = std::chrono::steady_clock::now();
   if (!program_) throw Error("draw: no program bound");
   const vgpu::Program& p = *program_;
@@ -363,6 +368,7 @@ void GlDevice::begin_query() {
 }
 
 uint64_t GlDevice::end_query() {
+  ctx_->make_current();
   if (!query_active_) throw Error("end_query: no query is active");
   query_active_ = false;
   // The read-back: wait for the passes drawn inside the query and sum what survived them.
@@ -383,6 +389,7 @@ uint64_t GlDevice::end_query() {
 }
 
 void GlDevice::settle(size_t keep) {
+  ctx_->make_current();
   const size_t n = pending_.size() > keep ? pending_.size() - keep : 0;
   for (size_t i = 0; i < n; ++i) {
     Pending& p = pending_[i];
@@ -414,6 +421,7 @@ void GlDevice::settle(size_t keep) {
 }
 
 void GlDevice::finish() {
+  ctx_->make_current();
   glFinish();
   settle(0);
 }

@@ -53,8 +53,13 @@ void add_passes(const vgpu::Counters& c, double n, const vgpu::Profile& hw, cons
   const double keep = 1.0 - p.branch_body_share * skipped / shaded;  // share of work still done
 
   const double packing = std::clamp(p.scalar_ops_per_instruction, 1.0, double(hw.alu_lanes));
-  const double rate = hw.alu_per_clock * (hw.precision == vgpu::Format::fp32 ? hw.fp32_rate : 1.0);
-  const double arith_s = ops * keep / packing / (hw.pipelines * hz * rate);
+  // Each operation at the rate of the precision the render ran it at (fp16 is the full rate).
+  const double ops24 = std::min(ops, double(c.alu_fp24) / n);
+  const double ops16 = std::min(ops - ops24, double(c.alu_fp16) / n);
+  const double ops32 = ops - ops24 - ops16;
+  const double rate_ops = ops32 / hw.rate(vgpu::Format::fp32) +
+                          ops24 / hw.rate(vgpu::Format::fp24) + ops16 / hw.rate(vgpu::Format::fp16);
+  const double arith_s = rate_ops * keep / packing / (hw.pipelines * hz * hw.alu_per_clock);
   const double tex_s = fetches * keep / (hw.pipelines * hz * hw.texels_per_clock);
   const double mem_s =
       (double(c.bytes_read) / n * keep + double(c.bytes_written) / n) / (hw.mem_gbps * 1e9);

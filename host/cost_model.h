@@ -3,7 +3,9 @@
 // the paper's Table 1; docs/table1.md lists every parameter with its source or marks it fitted.
 //
 // Per pass:  time = max(arithmetic, texture, memory) + pass_us
-//   arithmetic = ALU instructions / (pipelines x clock x alu_per_clock x precision rate)
+//   arithmetic = ALU instructions / (pipelines x clock x alu_per_clock x precision rate), each
+//                at the rate of the precision it ran at (Counters::alu_fp24 / alu_fp16,
+//                Profile::rate: NV3x fp16 full speed, fp32 and fp24 half)
 //   texture    = texel fetches / (pipelines x clock x texels_per_clock)
 //   memory     = (bytes read + bytes written) / bandwidth
 // Per frame:  + program loads (bytes over the bus + program_load_us each)

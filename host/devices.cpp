@@ -1,6 +1,7 @@
 // Device construction by name.
 #include "host/devices.h"
 
+#include "host/formats.h"
 #include "host/stream_tracer.h"
 #include "vgpu/gpu.h"
 #ifdef VGPU_HAVE_GL
@@ -21,12 +22,15 @@ std::unique_ptr<vgpu::Device> make_device(const RenderOptions& opt) {
   const vgpu::Profile& profile = vgpu::profile(opt.profile);
   if (opt.device == "vgpu") {
     auto gpu = std::make_unique<vgpu::Gpu>(profile, opt.threads, opt.lanes);
-    gpu->set_precision(opt.precision);
+    gpu->set_precision(opt.formats.finest());
     return gpu;
   }
   if (opt.device == "gl") {
 #ifdef VGPU_HAVE_GL
-    if (opt.precision != vgpu::Format::fp32)
+    bool fp32 = true;
+    for (const host::Group g : host::kGroups)
+      fp32 = fp32 && opt.formats.arithmetic(g) == vgpu::Format::fp32;
+    if (!fp32)
       throw vgpu::Error(
           "the GL device computes in fp32 only (GLSL floats); use --engine stream for --precision "
           "fp24/fp16");

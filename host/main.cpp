@@ -19,6 +19,7 @@
 #include "host/cost_model.h"
 #include "host/cpu_tracer.h"
 #include "host/devices.h"
+#include "host/formats.h"
 #include "host/gltf_loader.h"
 #include "host/grid.h"
 #include "host/image_io.h"
@@ -53,6 +54,7 @@ struct RenderArgs {
   std::string engine = "stream";
   std::string gl_device = "auto";
   std::string precision = "fp32";
+  std::string formats;
 };
 
 struct UsageError : std::runtime_error {
@@ -87,14 +89,12 @@ int run_render(const RenderArgs& a) {
   opt.profile = vgpu::profile(a.profile).name;
   opt.threads = a.threads;
   opt.lanes = a.lanes;
-  if (a.precision == "fp32")
-    opt.precision = vgpu::Format::fp32;
-  else if (a.precision == "fp24")
-    opt.precision = vgpu::Format::fp24;
-  else if (a.precision == "fp16")
-    opt.precision = vgpu::Format::fp16;
-  else
-    throw UsageError("--precision: expected fp32, fp24 or fp16, got '" + a.precision + "'");
+  host::FormatRequest formats;
+  try {
+    formats = host::parse_format_request(a.precision, a.formats);
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(e.what());
+  }
   const host::GridSpec grid_spec = host::parse_grid_spec(a.grid);
   if (a.stats != "table" && a.stats != "json" && a.stats != "none")
     throw UsageError("--stats: expected table, json or none, got '" + a.stats + "'");
@@ -147,6 +147,7 @@ int run_render(const RenderArgs& a) {
   const auto t0 = std::chrono::steady_clock::now();
   const host::Grid grid =
       host::build_grid(scene, host::grid_spec_for(grid_spec, scene, vgpu::profile(opt.profile)));
+  opt.formats = host::resolve(formats, scene, grid, vgpu::profile(opt.profile));
   const float aspect = float(opt.width) / float(opt.height);
   const host::Camera cam =
       scene.camera ? *scene.camera : host::frame_bounds(scene.bounds(), aspect);
@@ -190,6 +191,7 @@ int run_render(const RenderArgs& a) {
   j["threads"] = opt.threads;
   j["lanes"] = opt.lanes;
   j["precision"] = a.precision;
+  if (!cpu) j["formats"] = host::to_json(opt.formats);
   j["init_ms"] = init_ms;
   j["grid_build_ms"] = grid.build_ms;
   j["render_ms"] = r.render_ms;
@@ -259,6 +261,8 @@ int run_render(const RenderArgs& a) {
     std::printf("%s %s, %dx%d, %d iteration(s), %s shading, shadows %s, masks %s\n",
                 cpu ? "engine" : "profile", cpu ? "cpu" : opt.profile.c_str(), r.width, r.height,
                 r.iterations, a.shading.c_str(), a.shadows.c_str(), a.masks.c_str());
+    if (!cpu)
+      std::cout << "formats (texture and arithmetic, per group):\n" << describe(opt.formats);
     std::printf("initialization %.1f ms (grid %.1f ms), render %.1f ms (%s)\n", init_ms,
                 grid.build_ms, r.render_ms,
                 cpu  ? "host CPU"
@@ -352,7 +356,8 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   render->add_option("--shadows", a.shadows, "on | off")->capture_default_str();
   render->add_option("--grid", a.grid, "auto | N | AxBxC voxels")->capture_default_str();
-  render->add_option("--profile", a.profile, "gf5700 | gf6600 | rtx4090 | h200")->capture_default_str();
+  render->add_option("--profile", a.profile, "gf5700 | r300 | gf6600 | rtx4090 | h200")
+      ->capture_default_str();
   render->add_option("--threads", a.threads, "Host threads (0: all cores)")->capture_default_str();
   render->add_option("--lanes", a.lanes, "SIMD lanes per batch: 1 (scalar reference), 4, 8, 16")
       ->capture_default_str();
@@ -370,8 +375,12 @@ int main(int argc, char** argv) {
   render->add_flag("--quiet,-q", a.quiet, "No progress on stderr");
   render
       ->add_option("--precision", a.precision,
-                   "Ray-state textures and kernel arithmetic: fp32 | fp24 | fp16")
+                   "Ray-state textures and kernel arithmetic, every group: fp32 | fp24 | fp16 | "
+                   "auto (per group, the fewest bits this scene needs; the report says why)")
       ->capture_default_str();
+  render->add_option("--formats", a.formats,
+                     "Per group, over --precision: GROUP=FORMAT,... with GROUP rays, traversal, "
+                     "voxel, hits, colour (e.g. colour=fp16,voxel=fp16)");
   render
       ->add_option("--engine", a.engine,
                    "stream (the vgpu pipeline) | gl (the same passes on an OpenGL driver) | cpu "

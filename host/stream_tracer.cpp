@@ -78,6 +78,24 @@ StreamTracer::StreamTracer(const Scene& scene, const Grid& grid, const RenderOpt
   if (opt_.trace_pixel && !gpu.has_stencil())
     throw vgpu::Error("--trace-pixel follows the emulator's finished-ray masks, which the " +
                       opt_.device + " device does not have");
+  // Each program computes in its group's arithmetic format (formats.h: which kernel is where).
+  const Formats& fm = opt_.formats;
+  for (auto [prog, g] :
+       std::initializer_list<std::pair<vgpu::Program*, Group>>{{&s_->generate, Group::rays},
+                                                               {&s_->origin, Group::rays},
+                                                               {&s_->direction, Group::rays},
+                                                               {&s_->shadow, Group::rays},
+                                                               {&s_->init, Group::traversal},
+                                                               {&s_->reset, Group::traversal},
+                                                               {&s_->traversal, Group::traversal},
+                                                               {&s_->in_grid, Group::queries},
+                                                               {&s_->update, Group::voxel},
+                                                               {&s_->next, Group::voxel},
+                                                               {&s_->intersecting, Group::queries},
+                                                               {&s_->intersect, Group::hits},
+                                                               {&s_->shader, Group::colour},
+                                                               {&s_->reflected, Group::colour}})
+    prog->set_precision(fm.arithmetic(g));
   const int maxs = gpu.profile().max_texture_size;
 
   // Scene textures: triangle i at texel (i mod width, i div width).
@@ -161,15 +179,14 @@ StreamTracer::StreamTracer(const Scene& scene, const Grid& grid, const RenderOpt
   const int W = opt_.width, H = opt_.height;
   for (int i = 0; i < 2; ++i) {
     const std::string sfx = i ? " B" : " A";
-    const Format fmt = opt_.precision;
-    s_->rays[i] = gpu.make_texture("rays" + sfx, W, H, 4, fmt);
-    s_->origins[i] = gpu.make_texture("origins" + sfx, W, H, 4, fmt);
-    s_->trav[i] = gpu.make_texture("traversal" + sfx, W, H, 4, fmt);
-    s_->vs[i] = gpu.make_texture("voxel state" + sfx, W, H, 4, fmt);
-    s_->isect[i] = gpu.make_texture("intersection" + sfx, W, H, 4, fmt);
-    s_->result[i] = gpu.make_texture("result" + sfx, W, H, 4, fmt);
+    s_->rays[i] = gpu.make_texture("rays" + sfx, W, H, 4, fm[Group::rays]);
+    s_->origins[i] = gpu.make_texture("origins" + sfx, W, H, 4, fm[Group::rays]);
+    s_->trav[i] = gpu.make_texture("traversal" + sfx, W, H, 4, fm[Group::traversal]);
+    s_->vs[i] = gpu.make_texture("voxel state" + sfx, W, H, 4, fm[Group::voxel]);
+    s_->isect[i] = gpu.make_texture("intersection" + sfx, W, H, 4, fm[Group::hits]);
+    s_->result[i] = gpu.make_texture("result" + sfx, W, H, 4, fm[Group::colour]);
   }
-  s_->shadow_rays = gpu.make_texture("shadow rays", W, H, 4, opt_.precision);
+  s_->shadow_rays = gpu.make_texture("shadow rays", W, H, 4, fm[Group::rays]);
   // Counting passes need a colour target; only their query result matters.
   s_->counter = gpu.make_texture("counter", W, H, 1, Format::fp16);
   s_->grid_mask = Stencil(W, H, 1);

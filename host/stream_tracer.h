@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "host/formats.h"
 #include "host/grid.h"
 #include "host/scene.h"
 #include "kernels/kernels.h"
@@ -35,9 +36,10 @@ struct RenderOptions {
   std::string gl_device = "auto";
   int threads = 0;  // 0: every host core
   int lanes = vgpu::kLanes;
-  // Precision of the ray-state textures and of the arithmetic inside kernels (--precision).
-  // The scene textures stay fp32. fp16 cannot address texels past 2048 exactly, as on NV3x.
-  vgpu::Format precision = vgpu::Format::fp32;
+  // Formats of the ray-state textures and of the arithmetic of the kernels writing them, per
+  // group (host/formats.h; --precision sets them all, --formats one by one). The scene textures
+  // stay fp32. fp16 cannot address texels past 1024 exactly, as on NV3x.
+  Formats formats;
   // Early-z/stencil masks for finished rays (the paper's future work): masked fragments cost
   // nothing. Off: every fragment runs every pass, as on the paper's GeForce FX.
   bool masks = false;

@@ -110,9 +110,9 @@ def fit(data):
 def parse_parameters():
     """Every profile figure with its source comment, from vgpu/profile.cpp."""
     text = open(os.path.join(ROOT, "vgpu/profile.cpp")).read()
-    var = {"fx": "gf5700", "g6": "gf6600", "m": "rtx4090"}
+    var = {"fx": "gf5700", "ati": "r300", "g6": "gf6600", "m": "rtx4090"}
     rows = {p: [] for p in var.values()}
-    for m in re.finditer(r"^\s+(fx|g6|m)\.(\w+) = (.+?);[ \t]*(?://[ \t]*(.*))?$", text, re.M):
+    for m in re.finditer(r"^\s+(fx|ati|g6|m)\.(\w+) = (.+?);[ \t]*(?://[ \t]*(.*))?$", text, re.M):
         v, field, value, source = m.group(1), m.group(2), m.group(3), (m.group(4) or "").strip()
         if field in ("name", "display", "cg_profile"):
             continue
@@ -418,7 +418,8 @@ def write_doc(data, masks, cpu, figures, readings):
       "x `instruction_bytes`) over `bus_mbps` plus `program_load_us`; per query read-back "
       "`readback_us`; per clear its bytes over `mem_gbps`. Arithmetic: counted operations minus "
       "fetches, / `scalar_ops_per_instruction`, / (`pipelines` x `core_mhz` x `alu_per_clock` x "
-      "`fp32_rate` when `precision` is fp32). Texture: fetches / (`pipelines` x `core_mhz` x "
+      "the part's rate for the precision each operation ran at: `fp32_rate`, `fp24_rate`, or 1 "
+      "for fp16, counted per pass as `alu_fp24` / `alu_fp16`). Texture: fetches / (`pipelines` x `core_mhz` x "
       "`texels_per_clock`). Memory: bytes / `mem_gbps`. Dynamic branching (6600, RTX 4090): "
       "the pass's branch-idle fragments that sit in all-idle batches of the profile's granularity "
       "(counted) skip `branch_body_share` of the program's operations, fetches and bytes read. Not modeled: texture caches (every fetched "

@@ -403,16 +403,17 @@ const PassRecord& Gpu::draw(const Rect& rect) {
     batch_flags_.assign(size_t(rect.width()) * size_t(rect.height()), 0);
     flags = batch_flags_.data();
   }
+  const Format precision = precision_of(p);
   auto body = [&](int ya, int yb, Chunk& c) {
     // Reduced precision runs at width 1 (the scalar reference) or 8.
-    if (precision_ == Format::fp16) {
+    if (precision == Format::fp16) {
       if (lanes_ == 1)
         run_rows<RoundedLanes<1, Format::fp16>>(p, rect, ya, yb, idle_branches, flags, c);
       else
         run_rows<RoundedLanes<8, Format::fp16>>(p, rect, ya, yb, idle_branches, flags, c);
       return;
     }
-    if (precision_ == Format::fp24) {
+    if (precision == Format::fp24) {
       if (lanes_ == 1)
         run_rows<RoundedLanes<1, Format::fp24>>(p, rect, ya, yb, idle_branches, flags, c);
       else
@@ -455,6 +456,10 @@ const PassRecord& Gpu::draw(const Rect& rect) {
     c.idle_in_batch32 = batch[0];
     c.idle_in_batch1024 = batch[1];
   }
+  // Arithmetic (every counted operation but the fetches) by the precision it ran at.
+  const uint64_t alu = c.instructions - c.texture_fetches;
+  if (precision == Format::fp24) c.alu_fp24 = alu;
+  if (precision == Format::fp16) c.alu_fp16 = alu;
   if (query_active_) query_count_ += sum.shaded - sum.discarded;
   c.host_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();

@@ -39,9 +39,14 @@ class Gpu final : public Device {
   int threads() const { return int(workers_.size()) + 1; }
   int lanes() const { return lanes_; }
   // Arithmetic precision of the fragment units: fp32, or every operation rounded to fp24 (R300)
-  // or fp16 (NV3x half). Texture formats are set per texture.
+  // or fp16 (NV3x half). A program may ask for less (Program::set_precision); a pass computes
+  // in the coarser of the two, as the profile allows (Profile::computes: R300 only has fp24).
+  // Texture formats are set per texture.
   void set_precision(Format f) { precision_ = f; }
   Format precision() const { return precision_; }
+  Format precision_of(const Program& p) const {
+    return profile_.computes(coarser(precision_, p.precision()));
+  }
 
   // The emulator's textures live in host memory: nothing to copy.
   void upload(const Texture&) override {}

@@ -1,4 +1,4 @@
-// The profile table. Sources are named per figure; see ../shared/paper/HARDWARE.md.
+// The profile table. Sources are named per figure (review, datasheet or specification).
 #include "vgpu/profile.h"
 
 #include <stdexcept>
@@ -30,8 +30,40 @@ const std::vector<Profile>& profiles() {
     fx.alu_lanes = 4;          // NV_fragment_program instructions are 4-component (vec4)
     fx.alu_per_clock = 1;      // hexus.net FX 5700 Ultra review p.2: one shader unit per pipe
     fx.fp32_rate = 0.5;        // model parameter: NV3x slow at fp32 (Tom's Hardware NV40 review)
+    fx.fp24_rate = 0.5;        // no fp24 units: fp24 values need the fp32 path
     fx.texels_per_clock = 1;   // hexus.net FX 5700 Ultra review p.2: one texture unit per pipe
     t.push_back(fx);
+
+    // The fp24 part of 2004: every fragment operation in s7e16, no fp32 and no separate half
+    // speed (partial precision runs on the same fp24 units).
+    Profile ati;
+    ati.name = "r300";
+    ati.display = "Radeon 9700 Pro (R300), ps_2_0 / ARB_fragment_program";
+    ati.cg_profile = "arbfp1";
+    ati.pipelines = 8;     // guru3d.com Radeon 9700 Pro review p.2: 8 rendering pipelines
+    ati.core_mhz = 325;    // guru3d.com Radeon 9700 Pro review p.2: engine clock 325 MHz
+    ati.mem_gbps = 19.84;  // 256-bit DDR @ 310 MHz (620 MT/s effective), same review
+    ati.max_outputs = 4;   // multiple render targets (rage3d.com R9500/9700 feature list)
+    // ps_2_0 has 64 arithmetic + 32 texture instruction slots; the vgpu checks the limit against
+    // counted scalar operations, so 96 slots x 3 operations per vec4 instruction. The ALU/TEX
+    // split and R300's 4 levels of dependent texture reads are not modeled.
+    ati.max_instructions = 96 * 3;    // model parameter: Direct3D 9 ps_2_0 96 slots x 3 operations
+    ati.branching = Branching::none;  // ps_2_0: no flow control in fragment programs
+    ati.branch_granularity = 1;       // no branching
+    ati.max_texture_size = 2048;      // R300 GL_MAX_TEXTURE_SIZE (driver caps)
+    ati.precision = Format::fp24;  // en.wikipedia.org "Radeon 9000 series": FP24 shader precision
+    ati.has_fp16 = false;          // partial-precision hints run at fp24 on R300
+    ati.bus_mbps = 2112;           // AGP 8x, as the FX 5700
+    // Fixed costs: no Table 1 figure on this card to fit; the FX 5700's fitted values.
+    ati.program_load_us = 651;  // model parameter: the FX 5700's fitted value (no Table 1 cell)
+    ati.readback_us = 1301;     // model parameter: the FX 5700's fitted value (no Table 1 cell)
+    ati.pass_us = 651;          // model parameter: the FX 5700's fitted value (no Table 1 cell)
+    ati.alu_lanes = 4;          // vec3 + scalar co-issue: one vec4 instruction a clock
+    ati.alu_per_clock = 1;      // one shader ALU per pipe (guru3d.com review: 8 pipes)
+    ati.fp32_rate = 1;          // fp32 requests compute in fp24 (Profile::computes), full speed
+    ati.fp24_rate = 1;          // native format
+    ati.texels_per_clock = 1;   // 8 TMUs for 8 pipes (guru3d.com: 2600 Mtexel/s at 325 MHz)
+    t.push_back(ati);
 
     Profile g6;
     g6.name = "gf6600";
@@ -54,6 +86,7 @@ const std::vector<Profile>& profiles() {
     g6.alu_lanes = 4;          // NV_fragment_program2 instructions are 4-component (vec4)
     g6.alu_per_clock = 2;      // Tom's Hardware NV40 review: two FP32 units per pipe
     g6.fp32_rate = 1;          // NVIDIA CineFX 3.0 brief: FP32 and FP16 equal speed
+    g6.fp24_rate = 1;          // computed on the fp32 units, at their speed
     g6.texels_per_clock = 1;   // one texture unit per pipe (NV4x pipe, GPU Gems 2 ch. 30)
     t.push_back(g6);
 
@@ -110,6 +143,11 @@ const std::vector<Profile>& profiles() {
     return t;
   }();
   return table;
+}
+
+Format Profile::computes(Format f) const {
+  const Format g = coarser(f, precision);
+  return g == Format::fp16 && !has_fp16 ? precision : g;
 }
 
 const Profile& profile(std::string_view name) {

@@ -29,6 +29,7 @@ struct Profile {
   int branch_granularity = 1;       // pixels that branch together (dynamic branching only)
   int max_texture_size = 0;         // texels per side
   Format precision = Format::fp32;  // full arithmetic precision of the fragment units
+  bool has_fp16 = true;             // a half-precision arithmetic mode (NV3x+ "half"; not R300)
   double bus_mbps = 0;              // host to GPU bus, MB/s, for program uploads
   double program_load_us = 0;  // driver cost of binding another fragment program (model parameter)
   double readback_us = 0;      // occlusion-query read-back: pipeline drain + sync (model parameter)
@@ -38,10 +39,29 @@ struct Profile {
   int alu_lanes = 4;            // scalar lanes one arithmetic instruction drives (4: vec4 ALU)
   double alu_per_clock = 1;     // arithmetic instructions per pipeline per clock, fp16
   double fp32_rate = 1;         // fp32 arithmetic throughput relative to fp16
+  double fp24_rate = 1;         // fp24 throughput relative to fp16 (a part without fp24 units
+                                // computes fp24 values in fp32: its fp32 rate)
   double texels_per_clock = 1;  // texture fetches per pipeline per clock
+
+  // Arithmetic throughput at format f, relative to alu_per_clock (the fp16 rate).
+  double rate(Format f) const {
+    return f == Format::fp32 ? fp32_rate : f == Format::fp24 ? fp24_rate : 1.0;
+  }
+  // The format the fragment units compute in when a program asks for f: never finer than the
+  // profile's precision (R300 computes everything in fp24), fp16 only where the part has it.
+  Format computes(Format f) const;
 };
 
-// The built-in profiles: gf5700, gf6600, rtx4090.
+// Bits of precision of a format (significand, implicit bit included): fp32 24, fp24 17, fp16 11.
+constexpr int significand_bits(Format f) {
+  return f == Format::fp32 ? 24 : f == Format::fp24 ? 17 : 11;
+}
+// The format with fewer bits of the two.
+constexpr Format coarser(Format a, Format b) {
+  return significand_bits(a) <= significand_bits(b) ? a : b;
+}
+
+// The built-in profiles: gf5700, r300, gf6600, rtx4090.
 const std::vector<Profile>& profiles();
 // Looks a profile up by name; throws std::invalid_argument naming the known ones.
 const Profile& profile(std::string_view name);

@@ -35,6 +35,11 @@ class Program {
   virtual int passthrough(int output) const = 0;
   virtual bool idle_discards() const = 0;
   uint32_t id() const { return id_; }
+  // Arithmetic precision the program asks for (Cg's float / half per program): fp32 by default.
+  // A pass computes in the coarser of this and Gpu::precision(), as the profile allows
+  // (Profile::computes).
+  void set_precision(Format f) { precision_ = f; }
+  Format precision() const { return precision_; }
 
   virtual void run(Fragments<SimdLanes<1>>& f) const = 0;
   virtual void run(Fragments<SimdLanes<4>>& f) const = 0;
@@ -68,6 +73,7 @@ class Program {
 
  private:
   uint32_t id_;
+  Format precision_ = Format::fp32;
 };
 
 template <class K>

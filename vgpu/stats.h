@@ -16,7 +16,10 @@ struct Counters {
   uint64_t fragments_shaded = 0;     // fragments the program ran on (launched minus masked)
   uint64_t fragments_masked = 0;     // skipped by the early-z/stencil mask before shading
   uint64_t fragments_discarded = 0;  // shaded, then killed (no write, not counted by a query)
-  uint64_t lanes_idle = 0;  // SIMD lanes issued without a live fragment, or idle in a branch
+  // Shaded fragments idle in a branch: each f.branch() block a shaded fragment does not take
+  // counts it once (a work-masked idle fragment, once per branch of the program). Lanes issued
+  // without a live fragment (partial batches, masked fragments) are not counted.
+  uint64_t lanes_idle = 0;
   // Shaded fragments idle in the program's branch that sit in a batch with no shaded fragment
   // taking it: what dynamic branching skips at a granularity of 32 (8x4 pixel tiles, a warp) or
   // 1024 (32x32 tiles, NV4x) fragments. Tiles are aligned to the drawn rectangle's corner.
@@ -24,6 +27,10 @@ struct Counters {
   uint64_t idle_in_batch1024 = 0;
   uint64_t instructions = 0;     // fragment-program instructions executed (shaded x static count)
   uint64_t texture_fetches = 0;  // texels fetched through texture units
+  // Of instructions: the arithmetic (all but the fetches) run at fp24 or at fp16; the rest of
+  // the arithmetic ran at fp32. The cost model charges each at the profile's rate for it.
+  uint64_t alu_fp24 = 0;
+  uint64_t alu_fp16 = 0;
   uint64_t bytes_read = 0;       // bytes fetched through texture units
   uint64_t bytes_written = 0;    // bytes written to render targets
   uint64_t program_loads = 0;    // binds of a program different from the last one
@@ -54,6 +61,8 @@ inline constexpr std::pair<const char*, uint64_t Counters::*> kCounterFields[] =
     {"idle_in_batch1024", &Counters::idle_in_batch1024},
     {"instructions", &Counters::instructions},
     {"texture_fetches", &Counters::texture_fetches},
+    {"alu_fp24", &Counters::alu_fp24},
+    {"alu_fp16", &Counters::alu_fp16},
     {"bytes_read", &Counters::bytes_read},
     {"bytes_written", &Counters::bytes_written},
     {"program_loads", &Counters::program_loads},

@@ -434,7 +434,7 @@ inline host::RenderOptions options_of(const Case& c, vgpu::Format precision) {
   opt.shadows = false;
   opt.shading = kernels::ShadingModel::diffuse;
   opt.threads = 1;
-  opt.precision = precision;
+  opt.formats = host::Formats::all(precision);
   return opt;
 }
 

@@ -192,3 +192,42 @@ TEST_CASE(
   CHECK(fx == doctest::Approx(5075).epsilon(0.01));
   CHECK(g6 == doctest::Approx(1079).epsilon(0.01));
 }
+
+TEST_CASE("arithmetic is charged at the rate of the precision it ran at") {
+  vgpu::Counters k = kernel_passes(2);
+  const double fp32 = host::predict(frame(k), card(), params()).arithmetic_demand_ms;
+  CHECK(fp32 == doctest::Approx(0.400));            // as above: 0.5 of the fp16 rate
+  k.alu_fp16 = k.instructions - k.texture_fetches;  // every operation in half precision
+  CHECK(host::predict(frame(k), card(), params()).arithmetic_demand_ms == doctest::Approx(0.200));
+  k.alu_fp16 = (k.instructions - k.texture_fetches) / 2;  // half of them
+  CHECK(host::predict(frame(k), card(), params()).arithmetic_demand_ms == doctest::Approx(0.300));
+  k.alu_fp16 = 0;
+  k.alu_fp24 = k.instructions - k.texture_fetches;
+  vgpu::Profile r3 = card();
+  r3.fp24_rate = 1;  // an fp24 part: full speed
+  CHECK(host::predict(frame(k), r3, params()).arithmetic_demand_ms == doctest::Approx(0.200));
+  r3.fp24_rate = 0.5;  // fp24 on fp32 units
+  CHECK(host::predict(frame(k), r3, params()).arithmetic_demand_ms == doctest::Approx(0.400));
+}
+
+TEST_CASE(
+    "in a real render fp16 operations cost half of fp32's on the FX 5700, the same on the 6600") {
+  // Per counted operation: fp16 and fp32 renders run different pass counts (stuck fp16 rays).
+  const host::Scene scene = host::load_scene(VGPU_SCENES_DIR "/bunny.gltf");
+  const host::Grid grid = host::build_grid(scene, host::parse_grid_spec("8"));
+  host::RenderOptions opt;
+  opt.width = opt.height = 32;
+  opt.bounces = 0;
+  opt.threads = 2;
+  auto demand = [&](vgpu::Format f, const char* part) {
+    opt.formats = host::Formats::all(f);
+    host::StreamTracer tracer(scene, grid, opt);
+    const host::RenderResult r = tracer.render(*scene.camera);
+    const double ops = double(r.stats.totals.instructions - r.stats.totals.texture_fetches);
+    return host::predict(r.stats, vgpu::profile(part)).arithmetic_demand_ms / ops;
+  };
+  CHECK(demand(vgpu::Format::fp16, "gf5700") ==
+        doctest::Approx(demand(vgpu::Format::fp32, "gf5700") / 2).epsilon(0.02));
+  CHECK(demand(vgpu::Format::fp16, "gf6600") ==
+        doctest::Approx(demand(vgpu::Format::fp32, "gf6600")).epsilon(0.02));
+}

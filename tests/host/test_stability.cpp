@@ -3,10 +3,12 @@
 // faces, closed meshes and fans without cracks, grazing hits, reflection acne, the camera inside
 // the grid, misses, scenes far from the origin, very thin and very large triangles.
 // Each case checks (1) the analytic expectation against brute_force_hit in double, (2) the stream
-// tracer at fp32 against the expectation, pixel for pixel, with no unfinished rays.
+// tracer at fp32 against the expectation, pixel for pixel, with no unfinished rays, and (3) at
+// fp24 and fp16, the written-down count of wrong pixels (zero where the case fits the format).
 #include <doctest/doctest.h>
 
 #include <string>
+#include <tuple>
 
 #include "host/reference.h"
 #include "stability_cases.h"
@@ -132,4 +134,45 @@ TEST_CASE("a very thin triangle is hit across its width") {
 }
 TEST_CASE("a very large triangle behind a small one is hit around it") {
   check_case("a very large triangle behind a small one is hit around it");
+}
+
+namespace {
+
+// Known outcomes at reduced precision (docs/stability.md): hit ids wrong at fp24 and at fp16,
+// and the mirror's colour failures at fp16. Cases not listed pass at both. No case leaves rays
+// unfinished. A change of the rounding rules (vgpu/format.h) or of a kernel's arithmetic moves
+// these counts.
+struct Known {
+  const char* name;
+  int fp24_wrong, fp16_wrong, fp16_colour_wrong;
+};
+constexpr Known kReduced[] = {
+    {"a closed octahedron has no cracks along its shared edges and vertices", 3, 0, 0},
+    {"a mirror facing a red wall shows the wall, never itself", 0, 0, 1},
+    {"a quad lying exactly in a voxel face is hit at 1e4", 3, 28, 0},
+    {"a closed octahedron has no cracks along its shared edges and vertices at 1e4", 3, 145, 0},
+    {"a quad lying exactly in a voxel face is hit at 1e5", 28, 27, 0},
+    {"a closed octahedron has no cracks along its shared edges and vertices at 1e5", 79, 145, 0},
+    {"a very thin triangle is hit across its width", 0, 4, 0},
+    {"a very large triangle behind a small one is hit around it", 0, 68, 0},
+};
+
+}  // namespace
+
+TEST_CASE("every stability case at fp24 and fp16 gives its written-down outcome") {
+  for (const stability::Case& c : stability::cases()) {
+    Known k{c.name.c_str(), 0, 0, 0};
+    for (const Known& r : kReduced)
+      if (c.name == r.name) k = r;
+    for (auto [f, wrong, colour] :
+         {std::tuple{vgpu::Format::fp24, k.fp24_wrong, 0},
+          std::tuple{vgpu::Format::fp16, k.fp16_wrong, k.fp16_colour_wrong}}) {
+      INFO(c.name << " at " << vgpu::format_name(f));
+      const stability::Outcome o = stability::run(c, f);
+      REQUIRE_MESSAGE(o.error.empty(), o.error);
+      CHECK(o.wrong == wrong);
+      CHECK(o.colour_wrong == colour);
+      CHECK(o.unfinished == 0);
+    }
+  }
 }

@@ -1,7 +1,7 @@
 // Every kernel gives bit-identical outputs, query counts and pass counters at lane widths 1, 4,
-// 8 and 16, on a 13x3 target (partial batches at every width above 1) of random-ish texels that
-// reach every branch: hits and misses, done and walking rays, empty and full voxels, plus a few
-// NaN, infinite and signed-zero channels.
+// 8 and 16, in fp32 and in the rounded fp24 and fp16 lane families, on a 13x3 target (partial
+// batches at every width above 1) of random-ish texels that reach every branch: hits and misses,
+// done and walking rays, empty and full voxels, plus a few NaN, infinite and signed-zero channels.
 #include <doctest/doctest.h>
 
 #include <cstdint>
@@ -123,8 +123,10 @@ struct Output {
 };
 
 template <class K>
-Output run_at(int lanes, const K& k, const std::vector<const Texture*>& units, bool query) {
+Output run_at(int lanes, const K& k, const std::vector<const Texture*>& units, bool query,
+              vgpu::Format precision = vgpu::Format::fp32) {
   vgpu::Gpu gpu(ktest::gf5700(), 1, lanes);
+  gpu.set_precision(precision);
   Output o;
   o.tex = ktest::run(gpu, k, units, kW, kH, glm::vec4(7.0f), query ? &o.query : nullptr, &o.rec);
   return o;
@@ -133,20 +135,26 @@ Output run_at(int lanes, const K& k, const std::vector<const Texture*>& units, b
 template <class K>
 void check_widths(const K& k, const std::vector<const Texture*>& units, bool query = false) {
   CAPTURE(std::string(K::name));
-  const Output ref = run_at(1, k, units, query);
-  for (int lanes : {4, 8, 16}) {
-    CAPTURE(lanes);
-    const Output o = run_at(lanes, k, units, query);
-    CHECK(std::memcmp(o.tex.data().data(), ref.tex.data().data(), ref.tex.data().size_bytes()) ==
-          0);
-    CHECK(o.query == ref.query);
-    CHECK(o.rec.counters.same_counts(ref.rec.counters));
+  // The rounded lane family runs at width 1 or 8 (Gpu::draw): every other width is 8.
+  for (vgpu::Format f : {vgpu::Format::fp32, vgpu::Format::fp24, vgpu::Format::fp16}) {
+    CAPTURE(vgpu::format_name(f));
+    const Output ref = run_at(1, k, units, query, f);
+    for (int lanes : {4, 8, 16}) {
+      CAPTURE(lanes);
+      const Output o = run_at(lanes, k, units, query, f);
+      CHECK(std::memcmp(o.tex.data().data(), ref.tex.data().data(), ref.tex.data().size_bytes()) ==
+            0);
+      CHECK(o.query == ref.query);
+      CHECK(o.rec.counters.same_counts(ref.rec.counters));
+    }
   }
 }
 
 }  // namespace
 
-TEST_CASE("every kernel gives bit-identical outputs and counters at lane widths 1, 4, 8 and 16") {
+TEST_CASE(
+    "every kernel gives bit-identical outputs and counters at lane widths 1, 4, 8 and 16, at fp32, "
+    "fp24 and fp16") {
   const Inputs in;
   {
     kernels::GenerateRays k;

@@ -278,12 +278,18 @@ TEST_CASE("queries must be begun before they are ended, and not twice") {
 TEST_CASE("only lane widths 1, 4, 8 and 16 and known profiles exist") {
   CHECK_THROWS_WITH_AS(Gpu(profile("gf5700"), 1, 3), Contains("lane width must be 1, 4, 8 or 16"),
                        Error);
-  CHECK_THROWS_WITH_AS(profile("voodoo2"), Contains("known: gf5700, gf6600, rtx4090, h200"),
+  CHECK_THROWS_WITH_AS(profile("voodoo2"), Contains("known: gf5700, r300, gf6600, rtx4090, h200"),
                        std::invalid_argument);
   CHECK(profile("gf5700").max_outputs == 1);
   CHECK(profile("gf5700").max_instructions == 1024);
   CHECK(profile("gf5700").branching == Branching::none);
   CHECK(profile("gf6600").max_outputs == 4);
   CHECK(profile("gf6600").branching == Branching::dynamic);
-  CHECK(profiles().size() == 3);
+  CHECK(profile("r300").precision == Format::fp24);
+  CHECK(profile("r300").computes(Format::fp32) == Format::fp24);  // R300 has only fp24 units
+  CHECK(profile("r300").computes(Format::fp16) == Format::fp24);
+  CHECK(profile("gf5700").computes(Format::fp16) == Format::fp16);
+  CHECK(profile("gf5700").rate(Format::fp16) == 2 * profile("gf5700").rate(Format::fp32));
+  CHECK(profiles().size() == 5);
+  CHECK(profile("h200").max_outputs == 8);
 }
