@@ -18,6 +18,7 @@
 #include <initializer_list>
 #include <memory>
 #include <mutex>
+#include <span>
 #include <stdexcept>
 #include <thread>
 #include <vector>
@@ -40,6 +41,9 @@ struct Rect {
   int height() const { return y1 - y0; }
   uint64_t area() const { return uint64_t(width()) * uint64_t(height()); }
 };
+
+// Batch flags of one fragment (Gpu::branch_flags): it took the program's branch, or sat idle in it.
+inline constexpr uint8_t kBranchTook = 1, kBranchIdle = 2;
 
 class Gpu {
  public:
@@ -94,6 +98,10 @@ class Gpu {
   // end_query() reads the result back (a synchronisation, counted as a query read-back).
   void begin_query();
   uint64_t end_query();
+
+  // After a draw of a program that branches: per fragment of the drawn rectangle, row by row,
+  // kBranchTook, kBranchIdle or 0 (not shaded). Empty after a draw of one that does not.
+  std::span<const uint8_t> branch_flags() const { return batch_flags_; }
 
   FrameStats& stats() { return stats_; }
   const FrameStats& stats() const { return stats_; }
