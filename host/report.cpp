@@ -16,6 +16,7 @@
 #include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -37,7 +38,7 @@ using json = nlohmann::ordered_json;
 // gzip (zlib, RFC 1952: what the browser's DecompressionStream('gzip') reads) then base64.
 std::string pack(const void* data, size_t bytes) {
   z_stream z{};
-  if (deflateInit2(&z, 9, Z_DEFLATED, 15 + 16, 8, Z_DEFAULT_STRATEGY) != Z_OK)
+  if (deflateInit2(&z, 6, Z_DEFLATED, 15 + 16, 8, Z_DEFAULT_STRATEGY) != Z_OK)
     throw std::runtime_error("report: zlib cannot start");
   std::string out(deflateBound(&z, uLong(bytes)), '\0');
   z.next_in = static_cast<Bytef*>(const_cast<void*>(data));
@@ -129,16 +130,20 @@ void FrameRecorder::trace_end() {
 
 int FrameRecorder::store_mask(const vgpu::Stencil& s) {
   const size_t n = size_t(w_) * size_t(h_);
-  packed_.assign((n + 7) / 8, 0);
   const uint8_t* b = s.row(0);  // rows are contiguous
+  // The host loop alternates two masks (rays walking, rays testing): look a few back, byte
+  // for byte, before packing a new one.
+  for (auto& [id, bytes] : recent_)
+    if (id >= 0 && std::equal(bytes.begin(), bytes.end(), b)) return id;
+  packed_.assign((n + 7) / 8, 0);
   for (size_t i = 0; i < n; ++i)
     if (b[i]) packed_[i / 8] |= uint8_t(1u << (i % 8));
-  // The host loop alternates two masks (rays walking, rays testing): look a few back.
-  const int m = int(masks_bits_.size());
-  for (int k = m - 1; k >= std::max(0, m - 4); --k)
-    if (masks_bits_[size_t(k)] == packed_) return k;
+  const int id = int(masks_bits_.size());
   masks_bits_.push_back(packed_);
-  return m;
+  auto& slot = recent_[size_t(id) % recent_.size()];
+  slot.first = id;
+  slot.second.assign(b, b + n);
+  return id;
 }
 
 FrameRecorder::Occupancy& FrameRecorder::occupancy_of(const std::string& program) {
@@ -152,7 +157,11 @@ void FrameRecorder::pass_begin(const vgpu::Stencil* work) {
   work_id_ = -1;
   if (!work || work->width() != w_ || work->height() != h_) return;
   work_id_ = store_mask(*work);
-  work_.assign(work->row(0), work->row(0) + size_t(w_) * size_t(h_));
+  const uint8_t* b = work->row(0);
+  const size_t n = size_t(w_) * size_t(h_);
+  work_.resize(n);
+  uint8_t* w = work_.data();  // locals, so the loop vectorizes
+  for (size_t i = 0; i < n; ++i) w[i] = b[i] != 0;
 }
 
 void FrameRecorder::pass(const PassObserver::Pass& p) {
@@ -175,20 +184,25 @@ void FrameRecorder::pass(const PassObserver::Pass& p) {
     r.work_mask = work_id_;
     const bool trav = r.program == kernels::Traversal::name;
     const bool isect = r.program == kernels::Intersections::name;
+    // Plain loops over 0/1 bytes: they vectorize (this runs for every pass of the frame).
     uint64_t useful = 0;
+    uint32_t* idle = idle_.data();
     for (size_t i = 0; i < n; ++i) {
-      if (!work[i]) {
-        ++idle_[i];
-        continue;
-      }
-      ++useful;
-      if (trav) {
-        ++voxels_[i];
-        if (trace_ >= 0) ++wave_[size_t(trace_)][i];
-      }
-      if (isect) ++tests_[i];
+      useful += work[i];
+      idle[i] += 1u - work[i];
     }
-    if (trav && trace_ >= 0) ++traces_[size_t(trace_)].steps;
+    if (trav) {
+      uint16_t* wave = trace_ >= 0 ? wave_[size_t(trace_)].data() : nullptr;
+      uint32_t* vox = voxels_.data();
+      for (size_t i = 0; i < n; ++i) vox[i] += work[i];
+      if (wave)
+        for (size_t i = 0; i < n; ++i) wave[i] = uint16_t(wave[i] + work[i]);
+      if (trace_ >= 0) ++traces_[size_t(trace_)].steps;
+    }
+    if (isect) {
+      uint32_t* tests = tests_.data();
+      for (size_t i = 0; i < n; ++i) tests[i] += work[i];
+    }
     r.useful = useful;
   } else {
     work = nullptr;
@@ -196,27 +210,46 @@ void FrameRecorder::pass(const PassObserver::Pass& p) {
   }
   r.idle = r.counters.fragments_shaded - std::min(r.useful, r.counters.fragments_shaded);
 
-  // SIMD occupancy: lanes doing the program's work in each 8x4 and 32x32 tile of the rectangle.
+  // SIMD occupancy: lanes doing the program's work in each 8x4 and 32x32 tile of the rectangle
+  // (took its branch; without a branch, every shaded fragment runs all of it).
   const std::span<const uint8_t> flags = p.branch_flags;
-  auto active = [&](size_t i) -> bool {
-    if (flags.size() == n) return flags[i] == vgpu::kBranchTook;
-    return !(work && masks_) || work[i] != 0;  // no branch: every shaded fragment runs it all
-  };
+  const uint8_t* act = nullptr;
+  if (flags.size() == n) {
+    active_.resize(n);
+    uint8_t* a = active_.data();
+    const uint8_t* f = flags.data();
+    for (size_t i = 0; i < n; ++i) a[i] = f[i] == vgpu::kBranchTook;
+    act = a;
+  } else if (work && masks_) {
+    act = work;
+  }
   Occupancy& occ = occupancy_of(r.program);
-  for (int ty = 0; ty < H; ty += 4)
-    for (int tx = 0; tx < W; tx += 8) {
-      int a = 0;
-      for (int y = ty; y < std::min(H, ty + 4); ++y)
-        for (int x = tx; x < std::min(W, tx + 8); ++x) a += active(size_t(y) * W + x);
-      ++occ.tile8x4[size_t(a)];
+  const int cols8 = (W + 7) / 8, cols32 = (W + 31) / 32;
+  tile8_.assign(size_t(cols8), 0);
+  tile32_.assign(size_t(cols32), 0);
+  for (int y = 0; y < H; ++y) {
+    for (int c = 0; c < cols8; ++c) {
+      const int k = std::min(8, W - 8 * c);
+      if (!act) {
+        tile8_[size_t(c)] += k;
+        continue;
+      }
+      uint64_t v = 0;
+      std::memcpy(&v, act + size_t(y) * W + 8 * c, size_t(k));  // the tail reads 0s
+      tile8_[size_t(c)] += std::popcount(v);
     }
-  for (int ty = 0; ty < H; ty += 32)
-    for (int tx = 0; tx < W; tx += 32) {
-      int a = 0;
-      for (int y = ty; y < std::min(H, ty + 32); ++y)
-        for (int x = tx; x < std::min(W, tx + 32); ++x) a += active(size_t(y) * W + x);
-      ++occ.tile32x32[size_t((a + 31) / 32)];
-    }
+    if (y % 4 == 3 || y == H - 1)
+      for (int c = 0; c < cols8; ++c) {
+        ++occ.tile8x4[size_t(tile8_[size_t(c)])];
+        tile32_[size_t(c / 4)] += tile8_[size_t(c)];
+        tile8_[size_t(c)] = 0;
+      }
+    if (y % 32 == 31 || y == H - 1)
+      for (int c = 0; c < cols32; ++c) {
+        ++occ.tile32x32[size_t((tile32_[size_t(c)] + 31) / 32)];
+        tile32_[size_t(c)] = 0;
+      }
+  }
 
   // Pixel history: the state after the pass of every kept pixel that took part in it.
   if (r.prints)

@@ -101,9 +101,13 @@ class FrameRecorder final : public PassObserver {
   std::vector<Trace> traces_;
   vgpu::Counters last_totals_, tail_;
   std::vector<std::vector<uint8_t>> masks_bits_;
-  std::vector<uint8_t> packed_;  // scratch
-  int work_id_ = -1;             // the coming pass's work mask (pass_begin)
-  std::vector<uint8_t> work_;    // and its bytes, one per pixel
+  std::vector<uint8_t> packed_, active_;  // scratch
+  std::vector<int> tile8_, tile32_;       // scratch: active lanes per tile column
+  // The last masks stored, byte per pixel, for a quick match: {id, bytes}.
+  std::array<std::pair<int, std::vector<uint8_t>>, 4> recent_{
+      {{-1, {}}, {-1, {}}, {-1, {}}, {-1, {}}}};
+  int work_id_ = -1;           // the coming pass's work mask (pass_begin)
+  std::vector<uint8_t> work_;  // and its bytes, one per pixel
   std::vector<uint32_t> voxels_, tests_, idle_;
   std::vector<std::vector<uint16_t>> wave_;
   std::vector<std::pair<std::string, Occupancy>> occ_;
