@@ -297,7 +297,7 @@ void write_report(const std::string& path, const FrameRecorder& rec, const Rende
   d["depth"] = pack(res.depth);
   d["hit"] = pack(res.hit_id);
 
-  // Passes, one array per column (kernel and target names as indices into name lists).
+  // Passes, one Float64Array per column (kernel and target names as indices into name lists).
   std::vector<std::string> kernels, papers, targets;
   auto index_of = [](std::vector<std::string>& names, const std::string& s) {
     auto it = std::find(names.begin(), names.end(), s);
@@ -311,7 +311,7 @@ void write_report(const std::string& path, const FrameRecorder& rec, const Rende
                          "masked",       "discarded", "fetches",     "bytes_read", "bytes_written",
                          "instructions", "query",     "work",        "written",    "loads",
                          "load_bytes",   "clears",    "clear_bytes", "readbacks"};
-  std::vector<json> c(std::size(names), json::array());
+  std::vector<std::vector<double>> c(std::size(names));  // exact: every count is below 2^53
   for (const FrameRecorder::Pass& p : rec.passes()) {
     const int k = index_of(kernels, p.program);
     if (size_t(k) == papers.size()) papers.push_back(p.paper_name);
@@ -340,9 +340,9 @@ void write_report(const std::string& path, const FrameRecorder& rec, const Rende
                          int64_t(p.before.clears + p.after.clears),
                          int64_t(p.before.bytes_written + p.after.bytes_written),
                          int64_t(p.before.query_readbacks + p.after.query_readbacks)};
-    for (size_t i = 0; i < std::size(names); ++i) c[i].push_back(v[i]);
+    for (size_t i = 0; i < std::size(names); ++i) c[i].push_back(double(v[i]));
   }
-  for (size_t i = 0; i < std::size(names); ++i) cols[names[i]] = std::move(c[i]);
+  for (size_t i = 0; i < std::size(names); ++i) cols[names[i]] = pack(c[i]);
   d["passes"] = std::move(cols);
   d["kernel_names"] = kernels;
   d["paper_names"] = papers;

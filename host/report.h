@@ -18,9 +18,9 @@ namespace host {
 // Occupancy histogram bins: active lanes of an 8x4 tile (0..32, one bin each) and of a 32x32
 // tile (bin 0: none, bin b: 32(b-1)+1 .. 32b lanes).
 inline constexpr int kOccupancyBins = 33;
-// The report keeps every pass's state for the pixels on this grid (every 16th pixel in x and
-// y): 256 pixels at 256x256, about 1 MB of the report for bunny-refl.
-inline constexpr int kHistoryStride = 16;
+// The report keeps every pass's state for the pixels on this grid (every 8th pixel in x and y):
+// 1024 pixels at 256x256, about 1.6 MB of the report for bunny-refl.
+inline constexpr int kHistoryStride = 8;
 
 class FrameRecorder final : public PassObserver {
  public:
