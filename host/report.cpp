@@ -438,13 +438,20 @@ double number(const json& o, const char* key) {
   return o.is_object() && o.contains(key) && o[key].is_number() ? o[key].get<double>() : 0.0;
 }
 
+// Counts as integers, anything else (milliseconds) with three decimals.
+std::string cell(double v, bool sign = false) {
+  char t[48];
+  const bool whole = v == std::floor(v) && std::fabs(v) < 1e18;
+  std::snprintf(t, sizeof t, whole ? (sign ? "%+.0f" : "%.0f") : (sign ? "%+.3f" : "%.3f"), v);
+  return t;
+}
+
 void row(std::ostringstream& o, const std::string& name, double a, double b) {
-  char line[200];
-  const double d = b - a;
+  char line[240];
   char ratio[32] = "-";
   if (a != 0) std::snprintf(ratio, sizeof ratio, "%.3f", b / a);
-  std::snprintf(line, sizeof line, "  %-22s %16.10g %16.10g %+16.10g %9s\n", name.c_str(), a, b, d,
-                ratio);
+  std::snprintf(line, sizeof line, "  %-22s %18s %18s %19s %9s\n", name.c_str(), cell(a).c_str(),
+                cell(b).c_str(), cell(b - a, true).c_str(), ratio);
   o << line;
 }
 
@@ -468,7 +475,7 @@ std::string diff_stats(const std::string& a_path, const std::string& b_path) {
     if (x != y) o << "differs: " << s << " " << x << " -> " << y << "\n";
   }
   char head[200];
-  std::snprintf(head, sizeof head, "  %-22s %16s %16s %16s %9s\n", "", "A", "B", "B - A", "B / A");
+  std::snprintf(head, sizeof head, "  %-22s %18s %18s %19s %9s\n", "", "A", "B", "B - A", "B / A");
   o << "\ntotals\n" << head;
   block(o, a["totals"], b["totals"]);
   if (a.contains("predicted_ms") && b.contains("predicted_ms") && a["predicted_ms"].is_object())
