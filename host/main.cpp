@@ -126,12 +126,16 @@ int run_render(const RenderArgs& a) {
   if (cpu && (!a.report.empty() || !a.stats_csv.empty()))
     throw UsageError(
         "--report and --stats-csv need --engine stream (the CPU engine runs no passes)");
+  if (!a.report.empty() && int64_t(opt.width) * opt.height > host::kReportMaxPixels)
+    throw UsageError("--report: at most " + std::to_string(host::kReportMaxPixels) +
+                     " pixels (512x512); got " + a.size);
   if (!a.report.empty()) host::check_output_path(a.report, ".html");
   if (!a.stats_csv.empty()) host::check_output_path(a.stats_csv, ".csv");
   std::optional<host::FrameRecorder> recorder;
   if (!a.report.empty() || !a.stats_csv.empty()) {
     recorder.emplace(opt.width, opt.height, opt.masks, a.report.empty() ? 0 : host::kHistoryStride,
-                     opt.trace_pixel ? std::vector{*opt.trace_pixel} : std::vector<glm::ivec2>{});
+                     opt.trace_pixel ? std::vector{*opt.trace_pixel} : std::vector<glm::ivec2>{},
+                     !a.report.empty());
     opt.observer = &*recorder;
   }
 

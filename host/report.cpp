@@ -98,15 +98,20 @@ vgpu::Counters minus(const vgpu::Counters& a, const vgpu::Counters& b) {
 }
 
 FrameRecorder::FrameRecorder(int width, int height, bool masks, int history_stride,
-                             std::vector<glm::ivec2> extra)
-    : w_(width), h_(height), masks_(masks), stride_(history_stride) {
+                             std::vector<glm::ivec2> extra, bool per_pixel)
+    : w_(width),
+      h_(height),
+      masks_(masks),
+      stride_(per_pixel ? history_stride : 0),
+      per_pixel_(per_pixel) {
+  if (!per_pixel) return;
   const size_t n = size_t(width) * size_t(height);
   voxels_.assign(n, 0);
   tests_.assign(n, 0);
   idle_.assign(n, 0);
-  if (history_stride > 0)
-    for (int y = 0; y < height; y += history_stride)
-      for (int x = 0; x < width; x += history_stride) hist_px_.push_back({x, y});
+  if (stride_ > 0)
+    for (int y = 0; y < height; y += stride_)
+      for (int x = 0; x < width; x += stride_) hist_px_.push_back({x, y});
   for (const glm::ivec2& p : extra)
     if (p.x >= 0 && p.y >= 0 && p.x < width && p.y < height &&
         std::find(hist_px_.begin(), hist_px_.end(), p) == hist_px_.end())
@@ -120,7 +125,7 @@ void FrameRecorder::iteration(int iteration) {
 
 void FrameRecorder::trace_begin(TraceKind kind) {
   traces_.push_back({kind, std::max(iteration_, 1), int(passes_.size()), 0});
-  wave_.emplace_back(size_t(w_) * size_t(h_), uint16_t(0));
+  if (per_pixel_) wave_.emplace_back(size_t(w_) * size_t(h_), uint16_t(0));
   trace_ = int(traces_.size()) - 1;
 }
 
@@ -155,8 +160,9 @@ FrameRecorder::Occupancy& FrameRecorder::occupancy_of(const std::string& program
 
 void FrameRecorder::pass_begin(const vgpu::Stencil* work) {
   work_id_ = -1;
-  if (!work || work->width() != w_ || work->height() != h_) return;
-  work_id_ = store_mask(*work);
+  has_work_ = work && work->width() == w_ && work->height() == h_;
+  if (!has_work_) return;
+  if (per_pixel_) work_id_ = store_mask(*work);
   const uint8_t* b = work->row(0);
   const size_t n = size_t(w_) * size_t(h_);
   work_.resize(n);
@@ -179,34 +185,34 @@ void FrameRecorder::pass(const PassObserver::Pass& p) {
 
   const int W = p.record.width, H = p.record.height;
   const size_t n = size_t(W) * size_t(H);
-  const uint8_t* work = work_id_ >= 0 ? work_.data() : nullptr;
+  const uint8_t* work = has_work_ ? work_.data() : nullptr;
+  const bool trav = r.program == kernels::Traversal::name;
+  const bool isect = r.program == kernels::Intersections::name;
   if (work && W == w_ && H == h_) {
     r.work_mask = work_id_;
-    const bool trav = r.program == kernels::Traversal::name;
-    const bool isect = r.program == kernels::Intersections::name;
     // Plain loops over 0/1 bytes: they vectorize (this runs for every pass of the frame).
     uint64_t useful = 0;
+    for (size_t i = 0; i < n; ++i) useful += work[i];
+    r.useful = useful;
+  } else {
+    work = nullptr;
+    r.useful = r.counters.fragments_shaded;
+  }
+  if (trav && trace_ >= 0) ++traces_[size_t(trace_)].steps;
+  if (work && per_pixel_) {
     uint32_t* idle = idle_.data();
-    for (size_t i = 0; i < n; ++i) {
-      useful += work[i];
-      idle[i] += 1u - work[i];
-    }
+    for (size_t i = 0; i < n; ++i) idle[i] += 1u - work[i];
     if (trav) {
       uint16_t* wave = trace_ >= 0 ? wave_[size_t(trace_)].data() : nullptr;
       uint32_t* vox = voxels_.data();
       for (size_t i = 0; i < n; ++i) vox[i] += work[i];
       if (wave)
         for (size_t i = 0; i < n; ++i) wave[i] = uint16_t(wave[i] + work[i]);
-      if (trace_ >= 0) ++traces_[size_t(trace_)].steps;
     }
     if (isect) {
       uint32_t* tests = tests_.data();
       for (size_t i = 0; i < n; ++i) tests[i] += work[i];
     }
-    r.useful = useful;
-  } else {
-    work = nullptr;
-    r.useful = r.counters.fragments_shaded;
   }
   r.idle = r.counters.fragments_shaded - std::min(r.useful, r.counters.fragments_shaded);
 
@@ -268,7 +274,7 @@ void FrameRecorder::query(uint64_t result, const vgpu::Stencil* written,
   if (passes_.empty()) return;
   Pass& r = passes_.back();
   r.query = int64_t(result);
-  if (written && written->width() == w_ && written->height() == h_)
+  if (per_pixel_ && written && written->width() == w_ && written->height() == h_)
     r.written_mask = store_mask(*written);
   r.after = minus(s.totals, last_totals_);
   last_totals_ = s.totals;

@@ -21,6 +21,9 @@ inline constexpr int kOccupancyBins = 33;
 // The report keeps every pass's state for the pixels on this grid (every 8th pixel in x and y):
 // 1024 pixels at 256x256, about 1.6 MB of the report for bunny-refl.
 inline constexpr int kHistoryStride = 8;
+// The report keeps every distinct work mask (thousands per frame, a bit per pixel each): past
+// 512x512 pixels that outgrows a browser tab, so the CLI refuses it.
+inline constexpr int64_t kReportMaxPixels = 512 * 512;
 
 class FrameRecorder final : public PassObserver {
  public:
@@ -52,9 +55,10 @@ class FrameRecorder final : public PassObserver {
 
   // history_stride: every pixel at (x, y) with x and y multiples of it keeps its state after
   // every pass (0: none); `extra` pixels too. masks: the run models --masks on (idle fragments
-  // are masked, not shaded).
+  // are masked, not shaded). per_pixel off: only the per-pass records (the CSV), no masks, maps,
+  // wavefront or history, so memory does not grow with passes times pixels.
   FrameRecorder(int width, int height, bool masks, int history_stride = kHistoryStride,
-                std::vector<glm::ivec2> extra = {});
+                std::vector<glm::ivec2> extra = {}, bool per_pixel = true);
 
   void iteration(int iteration) override;
   void trace_begin(TraceKind kind) override;
@@ -106,7 +110,9 @@ class FrameRecorder final : public PassObserver {
   // The last masks stored, byte per pixel, for a quick match: {id, bytes}.
   std::array<std::pair<int, std::vector<uint8_t>>, 4> recent_{
       {{-1, {}}, {-1, {}}, {-1, {}}, {-1, {}}}};
-  int work_id_ = -1;           // the coming pass's work mask (pass_begin)
+  bool per_pixel_;
+  bool has_work_ = false;      // the coming pass has a work mask (pass_begin)
+  int work_id_ = -1;           // its id, when masks are kept
   std::vector<uint8_t> work_;  // and its bytes, one per pixel
   std::vector<uint32_t> voxels_, tests_, idle_;
   std::vector<std::vector<uint16_t>> wave_;

@@ -203,3 +203,21 @@ TEST_CASE("diff shows each counter of two stats files, B - A and B / A, and refu
                        doctest::Contains("cannot open"), host::InputError);
   for (const std::string& p : {a, b, bad}) std::remove(p.c_str());
 }
+
+TEST_CASE("a counts-only recorder (the CSV's) records the same passes and keeps no pixels") {
+  host::FrameRecorder full(48, 40, false), counts(48, 40, false, 8, {}, false);
+  render(full, false);
+  render(counts, false);
+  REQUIRE(counts.passes().size() == full.passes().size());
+  for (size_t i = 0; i < full.passes().size(); ++i) {
+    CAPTURE(i);
+    CHECK(counts.passes()[i].useful == full.passes()[i].useful);
+    CHECK(counts.passes()[i].idle == full.passes()[i].idle);
+    CHECK(counts.passes()[i].query == full.passes()[i].query);
+    CHECK(counts.passes()[i].work_mask == -1);
+  }
+  CHECK(counts.masks().empty());
+  CHECK(counts.voxel_steps().empty());
+  CHECK(counts.history_pixels().empty());
+  CHECK(!full.masks().empty());
+}

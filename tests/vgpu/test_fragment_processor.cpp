@@ -358,21 +358,6 @@ TEST_CASE("the counting run derives instructions, fetches and branches from the 
   CHECK(three.fetches.total() == 1);
 }
 
-namespace {
-
-struct NoBranch {
-  static constexpr const char* name = "no branch";
-  static constexpr const char* paper_name = "-";
-  static constexpr int outputs = 1;
-  template <class L>
-  void operator()(Fragments<L>& f) const {
-    using F = typename L::F;
-    f.out(0) = Vec4<F>{f.x, f.y, F(0.0f), F(1.0f)};
-  }
-};
-
-}  // namespace
-
 TEST_CASE("branch_flags says per fragment whether it took the branch, sat idle or was not shaded") {
   for (int lanes : {1, 8}) {
     CAPTURE(lanes);
@@ -397,8 +382,10 @@ TEST_CASE("branch_flags says per fragment whether it took the branch, sat idle o
         const uint8_t want = !test.get(x, y) ? 0 : x < 10 ? kBranchTook : kBranchIdle;
         CHECK(flags[size_t(y) * 24 + x] == want);
       }
-    KernelProgram<NoBranch> plain;
+    KernelProgram<vgpu_test::Copy> plain;  // no branch
+    Texture in = gpu.make_texture("in", 24, 6, 4);
     gpu.use_program(plain);
+    gpu.bind_texture(0, in);
     gpu.draw();
     CHECK(gpu.branch_flags().empty());
   }
