@@ -28,13 +28,15 @@ struct Frame {
 };
 
 // sphere.gltf at 48x40 (not a multiple of the 8x4 and 32x32 tiles) with the recorder attached.
-Frame render(host::FrameRecorder& rec, bool masks, std::optional<glm::ivec2> trace_pixel = {}) {
+Frame render(host::FrameRecorder& rec, bool masks, std::optional<glm::ivec2> trace_pixel = {},
+             int threads = 2, int lanes = vgpu::kLanes) {
   static const host::Scene scene = host::load_scene(host::resolve_scene("sphere"));
   host::RenderOptions opt;
   opt.width = 48;
   opt.height = 40;
   opt.masks = masks;
-  opt.threads = 2;
+  opt.threads = threads;
+  opt.lanes = lanes;
   opt.observer = &rec;
   std::ostringstream trace;
   if (trace_pixel) {
@@ -220,4 +222,28 @@ TEST_CASE("a counts-only recorder (the CSV's) records the same passes and keeps 
   CHECK(counts.voxel_steps().empty());
   CHECK(counts.history_pixels().empty());
   CHECK(!full.masks().empty());
+}
+
+TEST_CASE("what the recorder sees is the same for any thread count and lane width") {
+  host::FrameRecorder a(48, 40, false), b(48, 40, false);
+  render(a, false, {}, 1, 1);
+  render(b, false, {}, 3, 16);
+  REQUIRE(a.passes().size() == b.passes().size());
+  for (size_t i = 0; i < a.passes().size(); ++i) {
+    CAPTURE(i);
+    CHECK(a.passes()[i].counters.same_counts(b.passes()[i].counters));
+    CHECK(a.passes()[i].useful == b.passes()[i].useful);
+    CHECK(a.passes()[i].work_mask == b.passes()[i].work_mask);
+  }
+  CHECK(a.masks() == b.masks());
+  CHECK(a.voxel_steps() == b.voxel_steps());
+  CHECK(a.triangle_tests() == b.triangle_tests());
+  CHECK(a.wavefront() == b.wavefront());
+  CHECK(a.history_states() == b.history_states());
+  REQUIRE(a.occupancy().size() == b.occupancy().size());
+  for (size_t k = 0; k < a.occupancy().size(); ++k) {
+    CAPTURE(a.occupancy()[k].first);
+    CHECK(a.occupancy()[k].second.tile8x4 == b.occupancy()[k].second.tile8x4);
+    CHECK(a.occupancy()[k].second.tile32x32 == b.occupancy()[k].second.tile32x32);
+  }
 }
