@@ -18,12 +18,18 @@
 #include "host/camera.h"
 #include "host/cost_model.h"
 #include "host/cpu_tracer.h"
+#include "host/devices.h"
 #include "host/gltf_loader.h"
 #include "host/grid.h"
 #include "host/image_io.h"
 #include "host/report.h"
 #include "host/stream_tracer.h"
+#include "kernels/registry.h"
+#include "vgpu/glsl.h"
 #include "vgpu/vgpu.h"
+#ifdef VGPU_HAVE_GL
+#include "gl/context.h"
+#endif
 
 namespace {
 
@@ -48,6 +54,7 @@ struct RenderArgs {
   bool quiet = false;
   bool predict = false;
   std::string engine = "stream";
+  std::string gl_device = "auto";
   std::string precision = "fp32";
 };
 
@@ -118,14 +125,29 @@ int run_render(const RenderArgs& a) {
     opt.trace_out = &std::cout;
   }
 
-  if (a.engine != "stream" && a.engine != "cpu")
-    throw UsageError("--engine: expected stream or cpu, got '" + a.engine + "'");
+  if (a.engine != "stream" && a.engine != "cpu" && a.engine != "gl")
+    throw UsageError("--engine: expected stream, cpu or gl, got '" + a.engine + "'");
   const bool cpu = a.engine == "cpu";
+  const bool gl = a.engine == "gl";
   if (cpu && (a.predict || !a.trace_pixel.empty()))
     throw UsageError("--predict and --trace-pixel need --engine stream");
-  if (cpu && (!a.report.empty() || !a.stats_csv.empty()))
+  if (a.engine != "stream" && (!a.report.empty() || !a.stats_csv.empty()))
     throw UsageError(
-        "--report and --stats-csv need --engine stream (the CPU engine runs no passes)");
+        "--report and --stats-csv need --engine stream (the report reads the "
+        "emulator's per-fragment state)");
+  if (gl) {
+    // The GL device runs every fragment in fp32 GLSL; the emulator-only features are refused.
+    if (!host::have_gl_device())
+      throw host::InputError(
+          "--engine gl: this build has no GL device (EGL and OpenGL were not found when it was "
+          "built; scripts/setup.sh installs them)");
+    if (a.predict || !a.trace_pixel.empty() || opt.masks || a.precision != "fp32")
+      throw UsageError(
+          "--engine gl runs the multipass pipeline as a driver does: --predict, --trace-pixel, "
+          "--masks on and --precision fp24/fp16 need --engine stream");
+    opt.device = "gl";
+    opt.gl_device = a.gl_device;
+  }
   if (!a.report.empty() && int64_t(opt.width) * opt.height > host::kReportMaxPixels)
     throw UsageError("--report: at most " + std::to_string(host::kReportMaxPixels) +
                      " pixels (512x512); got " + a.size);
@@ -172,6 +194,7 @@ int run_render(const RenderArgs& a) {
   j["scene"] = scene.name;
   j["scene_path"] = path;
   j["engine"] = a.engine;
+  if (tracer) j["device"] = tracer->device().description();
   j["triangles"] = scene.triangle_count();
   j["input_triangles"] = scene.input_triangles;
   j["dropped_degenerate"] = scene.dropped_degenerate;
@@ -199,13 +222,18 @@ int run_render(const RenderArgs& a) {
   j["rays_unfinished"] = r.rays_unfinished;
   {
     nlohmann::ordered_json stats = r.stats.json();
+    if (gl)  // the emulator's SIMD model: a driver does not show its lanes
+      for (const char* key : {"lanes_idle", "idle_in_batch32", "idle_in_batch1024"}) {
+        stats["totals"][key] = nullptr;
+        for (auto& k : stats["programs"]) k[key] = nullptr;
+      }
     j["totals"] = std::move(stats["totals"]);
     j["kernels"] = std::move(stats["programs"]);
   }
   // The cost model's prediction for every built-in profile (the counters do not depend on it).
   nlohmann::ordered_json predicted_ms, predicted_breakdown;
   for (const vgpu::Profile& p : vgpu::profiles()) {
-    if (cpu) break;  // the CPU engine runs no passes: nothing to predict
+    if (cpu || gl) break;  // no passes, or no SIMD counters to predict from
     const host::CostBreakdown c = host::predict(r.stats, p);
     predicted_ms[p.name] = c.total_ms;
     for (const auto& [key, v] : c.items()) predicted_breakdown[p.name][key] = v;
@@ -214,7 +242,7 @@ int run_render(const RenderArgs& a) {
   j["predicted_breakdown"] = predicted_breakdown;
   auto what_if = nlohmann::ordered_json::array();  // MRT and resident programs (docs/table1.md)
   for (const auto& [name, s] :
-       cpu ? decltype(host::what_ifs(r.stats)){} : host::what_ifs(r.stats)) {
+       cpu || gl ? decltype(host::what_ifs(r.stats)){} : host::what_ifs(r.stats)) {
     nlohmann::ordered_json w = {{"name", name}, {"totals", vgpu::to_json(s.totals)}};
     for (const vgpu::Profile& p : vgpu::profiles())
       for (const auto& [key, v] : host::predict(s, p).items())
@@ -254,13 +282,76 @@ int run_render(const RenderArgs& a) {
                 cpu ? "engine" : "profile", cpu ? "cpu" : opt.profile.c_str(), r.width, r.height,
                 r.iterations, a.shading.c_str(), a.shadows.c_str(), a.masks.c_str());
     std::printf("initialization %.1f ms (grid %.1f ms), render %.1f ms (%s)\n", init_ms,
-                grid.build_ms, r.render_ms, cpu ? "host CPU" : "host, emulated");
+                grid.build_ms, r.render_ms,
+                cpu  ? "host CPU"
+                : gl ? "wall, GL device"
+                     : "host, emulated");
+    if (gl)
+      std::printf("device %s: passes %.2f ms of GPU time (timer queries)\n",
+                  tracer->device().description().c_str(), r.stats.totals.device_ms);
   }
   if (a.predict) {
     const vgpu::Profile& p = vgpu::profile(opt.profile);
     std::cout << host::describe(host::predict(r.stats, p), p);
   }
   return 0;
+}
+
+// `vgpu-rt kernels [NAME] [--glsl]`: what a fragment program is, per kernel.
+int run_kernels(const std::string& name, bool glsl) {
+  const auto programs = kernels::all_programs();
+  auto spelled = [](std::string n) {
+    for (char& c : n)
+      if (c == ' ') c = '-';
+    return n;
+  };
+  if (name.empty()) {
+    if (glsl) throw UsageError("kernels --glsl: name a kernel (vgpu-rt kernels lists them)");
+    std::printf("%-22s %-22s %7s %7s %8s  %s\n", "kernel", "paper name", "outputs", "instr.",
+                "branches", "textures (unit: contents, fetches per fragment)");
+    for (const auto& p : programs) {
+      const vgpu::Program::Analysis a = p->analyze();
+      std::string units;
+      for (int u = 0; u < vgpu::kMaxTextureUnits; ++u)
+        if (a.fetches.per_unit[u])
+          units += (units.empty() ? "" : ", ") + std::to_string(u) + ": " + p->unit_name(u) +
+                   (a.fetches.per_unit[u] > 1 ? " x" + std::to_string(a.fetches.per_unit[u]) : "");
+      std::printf("%-22s %-22s %7d %7d %8d  %s\n", spelled(p->name()).c_str(), p->paper_name(),
+                  p->outputs(), a.instructions, a.branches, units.empty() ? "-" : units.c_str());
+    }
+    std::printf(
+        "instructions: one per arithmetic, compare, select and fetch, every branch taken (the "
+        "counting run); default uniforms\n");
+    return 0;
+  }
+  for (const auto& p : programs) {
+    if (name != p->name() && name != spelled(p->name()) && name != p->paper_name()) continue;
+    if (glsl) {
+      std::fputs(vgpu::to_glsl(*p, true).source.c_str(), stdout);
+    } else {
+      const vgpu::Program::Analysis a = p->analyze();
+      std::printf("%s (paper: %s): %d output(s), %d instructions, %d branch block(s)\n", p->name(),
+                  p->paper_name(), p->outputs(), a.instructions, a.branches);
+      for (int u = 0; u < vgpu::kMaxTextureUnits; ++u)
+        if (a.fetches.per_unit[u])
+          std::printf("  unit %2d  %-16s %d fetch(es) per fragment\n", u, p->unit_name(u).c_str(),
+                      a.fetches.per_unit[u]);
+    }
+    return 0;
+  }
+  throw UsageError("kernels: no kernel named '" + name + "' (vgpu-rt kernels lists them)");
+}
+
+int run_gl_devices() {
+#ifdef VGPU_HAVE_GL
+  const auto devices = gl::Context::list_devices();
+  if (devices.empty()) std::printf("EGL lists no devices (auto uses the surfaceless platform)\n");
+  for (const auto& d : devices)
+    std::printf("%d  %s%s\n", d.index, d.name.c_str(), d.software ? " (software)" : "");
+  return 0;
+#else
+  throw host::InputError("gl-devices: this build has no GL device (EGL was not found)");
+#endif
 }
 
 }  // namespace
@@ -283,7 +374,8 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   render->add_option("--shadows", a.shadows, "on | off")->capture_default_str();
   render->add_option("--grid", a.grid, "auto | N | AxBxC voxels")->capture_default_str();
-  render->add_option("--profile", a.profile, "gf5700 | gf6600 | rtx4090")->capture_default_str();
+  render->add_option("--profile", a.profile, "gf5700 | gf6600 | rtx4090 | h200")
+      ->capture_default_str();
   render->add_option("--threads", a.threads, "Host threads (0: all cores)")->capture_default_str();
   render->add_option("--lanes", a.lanes, "SIMD lanes per batch: 1 (scalar reference), 4, 8, 16")
       ->capture_default_str();
@@ -309,11 +401,24 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   render
       ->add_option("--engine", a.engine,
-                   "stream (the vgpu pipeline) | cpu (double-precision reference)")
+                   "stream (the vgpu pipeline) | gl (the same passes on an OpenGL driver) | cpu "
+                   "(double-precision reference)")
+      ->capture_default_str();
+  render
+      ->add_option("--gl-device", a.gl_device,
+                   "With --engine gl: auto, or an EGL device index (see vgpu-rt gl-devices)")
       ->capture_default_str();
   render->add_flag("--predict", a.predict,
                    "Print the cost model's predicted time for --profile, with its breakdown");
   auto* scenes = app.add_subcommand("scenes", "List the scenes in scenes/");
+  std::string kernel_name;
+  bool kernel_glsl = false;
+  auto* kernels_cmd = app.add_subcommand(
+      "kernels", "List the fragment programs (kernels), or print one as its generated GLSL");
+  kernels_cmd->add_option("name", kernel_name, "A kernel's name or paper name (e.g. traversal)");
+  kernels_cmd->add_flag("--glsl", kernel_glsl,
+                        "Print the GLSL fragment shader generated from the kernel's C++ functor");
+  auto* gl_devices = app.add_subcommand("gl-devices", "List the EGL devices --gl-device can pick");
   std::string ca, cb;
   double threshold = 1.0 / 255.0;
   auto* compare = app.add_subcommand(
@@ -356,6 +461,8 @@ int main(int argc, char** argv) {
       std::cout << host::diff_stats(da, db);
       return 0;
     }
+    if (*kernels_cmd) return run_kernels(kernel_name, kernel_glsl);
+    if (*gl_devices) return run_gl_devices();
     if (*compare) {
       const host::ImageComparison c = host::compare_images(ca, cb, threshold);
       std::printf(

@@ -24,6 +24,8 @@
 
 #include "host/image_io.h"
 #include "host/scene.h"
+#include "kernels/registry.h"
+#include "vgpu/glsl.h"
 
 namespace host {
 
@@ -387,8 +389,11 @@ void write_report(const std::string& path, const FrameRecorder& rec, const Rende
   }
   d["history"] = {
       {"stride", rec.history_stride()}, {"pixels", std::move(px)}, {"states", std::move(states)}};
-  // Slot for each kernel's generated program (GLSL), once the project can print it.
-  d["glsl"] = json::object();
+  // Each kernel's fragment program as GLSL, generated from its functor (default uniforms), as
+  // `vgpu-rt kernels NAME --glsl` prints it.
+  json glsl = json::object();
+  for (const auto& p : kernels::all_programs()) glsl[p->name()] = vgpu::to_glsl(*p, true).source;
+  d["glsl"] = std::move(glsl);
 
   std::string data = d.dump();
   // Inside <script>, "</" would end the element early; "<\/" is the same JSON string.

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <stdexcept>
 
+#include "host/devices.h"
 #include "host/parallel.h"
 
 namespace host {
@@ -68,10 +69,15 @@ kernels::ShadingModel parse_shading(const std::string& name) {
 StreamTracer::StreamTracer(const Scene& scene, const Grid& grid, const RenderOptions& options)
     : scene_(scene), grid_(grid), opt_(options) {
   const auto t0 = std::chrono::steady_clock::now();
-  gpu_ = std::make_unique<vgpu::Gpu>(vgpu::profile(opt_.profile), opt_.threads, opt_.lanes);
+  gpu_ = make_device(opt_);
   s_ = std::make_unique<State>();
-  vgpu::Gpu& gpu = *gpu_;
-  gpu.set_precision(opt_.precision);
+  vgpu::Device& gpu = *gpu_;
+  if (opt_.masks && !gpu.has_stencil())
+    throw vgpu::Error("--masks on needs stencil masks, which the " + opt_.device +
+                      " device does not have");
+  if (opt_.trace_pixel && !gpu.has_stencil())
+    throw vgpu::Error("--trace-pixel follows the emulator's finished-ray masks, which the " +
+                      opt_.device + " device does not have");
   const int maxs = gpu.profile().max_texture_size;
 
   // Scene textures: triangle i at texel (i mod width, i div width).
@@ -146,6 +152,11 @@ StreamTracer::StreamTracer(const Scene& scene, const Grid& grid, const RenderOpt
         s_->pointers.texel_mut(x * r.y + y, z)[0] = start;
       }
 
+  // Video memory gets the static textures once, at initialization.
+  for (const Texture* t : {&s_->v[0], &s_->v[1], &s_->v[2], &s_->n[0], &s_->n[1], &s_->n[2],
+                           &s_->colors, &s_->lists, &s_->pointers})
+    gpu.upload(*t);
+
   // Dynamic textures: one texel per pixel.
   const int W = opt_.width, H = opt_.height;
   for (int i = 0; i < 2; ++i) {
@@ -208,7 +219,7 @@ uint64_t StreamTracer::texture_bytes() const {
 const vgpu::PassRecord& StreamTracer::pass(const vgpu::Program& p,
                                            std::initializer_list<const Texture*> in, Texture& out,
                                            const Stencil* work) {
-  vgpu::Gpu& gpu = *gpu_;
+  vgpu::Device& gpu = *gpu_;
   gpu.use_program(p);
   gpu.unbind_textures();
   int unit = 0;
@@ -216,9 +227,11 @@ const vgpu::PassRecord& StreamTracer::pass(const vgpu::Program& p,
   gpu.set_targets({&out});
   // The same finished-ray mask either skips fragments on the modeled hardware (masks on) or
   // only saves the emulator's host work (masks off: every fragment is charged).
-  gpu.set_stencil_test(nullptr);
-  gpu.set_work_mask(opt_.masks || opt_.host_shortcut ? work : nullptr);
-  gpu.set_work_mask_counts_as_masked(opt_.masks);
+  if (gpu.has_stencil()) {
+    gpu.set_stencil_test(nullptr);
+    gpu.set_work_mask(opt_.masks || opt_.host_shortcut ? work : nullptr);
+    gpu.set_work_mask_counts_as_masked(opt_.masks);
+  }
   const bool traced = traces_pixel(work);
   if (opt_.observer) opt_.observer->pass_begin(work);
   const vgpu::PassRecord& rec = gpu.draw();
@@ -243,13 +256,14 @@ bool StreamTracer::traces_pixel(const Stencil* work) const {
 
 uint64_t StreamTracer::count(const vgpu::Program& p, const Texture& in, const Stencil* work,
                              Stencil* write) {
-  vgpu::Gpu& gpu = *gpu_;
+  vgpu::Device& gpu = *gpu_;
   const bool traced = traces_pixel(work);
-  gpu.set_stencil_write(write);
+  // The masks are the emulator's (its work mask, or stencils under --masks on).
+  if (gpu.has_stencil()) gpu.set_stencil_write(write);
   gpu.begin_query();
   pass(p, {&in}, s_->counter, work);
   const uint64_t n = gpu.end_query();
-  gpu.set_stencil_write(nullptr);
+  if (gpu.has_stencil()) gpu.set_stencil_write(nullptr);
   if (opt_.observer) opt_.observer->query(n, write, gpu.stats());
   if (traced) {
     char line[160];
@@ -264,7 +278,7 @@ uint64_t StreamTracer::count(const vgpu::Program& p, const Texture& in, const St
 }
 
 void StreamTracer::trace(Texture& origins, Texture& rays, bool primary, const Camera& cam) {
-  vgpu::Gpu& gpu = *gpu_;
+  vgpu::Device& gpu = *gpu_;
   State& s = *s_;
   auto swap = [](int& i) { i ^= 1; };
   gpu.clear(s.isect[s.cur_isect], {kFar, 0, 0, kNone});
@@ -317,7 +331,7 @@ void StreamTracer::trace(Texture& origins, Texture& rays, bool primary, const Ca
 
 RenderResult StreamTracer::render(const Camera& cam) {
   const auto t0 = std::chrono::steady_clock::now();
-  vgpu::Gpu& gpu = *gpu_;
+  vgpu::Device& gpu = *gpu_;
   State& s = *s_;
   gpu.stats().clear();
   s.rays_traced = 0;
@@ -355,8 +369,9 @@ RenderResult StreamTracer::render(const Camera& cam) {
                                     : PassObserver::TraceKind::primary);
     trace(s.origins[ro], rays, it == 0, cam);
     if (opt_.observer) opt_.observer->trace_end();
-    const Texture& hits = s.isect[s.cur_isect];
+    Texture& hits = s.isect[s.cur_isect];
     if (it == 0) {
+      gpu.download(hits);
       res.depth.assign(size_t(W) * H, 0.0f);
       res.hit_id.assign(size_t(W) * H, -1.0f);
       for (int y = 0; y < H; ++y)
@@ -403,7 +418,8 @@ RenderResult StreamTracer::render(const Camera& cam) {
     ro ^= 1;
   }
 
-  const Texture& out = s.result[s.cur_result];
+  Texture& out = s.result[s.cur_result];
+  gpu.download(out);
   res.rgb.resize(size_t(W) * H * 3);
   for (int y = 0; y < H; ++y)
     for (int x = 0; x < W; ++x) {

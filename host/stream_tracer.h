@@ -57,6 +57,10 @@ struct RenderOptions {
   kernels::ShadingModel shading = kernels::ShadingModel::phong;
   bool shadows = true;
   std::string profile = "gf5700";
+  // The device the passes run on: "vgpu" (the emulator) or "gl" (a real OpenGL driver, EGL
+  // device gl_device: "auto" or an index).
+  std::string device = "vgpu";
+  std::string gl_device = "auto";
   int threads = 0;  // 0: every host core
   int lanes = vgpu::kLanes;
   // Precision of the ray-state textures and of the arithmetic inside kernels (--precision).
@@ -96,6 +100,7 @@ class StreamTracer {
   ~StreamTracer();
   RenderResult render(const Camera& camera);
   double init_ms() const { return init_ms_; }
+  vgpu::Device& device() { return *gpu_; }
   uint64_t texture_bytes() const;  // static + dynamic textures, as the modeled card holds them
 
  private:
@@ -113,7 +118,7 @@ class StreamTracer {
   const Scene& scene_;
   const Grid& grid_;
   RenderOptions opt_;
-  std::unique_ptr<vgpu::Gpu> gpu_;
+  std::unique_ptr<vgpu::Device> gpu_;
   std::unique_ptr<State> s_;
   double init_ms_ = 0;
 };

@@ -42,6 +42,7 @@ struct InitTraversal {
   static constexpr const char* paper_name = "initTraversal";
   static constexpr int outputs = 1;  // -> traversal
   enum Unit { kRays };
+  static constexpr std::array<const char*, 1> units{"rays"};
 
   glm::vec3 eye{0.0f};  // camera position, world space: every primary ray starts there
   GridUniforms grid;

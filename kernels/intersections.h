@@ -13,6 +13,9 @@ struct Intersections {
   static constexpr const char* paper_name = "intersecciones";
   static constexpr int outputs = 1;  // -> intersection
   enum Unit { kOrigins, kRays, kTraversal, kVoxelState, kIntersection, kV0, kV1, kV2 };
+  static constexpr std::array<const char*, 8> units{"origins",     "rays",         "traversal",
+                                                    "voxel_state", "intersection", "vertices0",
+                                                    "vertices1",   "vertices2"};
   static constexpr std::array<int, 1> passthrough{kIntersection};
 
   GridUniforms grid;

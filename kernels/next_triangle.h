@@ -11,6 +11,7 @@ struct NextTriangle {
   static constexpr const char* paper_name = "proximoTriangulo";
   static constexpr int outputs = 1;  // -> voxel state
   enum Unit { kVoxelState, kLists };
+  static constexpr std::array<const char*, 2> units{"voxel_state", "triangle_lists"};
   static constexpr std::array<int, 1> passthrough{kVoxelState};
 
   GridUniforms grid;

@@ -12,6 +12,7 @@ struct RaysInGrid {
   static constexpr int outputs = 1;  // a dummy target: the count is what matters
   static constexpr bool idle_discards = true;
   enum Unit { kTraversal };
+  static constexpr std::array<const char*, 1> units{"traversal"};
 
   template <class L>
   void operator()(Fragments<L>& f) const {

@@ -12,6 +12,7 @@ struct RaysIntersecting {
   static constexpr int outputs = 1;  // a dummy target: the count is what matters
   static constexpr bool idle_discards = true;
   enum Unit { kVoxelState };
+  static constexpr std::array<const char*, 1> units{"voxel_state"};
 
   template <class L>
   void operator()(Fragments<L>& f) const {

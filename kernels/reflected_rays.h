@@ -12,6 +12,7 @@ struct ReflectedRays {
   static constexpr int outputs = 1;  // a dummy target: the count is what matters
   static constexpr bool idle_discards = true;
   enum Unit { kResult };
+  static constexpr std::array<const char*, 1> units{"result"};
 
   float min_weight = 1.0f / 512.0f;  // a ray that adds under 1/2 of an 8-bit step is not traced
 

@@ -12,6 +12,9 @@ struct ReflectionDirection {
   static constexpr const char* paper_name = "direccionReflejo";
   static constexpr int outputs = 1;  // -> rays
   enum Unit { kRays, kSurface, kResult, kV0, kV1, kV2, kN0, kN1, kN2 };
+  static constexpr std::array<const char*, 9> units{"rays",      "surface",   "result",
+                                                    "vertices0", "vertices1", "vertices2",
+                                                    "normals0",  "normals1",  "normals2"};
 
   SceneUniforms scene;
   float min_weight = 1.0f / 512.0f;  // as in rayosReflejados

@@ -13,6 +13,8 @@ struct ReflectionOrigin {
   static constexpr const char* paper_name = "inicioReflejo";
   static constexpr int outputs = 1;  // -> surface (next origins)
   enum Unit { kOrigins, kRays, kIntersection, kV0, kV1, kV2 };
+  static constexpr std::array<const char*, 6> units{"origins",   "rays",      "intersection",
+                                                    "vertices0", "vertices1", "vertices2"};
 
   SceneUniforms scene;
   float offset = 1e-4f;  // world units

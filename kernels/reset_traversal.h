@@ -12,6 +12,7 @@ struct ResetTraversal {
   static constexpr const char* paper_name = "reinicializarTraversal";
   static constexpr int outputs = 1;  // -> traversal
   enum Unit { kOrigins, kRays };
+  static constexpr std::array<const char*, 2> units{"origins", "rays"};
 
   GridUniforms grid;
 

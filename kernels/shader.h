@@ -18,6 +18,9 @@ struct Shader {
   static constexpr const char* paper_name = "shader";
   static constexpr int outputs = 1;  // -> result
   enum Unit { kSurface, kRays, kResult, kShadow, kColors, kV0, kV1, kV2, kN0, kN1, kN2 };
+  static constexpr std::array<const char*, 11> units{
+      "surface",   "rays",      "result",   "shadow_hits", "colors",  "vertices0",
+      "vertices1", "vertices2", "normals0", "normals1",    "normals2"};
 
   SceneUniforms scene;
   ShadingModel model = ShadingModel::diffuse;

@@ -12,6 +12,7 @@ struct ShadowRays {
   static constexpr const char* paper_name = "rayosSombra (extension)";
   static constexpr int outputs = 1;  // -> rays (a separate shadow-ray texture)
   enum Unit { kSurface, kResult };
+  static constexpr std::array<const char*, 2> units{"surface", "result"};
 
   glm::vec3 light{0.0f};  // world space
   float min_weight = 1.0f / 512.0f;

@@ -13,6 +13,7 @@ struct Traversal {
   static constexpr const char* paper_name = "traversal";
   static constexpr int outputs = 1;  // -> traversal
   enum Unit { kOrigins, kRays, kTraversal, kIntersection };
+  static constexpr std::array<const char*, 4> units{"origins", "rays", "traversal", "intersection"};
   static constexpr std::array<int, 1> passthrough{kTraversal};  // done rays keep their state
 
   GridUniforms grid;

@@ -12,6 +12,8 @@ struct UpdateVoxel {
   static constexpr const char* paper_name = "actualizarVoxel";
   static constexpr int outputs = 1;  // -> voxel state
   enum Unit { kTraversal, kVoxelState, kPointers, kLists };
+  static constexpr std::array<const char*, 4> units{"traversal", "voxel_state", "voxel_pointers",
+                                                    "triangle_lists"};
   static constexpr std::array<int, 1> passthrough{kVoxelState};
 
   GridUniforms grid;

@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
 # Installs everything vgpu-rt needs on a fresh Debian 12 machine (run as root or with sudo).
+# EGL, glvnd's libOpenGL and Mesa (llvmpipe) are for the GL device (--engine gl) and its tests.
 # Idempotent: skips apt when every package is already present.
 set -euo pipefail
 pkgs=(
@@ -8,6 +9,7 @@ pkgs=(
   doctest-dev libbenchmark-dev libcli11-dev libmeshoptimizer-dev
   clang libclang-rt-14-dev clang-format
   python3-matplotlib
+  libegl-dev libopengl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri
   chromium
 )
 missing=()

@@ -10,6 +10,7 @@
 #include <cstring>
 
 #include "vgpu/lanes.h"
+#include "vgpu/record.h"
 
 namespace vgpu {
 
@@ -130,6 +131,15 @@ class Fragments {
       ++OpCounter::ops;
       ++tally_->per_unit[unit];
       return {F(0.0f), F(0.0f), F(0.0f), F(1.0f)};
+    } else if constexpr (L::recording) {
+      // The own texel (u, v are this fragment's x, y) is the common case a printer can say so.
+      const bool own = u.id == x.id && v.id == y.id;
+      const int t = own ? Recorder::current->push({Op::fetch_own, -1, -1, -1, unit})
+                        : Recorder::current->push({Op::fetch, u.id, v.id, -1, unit});
+      auto ch = [&](int c) {
+        return F::node(Recorder::current->push({Op::channel, t, -1, -1, c}));
+      };
+      return {ch(0), ch(1), ch(2), ch(3)};
     } else {
       const F fu = floor(u), fv = floor(v);
       const float u0 = fu[0], v0 = fv[0];
@@ -171,6 +181,8 @@ class Fragments {
     if constexpr (L::counting) {
       ++*idle_;  // the counting run tallies branch() calls
       return true;
+    } else if constexpr (L::recording) {
+      return true;  // recorded straight-line: both sides run, results go through select
     } else {
       *idle_ += uint64_t(lanes_on(live_ && !m));
       idle_any_ = idle_any_ || (live_ && !m);

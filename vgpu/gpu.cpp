@@ -92,22 +92,6 @@ void Gpu::fail(const std::string& what) const {
   throw Error(what);
 }
 
-Texture Gpu::make_texture(std::string name, int width, int height, int channels,
-                          Format format) const {
-  Texture t(std::move(name), std::max(width, 1), std::max(height, 1), channels, format);
-  if (width <= 0 || height <= 0) fail("texture '" + t.name() + "' has an empty size");
-  check_texture(t);
-  return t;
-}
-
-void Gpu::check_texture(const Texture& t) const {
-  const int m = profile_.max_texture_size;
-  if (t.width() > m || t.height() > m)
-    fail("texture '" + t.name() + "' is " + std::to_string(t.width()) + "x" +
-         std::to_string(t.height()) + " texels; profile " + profile_.name + " allows at most " +
-         std::to_string(m) + "x" + std::to_string(m));
-}
-
 void Gpu::use_program(const Program& program) {
   if (in_draw_)
     fail(std::string("program '") + program.name() + "': no recursion (bind inside a pass)");
@@ -389,35 +373,9 @@ const PassRecord& Gpu::draw(const Rect& rect) {
   const std::string pname = p.name();
   if (in_draw_) fail("program '" + pname + "': no recursion (a pass started inside a pass)");
 
-  // The profile's limits.
-  if (p.outputs() > profile_.max_outputs)
-    fail("program '" + pname + "' writes " + std::to_string(p.outputs()) + " outputs; profile " +
-         profile_.name + " allows " + std::to_string(profile_.max_outputs) +
-         " (no multiple render targets)");
-  if (int(targets_.size()) != p.outputs())
-    fail("program '" + pname + "' writes " + std::to_string(p.outputs()) + " outputs but " +
-         std::to_string(targets_.size()) + " render targets are set");
   const Program::Analysis a = p.analyze();
-  if (a.instructions > profile_.max_instructions)
-    fail("program '" + pname + "' has " + std::to_string(a.instructions) +
-         " instructions; profile " + profile_.name + " allows " +
-         std::to_string(profile_.max_instructions));
+  check_pass(profile_, p, a, units_.data(), targets_, rect);
   const Texture& t0tex = *targets_[0];
-  for (Texture* t : targets_) {
-    if (t->width() != t0tex.width() || t->height() != t0tex.height())
-      fail("program '" + pname + "': render targets differ in size");
-    for (int u = 0; u < kMaxTextureUnits; ++u)
-      if (units_[u] == t)
-        fail("program '" + pname + "' reads texture '" + t->name() + "' (unit " +
-             std::to_string(u) + ") while rendering to it: read/write hazard, use ping-pong");
-  }
-  for (int u = 0; u < kMaxTextureUnits; ++u)
-    if (a.fetches.per_unit[u] && !units_[u])
-      fail("program '" + pname + "' fetches from texture unit " + std::to_string(u) +
-           ", which has no texture bound");
-  if (rect.x0 < 0 || rect.y0 < 0 || rect.x1 > t0tex.width() || rect.y1 > t0tex.height() ||
-      rect.x0 > rect.x1 || rect.y0 > rect.y1)
-    fail("program '" + pname + "': drawn rectangle outside the render target");
   auto check_mask = [&](const Stencil* s, const char* what) {
     if (s && (s->width() != t0tex.width() || s->height() != t0tex.height()))
       fail("program '" + pname + "': " + what + " size differs from the render target");
@@ -490,12 +448,8 @@ const PassRecord& Gpu::draw(const Rect& rect) {
     sum.idle += c.idle;
   }
   // Static per-fragment costs times shaded fragments: identical at any width and thread count.
-  Counters c;
-  c.passes = 1;
-  c.fragments_launched = sum.launched;
-  c.fragments_shaded = sum.shaded;
+  Counters c = pass_counters(a, units_.data(), targets_, sum.launched, sum.shaded, sum.discarded);
   c.fragments_masked = sum.masked;
-  c.fragments_discarded = sum.discarded;
   c.lanes_idle = sum.idle;
   if (flags) {
     const std::array<uint64_t, 2> batch =
@@ -503,16 +457,6 @@ const PassRecord& Gpu::draw(const Rect& rect) {
     c.idle_in_batch32 = batch[0];
     c.idle_in_batch1024 = batch[1];
   }
-  c.instructions = sum.shaded * uint64_t(a.instructions);
-  uint64_t read_per_frag = 0;
-  for (int u = 0; u < kMaxTextureUnits; ++u)
-    if (a.fetches.per_unit[u])
-      read_per_frag += uint64_t(a.fetches.per_unit[u]) * uint64_t(units_[u]->bytes_per_texel());
-  c.texture_fetches = sum.shaded * uint64_t(a.fetches.total());
-  c.bytes_read = sum.shaded * read_per_frag;
-  uint64_t write_per_frag = 0;
-  for (Texture* t : targets_) write_per_frag += uint64_t(t->bytes_per_texel());
-  c.bytes_written = (sum.shaded - sum.discarded) * write_per_frag;
   if (query_active_) query_count_ += sum.shaded - sum.discarded;
   c.host_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();

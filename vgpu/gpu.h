@@ -23,29 +23,14 @@
 #include <thread>
 #include <vector>
 
-#include "vgpu/profile.h"
-#include "vgpu/program.h"
-#include "vgpu/stats.h"
-#include "vgpu/texture.h"
+#include "vgpu/device.h"
 
 namespace vgpu {
-
-struct Error : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
-
-// A rectangle of the render target in pixels: [x0, x1) x [y0, y1).
-struct Rect {
-  int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
-  int width() const { return x1 - x0; }
-  int height() const { return y1 - y0; }
-  uint64_t area() const { return uint64_t(width()) * uint64_t(height()); }
-};
 
 // Batch flags of one fragment (Gpu::branch_flags): it took the program's branch, or sat idle in it.
 inline constexpr uint8_t kBranchTook = 1, kBranchIdle = 2;
 
-class Gpu {
+class Gpu final : public Device {
  public:
   // threads = 0: one per host core. lanes: 1 (scalar reference), 4, 8 or 16.
   explicit Gpu(const Profile& profile, int threads = 0, int lanes = kLanes);
@@ -53,7 +38,8 @@ class Gpu {
   Gpu(const Gpu&) = delete;
   Gpu& operator=(const Gpu&) = delete;
 
-  const Profile& profile() const { return profile_; }
+  const Profile& profile() const override { return profile_; }
+  std::string description() const override { return "vgpu (emulator)"; }
   int threads() const { return int(workers_.size()) + 1; }
   int lanes() const { return lanes_; }
   // Arithmetic precision of the fragment units: fp32, or every operation rounded to fp24 (R300)
@@ -61,20 +47,20 @@ class Gpu {
   void set_precision(Format f) { precision_ = f; }
   Format precision() const { return precision_; }
 
-  // Video memory: a texture the profile can hold (throws Error past max_texture_size).
-  Texture make_texture(std::string name, int width, int height, int channels,
-                       Format format = Format::fp32) const;
-  void check_texture(const Texture& t) const;
+  // The emulator's textures live in host memory: nothing to copy.
+  void upload(const Texture&) override {}
+  void download(Texture&) override {}
 
   // Pipeline state.
-  void use_program(const Program& program);
-  void bind_texture(int unit, const Texture& texture);
-  void unbind_textures();
-  void set_targets(std::initializer_list<Texture*> targets);
+  void use_program(const Program& program) override;
+  void bind_texture(int unit, const Texture& texture) override;
+  void unbind_textures() override;
+  void set_targets(std::initializer_list<Texture*> targets) override;
   // Early-z / stencil mask: fragments whose stencil is 0 are skipped before shading.
-  void set_stencil_test(const Stencil* stencil) { stencil_test_ = stencil; }
+  bool has_stencil() const override { return true; }
+  void set_stencil_test(const Stencil* stencil) override { stencil_test_ = stencil; }
   // After each pass, the stencil of every shaded fragment becomes 1 if it survived, 0 if killed.
-  void set_stencil_write(Stencil* stencil) { stencil_write_ = stencil; }
+  void set_stencil_write(Stencil* stencil) override { stencil_write_ = stencil; }
 
   // Emulator shortcut, not hardware: fragments whose work mask is 0 run no host code. They are
   // counted exactly as if shaded (the statistics use each program's static per-fragment counts),
@@ -82,28 +68,28 @@ class Gpu {
   // program says idle fragments are. The host marks a fragment idle only where the program's
   // result provably equals that (a finished ray) and the fragment takes none of the program's
   // f.branch() blocks (each counts it as an idle lane), so images and statistics do not change.
-  void set_work_mask(const Stencil* work) { work_mask_ = work; }
+  void set_work_mask(const Stencil* work) override { work_mask_ = work; }
   // Model the same mask as an early-z/stencil test instead: idle fragments are charged as
   // masked (no shading, no fetches, no query count) while their state is still carried over.
-  void set_work_mask_counts_as_masked(bool masked) { work_masked_ = masked; }
+  void set_work_mask_counts_as_masked(bool masked) override { work_masked_ = masked; }
 
   // glClear: every texel of t becomes value (channels() floats). Counted as a clear and its bytes.
-  void clear(Texture& t, std::initializer_list<float> value);
+  void clear(Texture& t, std::initializer_list<float> value) override;
 
   // One pass over rect (default: the whole first target).
-  const PassRecord& draw();
-  const PassRecord& draw(const Rect& rect);
+  const PassRecord& draw() override;
+  const PassRecord& draw(const Rect& rect) override;
 
   // Occlusion queries: begin, draw one or more passes, end returns the surviving fragments.
   // end_query() reads the result back (a synchronisation, counted as a query read-back).
-  void begin_query();
-  uint64_t end_query();
+  void begin_query() override;
+  uint64_t end_query() override;
 
   // After a draw of a program that branches: per fragment of the drawn rectangle, row by row,
   // kBranchTook, kBranchIdle or 0 (not shaded). Empty after a draw of one that does not.
-  std::span<const uint8_t> branch_flags() const { return batch_flags_; }
+  std::span<const uint8_t> branch_flags() const override { return batch_flags_; }
 
-  FrameStats& stats() { return stats_; }
+  FrameStats& stats() override { return stats_; }
   const FrameStats& stats() const { return stats_; }
 
  private:

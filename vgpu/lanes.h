@@ -19,6 +19,7 @@ template <int W>
 struct SimdLanes {
   static constexpr int width = W;
   static constexpr bool counting = false;
+  static constexpr bool recording = false;
   using F = stdx::fixed_size_simd<float, W>;
   using M = typename F::mask_type;
 };
@@ -170,6 +171,7 @@ inline CFloat rsqrt(CFloat a) {
 struct CountingLanes {
   static constexpr int width = 1;
   static constexpr bool counting = true;
+  static constexpr bool recording = false;
   using F = CFloat;
   using M = CMask;
 };

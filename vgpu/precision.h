@@ -109,6 +109,7 @@ template <int W, Format Fm>
 struct RoundedLanes {
   static constexpr int width = W;
   static constexpr bool counting = false;
+  static constexpr bool recording = false;
   static constexpr Format precision = Fm;
   using F = RFloat<W, Fm>;
   using M = typename F::mask_type;

@@ -23,4 +23,25 @@ Program::Analysis Program::analyze() const {
   return a;
 }
 
+Recording Program::record() const {
+  Recording rec;
+  Recording* const outer = Recorder::current;
+  Recorder::current = &rec;
+  {
+    BoundTexture none[kMaxTextureUnits]{};
+    Fragments<RecordingLanes> f(none, false, nullptr, nullptr);
+    f.reset(RFloat32::node(rec.push({Op::frag_x})), RFloat32::node(rec.push({Op::frag_y})),
+            RMask(true), outputs());
+    run(f);
+    for (int o = 0; o < outputs(); ++o) {
+      const Vec4<RFloat32>& v = f.output(o);
+      rec.outputs.push_back({v.x.id, v.y.id, v.z.id, v.w.id});
+    }
+    const int kill = f.killed().id;
+    rec.kill = kill == rec.mask_false ? -1 : kill;
+  }
+  Recorder::current = outer;
+  return rec;
+}
+
 }  // namespace vgpu

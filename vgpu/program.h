@@ -10,10 +10,14 @@
 // and may provide, for the emulator's host shortcut (see Gpu::set_work_mask):
 //   static constexpr std::array<int, outputs> passthrough;  // unit holding output i's old value
 //   static constexpr bool idle_discards;                     // an idle fragment is discarded
+// and, to name its texture units in listings and generated shaders:
+//   static constexpr std::array<const char*, N> units;       // what unit i holds
 // Uniforms are the functor's data members, set by the host between passes.
 #pragma once
 
 #include <array>
+#include <cstddef>
+#include <span>
 #include <string>
 
 #include "vgpu/fragment.h"
@@ -41,6 +45,12 @@ class Program {
   virtual void run(Fragments<RoundedLanes<8, Format::fp24>>& f) const = 0;
   virtual void run(Fragments<RoundedLanes<1, Format::fp16>>& f) const = 0;
   virtual void run(Fragments<RoundedLanes<8, Format::fp16>>& f) const = 0;
+  virtual void run(Fragments<RecordingLanes>& f) const = 0;
+  // What texture unit u holds ("unit u" where the kernel names none).
+  virtual std::string unit_name(int unit) const = 0;
+  // The functor's uniforms as raw bytes: equal bytes give an equal recording (padding may
+  // differ between equal values; that only costs a re-recording).
+  virtual std::span<const std::byte> uniform_bytes() const = 0;
 
   // The counting run: static instructions per fragment and fetches per unit, with the current
   // uniforms (a uniform loop bound, e.g. the number of lights, changes the count).
@@ -50,6 +60,8 @@ class Program {
     FetchTally fetches;
   };
   Analysis analyze() const;
+  // The recording run: every operation of the program, with the current uniforms.
+  Recording record() const;
 
  protected:
   Program();
@@ -93,6 +105,15 @@ class KernelProgram final : public Program {
   void run(Fragments<RoundedLanes<8, Format::fp24>>& f) const override { kernel(f); }
   void run(Fragments<RoundedLanes<1, Format::fp16>>& f) const override { kernel(f); }
   void run(Fragments<RoundedLanes<8, Format::fp16>>& f) const override { kernel(f); }
+  void run(Fragments<RecordingLanes>& f) const override { kernel(f); }
+  std::string unit_name(int unit) const override {
+    if constexpr (requires { K::units; })
+      if (unit >= 0 && unit < int(K::units.size())) return K::units[size_t(unit)];
+    return "unit" + std::to_string(unit);
+  }
+  std::span<const std::byte> uniform_bytes() const override {
+    return std::as_bytes(std::span<const K, 1>(&kernel, 1));
+  }
 };
 
 }  // namespace vgpu

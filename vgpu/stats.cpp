@@ -13,6 +13,7 @@ namespace vgpu {
 Counters& Counters::operator+=(const Counters& o) {
   for (const auto& [name, field] : kCounterFields) this->*field += o.*field;
   host_ms += o.host_ms;
+  device_ms += o.device_ms;
   return *this;
 }
 
@@ -22,10 +23,11 @@ bool Counters::same_counts(const Counters& o) const {
   return true;
 }
 
-nlohmann::ordered_json to_json(const Counters& c) {
+nlohmann::ordered_json to_json(const Counters& c, bool device_timed) {
   nlohmann::ordered_json j;
   for (const auto& [name, field] : kCounterFields) j[name] = c.*field;
   j["host_ms"] = c.host_ms;
+  j["device_ms"] = device_timed ? nlohmann::ordered_json(c.device_ms) : nlohmann::ordered_json();
   return j;
 }
 
@@ -51,7 +53,7 @@ void FrameStats::clear() {
 
 nlohmann::ordered_json FrameStats::json() const {
   nlohmann::ordered_json j;
-  j["totals"] = vgpu::to_json(totals);
+  j["totals"] = vgpu::to_json(totals, device_timed);
   auto progs = nlohmann::ordered_json::array();
   for (const ProgramTotals& p : programs) {
     nlohmann::ordered_json e;
@@ -59,7 +61,7 @@ nlohmann::ordered_json FrameStats::json() const {
     e["paper_name"] = p.paper_name;
     // The static count has its own key: the counters' "instructions" (executed) follow.
     e["static_instructions"] = p.instructions;
-    const nlohmann::ordered_json c = vgpu::to_json(p.counters);  // items() needs it alive
+    const nlohmann::ordered_json c = vgpu::to_json(p.counters, device_timed);  // items() needs it
     for (auto& [k, v] : c.items()) e[k] = v;
     progs.push_back(e);
   }
@@ -87,18 +89,24 @@ static std::string human(uint64_t v) {
 std::string FrameStats::to_table() const {
   std::string out;
   char line[512];
-  std::snprintf(line, sizeof line, "%-24s %-22s %7s %9s %9s %9s %9s %9s %9s %6s %6s %9s\n",
+  std::snprintf(line, sizeof line, "%-24s %-22s %7s %9s %9s %9s %9s %9s %9s %6s %6s %9s%s\n",
                 "kernel", "paper name", "passes", "launched", "shaded", "discarded", "fetches",
-                "read B", "written B", "loads", "reads", "host ms");
+                "read B", "written B", "loads", "reads", "host ms",
+                device_timed ? "    gpu ms" : "");
   out += line;
   auto row = [&](const std::string& n, const std::string& pn, const Counters& c) {
-    std::snprintf(line, sizeof line, "%-24s %-22s %7s %9s %9s %9s %9s %9s %9s %6s %6s %9.2f\n",
+    std::snprintf(line, sizeof line, "%-24s %-22s %7s %9s %9s %9s %9s %9s %9s %6s %6s %9.2f",
                   n.c_str(), pn.c_str(), human(c.passes).c_str(),
                   human(c.fragments_launched).c_str(), human(c.fragments_shaded).c_str(),
                   human(c.fragments_discarded).c_str(), human(c.texture_fetches).c_str(),
                   human(c.bytes_read).c_str(), human(c.bytes_written).c_str(),
                   human(c.program_loads).c_str(), human(c.query_readbacks).c_str(), c.host_ms);
     out += line;
+    if (device_timed) {
+      std::snprintf(line, sizeof line, " %9.2f", c.device_ms);
+      out += line;
+    }
+    out += "\n";
   };
   for (const ProgramTotals& p : programs) row(p.name, p.paper_name, p.counters);
   row("total", "", totals);

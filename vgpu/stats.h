@@ -32,6 +32,9 @@ struct Counters {
   uint64_t queries = 0;          // occlusion queries issued
   uint64_t query_readbacks = 0;  // query results read back by the host (a CPU-GPU sync)
   double host_ms = 0;            // host wall time (the only counter that varies run to run)
+  // Time the passes took on a real device (GL timer queries); 0 on the emulator, which has no
+  // device time of its own (the cost model predicts one).
+  double device_ms = 0;
 
   Counters& operator+=(const Counters& o);
   // Every integer counter equal (host_ms excluded).
@@ -59,8 +62,9 @@ inline constexpr std::pair<const char*, uint64_t Counters::*> kCounterFields[] =
     {"queries", &Counters::queries},
     {"query_readbacks", &Counters::query_readbacks}};
 
-// The counters as a JSON object: every field of kCounterFields, then host_ms.
-nlohmann::ordered_json to_json(const Counters& c);
+// The counters as a JSON object: every field of kCounterFields, then host_ms, then device_ms
+// (null unless the device measured it).
+nlohmann::ordered_json to_json(const Counters& c, bool device_timed = false);
 
 // One pass as recorded: which program, what it drew, what it cost.
 struct PassRecord {
@@ -82,6 +86,7 @@ struct FrameStats {
   std::vector<ProgramTotals> programs;
   Counters totals;
   bool keep_pass_records = true;  // off: only per-program and frame totals (long renders)
+  bool device_timed = false;      // device_ms holds measured times (the GL device)
 
   ProgramTotals& program(const std::string& name, const std::string& paper_name, int instructions);
   const ProgramTotals* find(const std::string& name) const;

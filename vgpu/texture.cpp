@@ -2,6 +2,7 @@
 #include "vgpu/texture.h"
 
 #include <algorithm>
+#include <atomic>
 #include <stdexcept>
 
 namespace vgpu {
@@ -12,6 +13,11 @@ Texture::Texture(std::string name, int width, int height, int channels, Format f
   if (channels < 1 || channels > 4)
     throw std::invalid_argument("texture " + name_ + ": texels have 1 to 4 channels");
   data_.assign(size_t(width) * height * channels, 0.0f);
+}
+
+uint64_t Texture::next_id() {
+  static std::atomic<uint64_t> next{1};
+  return next++;
 }
 
 void Texture::fill(std::span<const float> texel) {

@@ -17,6 +17,14 @@ class Texture {
   Texture() = default;
   // Allocates width x height texels of `channels` channels, all zero.
   Texture(std::string name, int width, int height, int channels, Format format = Format::fp32);
+  // A copy is another texture in video memory (a new id); a move keeps the id.
+  Texture(const Texture& o) : Texture(o, next_id()) {}
+  Texture& operator=(const Texture& o) { return *this = Texture(o); }
+  Texture(Texture&&) = default;
+  Texture& operator=(Texture&&) = default;
+
+  // Identity for devices that keep their own copy of a texture (the GL device's objects).
+  uint64_t id() const { return id_; }
 
   const std::string& name() const { return name_; }
   int width() const { return width_; }
@@ -37,10 +45,21 @@ class Texture {
   size_t index(int x, int y) const { return (size_t(y) * width_ + x) * channels_; }
 
  private:
+  Texture(const Texture& o, uint64_t id)
+      : name_(o.name_),
+        width_(o.width_),
+        height_(o.height_),
+        channels_(o.channels_),
+        format_(o.format_),
+        data_(o.data_),
+        id_(id) {}
+  static uint64_t next_id();
+
   std::string name_;
   int width_ = 0, height_ = 0, channels_ = 0;
   Format format_ = Format::fp32;
   std::vector<float> data_;
+  uint64_t id_ = next_id();
 };
 
 // An early-z / stencil style mask over a render target: one byte per pixel. A pass that tests

@@ -3,6 +3,8 @@
 
 #include "vgpu/format.h"
 #include "vgpu/fragment.h"
+#include "vgpu/device.h"
+#include "vgpu/glsl.h"
 #include "vgpu/gpu.h"
 #include "vgpu/lanes.h"
 #include "vgpu/precision.h"

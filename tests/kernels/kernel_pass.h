@@ -1,6 +1,8 @@
 // Helpers shared by the kernel tests: hand-made textures, one kernel pass through a real
 // vgpu::Gpu (profile gf5700), and per-channel texel checks. Expected values always come from the
-// test itself, never from the kernels' own helpers.
+// test itself, never from the kernels' own helpers. Built into test_gl (KTEST_GL), every pass
+// that run() makes on the vgpu is made again on the GL device, from the same texels, and its
+// outputs and query count are checked against the vgpu's (tests/gl/gl_compare.h).
 #pragma once
 
 #include <doctest/doctest.h>
@@ -12,6 +14,9 @@
 
 #include "kernels/kernels.h"
 #include "vgpu/vgpu.h"
+#ifdef KTEST_GL
+#include "tests/gl/gl_compare.h"
+#endif
 
 namespace ktest {
 
@@ -55,7 +60,7 @@ inline glm::vec4 at(const Texture& t, int x, int y) {
 // One pass of program p: units[i] bound to texture unit i, rendering into target (whatever the
 // target held is kept where fragments are discarded). With `query`, the pass runs inside an
 // occlusion query and its count is stored there.
-inline vgpu::PassRecord draw(vgpu::Gpu& gpu, const vgpu::Program& p,
+inline vgpu::PassRecord draw(vgpu::Device& gpu, const vgpu::Program& p,
                              const std::vector<const Texture*>& units, Texture& target,
                              uint64_t* query = nullptr) {
   gpu.use_program(p);
@@ -70,15 +75,22 @@ inline vgpu::PassRecord draw(vgpu::Gpu& gpu, const vgpu::Program& p,
 
 // One pass of kernel k over a fresh w x h target of 4 channels, cleared to `fill`.
 template <class K>
-Texture run(vgpu::Gpu& gpu, const K& k, const std::vector<const Texture*>& units, int w, int h,
+Texture run(vgpu::Device& gpu, const K& k, const std::vector<const Texture*>& units, int w, int h,
             glm::vec4 fill = glm::vec4(0.0f), uint64_t* query = nullptr,
             vgpu::PassRecord* record = nullptr) {
   vgpu::KernelProgram<K> program(k);
   Texture out = gpu.make_texture(std::string(K::name) + " out", w, h, 4);
   const float f[4] = {fill.x, fill.y, fill.z, fill.w};
   out.fill(f);
+#ifdef KTEST_GL
+  const Texture before = out;  // the GL pass starts from the same texels
+#endif
   const vgpu::PassRecord rec = draw(gpu, program, units, out, query);
+  gpu.download(out);
   if (record) *record = rec;
+#ifdef KTEST_GL
+  if (dynamic_cast<vgpu::Gpu*>(&gpu)) gltest::check_same_pass(program, units, before, out, query);
+#endif
   return out;
 }
 

@@ -278,7 +278,7 @@ TEST_CASE("queries must be begun before they are ended, and not twice") {
 TEST_CASE("only lane widths 1, 4, 8 and 16 and known profiles exist") {
   CHECK_THROWS_WITH_AS(Gpu(profile("gf5700"), 1, 3), Contains("lane width must be 1, 4, 8 or 16"),
                        Error);
-  CHECK_THROWS_WITH_AS(profile("voodoo2"), Contains("known: gf5700, gf6600, rtx4090"),
+  CHECK_THROWS_WITH_AS(profile("voodoo2"), Contains("known: gf5700, gf6600, rtx4090, h200"),
                        std::invalid_argument);
   CHECK(profile("gf5700").max_outputs == 1);
   CHECK(profile("gf5700").max_instructions == 1024);

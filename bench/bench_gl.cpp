@@ -1,0 +1,285 @@
+// bench_gl: the paper's passes on a real OpenGL driver (the GL device) beside the virtual GPU.
+// Prints, and writes as JSON, per scene and image size: wall ms and GPU ms (timer queries) of a
+// frame and of every kernel, passes and query read-backs, medians of several runs, with the
+// emulator's host ms and the cost model's predictions for the same counters; and the fixed
+// costs of one pass, one query read-back and one program switch, measured on tiny passes.
+// Needs no OpenImageIO and no display: it runs on any machine with EGL (llvmpipe, NVIDIA).
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "gl/context.h"
+#include "gl/gl_device.h"
+#include "host/camera.h"
+#include "host/cost_model.h"
+#include "host/gltf_loader.h"
+#include "host/grid.h"
+#include "host/stream_tracer.h"
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using json = nlohmann::ordered_json;
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  const size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+double ms_since(Clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+// Tiny programs for the fixed costs: copy the own texel (one fetch, one output), the same with
+// one multiply (a second program, so switching between them is a real program change), and a
+// two-target copy (MRT, the profile's outputs permitting).
+struct CopyTexel {
+  static constexpr const char* name = "copy texel";
+  static constexpr const char* paper_name = "-";
+  static constexpr int outputs = 1;
+  static constexpr std::array<const char*, 1> units{"source"};
+  template <class L>
+  void operator()(vgpu::Fragments<L>& f) const {
+    f.out(0) = f.fetch_own(0);
+  }
+};
+struct ScaleTexel {
+  static constexpr const char* name = "scale texel";
+  static constexpr const char* paper_name = "-";
+  static constexpr int outputs = 1;
+  static constexpr std::array<const char*, 1> units{"source"};
+  template <class L>
+  void operator()(vgpu::Fragments<L>& f) const {
+    const vgpu::Vec4<typename L::F> v = f.fetch_own(0);
+    f.out(0) = {v.x * typename L::F(0.5f), v.y, v.z, v.w};
+  }
+};
+struct CopyTwice {
+  static constexpr const char* name = "copy to two targets";
+  static constexpr const char* paper_name = "-";
+  static constexpr int outputs = 2;
+  static constexpr std::array<const char*, 2> units{"source_a", "source_b"};
+  template <class L>
+  void operator()(vgpu::Fragments<L>& f) const {
+    f.out(0) = f.fetch_own(0);
+    f.out(1) = f.fetch_own(1);
+  }
+};
+
+struct Fixed {
+  double wall_us = 0, gpu_us = 0;
+};
+
+// n passes of program p (alternating with q when given) over a size x size target, ping-ponged,
+// each inside an occlusion query read back at once when `readback`; per pass, medians of runs.
+Fixed time_passes(gl::GlDevice& d, int size, int n, int runs, bool readback, const vgpu::Program& p,
+                  const vgpu::Program* q, int targets = 1) {
+  std::vector<vgpu::Texture> tex;
+  for (int i = 0; i < 2 * targets; ++i)
+    tex.push_back(d.make_texture("t" + std::to_string(i), size, size, 4));
+  for (auto& t : tex) d.upload(t);
+  std::vector<double> wall, gpu;
+  for (int r = 0; r <= runs; ++r) {  // run 0 warms up (compiles)
+    d.finish();
+    d.stats().clear();
+    const auto t0 = Clock::now();
+    for (int i = 0; i < n; ++i) {
+      const int a = i & 1, b = a ^ 1;
+      d.use_program(q && (i & 1) ? *q : p);
+      d.unbind_textures();
+      for (int k = 0; k < targets; ++k) d.bind_texture(k, tex[size_t(2 * k + a)]);
+      if (targets == 1)
+        d.set_targets({&tex[size_t(b)]});
+      else
+        d.set_targets({&tex[size_t(b)], &tex[size_t(2 + b)]});
+      if (readback) d.begin_query();
+      d.draw();
+      if (readback) d.end_query();
+    }
+    d.finish();
+    const double w = ms_since(t0);
+    if (r == 0) continue;
+    wall.push_back(1e3 * w / n);
+    gpu.push_back(1e3 * d.stats().totals.device_ms / n);
+  }
+  return {median(wall), median(gpu)};
+}
+
+struct FrameRun {
+  std::vector<double> wall, gpu, host;
+  std::map<std::string, std::vector<double>> kernel_gpu, kernel_host;
+  vgpu::FrameStats stats;
+  std::string device;
+};
+
+FrameRun run_frames(const host::Scene& scene, const host::Grid& grid, const host::Camera& cam,
+                    host::RenderOptions opt, int runs) {
+  FrameRun fr;
+  host::StreamTracer tracer(scene, grid, opt);
+  fr.device = tracer.device().description();
+  for (int r = 0; r <= runs; ++r) {  // run 0 warms up (the GL device compiles its programs)
+    const host::RenderResult res = tracer.render(cam);
+    if (r == 0) continue;
+    fr.wall.push_back(res.render_ms);
+    fr.gpu.push_back(res.stats.totals.device_ms);
+    for (const auto& p : res.stats.programs) {
+      fr.kernel_gpu[p.name].push_back(p.counters.device_ms);
+      fr.kernel_host[p.name].push_back(p.counters.host_ms);
+    }
+    fr.stats = res.stats;
+  }
+  return fr;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"bench_gl: the stream ray tracer's passes on the GL device beside the vgpu"};
+  std::string device = "auto", json_path, grid_text = "15";
+  std::vector<std::string> scenes = {"sphere-alone", "bunny", "bunny-mirror"};
+  std::vector<int> sizes = {256};
+  int runs = 3, micro_passes = 200, threads = 0;
+  bool no_stream = false, no_frames = false;
+  app.add_option("--gl-device", device, "auto, or an EGL device index")->capture_default_str();
+  app.add_option("--scenes", scenes, "Scene names or .gltf paths")->capture_default_str();
+  app.add_option("--sizes", sizes, "Image sizes (square)")
+      ->capture_default_str()
+      ->check(CLI::Range(8, 4096));
+  app.add_option("--grid", grid_text, "Grid: auto, N or AxBxC")->capture_default_str();
+  app.add_option("--runs", runs, "Timed runs per figure (after one warm-up)")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 100));
+  app.add_option("--micro-passes", micro_passes, "Passes per fixed-cost measurement")
+      ->capture_default_str()
+      ->check(CLI::Range(10, 100000));
+  app.add_option("--threads", threads, "Host threads of the vgpu runs (0: all cores)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 256));
+  app.add_flag("--no-stream", no_stream, "Skip the vgpu (emulator) runs");
+  app.add_flag("--no-frames", no_frames, "Only the fixed costs");
+  app.add_option("--json", json_path, "Also write every figure as JSON to this file");
+  CLI11_PARSE(app, argc, argv);
+
+  try {
+    json out;
+    // Fixed costs first, on a device of its own (gf6600: two outputs for the MRT pass).
+    {
+      gl::GlDevice d(vgpu::profile("gf6600"), device);
+      out["device"] = d.description();
+      out["renderer"] = d.context().renderer();
+      out["gl_version"] = d.context().version();
+      std::printf("device: %s\n", d.description().c_str());
+      vgpu::KernelProgram<CopyTexel> copy;
+      vgpu::KernelProgram<ScaleTexel> scale;
+      vgpu::KernelProgram<CopyTwice> twice;
+      json fixed = json::array();
+      auto row = [&](const std::string& what, int size, const Fixed& f) {
+        std::printf("  %-46s %5dx%-5d wall %9.2f us  gpu %9.2f us\n", what.c_str(), size, size,
+                    f.wall_us, f.gpu_us);
+        fixed.push_back(
+            {{"what", what}, {"size", size}, {"wall_us", f.wall_us}, {"gpu_us", f.gpu_us}});
+      };
+      std::printf("fixed costs, per pass (medians of %d runs of %d passes):\n", runs, micro_passes);
+      for (int size : {1, 64, 256}) {
+        const Fixed pass = time_passes(d, size, micro_passes, runs, false, copy, nullptr);
+        const Fixed rb = time_passes(d, size, micro_passes, runs, true, copy, nullptr);
+        const Fixed sw = time_passes(d, size, micro_passes, runs, false, copy, &scale);
+        row("pass", size, pass);
+        row("pass + blocking query read-back", size, rb);
+        row("pass, program switched every pass", size, sw);
+        if (size == 1) {
+          out["pass_us"] = pass.wall_us;
+          out["readback_us"] = rb.wall_us - pass.wall_us;
+          out["program_switch_us"] = sw.wall_us - pass.wall_us;
+        }
+      }
+      for (int size : {1024, 2048}) {
+        row("pass, one RGBA32F target", size,
+            time_passes(d, size, std::max(10, micro_passes / 10), runs, false, copy, nullptr));
+        row("pass, two RGBA32F targets (MRT)", size,
+            time_passes(d, size, std::max(10, micro_passes / 10), runs, false, twice, nullptr, 2));
+      }
+      std::printf(
+          "  => one pass %.2f us, one query read-back %.2f us, one program switch %.2f us "
+          "(1x1 passes, wall)\n",
+          out["pass_us"].get<double>(), out["readback_us"].get<double>(),
+          out["program_switch_us"].get<double>());
+      out["fixed"] = fixed;
+    }
+    if (!no_frames) {
+      json frames = json::array();
+      for (const std::string& name : scenes) {
+        const host::Scene scene = host::load_scene(host::resolve_scene(name));
+        for (int size : sizes) {
+          host::RenderOptions opt;  // docs/table1.md's settings
+          opt.width = opt.height = size;
+          opt.bounces = 2;
+          opt.shading = kernels::ShadingModel::phong;
+          opt.shadows = false;
+          opt.threads = threads;
+          opt.gl_device = device;
+          const host::Grid grid =
+              host::build_grid(scene, host::grid_spec_for(host::parse_grid_spec(grid_text), scene,
+                                                          vgpu::profile(opt.profile)));
+          const host::Camera cam =
+              scene.camera ? *scene.camera : host::frame_bounds(scene.bounds(), 1.0f);
+          for (const char* engine : {"gl", "stream"}) {
+            if (no_stream && std::string(engine) == "stream") continue;
+            opt.device = std::string(engine) == "gl" ? "gl" : "vgpu";
+            const FrameRun fr = run_frames(scene, grid, cam, opt, runs);
+            json f = {{"scene", scene.name},
+                      {"size", size},
+                      {"engine", engine},
+                      {"device", fr.device},
+                      {"runs", runs},
+                      {"wall_ms", median(fr.wall)},
+                      {"gpu_ms", std::string(engine) == "gl" ? json(median(fr.gpu)) : json()},
+                      {"passes", fr.stats.totals.passes},
+                      {"query_readbacks", fr.stats.totals.query_readbacks},
+                      {"program_loads", fr.stats.totals.program_loads},
+                      {"fragments_shaded", fr.stats.totals.fragments_shaded}};
+            json kernels = json::array();
+            for (const auto& p : fr.stats.programs)
+              kernels.push_back({{"name", p.name},
+                                 {"paper_name", p.paper_name},
+                                 {"passes", p.counters.passes},
+                                 {"gpu_ms", median(fr.kernel_gpu.at(p.name))},
+                                 {"host_ms", median(fr.kernel_host.at(p.name))}});
+            f["kernels"] = kernels;
+            if (std::string(engine) == "stream") {
+              json pred;
+              for (const vgpu::Profile& p : vgpu::profiles())
+                pred[p.name] = host::predict(fr.stats, p).total_ms;
+              f["predicted_ms"] = pred;
+            }
+            std::printf("%-14s %4dx%-4d %-6s wall %9.1f ms", scene.name.c_str(), size, size, engine,
+                        median(fr.wall));
+            if (std::string(engine) == "gl") std::printf("  gpu %9.1f ms", median(fr.gpu));
+            std::printf("  passes %6llu  read-backs %5llu\n",
+                        static_cast<unsigned long long>(fr.stats.totals.passes),
+                        static_cast<unsigned long long>(fr.stats.totals.query_readbacks));
+            std::fflush(stdout);
+            frames.push_back(f);
+          }
+        }
+      }
+      out["frames"] = frames;
+    }
+    if (!json_path.empty()) {
+      std::ofstream f(json_path);
+      f << out.dump(2) << "\n";
+      if (!f) throw std::runtime_error(json_path + ": cannot write");
+    }
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "bench_gl: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,89 @@
+// The GL device: the vgpu::Device operations on a real OpenGL 3.3 driver (headless, EGL).
+// Textures become GL textures (RGBA32F and the 1-4 channel fp32/fp16 formats), texture units
+// sampler units read with texelFetch, a program the GLSL printed from its functor's recording
+// (vgpu/glsl.h), a pass one triangle over the rectangle into a framebuffer with the targets
+// attached, a query GL_SAMPLES_PASSED. Every pass is also timed (GL_TIME_ELAPSED) and counted
+// (a GL_SAMPLES_PASSED of its own for its discards); those results are collected without
+// stalling, when the statistics are read. Counters are the emulator's where a driver can know
+// them; lanes_idle and the batch counters are the emulator's SIMD model and stay 0 here.
+#pragma once
+
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "vgpu/device.h"
+#include "vgpu/glsl.h"
+
+namespace gl {
+
+class Context;
+
+class GlDevice final : public vgpu::Device {
+ public:
+  // device: "auto" or an EGL device index (gl::Context). Throws gl::Unavailable.
+  GlDevice(const vgpu::Profile& profile, const std::string& device = "auto");
+  ~GlDevice() override;
+
+  const vgpu::Profile& profile() const override { return profile_; }
+  std::string description() const override;
+  const Context& context() const { return *ctx_; }
+
+  void upload(const vgpu::Texture& t) override;
+  void download(vgpu::Texture& t) override;
+  void use_program(const vgpu::Program& program) override;
+  void bind_texture(int unit, const vgpu::Texture& texture) override;
+  void unbind_textures() override;
+  void set_targets(std::initializer_list<vgpu::Texture*> targets) override;
+  bool has_stencil() const override { return false; }
+  void set_stencil_test(const vgpu::Stencil* stencil) override;
+  void set_stencil_write(vgpu::Stencil* stencil) override;
+  void set_work_mask(const vgpu::Stencil* work) override;
+  void set_work_mask_counts_as_masked(bool) override {}
+  void clear(vgpu::Texture& t, std::initializer_list<float> value) override;
+  const vgpu::PassRecord& draw() override;
+  const vgpu::PassRecord& draw(const vgpu::Rect& rect) override;
+  void begin_query() override;
+  uint64_t end_query() override;
+  vgpu::FrameStats& stats() override;
+
+  // Waits for every pass issued so far (glFinish) and settles their counters and times.
+  void finish();
+  // The GLSL this device compiled for a program with its current uniforms.
+  vgpu::GlslProgram glsl(const vgpu::Program& p) const { return vgpu::to_glsl(p); }
+
+ private:
+  struct GlTexture;
+  struct GlProgram;
+  struct Pending;
+  GlTexture& texture(const vgpu::Texture& t);
+  GlProgram& program_for(const vgpu::Program& p);
+  unsigned framebuffer_for(const std::vector<vgpu::Texture*>& targets);
+  void settle(size_t keep);
+
+  vgpu::Profile profile_;
+  std::unique_ptr<Context> ctx_;
+  unsigned vao_ = 0, clear_fbo_ = 0;
+  std::map<uint64_t, std::unique_ptr<GlTexture>> textures_;
+  std::map<std::string, std::unique_ptr<GlProgram>> compiled_;  // by source text
+  struct Recorded {
+    std::vector<std::byte> uniforms;
+    vgpu::GlslProgram glsl;
+    GlProgram* gl = nullptr;
+  };
+  std::map<uint32_t, Recorded> recorded_;  // by program id
+  std::map<std::vector<uint64_t>, unsigned> fbos_;
+  const vgpu::Program* program_ = nullptr;
+  uint32_t loaded_program_ = 0;
+  std::array<const vgpu::Texture*, vgpu::kMaxTextureUnits> units_{};
+  std::vector<vgpu::Texture*> targets_;
+  bool query_active_ = false;
+  size_t query_first_ = 0;  // first pending pass inside the active query
+  std::vector<Pending> pending_;
+  std::vector<unsigned> free_samples_, free_times_;  // query objects, one pool per target
+  vgpu::FrameStats stats_;
+  vgpu::PassRecord last_pass_;
+};
+
+}  // namespace gl

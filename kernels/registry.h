@@ -1,0 +1,32 @@
+// Every kernel as a program with its default uniforms, in the order a frame first runs them:
+// what `vgpu-rt kernels` lists and prints as GLSL.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "kernels/kernels.h"
+#include "vgpu/program.h"
+
+namespace kernels {
+
+inline std::vector<std::unique_ptr<vgpu::Program>> all_programs() {
+  std::vector<std::unique_ptr<vgpu::Program>> v;
+  v.push_back(std::make_unique<vgpu::KernelProgram<GenerateRays>>());
+  v.push_back(std::make_unique<vgpu::KernelProgram<InitTraversal>>());
+  v.push_back(std::make_unique<vgpu::KernelProgram<RaysInGrid>>());
+  v.push_back(std::make_unique<vgpu::KernelProgram<UpdateVoxel>>());
+  v.push_back(std::make_unique<vgpu::KernelProgram<RaysIntersecting>>());
+  v.push_back(std::make_unique<vgpu::KernelProgram<Intersections>>());
+  v.push_back(std::make_unique<vgpu::KernelProgram<NextTriangle>>());
+  v.push_back(std::make_unique<vgpu::KernelProgram<Traversal>>());
+  v.push_back(std::make_unique<vgpu::KernelProgram<ReflectionOrigin>>());
+  v.push_back(std::make_unique<vgpu::KernelProgram<ShadowRays>>());
+  v.push_back(std::make_unique<vgpu::KernelProgram<Shader>>());
+  v.push_back(std::make_unique<vgpu::KernelProgram<ReflectedRays>>());
+  v.push_back(std::make_unique<vgpu::KernelProgram<ReflectionDirection>>());
+  v.push_back(std::make_unique<vgpu::KernelProgram<ResetTraversal>>());
+  return v;
+}
+
+}  // namespace kernels

@@ -1,0 +1,142 @@
+// The GL device against the vgpu on whole frames: the generated programs, every occlusion-query
+// count of a frame query by query, and every bundled scene's image and hit ids. Runs on
+// llvmpipe in CI (any EGL device works).
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+
+#include "gl/context.h"
+#include "host/camera.h"
+#include "host/gltf_loader.h"
+#include "host/grid.h"
+#include "host/stream_tracer.h"
+#include "kernels/registry.h"
+#include "tests/gl/gl_compare.h"
+
+namespace {
+
+struct Frame {
+  host::RenderResult result;
+  std::string device;
+};
+
+Frame render(const std::string& scene_name, const std::string& device, int size, bool keep_passes) {
+  const host::Scene scene = host::load_scene(host::resolve_scene(scene_name));
+  host::RenderOptions opt;
+  opt.width = opt.height = size;
+  opt.device = device;
+  opt.threads = 2;
+  opt.keep_pass_records = keep_passes;
+  const host::Grid grid =
+      host::build_grid(scene, host::grid_spec_for({}, scene, vgpu::profile(opt.profile)));
+  const host::Camera cam = scene.camera ? *scene.camera : host::frame_bounds(scene.bounds(), 1.0f);
+  host::StreamTracer tracer(scene, grid, opt);
+  Frame f{tracer.render(cam), tracer.device().description()};
+  return f;
+}
+
+// The counters a driver can know: every one but the emulator's SIMD model.
+bool same_driver_counts(const vgpu::Counters& a, const vgpu::Counters& b) {
+  for (const auto& [name, field] : vgpu::kCounterFields) {
+    const std::string n = name;
+    if (n == "lanes_idle" || n == "idle_in_batch32" || n == "idle_in_batch1024") continue;
+    if (a.*field != b.*field) return false;
+  }
+  return true;
+}
+
+// Per-kernel worst ulps, printed when the kernel tests ran in this process (VGPU_GL_ULPS=1).
+const int kReport = [] {
+  if (std::getenv("VGPU_GL_ULPS"))
+    std::atexit([] {
+      for (const auto& [name, ulps] : gltest::worst_ulps())
+        std::fprintf(stderr, "gl ulps: %-22s %6llu (allowed %d)\n", name.c_str(),
+                     static_cast<unsigned long long>(ulps), gltest::ulps_allowed(name));
+    });
+  return 0;
+}();
+
+}  // namespace
+
+TEST_CASE("every kernel's generated GLSL compiles on the GL device and declares its outputs") {
+  for (const auto& p : kernels::all_programs()) {
+    const vgpu::GlslProgram g = vgpu::to_glsl(*p);
+    CAPTURE(p->name());
+    CHECK(g.source.find("layout(location = 0) out vec4 out0;") != std::string::npos);
+    // One sampler per unit the counting run says the kernel fetches from.
+    const vgpu::Program::Analysis a = p->analyze();
+    int fetched = 0;
+    for (int u = 0; u < vgpu::kMaxTextureUnits; ++u) fetched += a.fetches.per_unit[u] > 0;
+    CHECK(int(g.units.size()) == fetched);
+    // Never more statements than the counting run's instructions (dead ones are dropped), and
+    // a discard exactly in the programs that kill fragments.
+    CHECK(g.statements <= a.instructions + 1);
+    CHECK((g.source.find("discard;") != std::string::npos) == p->idle_discards());
+  }
+}
+
+TEST_CASE("a uniform change reuses the compiled GLSL: constants are uniforms, not text") {
+  vgpu::KernelProgram<kernels::Traversal> a, b;
+  b.kernel.grid.lo = {1.5f, -2.0f, 3.25f};
+  b.kernel.grid.res = {7, 8, 9};
+  const vgpu::GlslProgram ga = vgpu::to_glsl(a), gb = vgpu::to_glsl(b);
+  CHECK(ga.source == gb.source);
+  CHECK(ga.constants != gb.constants);
+}
+
+TEST_CASE("the GL device refuses what it cannot do, naming it") {
+  gl::GlDevice& d = gltest::device();
+  vgpu::Stencil mask(4, 4);
+  CHECK_THROWS_WITH_AS(d.set_stencil_test(&mask), doctest::Contains("no stencil masks"),
+                       vgpu::Error);
+  vgpu::Texture t("fp24 state", 4, 4, 4, vgpu::Format::fp24);
+  CHECK_THROWS_WITH_AS(d.upload(t), doctest::Contains("fp24"), vgpu::Error);
+  CHECK_THROWS_WITH_AS(gl::Context("99"), doctest::Contains("--gl-device 99"), gl::Unavailable);
+  CHECK_THROWS_AS(gl::Context("first"), gl::Unavailable);
+}
+
+TEST_CASE("every occlusion-query count of a bunny and a bunny-refl frame equals the vgpu's") {
+  for (const char* name : {"bunny", "bunny-refl"}) {
+    CAPTURE(name);
+    const Frame v = render(name, "vgpu", 64, true), g = render(name, "gl", 64, true);
+    const auto& pv = v.result.stats.passes;
+    const auto& pg = g.result.stats.passes;
+    size_t queries = 0;
+    for (size_t i = 0; i < std::min(pv.size(), pg.size()); ++i) {
+      CAPTURE(i);
+      CAPTURE(pv[i].program);
+      REQUIRE(pv[i].program == pg[i].program);
+      REQUIRE(pv[i].query_result == pg[i].query_result);
+      queries += pv[i].query_result >= 0;
+      CHECK(same_driver_counts(pv[i].counters, pg[i].counters));
+    }
+    REQUIRE(pv.size() == pg.size());
+    CHECK(queries == v.result.stats.totals.query_readbacks);
+    CHECK(same_driver_counts(v.result.stats.totals, g.result.stats.totals));
+    CHECK(g.result.stats.totals.device_ms > 0);
+  }
+}
+
+TEST_CASE("every bundled scene at 128x128 on the GL device matches the vgpu's hit ids and colour") {
+  for (const auto& [name, path] : host::list_scenes()) {
+    CAPTURE(name);
+    const Frame v = render(name, "vgpu", 128, false), g = render(name, "gl", 128, false);
+    const size_t n = v.result.hit_id.size();
+    size_t same = 0;
+    double sq = 0;
+    for (size_t i = 0; i < n; ++i) same += v.result.hit_id[i] == g.result.hit_id[i];
+    for (size_t i = 0; i < v.result.rgb.size(); ++i) {
+      const double d = double(v.result.rgb[i]) - double(g.result.rgb[i]);
+      sq += d * d;
+    }
+    const double mse = sq / double(v.result.rgb.size());
+    const double psnr = mse == 0 ? INFINITY : 10 * std::log10(1.0 / mse);
+    MESSAGE(name << ": hit ids equal on " << same << " of " << n << " pixels, colour PSNR " << psnr
+                 << " dB");
+    CHECK(double(same) >= 0.999 * double(n));
+    CHECK(psnr >= 60.0);
+  }
+}

@@ -1,0 +1,80 @@
+// What every device shares: texture limits, the checks before a pass and its static counters.
+#include "vgpu/device.h"
+
+#include <algorithm>
+
+namespace vgpu {
+
+Texture Device::make_texture(std::string name, int width, int height, int channels,
+                             Format format) const {
+  Texture t(std::move(name), std::max(width, 1), std::max(height, 1), channels, format);
+  if (width <= 0 || height <= 0) throw Error("texture '" + t.name() + "' has an empty size");
+  check_texture(t);
+  return t;
+}
+
+void Device::check_texture(const Texture& t) const {
+  const Profile& pr = profile();
+  const int m = pr.max_texture_size;
+  if (t.width() > m || t.height() > m)
+    throw Error("texture '" + t.name() + "' is " + std::to_string(t.width()) + "x" +
+                std::to_string(t.height()) + " texels; profile " + pr.name + " allows at most " +
+                std::to_string(m) + "x" + std::to_string(m));
+}
+
+void check_pass(const Profile& profile, const Program& p, const Program::Analysis& a,
+                const Texture* const* units, const std::vector<Texture*>& targets,
+                const Rect& rect) {
+  const std::string pname = p.name();
+  auto fail = [](const std::string& what) { throw Error(what); };
+  if (p.outputs() > profile.max_outputs)
+    fail("program '" + pname + "' writes " + std::to_string(p.outputs()) + " outputs; profile " +
+         profile.name + " allows " + std::to_string(profile.max_outputs) +
+         " (no multiple render targets)");
+  if (int(targets.size()) != p.outputs())
+    fail("program '" + pname + "' writes " + std::to_string(p.outputs()) + " outputs but " +
+         std::to_string(targets.size()) + " render targets are set");
+  if (a.instructions > profile.max_instructions)
+    fail("program '" + pname + "' has " + std::to_string(a.instructions) +
+         " instructions; profile " + profile.name + " allows " +
+         std::to_string(profile.max_instructions));
+  const Texture& t0 = *targets[0];
+  for (const Texture* t : targets) {
+    if (t->width() != t0.width() || t->height() != t0.height())
+      fail("program '" + pname + "': render targets differ in size");
+    for (int u = 0; u < kMaxTextureUnits; ++u)
+      if (units[u] == t)
+        fail("program '" + pname + "' reads texture '" + t->name() + "' (unit " +
+             std::to_string(u) + ") while rendering to it: read/write hazard, use ping-pong");
+  }
+  for (int u = 0; u < kMaxTextureUnits; ++u)
+    if (a.fetches.per_unit[u] && !units[u])
+      fail("program '" + pname + "' fetches from texture unit " + std::to_string(u) +
+           ", which has no texture bound");
+  if (rect.x0 < 0 || rect.y0 < 0 || rect.x1 > t0.width() || rect.y1 > t0.height() ||
+      rect.x0 > rect.x1 || rect.y0 > rect.y1)
+    fail("program '" + pname + "': drawn rectangle outside the render target");
+}
+
+Counters pass_counters(const Program::Analysis& a, const Texture* const* units,
+                       const std::vector<Texture*>& targets, uint64_t launched, uint64_t shaded,
+                       uint64_t discarded) {
+  Counters c;
+  c.passes = 1;
+  c.fragments_launched = launched;
+  c.fragments_shaded = shaded;
+  c.fragments_discarded = discarded;
+  c.instructions = shaded * uint64_t(a.instructions);
+  uint64_t read_per_frag = 0;
+  for (int u = 0; u < kMaxTextureUnits; ++u)
+    if (a.fetches.per_unit[u])
+      read_per_frag += uint64_t(a.fetches.per_unit[u]) * uint64_t(units[u]->bytes_per_texel());
+  c.texture_fetches = shaded * uint64_t(a.fetches.total());
+  c.bytes_read = shaded * read_per_frag;
+  uint64_t write_per_frag = 0;
+  for (const Texture* t : targets) write_per_frag += uint64_t(t->bytes_per_texel());
+  c.bytes_written = (shaded - discarded) * write_per_frag;
+  return c;
+}
+
+}  // namespace vgpu
