@@ -285,5 +285,5 @@ TEST_CASE("only lane widths 1, 4, 8 and 16 and known profiles exist") {
   CHECK(profile("gf5700").branching == Branching::none);
   CHECK(profile("gf6600").max_outputs == 4);
   CHECK(profile("gf6600").branching == Branching::dynamic);
-  CHECK(profiles().size() == 3);
+  CHECK(profiles().size() == 4);  // gf5700, gf6600, rtx4090, h200
 }
