@@ -25,6 +25,10 @@ void check_image_path(const std::string& path) {
   const std::string e = lower_ext(path);
   if (e != ".png" && e != ".exr")
     throw InputError(path + ": unsupported image extension '" + e + "' (use .png or .exr)");
+  check_output_dir(path);
+}
+
+void check_output_dir(const std::string& path) {
   const fs::path dir = fs::absolute(fs::path(path)).parent_path();
   std::error_code ec;
   if (!fs::is_directory(dir, ec))

@@ -16,6 +16,8 @@ void write_image(const std::string& path, int width, int height, int channels,
 
 // Checks a path can be written as an image before any work is done (extension, directory).
 void check_image_path(const std::string& path);
+// Checks the directory a file is to be written in exists and is writable.
+void check_output_dir(const std::string& path);
 
 struct ImageComparison {
   int width = 0, height = 0, channels = 0;

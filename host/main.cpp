@@ -23,6 +23,7 @@
 #include "host/gltf_loader.h"
 #include "host/grid.h"
 #include "host/image_io.h"
+#include "host/report.h"
 #include "host/stream_tracer.h"
 #include "kernels/registry.h"
 #include "vgpu/glsl.h"
@@ -47,6 +48,8 @@ struct RenderArgs {
   std::string masks = "off";
   std::string stats = "table";
   std::string stats_json;
+  std::string stats_csv;
+  std::string report;
   std::vector<std::string> aovs;
   std::string trace_pixel;
   bool quiet = false;
@@ -128,6 +131,10 @@ int run_render(const RenderArgs& a) {
   const bool gl = a.engine == "gl";
   if (cpu && (a.predict || !a.trace_pixel.empty()))
     throw UsageError("--predict and --trace-pixel need --engine stream");
+  if (a.engine != "stream" && (!a.report.empty() || !a.stats_csv.empty()))
+    throw UsageError(
+        "--report and --stats-csv need --engine stream (the report reads the "
+        "emulator's per-fragment state)");
   if (gl) {
     // The GL device runs every fragment in fp32 GLSL; the emulator-only features are refused.
     if (!host::have_gl_device())
@@ -140,6 +147,18 @@ int run_render(const RenderArgs& a) {
           "--masks on and --precision fp24/fp16 need --engine stream");
     opt.device = "gl";
     opt.gl_device = a.gl_device;
+  }
+  if (!a.report.empty() && int64_t(opt.width) * opt.height > host::kReportMaxPixels)
+    throw UsageError("--report: at most " + std::to_string(host::kReportMaxPixels) +
+                     " pixels (512x512); got " + a.size);
+  if (!a.report.empty()) host::check_output_path(a.report, ".html");
+  if (!a.stats_csv.empty()) host::check_output_path(a.stats_csv, ".csv");
+  std::optional<host::FrameRecorder> recorder;
+  if (!a.report.empty() || !a.stats_csv.empty()) {
+    recorder.emplace(opt.width, opt.height, opt.masks, a.report.empty() ? 0 : host::kHistoryStride,
+                     opt.trace_pixel ? std::vector{*opt.trace_pixel} : std::vector<glm::ivec2>{},
+                     !a.report.empty());
+    opt.observer = &*recorder;
   }
 
   const std::string path = host::resolve_scene(a.scene);
@@ -166,6 +185,7 @@ int run_render(const RenderArgs& a) {
   const host::RenderResult r =
       cpu ? host::render_cpu(scene, grid, cam, opt, &cpu_stats) : tracer->render(cam);
   if (tty) std::fprintf(stderr, "\n");
+  if (recorder) recorder->finish(r.stats);
 
   if (!a.out.empty()) host::write_image(a.out, r.width, r.height, 3, r.rgb);
   if (!aov_depth.empty()) host::write_image(aov_depth, r.width, r.height, 1, r.depth);
@@ -242,6 +262,8 @@ int run_render(const RenderArgs& a) {
       throw host::InputError(a.stats_json + ": cannot write the statistics");
     }
   }
+  if (!a.stats_csv.empty()) host::write_stats_csv(a.stats_csv, *recorder);
+  if (!a.report.empty()) host::write_report(a.report, *recorder, r, j);
   if (a.stats == "json") {
     std::cout << j.dump(2) << "\n";
   } else if (a.stats == "table") {
@@ -368,6 +390,10 @@ int main(int argc, char** argv) {
   render->add_option("--stats", a.stats, "table | json | none")->capture_default_str();
   render->add_option("--stats-json", a.stats_json,
                      "Also write the statistics as JSON to this file");
+  render->add_option("--stats-csv", a.stats_csv,
+                     "Also write one row per pass (kernel, fragments, fetches, query) as CSV");
+  render->add_option("--report", a.report,
+                     "Write an HTML report of the frame (timeline, cost maps, pixel history)");
   render->add_option("--aov", a.aovs,
                      "depth=FILE.exr (distance to primary hit) or hit=FILE.exr (triangle id)");
   render->add_option("--trace-pixel", a.trace_pixel,
@@ -410,6 +436,12 @@ int main(int argc, char** argv) {
   compare->add_option("--threshold", threshold, "Per-channel difference that makes a pixel differ")
       ->capture_default_str();
 
+  std::string da, db;
+  auto* diff = app.add_subcommand(
+      "diff", "Two runs' --stats-json side by side: per kernel and in total, B - A and B / A");
+  diff->add_option("a", da, "First --stats-json file")->required();
+  diff->add_option("b", db, "Second --stats-json file")->required();
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -431,6 +463,10 @@ int main(int argc, char** argv) {
           std::printf("%-14s (unreadable: %s)\n", name.c_str(), e.what());
         }
       }
+      return 0;
+    }
+    if (*diff) {
+      std::cout << host::diff_stats(da, db);
       return 0;
     }
     if (*kernels_cmd) return run_kernels(kernel_name, kernel_glsl);

@@ -250,7 +250,9 @@ const vgpu::PassRecord& StreamTracer::pass(const vgpu::Program& p,
     gpu.set_work_mask_counts_as_masked(opt_.masks);
   }
   const bool traced = traces_pixel(work);
+  if (opt_.observer) opt_.observer->pass_begin(work);
   const vgpu::PassRecord& rec = gpu.draw();
+  if (opt_.observer) opt_.observer->pass({p, rec, out, gpu.branch_flags(), gpu.stats()});
   if (traced && !p.idle_discards()) {
     const int x = opt_.trace_pixel->x, y = opt_.trace_pixel->y;
     const float* t = out.texel(x, y);
@@ -279,6 +281,7 @@ uint64_t StreamTracer::count(const vgpu::Program& p, const Texture& in, const St
   pass(p, {&in}, s_->counter, work);
   const uint64_t n = gpu.end_query();
   if (gpu.has_stencil()) gpu.set_stencil_write(nullptr);
+  if (opt_.observer) opt_.observer->query(n, write, gpu.stats());
   if (traced) {
     char line[160];
     const char* mine = !write                                                 ? ""
@@ -376,8 +379,13 @@ RenderResult StreamTracer::render(const Camera& cam) {
     if (opt_.trace_pixel && opt_.trace_out) *opt_.trace_out << "iteration " << it + 1 << ":\n";
     res.iterations = it + 1;
     if (opt_.progress) opt_.progress(it + 1, iterations);
+    if (opt_.observer) opt_.observer->iteration(it + 1);
     Texture& rays = s.rays[s.cur_rays];
+    if (opt_.observer)
+      opt_.observer->trace_begin(it ? PassObserver::TraceKind::reflected
+                                    : PassObserver::TraceKind::primary);
     trace(s.origins[ro], rays, it == 0, cam);
+    if (opt_.observer) opt_.observer->trace_end();
     Texture& hits = s.isect[s.cur_isect];
     if (it == 0) {
       gpu.download(hits);
@@ -406,7 +414,9 @@ RenderResult StreamTracer::render(const Camera& cam) {
       if (opt_.shadows) {
         s.shadow.kernel.light = lights[li].position;
         pass(s.shadow, {&surface, &s.result[s.cur_result]}, s.shadow_rays);
+        if (opt_.observer) opt_.observer->trace_begin(PassObserver::TraceKind::shadow);
         trace(surface, s.shadow_rays, false, cam);
+        if (opt_.observer) opt_.observer->trace_end();
       }
       pass(s.shader,
            {&surface, &rays, &s.result[s.cur_result], &s.isect[s.cur_isect], &s.colors, &s.v[0],

@@ -7,6 +7,7 @@
 #include <functional>
 #include <optional>
 #include <ostream>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -23,6 +24,33 @@ namespace host {
 inline constexpr double kSlackOfDiagonal = 1e-5;   // GridUniforms::t_slack (in-voxel rule)
 inline constexpr double kOffsetOfDiagonal = 1e-4;  // ReflectionOrigin::offset (origin lift)
 inline constexpr double kAttenOfDiagonal = 0.5;    // Shader::atten_dist
+
+// What the host loop shows an observer (the HTML frame report, host/report.h): every pass with
+// what it ran on, every occlusion-query result, and where iterations and traces begin.
+class PassObserver {
+ public:
+  enum class TraceKind { primary, shadow, reflected };
+  struct Pass {
+    const vgpu::Program& program;
+    const vgpu::PassRecord& record;
+    const vgpu::Texture& target;
+    // Per fragment of the drawn rectangle, row by row: vgpu::kBranchTook, kBranchIdle or 0 (not
+    // shaded); empty when the program does not branch.
+    std::span<const uint8_t> branch_flags;
+    const vgpu::FrameStats& stats;  // the frame so far, this pass included
+  };
+  virtual ~PassObserver() = default;
+  virtual void iteration(int iteration) = 0;  // 1-based
+  virtual void trace_begin(TraceKind kind) = 0;
+  virtual void trace_end() = 0;
+  // Before a pass: the fragments with work to do (nullptr: every fragment). A counting pass may
+  // write the same stencil, so this is the one moment it can be seen.
+  virtual void pass_begin(const vgpu::Stencil* work) = 0;
+  virtual void pass(const Pass& p) = 0;
+  // After a counting pass: its query result and the stencil it wrote (nullptr: none).
+  virtual void query(uint64_t result, const vgpu::Stencil* written,
+                     const vgpu::FrameStats& stats) = 0;
+};
 
 struct RenderOptions {
   int width = 256, height = 256;  // the paper's image size
@@ -51,6 +79,7 @@ struct RenderOptions {
   bool keep_pass_records = false;
   // Called at the start of each ray-tracing iteration (1-based) with the iteration count.
   std::function<void(int iteration, int iterations)> progress;
+  PassObserver* observer = nullptr;  // not owned
 };
 
 struct RenderResult {

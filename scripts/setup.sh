@@ -10,15 +10,26 @@ pkgs=(
   clang libclang-rt-14-dev clang-format
   python3-matplotlib
   libegl-dev libopengl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri
+  chromium
 )
 missing=()
 for p in "${pkgs[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
 done
+# node and npm for the report's JS (below): Debian's, unless some node is installed already.
+command -v npm >/dev/null || missing+=(nodejs npm)
 if ((${#missing[@]})); then
   sudo_cmd=""
   [ "$(id -u)" -ne 0 ] && sudo_cmd="sudo"
   echo "setup: installing ${missing[*]}" >&2
   $sudo_cmd apt-get update -qq
   DEBIAN_FRONTEND=noninteractive $sudo_cmd apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi
+
+# The HTML report's vendored JS (host/report/package-lock.json): Chart.js, embedded into every
+# report by the build, and playwright-core, which drives chromium in the report's browser test.
+report_dir="$(dirname "$0")/../host/report"
+if [ ! -f "$report_dir/node_modules/chart.js/dist/chart.umd.js" ] || [ ! -d "$report_dir/node_modules/playwright-core" ]; then
+  echo "setup: npm ci in host/report" >&2
+  (cd "$report_dir" && npm ci --no-audit --no-fund --loglevel=error)
 fi

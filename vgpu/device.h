@@ -5,6 +5,7 @@
 #pragma once
 
 #include <initializer_list>
+#include <span>
 #include <stdexcept>
 #include <string>
 
@@ -69,6 +70,11 @@ class Device {
   // end_query() reads the result back (a synchronisation, counted as a query read-back).
   virtual void begin_query() = 0;
   virtual uint64_t end_query() = 0;
+
+  // Per fragment of the last pass's rectangle, row by row, whether it took the program's branch
+  // (vgpu::Gpu: kBranchTook, kBranchIdle, 0), for the frame report's occupancy; empty on a
+  // device that does not see fragments (the GL device) or after a program without a branch.
+  virtual std::span<const uint8_t> branch_flags() const { return {}; }
 
   // The frame's statistics so far (a device that measures asynchronously settles them first).
   virtual FrameStats& stats() = 0;

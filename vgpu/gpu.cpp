@@ -13,7 +13,7 @@ namespace vgpu {
 namespace {
 
 // Batch flags per fragment: kTook took the branch, kIdle sat idle in it, 0 not shaded.
-constexpr uint8_t kTook = 1, kIdle = 2;
+constexpr uint8_t kTook = kBranchTook, kIdle = kBranchIdle;
 
 // Idle fragments in the 8x4 and the 32x32 tiles of a w x h flag map where no fragment took the
 // branch: {in 8x4 tiles, in 32x32 tiles}. Eight flags are tested at once as one 64-bit word.
@@ -402,6 +402,8 @@ const PassRecord& Gpu::draw(const Rect& rect) {
   if (a.branches > 0) {
     batch_flags_.assign(size_t(rect.width()) * size_t(rect.height()), 0);
     flags = batch_flags_.data();
+  } else {
+    batch_flags_.clear();
   }
   const Format precision = precision_of(p);
   auto body = [&](int ya, int yb, Chunk& c) {

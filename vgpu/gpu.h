@@ -18,6 +18,7 @@
 #include <initializer_list>
 #include <memory>
 #include <mutex>
+#include <span>
 #include <stdexcept>
 #include <thread>
 #include <vector>
@@ -25,6 +26,9 @@
 #include "vgpu/device.h"
 
 namespace vgpu {
+
+// Batch flags of one fragment (Gpu::branch_flags): it took the program's branch, or sat idle in it.
+inline constexpr uint8_t kBranchTook = 1, kBranchIdle = 2;
 
 class Gpu final : public Device {
  public:
@@ -85,6 +89,10 @@ class Gpu final : public Device {
   // end_query() reads the result back (a synchronisation, counted as a query read-back).
   void begin_query() override;
   uint64_t end_query() override;
+
+  // After a draw of a program that branches: per fragment of the drawn rectangle, row by row,
+  // kBranchTook, kBranchIdle or 0 (not shaded). Empty after a draw of one that does not.
+  std::span<const uint8_t> branch_flags() const override { return batch_flags_; }
 
   FrameStats& stats() override { return stats_; }
   const FrameStats& stats() const { return stats_; }

@@ -50,12 +50,15 @@ bool same_driver_counts(const vgpu::Counters& a, const vgpu::Counters& b) {
 
 // Per-kernel worst ulps, printed when the kernel tests ran in this process (VGPU_GL_ULPS=1).
 const int kReport = [] {
-  if (std::getenv("VGPU_GL_ULPS"))
+  if (std::getenv("VGPU_GL_ULPS")) {
+    gltest::worst_ulps();  // both maps constructed first, so they outlive the handler
+    gltest::ulps_allowed("");
     std::atexit([] {
       for (const auto& [name, ulps] : gltest::worst_ulps())
         std::fprintf(stderr, "gl ulps: %-22s %6llu (allowed %d)\n", name.c_str(),
                      static_cast<unsigned long long>(ulps), gltest::ulps_allowed(name));
     });
+  }
   return 0;
 }();
 

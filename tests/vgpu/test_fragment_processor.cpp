@@ -357,3 +357,36 @@ TEST_CASE("the counting run derives instructions, fetches and branches from the 
   CHECK(three.branches == 3);
   CHECK(three.fetches.total() == 1);
 }
+
+TEST_CASE("branch_flags says per fragment whether it took the branch, sat idle or was not shaded") {
+  for (int lanes : {1, 8}) {
+    CAPTURE(lanes);
+    Gpu gpu(profile("gf6600"), 2, lanes);
+    Texture out = gpu.make_texture("out", 24, 6, 4);
+    int runs = 0;
+    KernelProgram<LeftBranch> k;
+    k.kernel.runs = &runs;
+    Stencil test(24, 6, 1);
+    test.set(3, 2, 0);
+    test.set(15, 5, 0);
+    gpu.use_program(k);
+    gpu.set_targets({&out});
+    gpu.set_stencil_test(&test);
+    gpu.draw();
+    const std::span<const uint8_t> flags = gpu.branch_flags();
+    REQUIRE(flags.size() == 24 * 6);
+    for (int y = 0; y < 6; ++y)
+      for (int x = 0; x < 24; ++x) {
+        CAPTURE(x);
+        CAPTURE(y);
+        const uint8_t want = !test.get(x, y) ? 0 : x < 10 ? kBranchTook : kBranchIdle;
+        CHECK(flags[size_t(y) * 24 + x] == want);
+      }
+    KernelProgram<vgpu_test::Copy> plain;  // no branch
+    Texture in = gpu.make_texture("in", 24, 6, 4);
+    gpu.use_program(plain);
+    gpu.bind_texture(0, in);
+    gpu.draw();
+    CHECK(gpu.branch_flags().empty());
+  }
+}

@@ -1,0 +1,62 @@
+// The HTML report as a person would check it: vgpu-rt writes a report, headless chromium (driven
+// by playwright-core) opens it from disk; the test fails on any page script error, clicks a
+// pixel of the image and compares the history the page shows with that pixel's --trace-pixel
+// output, line by line, and compares the timeline's sums with the --stats-json totals.
+// Usage: node report_in_browser.mjs VGPU_RT WORK_DIR
+import { execFileSync } from "node:child_process";
+import fs from "node:fs";
+import { createRequire } from "node:module";
+import path from "node:path";
+
+const here = path.dirname(new URL(import.meta.url).pathname);
+const require = createRequire(import.meta.url);
+const { chromium } = require(path.join(here, "../../host/report/node_modules/playwright-core"));
+const [vgpu, work] = process.argv.slice(2);
+fs.mkdirSync(work, { recursive: true });
+const html = path.join(work, "sphere.html"), stats = path.join(work, "sphere.json");
+const [px, py] = [37, 29];  // on the sphere; off the 16-pixel sample grid (kept: it is traced)
+const trace = execFileSync(vgpu, ["render", "sphere", "--size", "64x48", "--quiet", "--stats", "none",
+  "--threads", "2", "--report", html, "--stats-json", stats, "--trace-pixel", `${px},${py}`], { encoding: "utf8" });
+// The pass lines of the trace (not "pixel x,y:" or "iteration n:").
+const expected = trace.split("\n").filter(l => l.startsWith("  "));
+
+let failed = 0, passed = 0;
+const check = (ok, what) => { if (ok) ++passed; else { ++failed; console.error("FAILED: " + what); } };
+
+const browser = await chromium.launch({ executablePath: "/usr/bin/chromium", args: ["--no-sandbox",
+  "--disable-gpu", "--disable-quic", "--no-first-run", "--disable-background-networking",
+  "--disable-component-update", "--disable-sync"] });
+try {
+  const page = await browser.newPage({ viewport: { width: 1320, height: 1000 } });
+  const errors = [];
+  page.on("pageerror", e => errors.push(e.message));
+  page.on("console", m => { if (m.type() === "error") errors.push(m.text()); });
+  page.on("request", r => { if (!r.url().startsWith("file:") && !r.url().startsWith("data:")) errors.push("network request: " + r.url()); });
+  await page.goto("file://" + path.resolve(html));
+  await page.waitForFunction(() => document.body.dataset.ready === "1" || document.body.dataset.error, null, { timeout: 60000 });
+  check(errors.length === 0 && !(await page.evaluate(() => document.body.dataset.error)), `no script errors (${errors.join("; ")})`);
+
+  // Click the pixel on the image as a person would: the canvas is scaled up.
+  const box = await page.locator("#img").boundingBox();
+  await page.mouse.click(box.x + (px + 0.5) * box.width / 64, box.y + (py + 0.5) * box.height / 48);
+  check(await page.evaluate(() => document.body.dataset.historyPixel) === `${px},${py}`, "the click picks the pixel");
+  const rows = await page.$$eval("#history tr", trs => trs.slice(1).map(tr => Array.from(tr.children, td => td.textContent)));
+  // Columns: #, pass, iteration, trace, paper name, kernel, writes, state/query. Printed as
+  // StreamTracer::pass and ::count print them.
+  const shown = rows.map(r => r[7].startsWith("query:")
+    ? `  ${r[4].padEnd(22)} ${r[5].padEnd(24)}    ${r[7]}`
+    : `  ${r[4].padEnd(22)} ${r[5].padEnd(24)} -> ${r[6].padEnd(14)} ${r[7]}`);
+  check(shown.length === expected.length, `the page lists ${shown.length} passes for the pixel, --trace-pixel ${expected.length}`);
+  let first = -1;
+  for (let i = 0; i < Math.min(shown.length, expected.length); ++i) if (shown[i] !== expected[i]) { first = i; break; }
+  check(first < 0, first < 0 ? "" : `history row ${first + 1}:\n  page:  ${shown[first]}\n  trace: ${expected[first]}`);
+  check(shown.length > 10 && shown[0].includes("generadorRayos") && shown[1].includes("initTraversal"), "the known first passes: generadorRayos, initTraversal");
+
+  const totals = JSON.parse(fs.readFileSync(stats, "utf8")).totals;
+  const sums = await page.evaluate(() => window.report.timelineTotals());
+  for (const [k, v] of Object.entries(sums)) check(totals[k] === v, `timeline sum of ${k}: ${v}, statistics ${totals[k]}`);
+} finally {
+  await browser.close();
+}
+console.log(`${passed} passed, ${failed} failed`);
+process.exit(failed ? 1 : 0);
