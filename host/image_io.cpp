@@ -6,6 +6,7 @@
 #include <OpenImageIO/imageio.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 
@@ -22,9 +23,16 @@ static std::string lower_ext(const std::string& path) {
 }
 
 void check_image_path(const std::string& path) {
+  check_output_path(path, {".png", ".exr"});
+}
+
+void check_output_path(const std::string& path, const std::vector<std::string>& extensions) {
   const std::string e = lower_ext(path);
-  if (e != ".png" && e != ".exr")
-    throw InputError(path + ": unsupported image extension '" + e + "' (use .png or .exr)");
+  if (std::find(extensions.begin(), extensions.end(), e) == extensions.end()) {
+    std::string known;
+    for (const std::string& k : extensions) known += (known.empty() ? "" : " or ") + k;
+    throw InputError(path + ": unsupported extension '" + e + "' (use " + known + ")");
+  }
   const fs::path dir = fs::absolute(fs::path(path)).parent_path();
   std::error_code ec;
   if (!fs::is_directory(dir, ec))

@@ -16,6 +16,9 @@ void write_image(const std::string& path, int width, int height, int channels,
 
 // Checks a path can be written as an image before any work is done (extension, directory).
 void check_image_path(const std::string& path);
+// The same for any output file whose extension (lower-cased, with the dot) must be one of
+// `extensions`. Throws host::InputError "PATH: problem".
+void check_output_path(const std::string& path, const std::vector<std::string>& extensions);
 
 struct ImageComparison {
   int width = 0, height = 0, channels = 0;
