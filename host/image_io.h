@@ -1,5 +1,5 @@
-// Image files through OpenImageIO: writing renders and AOVs without ever leaving a partial file,
-// and comparing two images (share of differing pixels, RMS error, PSNR).
+// Image files: writing renders and AOVs without ever leaving a partial file, and comparing two
+// images (share of differing pixels, RMS error, PSNR). OpenImageIO is loaded on first use.
 #pragma once
 
 #include <string>
