@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <functional>
 #include <string>
@@ -70,6 +71,7 @@ Case crowded_fan(int n) {
   c.scene.lights.push_back({glm::vec3(2, 2, 8), glm::vec3(1.0f)});
   c.grid = host::build_grid_in_box(c.scene, glm::vec3(0), glm::vec3(4), glm::ivec3(4), 1);
   c.camera = look({2, 2, 9}, {0, 0, -1}, 0.5f);
+  c.reps = 3;
   return c;
 }
 
@@ -112,10 +114,13 @@ int main(int argc, char** argv) {
   std::vector<std::function<Case()>> makers = {
       [] { return scene_file("bunny", 0); }, [] { return scene_file("bunny-refl", 2); },
       [] { return crowded_fan(2000); }, [] { return terrain(400); }};
-  const bool quick = argc > 1 && std::strcmp(argv[1], "quick") == 0;  // first case only
+  // `bench_speed quick`: the first case only; `bench_speed case K`: case K (0-based) only.
+  const bool quick = argc > 1 && std::strcmp(argv[1], "quick") == 0;
+  const int only = argc > 2 && std::strcmp(argv[1], "case") == 0 ? std::atoi(argv[2]) : -1;
   std::printf("%-28s %7s %7s %10s %10s %7s\n", "scene (256x256, no shadows)", "tris", "threads",
               "stream ms", "cpu ms", "ratio");
   for (size_t k = 0; k < (quick ? 1 : makers.size()); ++k) {
+    if (only >= 0 && int(k) != only) continue;
     const Case c = makers[k]();
     for (int threads : {1, 2}) {
       host::RenderOptions opt;

@@ -395,28 +395,43 @@ void Gpu::run_rows(const Program& p, const Rect& r, int y0, int y1, const DrawPl
   // With a work mask, the live fragments it marks are gathered into batches of W (across rows),
   // so a pass costs host time for the fragments that work, not for the screen; idle stretches
   // are handled at once, exactly as running them would (fragments are independent).
+  // The batch being gathered: lane i is fragment (px[i], py[i]), index pi[i] = py * tw + px,
+  // window position (fx[i], fy[i]).
   int px[W], py[W];
+  uint32_t pi[W];
+  alignas(64) float fx[W], fy[W];
   int pending = 0;
+  auto push = [&](int x, int y, uint32_t i) {
+    px[pending] = x;
+    py[pending] = y;
+    pi[pending] = i;
+    fx[pending] = float(x) + 0.5f;
+    fy[pending] = float(y) + 0.5f;
+    return ++pending == W;
+  };
   auto flush = [&] {
     if (pending == 0) return;
     const int n = pending;
     pending = 0;
     const M run = iota < float(n);
     // Unused lanes repeat lane 0's position: they fetch in range and are never stored.
-    f.reset(F([&](auto i) { return float(px[int(i) < n ? int(i) : 0]) + 0.5f; }),
-            F([&](auto i) { return float(py[int(i) < n ? int(i) : 0]) + 0.5f; }), run, nout);
+    for (int i = n; i < W; ++i) fx[i] = fx[0], fy[i] = fy[0];
+    f.reset(F([&](auto i) { return fx[i]; }), F([&](auto i) { return fy[i]; }), run, nout);
     p.run(f);
     const M kill = f.killed() && run;
     const M write = run && !kill;
-    const bool row_run = n == W && py[0] == py[W - 1] && px[W - 1] - px[0] == W - 1;
+    const bool row_run = n == W && pi[W - 1] - pi[0] == W - 1 && py[0] == py[W - 1];
     store(px, py, n, write, row_run && all(write));
     const M idle = f.idle_lanes();
+    const bool whole_flags = r.x0 == 0 && r.y0 == 0 && uint32_t(r.x1) == tw;
     for (int i = 0; i < n; ++i) {
-      out.discarded += kill[i] ? 1 : 0;
-      flag_ran(flag_row(py[i]), px[i], py[i], idle[i]);
-      if (plan.stencil) plan.stencil[uint32_t(py[i]) * tw + uint32_t(px[i])] = kill[i] ? 0 : 1;
-      if (plan.list_survivors && !kill[i])
-        out.survivors.push_back(uint32_t(py[i]) * tw + uint32_t(px[i]));
+      const bool killed = kill[i];
+      out.discarded += killed ? 1 : 0;
+      if (plan.flags)
+        flag_ran(whole_flags ? plan.flags + (pi[i] - uint32_t(px[i])) : flag_row(py[i]), px[i],
+                 py[i], idle[i]);
+      if (plan.stencil) plan.stencil[pi[i]] = killed ? 0 : 1;
+      if (plan.list_survivors && !killed) out.survivors.push_back(pi[i]);
     }
   };
   if (plan.list) {
@@ -432,9 +447,7 @@ void Gpu::run_rows(const Program& p, const Rect& r, int y0, int y1, const DrawPl
     out.discarded += idle_counts(nidle);
     if (plan.flags && !work_masked_) out.idle_flags += nidle;  // flags unwritten
     for (; b != e; ++b) {
-      px[pending] = int(*b % tw);
-      py[pending] = int(*b / tw);
-      if (++pending == W) flush();
+      if (push(int(*b % tw), int(*b / tw), *b)) flush();
     }
     flush();
     result = std::move(out);
@@ -454,9 +467,7 @@ void Gpu::run_rows(const Program& p, const Rect& r, int y0, int y1, const DrawPl
       ++out.shaded;
       if (wk[x] != 0) {  // runs, in the next batch
         if (plan.list_runs) out.runs.push_back(uint32_t(y) * tw + uint32_t(x));
-        px[pending] = x;
-        py[pending] = y;
-        if (++pending == W) flush();
+        if (push(x, y, uint32_t(y) * tw + uint32_t(x))) flush();
         ++x;
         continue;
       }

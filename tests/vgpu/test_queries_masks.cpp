@@ -303,3 +303,91 @@ TEST_CASE("without a stencil test, stretches of idle fragments give the same ima
         CHECK(kfast.totals.same_counts(kfull.totals));
       }
 }
+
+namespace {
+
+// Keeps the fragments whose walk is not finished (w > 0): the query counts them and the stencil
+// write marks them, as rayosEnGrilla marks the rays still walking.
+struct StillActive {
+  static constexpr const char* name = "still active";
+  static constexpr const char* paper_name = "-";
+  static constexpr int outputs = 1;
+  static constexpr bool idle_discards = true;
+  template <class L>
+  void operator()(Fragments<L>& f) const {
+    using F = typename L::F;
+    const Vec4<F> s = f.fetch_own(0);
+    f.discard(!(s.w > F(0.0f)));
+    f.out(0) = s;
+  }
+};
+
+enum class MaskSource { none, gpu, host };
+
+// The stream tracer's loop in small: a query pass writes the mask it tests (the Gpu then knows
+// the mask's non-zero pixels and the next pass visits only those), a step pass runs under it.
+// MaskSource::host rewrites the mask from the host before each step (the Gpu must scan it);
+// none runs every fragment.
+Walk query_walk(int threads, int lanes, MaskSource source) {
+  Gpu gpu(profile("gf6600"), threads, lanes);
+  Texture a = gpu.make_texture("a", 75, 61, 4), b = gpu.make_texture("b", 75, 61, 4);
+  Texture g = gpu.make_texture("g", 75, 61, 4), counter = gpu.make_texture("c", 75, 61, 1);
+  fill_pattern(a, 21);
+  fill_pattern(g, 22);
+  uint64_t seed = 23;
+  for (int y = 0; y < 61; ++y)
+    for (int x = 0; x < 75; ++x) a.set(x, y, 3, float(int(vgpu_test::mix(seed) % 6) - 1));
+  KernelProgram<StillActive> active;
+  KernelProgram<Step> step;
+  Stencil mask(75, 61, 1);
+  Walk r;
+  Texture* src = &a;
+  Texture* dst = &b;
+  for (int pass = 0; pass < 5; ++pass) {
+    gpu.use_program(active);
+    gpu.bind_texture(0, *src);
+    gpu.set_targets({&counter});
+    gpu.set_work_mask(source == MaskSource::none || pass == 0 ? nullptr : &mask);
+    gpu.set_stencil_write(&mask);
+    gpu.begin_query();
+    gpu.draw();
+    r.last_query += gpu.end_query();
+    gpu.set_stencil_write(nullptr);
+    if (source == MaskSource::host)
+      for (int y = 0; y < 61; ++y)
+        for (int x = 0; x < 75; ++x) mask.set(x, y, mask.get(x, y));
+    gpu.use_program(step);
+    gpu.bind_texture(0, *src);
+    gpu.bind_texture(1, g);
+    gpu.set_targets({dst});
+    gpu.set_work_mask(source == MaskSource::none ? nullptr : &mask);
+    gpu.draw();
+    gpu.unbind_textures();
+    std::swap(src, dst);
+  }
+  r.state = *src;
+  r.written = mask;
+  r.totals = gpu.stats().totals;
+  return r;
+}
+
+}  // namespace
+
+TEST_CASE("passes under a mask the Gpu wrote visit its listed fragments with the same results") {
+  for (int lanes : {1, 4, 8, 16})
+    for (int threads : {1, 3}) {
+      CAPTURE(lanes);
+      CAPTURE(threads);
+      const Walk full = query_walk(threads, lanes, MaskSource::none);
+      const Walk listed = query_walk(threads, lanes, MaskSource::gpu);
+      const Walk scanned = query_walk(threads, lanes, MaskSource::host);
+      CHECK(full.totals.lanes_idle > 0);
+      CHECK(full.last_query > 0);
+      for (const Walk* w : {&listed, &scanned}) {
+        CHECK(same_bits(w->state, full.state));
+        CHECK(same_bits(w->written, full.written));
+        CHECK(w->last_query == full.last_query);
+        CHECK(w->totals.same_counts(full.totals));
+      }
+    }
+}
