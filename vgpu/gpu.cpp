@@ -484,11 +484,14 @@ void Gpu::run_rows(const Program& p, const Rect& r, int y0, int y1, const DrawPl
   result = std::move(out);
 }
 
-void Gpu::parallel_rows(const Rect& r, const std::function<void(int, int, Chunk&)>& body,
+void Gpu::parallel_rows(const Rect& r, uint64_t work,
+                        const std::function<void(int, int, Chunk&)>& body,
                         std::vector<Chunk>& chunks) {
   const int rows = r.height();
-  // Enough chunks to balance uneven rows, few enough to keep scheduling cheap.
-  const int nchunks = std::max(1, std::min(rows, threads() * 8));
+  // Enough chunks to balance uneven rows, few enough to keep scheduling cheap; a pass that
+  // visits few fragments runs on the calling thread (waking workers would cost more).
+  const bool small = work < 4096;
+  const int nchunks = small ? 1 : std::max(1, std::min(rows, threads() * 8));
   chunks.resize(size_t(nchunks));
   for (Chunk& c : chunks) c.reset();
   std::atomic<int> next{0};
@@ -501,7 +504,7 @@ void Gpu::parallel_rows(const Rect& r, const std::function<void(int, int, Chunk&
       body(ya, yb, chunks[size_t(k)]);
     }
   };
-  if (workers_.empty() || nchunks == 1 || r.area() < 4096) {
+  if (workers_.empty() || nchunks == 1) {
     job();
     return;
   }
@@ -669,10 +672,9 @@ const PassRecord& Gpu::draw(const Rect& rect) {
           (same(&src, rec->b, rec->uid_b, rec->version_b) &&
            same(&dst, rec->a, rec->uid_a, rec->version_a))) {
         plan.out[o].idle_src = nullptr;
-        const int w = dst.width();
         const size_t ch = size_t(dst.channels());
-        for (const uint32_t i : rec->differ)
-          if (work_mask_->row(int(i / uint32_t(w)))[i % uint32_t(w)] == 0)
+        for (const uint32_t i : rec->differ)  // the mask is as wide as the target
+          if (work_mask_->bits_[i] == 0)
             std::memcpy(dst.data_.data() + i * ch, src.data_.data() + i * ch, ch * sizeof(float));
         pairs_.erase(rec);  // used up: if the pass fails, no record claims the textures agree
         break;
@@ -744,7 +746,7 @@ const PassRecord& Gpu::draw(const Rect& rect) {
         break;
     }
   };
-  parallel_rows(rect, body, chunks);
+  parallel_rows(rect, plan.list ? uint64_t(listed.size()) : rect.area(), body, chunks);
   in_draw_ = false;
   if (carries) track_pairs(p, plan.list, plan.list_runs);
   if (plan.list_survivors) {

@@ -104,8 +104,8 @@ class Gpu {
   template <class L>
   void run_rows(const Program& p, const Rect& r, int y0, int y1, const DrawPlan& plan,
                 Chunk& out) const;
-  void parallel_rows(const Rect& r, const std::function<void(int, int, Chunk&)>& body,
-                     std::vector<Chunk>& chunks);
+  void parallel_rows(const Rect& r, uint64_t work,
+                     const std::function<void(int, int, Chunk&)>& body, std::vector<Chunk>& chunks);
   void track_pairs(const Program& p, const std::vector<uint32_t>* runs, bool chunk_runs);
   void worker_loop();
   [[noreturn]] void fail(const std::string& what) const;
