@@ -378,12 +378,15 @@ void Gpu::run_rows(const Program& p, const Rect& r, int y0, int y1, const DrawPl
         for (int i = 0; i < W; ++i) px[i] = x + i, py[i] = y;
         store(px, py, n, write, all(write));  // all(write): W fragments, none killed
         out.discarded += uint64_t(lanes_on(kill));
-        const M idle = f.idle_lanes();
+        bool lv[W], killed[W], idle[W];
+        live.copy_to(lv, stdx::element_aligned);
+        kill.copy_to(killed, stdx::element_aligned);
+        f.idle_lanes().copy_to(idle, stdx::element_aligned);
         for (int i = 0; i < n; ++i) {
-          if (!live[i]) continue;
+          if (!lv[i]) continue;
           flag_ran(fl, x + i, y, idle[i]);
-          if (sw) sw[x + i] = kill[i] ? 0 : 1;
-          if (plan.list_survivors && !kill[i])
+          if (sw) sw[x + i] = killed[i] ? 0 : 1;
+          if (plan.list_survivors && !killed[i])
             out.survivors.push_back(uint32_t(y) * tw + uint32_t(x + i));
         }
       }
@@ -422,17 +425,22 @@ void Gpu::run_rows(const Program& p, const Rect& r, int y0, int y1, const DrawPl
     const M write = run && !kill;
     const bool row_run = n == W && pi[W - 1] - pi[0] == W - 1 && py[0] == py[W - 1];
     store(px, py, n, write, row_run && all(write));
-    const M idle = f.idle_lanes();
-    const bool whole_flags = r.x0 == 0 && r.y0 == 0 && uint32_t(r.x1) == tw;
-    for (int i = 0; i < n; ++i) {
-      const bool killed = kill[i];
-      out.discarded += killed ? 1 : 0;
-      if (plan.flags)
+    // Per-lane bookkeeping from plain arrays (one store per mask, not one extraction per lane).
+    bool killed[W], idle[W];
+    kill.copy_to(killed, stdx::element_aligned);
+    f.idle_lanes().copy_to(idle, stdx::element_aligned);
+    out.discarded += uint64_t(lanes_on(kill));
+    if (plan.flags) {
+      const bool whole_flags = r.x0 == 0 && r.y0 == 0 && uint32_t(r.x1) == tw;
+      for (int i = 0; i < n; ++i)
         flag_ran(whole_flags ? plan.flags + (pi[i] - uint32_t(px[i])) : flag_row(py[i]), px[i],
                  py[i], idle[i]);
-      if (plan.stencil) plan.stencil[pi[i]] = killed ? 0 : 1;
-      if (plan.list_survivors && !killed) out.survivors.push_back(pi[i]);
     }
+    if (plan.stencil)
+      for (int i = 0; i < n; ++i) plan.stencil[pi[i]] = killed[i] ? 0 : 1;
+    if (plan.list_survivors)
+      for (int i = 0; i < n; ++i)
+        if (!killed[i]) out.survivors.push_back(pi[i]);
   };
   if (plan.list) {
     // Only the listed fragments of rows [y0, y1) are visited; draw() settled the idle ones'
