@@ -311,26 +311,12 @@ TEST_CASE("without a stencil test, stretches of idle fragments give the same ima
 
 namespace {
 
-// Keeps the fragments whose walk is not finished (w > 0): the query counts them and the stencil
-// write marks them, as rayosEnGrilla marks the rays still walking.
-struct StillActive {
-  static constexpr const char* name = "still active";
-  static constexpr const char* paper_name = "-";
-  static constexpr int outputs = 1;
-  static constexpr bool idle_discards = true;
-  template <class L>
-  void operator()(Fragments<L>& f) const {
-    using F = typename L::F;
-    const Vec4<F> s = f.fetch_own(0);
-    f.discard(!(s.w > F(0.0f)));
-    f.out(0) = s;
-  }
-};
-
 enum class MaskSource { none, gpu, host };
 
-// The stream tracer's loop in small: a query pass writes the mask it tests (the Gpu then knows
-// the mask's non-zero pixels and the next pass visits only those), a step pass runs under it.
+// The stream tracer's loop in small: a query pass (StepOrKill keeps the fragments whose walk is
+// not finished, as rayosEnGrilla keeps the rays still walking) writes the mask it tests (the Gpu
+// then knows the mask's non-zero pixels and the next pass visits only those), a step pass runs
+// under it.
 // MaskSource::host rewrites the mask from the host before each step (the Gpu must scan it);
 // none runs every fragment.
 Walk query_walk(int threads, int lanes, MaskSource source) {
@@ -342,7 +328,7 @@ Walk query_walk(int threads, int lanes, MaskSource source) {
   uint64_t seed = 23;
   for (int y = 0; y < 61; ++y)
     for (int x = 0; x < 75; ++x) a.set(x, y, 3, float(int(vgpu_test::mix(seed) % 6) - 1));
-  KernelProgram<StillActive> active;
+  KernelProgram<StepOrKill> active;
   KernelProgram<Step> step;
   Stencil mask(75, 61, 1);
   Walk r;
