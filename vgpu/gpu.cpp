@@ -454,8 +454,42 @@ void Gpu::run_rows(const Program& p, const Rect& r, int y0, int y1, const DrawPl
     out.shaded += area;
     out.discarded += idle_counts(nidle);
     if (plan.flags && !work_masked_) out.idle_flags += nidle;  // flags unwritten
-    for (; b != e; ++b) {
-      if (push(int(*b % tw), int(*b / tw), *b)) flush();
+    // A W-aligned block of a row where at least half the fragments are listed runs in place, as
+    // the hardware's own quads would (contiguous fetches and stores); sparser ones are gathered.
+    bool on[W];
+    while (b != e) {
+      const int y = int(*b / tw), x0 = int(*b % tw) / W * W, x1 = std::min(int(tw), x0 + W);
+      const uint32_t* k = b;
+      while (k != e && *k < uint32_t(y) * tw + uint32_t(x1)) ++k;
+      if (2 * (k - b) < W) {
+        for (; b != k; ++b)
+          if (push(int(*b % tw), y, *b)) flush();
+        continue;
+      }
+      flush();  // the gathered fragments come first: survivors stay in ascending order
+      for (int i = 0; i < W; ++i) on[i] = false;
+      for (const uint32_t* q = b; q != k; ++q) on[*q - uint32_t(y) * tw - uint32_t(x0)] = true;
+      const M run(on, stdx::element_aligned);
+      f.reset(iota + float(x0) + 0.5f, F(float(y) + 0.5f), run, nout);
+      p.run(f);
+      const M kill = f.killed() && run;
+      const M write = run && !kill;
+      int bx[W], by[W];
+      for (int i = 0; i < W; ++i) bx[i] = x0 + i, by[i] = y;
+      store(bx, by, x1 - x0, write, all(write));
+      out.discarded += uint64_t(lanes_on(kill));
+      bool killed[W], idle[W];
+      kill.copy_to(killed, stdx::element_aligned);
+      f.idle_lanes().copy_to(idle, stdx::element_aligned);
+      uint8_t* fl = flag_row(y);
+      const uint32_t row0 = uint32_t(y) * tw;
+      for (int i = 0; i < x1 - x0; ++i) {
+        if (!on[i]) continue;
+        flag_ran(fl, x0 + i, y, idle[i]);
+        if (plan.stencil) plan.stencil[row0 + uint32_t(x0 + i)] = killed[i] ? 0 : 1;
+        if (plan.list_survivors && !killed[i]) out.survivors.push_back(row0 + uint32_t(x0 + i));
+      }
+      b = k;
     }
     flush();
     result = std::move(out);
@@ -547,7 +581,8 @@ void Gpu::worker_loop() {
 // After a pass that carried idle fragments over from passthrough units: each source and target
 // now agree except at the fragments that ran: `runs`, or those the row chunks listed when
 // `chunk_runs`; neither: no record.
-void Gpu::track_pairs(const Program& p, const std::vector<uint32_t>* runs, bool chunk_runs) {
+void Gpu::track_pairs(const Program& p, const std::shared_ptr<const std::vector<uint32_t>>& runs,
+                      bool chunk_runs) {
   for (int o = 0; o < p.outputs(); ++o) {
     const Texture& dst = *targets_[o];
     const Texture& src = *units_[p.passthrough(o)];
@@ -558,13 +593,14 @@ void Gpu::track_pairs(const Program& p, const std::vector<uint32_t>* runs, bool 
     if ((!runs && !chunk_runs) || src.format() != dst.format()) continue;
     PairRecord rec{&src, &dst, src.uid_, src.version_, dst.uid_, dst.version_, {}};
     if (runs) {
-      rec.differ = *runs;
+      rec.differ = runs;
     } else {
       size_t n = 0;
       for (const Chunk& c : chunks_) n += c.runs.size();
-      rec.differ.reserve(n);
-      for (const Chunk& c : chunks_)
-        rec.differ.insert(rec.differ.end(), c.runs.begin(), c.runs.end());
+      auto differ = std::make_shared<std::vector<uint32_t>>();
+      differ->reserve(n);
+      for (const Chunk& c : chunks_) differ->insert(differ->end(), c.runs.begin(), c.runs.end());
+      rec.differ = std::move(differ);
     }
     pairs_.push_back(std::move(rec));
   }
@@ -660,10 +696,11 @@ const PassRecord& Gpu::draw(const Rect& rect) {
     return t == r && t->uid_ == uid && t->version_ == version;
   };
   // Under a work mask whose non-zero pixels the last pass that wrote it listed, only those run.
-  std::vector<uint32_t> listed;  // a copy: this pass may rewrite the mask and its list
+  // Held here: this pass may write the mask and give it a new list.
+  std::shared_ptr<const std::vector<uint32_t>> listed;
   if (work_mask_ && whole && work_mask_->listed_version_ == work_mask_->version_) {
     listed = work_mask_->nonzero_;
-    plan.list = &listed;
+    plan.list = listed.get();
   }
   for (int o = 0; o < p.outputs(); ++o) {
     Texture& dst = *targets_[o];
@@ -681,7 +718,7 @@ const PassRecord& Gpu::draw(const Rect& rect) {
            same(&dst, rec->a, rec->uid_a, rec->version_a))) {
         plan.out[o].idle_src = nullptr;
         const size_t ch = size_t(dst.channels());
-        for (const uint32_t i : rec->differ)  // the mask is as wide as the target
+        for (const uint32_t i : *rec->differ)  // the mask is as wide as the target
           if (work_mask_->bits_[i] == 0)
             std::memcpy(dst.data_.data() + i * ch, src.data_.data() + i * ch, ch * sizeof(float));
         pairs_.erase(rec);  // used up: if the pass fails, no record claims the textures agree
@@ -703,7 +740,7 @@ const PassRecord& Gpu::draw(const Rect& rect) {
           for (size_t i = from * ch; i < to * ch; ++i) dst[i] = round_to(cp.fmt, cp.idle_src[i]);
       };
       size_t next = 0;
-      for (const uint32_t i : listed) {
+      for (const uint32_t i : *listed) {
         if (i > next) copy(next, i);
         next = size_t(i) + 1;
       }
@@ -754,13 +791,16 @@ const PassRecord& Gpu::draw(const Rect& rect) {
         break;
     }
   };
-  parallel_rows(rect, plan.list ? uint64_t(listed.size()) : rect.area(), body, chunks);
+  parallel_rows(rect, plan.list ? uint64_t(plan.list->size()) : rect.area(), body, chunks);
   in_draw_ = false;
-  if (carries) track_pairs(p, plan.list, plan.list_runs);
+  if (carries) track_pairs(p, listed, plan.list_runs);
   if (plan.list_survivors) {
-    std::vector<uint32_t>& nz = stencil_write_->nonzero_;
-    nz.clear();
-    for (const Chunk& c : chunks) nz.insert(nz.end(), c.survivors.begin(), c.survivors.end());
+    size_t n = 0;
+    for (const Chunk& c : chunks) n += c.survivors.size();
+    auto nz = std::make_shared<std::vector<uint32_t>>();
+    nz->reserve(n);
+    for (const Chunk& c : chunks) nz->insert(nz->end(), c.survivors.begin(), c.survivors.end());
+    stencil_write_->nonzero_ = std::move(nz);
     stencil_write_->listed_version_ = stencil_write_->version_;
   }
 

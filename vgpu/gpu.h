@@ -106,7 +106,8 @@ class Gpu {
                 Chunk& out) const;
   void parallel_rows(const Rect& r, uint64_t work,
                      const std::function<void(int, int, Chunk&)>& body, std::vector<Chunk>& chunks);
-  void track_pairs(const Program& p, const std::vector<uint32_t>* runs, bool chunk_runs);
+  void track_pairs(const Program& p, const std::shared_ptr<const std::vector<uint32_t>>& runs,
+                   bool chunk_runs);
   void worker_loop();
   [[noreturn]] void fail(const std::string& what) const;
 
@@ -133,7 +134,7 @@ class Gpu {
   struct PairRecord {
     const Texture *a = nullptr, *b = nullptr;
     uint64_t uid_a = 0, version_a = 0, uid_b = 0, version_b = 0;
-    std::vector<uint32_t> differ;
+    std::shared_ptr<const std::vector<uint32_t>> differ;  // shared with a mask's list
   };
   std::vector<PairRecord> pairs_;
   std::vector<Chunk> chunks_;  // per row chunk of a draw, kept for their run lists' capacity

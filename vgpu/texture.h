@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <string>
 #include <vector>
@@ -96,9 +97,9 @@ class Stencil {
   // Emulator bookkeeping, not modeled state: after a pass that wrote this mask, the Gpu lists its
   // non-zero pixels (indices y * width + x, ascending), so a later pass under it visits only
   // those. Valid while listed_version_ == version_; every host write access bumps version_.
-  // Copies carry the list with the bits.
+  // Copies share the (immutable) list with the bits.
   uint64_t version_ = 0, listed_version_ = ~uint64_t(0);
-  std::vector<uint32_t> nonzero_;
+  std::shared_ptr<const std::vector<uint32_t>> nonzero_;
 };
 
 }  // namespace vgpu
