@@ -1,5 +1,5 @@
-// Image files through OpenImageIO: writing renders and AOVs without ever leaving a partial file,
-// and comparing two images (share of differing pixels, RMS error, PSNR).
+// Image files: writing renders and AOVs without ever leaving a partial file, and comparing two
+// images (share of differing pixels, RMS error, PSNR). OpenImageIO is loaded on first use.
 #pragma once
 
 #include <string>
@@ -16,6 +16,9 @@ void write_image(const std::string& path, int width, int height, int channels,
 
 // Checks a path can be written as an image before any work is done (extension, directory).
 void check_image_path(const std::string& path);
+// The same for any output file whose extension (lower-cased, with the dot) must be one of
+// `extensions`. Throws host::InputError "PATH: problem".
+void check_output_path(const std::string& path, const std::vector<std::string>& extensions);
 // Checks the directory a file is to be written in exists and is writable.
 void check_output_dir(const std::string& path);
 

@@ -64,31 +64,188 @@ struct UsageError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-glm::ivec2 parse_pair(const std::string& text, const std::string& what, const std::regex& re) {
+// Largest image side: the render target limit of the largest profile (vgpu/profile.cpp).
+constexpr int kMaxImageSide = 16384;
+// Host threads: 0 (one per core) or 1..kMaxThreads; more than this only queues context switches.
+constexpr int kMaxThreads = 256;
+
+// "WxH" as two positive sides, or nullopt.
+std::optional<glm::ivec2> parse_size(const std::string& text) {
   std::smatch m;
-  if (!std::regex_match(text, m, re)) throw UsageError(what + ": cannot parse '" + text + "'");
-  return {std::stoi(m[1]), std::stoi(m[2])};
+  if (!std::regex_match(text, m, std::regex(R"((\d{1,9})[xX](\d{1,9}))"))) return std::nullopt;
+  return glm::ivec2(std::stoi(m[1]), std::stoi(m[2]));
 }
 
-bool parse_on_off(const std::string& v, const std::string& what) {
-  if (v == "on") return true;
-  if (v == "off") return false;
-  throw UsageError(what + ": expected on or off, got '" + v + "'");
+// "X,Y" pixel coordinates, or nullopt.
+std::optional<glm::ivec2> parse_pixel(const std::string& text) {
+  std::smatch m;
+  if (!std::regex_match(text, m, std::regex(R"((\d{1,9}),(\d{1,9}))"))) return std::nullopt;
+  return glm::ivec2(std::stoi(m[1]), std::stoi(m[2]));
 }
 
-int run_render(const RenderArgs& a) {
-  // Validate everything before any work, so a bad argument costs nothing and writes nothing.
+// CLI11 validators: each returns an empty string for a good value, else the problem (CLI11
+// prefixes the option name; main() prints it on one line and exits with 2).
+const CLI::Validator kSizeCheck(
+    [](std::string& text) -> std::string {
+      const std::optional<glm::ivec2> s = parse_size(text);
+      if (!s) return "expected WxH (e.g. 256x256), got '" + text + "'";
+      if (s->x < 1 || s->y < 1 || s->x > kMaxImageSide || s->y > kMaxImageSide)
+        return text + " is outside the limit 1x1.." + std::to_string(kMaxImageSide) + "x" +
+               std::to_string(kMaxImageSide);
+      return {};
+    },
+    "WxH in 1x1..16384x16384", "SIZE");
+
+const CLI::Validator kPixelCheck(
+    [](std::string& text) -> std::string {
+      return parse_pixel(text) ? "" : "expected X,Y (e.g. 128,128), got '" + text + "'";
+    },
+    "X,Y", "PIXEL");
+
+const CLI::Validator kGridCheck(
+    [](std::string& text) -> std::string {
+      try {
+        host::parse_grid_spec(text);
+        return {};
+      } catch (const std::invalid_argument& e) {
+        return e.what();
+      }
+    },
+    "auto | N | AxBxC, each 1.." + std::to_string(host::kMaxGridRes), "GRID");
+
+// An output file: the extension is one of `exts` and its directory exists and is writable.
+CLI::Validator output_check(std::vector<std::string> exts) {
+  std::string desc;
+  for (const std::string& e : exts) desc += (desc.empty() ? "FILE" : " | FILE") + e;
+  return CLI::Validator(
+      [exts](std::string& path) -> std::string {
+        try {
+          host::check_output_path(path, exts);
+          return {};
+        } catch (const host::InputError& e) {
+          return e.what();
+        }
+      },
+      desc, "OUTPUT");
+}
+
+// --aov KIND=FILE.exr: the AOVs are float images, so EXR only.
+const CLI::Validator kAovCheck(
+    [](std::string& aov) -> std::string {
+      const auto eq = aov.find('=');
+      const std::string kind = aov.substr(0, eq);
+      if (eq == std::string::npos || eq + 1 == aov.size())
+        return "expected depth=FILE.exr or hit=FILE.exr, got '" + aov + "'";
+      if (kind != "depth" && kind != "hit")
+        return "unknown AOV '" + kind + "' in '" + aov + "' (known: depth, hit)";
+      try {
+        host::check_output_path(aov.substr(eq + 1), {".exr"});
+        return {};
+      } catch (const host::InputError& e) {
+        return e.what();
+      }
+    },
+    "depth=FILE.exr | hit=FILE.exr", "AOV");
+
+std::vector<std::string> profile_names() {
+  std::vector<std::string> names;
+  for (const vgpu::Profile& p : vgpu::profiles()) names.push_back(p.name);
+  return names;
+}
+
+void add_render_options(CLI::App& render, RenderArgs& a) {
+  const std::vector<std::string> on_off{"on", "off"};
+  render.add_option("scene", a.scene, "glTF file (.gltf/.glb) or a scene name from scenes/")
+      ->capture_default_str();
+  render.add_option("--size", a.size, "Image size")->check(kSizeCheck)->capture_default_str();
+  render.add_option("--out", a.out, "Write the image")->check(output_check({".png", ".exr"}));
+  render.add_option("--bounces", a.bounces, "Reflection iterations after the primary one")
+      ->check(CLI::Range(0, 64))
+      ->capture_default_str();
+  render.add_option("--shading", a.shading, "Shading model")
+      ->check(CLI::IsMember({"diffuse", "phong", "phong-atten"}))
+      ->capture_default_str();
+  render.add_option("--shadows", a.shadows, "Shadow rays")
+      ->check(CLI::IsMember(on_off))
+      ->capture_default_str();
+  render.add_option("--grid", a.grid, "Grid voxels per axis")
+      ->check(kGridCheck)
+      ->capture_default_str();
+  render
+      .add_option("--profile", a.profile,
+                  "Modeled card (the cpu engine uses only its texture limit, for --grid auto)")
+      ->check(CLI::IsMember(profile_names()))
+      ->capture_default_str();
+  render.add_option("--threads", a.threads, "Host threads (0: one per core)")
+      ->check(CLI::Range(0, kMaxThreads))
+      ->capture_default_str();
+  render
+      .add_option("--lanes", a.lanes,
+                  "SIMD lanes per batch, stream engine (1: scalar reference; fp24/fp16 run at 1 "
+                  "or 8)")
+      ->check(CLI::IsMember({1, 4, 8, 16}))
+      ->capture_default_str();
+  render
+      .add_option("--masks", a.masks,
+                  "Early-z masks for finished rays (paper's future work), stream engine")
+      ->check(CLI::IsMember(on_off))
+      ->capture_default_str();
+  render.add_option("--stats", a.stats, "Statistics on stdout")
+      ->check(CLI::IsMember({"table", "json", "none"}))
+      ->capture_default_str();
+  render.add_option("--stats-json", a.stats_json, "Also write the statistics as JSON")
+      ->check(output_check({".json"}));
+  render
+      .add_option("--aov", a.aovs,
+                  "Float AOV: depth (distance to the primary hit) or hit (triangle id)")
+      ->check(kAovCheck);
+  render
+      .add_option("--trace-pixel", a.trace_pixel,
+                  "Print every pass this pixel took part in and its state (stream engine)")
+      ->check(kPixelCheck);
+  render.add_flag("--quiet,-q", a.quiet, "No progress on stderr");
+  render
+      .add_option("--stats-csv", a.stats_csv,
+                  "Also write one row per pass (kernel, fragments, fetches, query) as CSV")
+      ->check(output_check({".csv"}));
+  render
+      .add_option("--report", a.report,
+                  "Write an HTML report of the frame (timeline, cost maps, pixel history), "
+                  "stream engine")
+      ->check(output_check({".html"}));
+  render
+      .add_option("--precision", a.precision,
+                  "Ray-state textures and kernel arithmetic, every group, stream engine (auto: "
+                  "per group, the fewest bits this scene needs; the stats say why)")
+      ->check(CLI::IsMember({"fp32", "fp24", "fp16", "auto"}))
+      ->capture_default_str();
+  render.add_option("--formats", a.formats,
+                    "Per group, over --precision: GROUP=FORMAT[/ARITH],... with GROUP rays, "
+                    "traversal, voxel, hits, colour, queries (e.g. colour=fp16/fp32)");
+  render
+      .add_option("--engine", a.engine,
+                  "stream (the vgpu pipeline) | gl (the same passes on an OpenGL driver) | cpu "
+                  "(double-precision reference)")
+      ->check(CLI::IsMember({"stream", "gl", "cpu"}))
+      ->capture_default_str();
+  render
+      .add_option("--gl-device", a.gl_device,
+                  "With --engine gl: auto, or an EGL device index (see vgpu-rt gl-devices)")
+      ->capture_default_str();
+  render.add_flag("--predict", a.predict,
+                  "Print the cost model's predicted time for --profile, with its breakdown");
+}
+
+int run_render(const RenderArgs& a, bool lanes_given) {
+  // CLI11 checked each value; what is left are combinations of options.
   host::RenderOptions opt;
-  const glm::ivec2 size = parse_pair(a.size, "--size", std::regex(R"((\d{1,5})[xX](\d{1,5}))"));
-  if (size.x < 1 || size.y < 1 || size.x > 16384 || size.y > 16384)
-    throw UsageError("--size: " + a.size + " is outside 1x1..16384x16384");
+  const glm::ivec2 size = *parse_size(a.size);
   opt.width = size.x;
   opt.height = size.y;
-  if (a.bounces < 0 || a.bounces > 64) throw UsageError("--bounces: expected 0..64");
   opt.bounces = a.bounces;
   opt.shading = host::parse_shading(a.shading);
-  opt.shadows = parse_on_off(a.shadows, "--shadows");
-  opt.masks = parse_on_off(a.masks, "--masks");
+  opt.shadows = a.shadows == "on";
+  opt.masks = a.masks == "on";
   opt.profile = vgpu::profile(a.profile).name;
   opt.threads = a.threads;
   opt.lanes = a.lanes;
@@ -99,26 +256,13 @@ int run_render(const RenderArgs& a) {
     throw UsageError(e.what());
   }
   const host::GridSpec grid_spec = host::parse_grid_spec(a.grid);
-  if (a.stats != "table" && a.stats != "json" && a.stats != "none")
-    throw UsageError("--stats: expected table, json or none, got '" + a.stats + "'");
   std::string aov_depth, aov_hit;
   for (const std::string& aov : a.aovs) {
     const auto eq = aov.find('=');
-    const std::string kind = aov.substr(0, eq),
-                      file = eq == std::string::npos ? "" : aov.substr(eq + 1);
-    if (file.empty())
-      throw UsageError("--aov: expected depth=FILE.exr or hit=FILE.exr, got '" + aov + "'");
-    if (kind == "depth")
-      aov_depth = file;
-    else if (kind == "hit")
-      aov_hit = file;
-    else
-      throw UsageError("--aov: unknown AOV '" + kind + "' (known: depth, hit)");
-    host::check_image_path(file);
+    (aov.compare(0, eq, "depth") == 0 ? aov_depth : aov_hit) = aov.substr(eq + 1);
   }
-  if (!a.out.empty()) host::check_image_path(a.out);
   if (!a.trace_pixel.empty()) {
-    const glm::ivec2 p = parse_pair(a.trace_pixel, "--trace-pixel", std::regex(R"((\d+),(\d+))"));
+    const glm::ivec2 p = *parse_pixel(a.trace_pixel);
     if (p.x >= opt.width || p.y >= opt.height)
       throw UsageError("--trace-pixel: " + a.trace_pixel + " is outside the " + a.size + " image");
     opt.trace_pixel = p;
@@ -129,8 +273,25 @@ int run_render(const RenderArgs& a) {
     throw UsageError("--engine: expected stream, cpu or gl, got '" + a.engine + "'");
   const bool cpu = a.engine == "cpu";
   const bool gl = a.engine == "gl";
-  if (cpu && (a.predict || !a.trace_pixel.empty()))
-    throw UsageError("--predict and --trace-pixel need --engine stream");
+  // Settings the CPU reference does not use are refused rather than recorded as if they ran.
+  if (cpu) {
+    const char* unused = a.predict                ? "--predict"
+                         : !a.trace_pixel.empty() ? "--trace-pixel"
+                         : lanes_given            ? "--lanes"
+                         : opt.masks              ? "--masks on"
+                         : a.precision != "fp32"  ? "--precision"
+                         : !a.formats.empty()     ? "--formats"
+                                                  : nullptr;
+    if (unused)
+      throw UsageError(std::string(unused) +
+                       " needs --engine stream (the cpu engine is a double-precision reference "
+                       "without passes, lanes or masks)");
+  }
+  // Reduced precision runs at 1 or 8 lanes (vgpu/gpu.cpp): refuse another width.
+  const bool reduced = a.precision != "fp32" || !a.formats.empty();
+  if (reduced && opt.lanes != 1 && opt.lanes != 8)
+    throw UsageError("--lanes " + std::to_string(opt.lanes) + ": --precision " + a.precision +
+                     " runs at 1 or 8 lanes");
   if (a.engine != "stream" && (!a.report.empty() || !a.stats_csv.empty()))
     throw UsageError(
         "--report and --stats-csv need --engine stream (the report reads the "
@@ -151,8 +312,8 @@ int run_render(const RenderArgs& a) {
   if (!a.report.empty() && int64_t(opt.width) * opt.height > host::kReportMaxPixels)
     throw UsageError("--report: at most " + std::to_string(host::kReportMaxPixels) +
                      " pixels (512x512); got " + a.size);
-  if (!a.report.empty()) host::check_output_path(a.report, ".html");
-  if (!a.stats_csv.empty()) host::check_output_path(a.stats_csv, ".csv");
+  if (!a.report.empty()) host::check_output_path(a.report, {".html"});
+  if (!a.stats_csv.empty()) host::check_output_path(a.stats_csv, {".csv"});
   std::optional<host::FrameRecorder> recorder;
   if (!a.report.empty() || !a.stats_csv.empty()) {
     recorder.emplace(opt.width, opt.height, opt.masks, a.report.empty() ? 0 : host::kHistoryStride,
@@ -368,56 +529,7 @@ int main(int argc, char** argv) {
   RenderArgs a;
   auto* render = app.add_subcommand(
       "render", "Render a scene on the virtual GPU and print the pass statistics");
-  render->add_option("scene", a.scene, "glTF file (.gltf/.glb) or a scene name from scenes/")
-      ->capture_default_str();
-  render->add_option("--size", a.size, "Image size WxH")->capture_default_str();
-  render->add_option("--out", a.out, "Write the image (.png or .exr)");
-  render->add_option("--bounces", a.bounces, "Reflection iterations after the primary one")
-      ->capture_default_str();
-  render->add_option("--shading", a.shading, "diffuse | phong | phong-atten")
-      ->capture_default_str();
-  render->add_option("--shadows", a.shadows, "on | off")->capture_default_str();
-  render->add_option("--grid", a.grid, "auto | N | AxBxC voxels")->capture_default_str();
-  render->add_option("--profile", a.profile, "gf5700 | r300 | gf6600 | rtx4090 | h200")
-      ->capture_default_str();
-  render->add_option("--threads", a.threads, "Host threads (0: all cores)")->capture_default_str();
-  render->add_option("--lanes", a.lanes, "SIMD lanes per batch: 1 (scalar reference), 4, 8, 16")
-      ->capture_default_str();
-  render
-      ->add_option("--masks", a.masks,
-                   "Early-z masks for finished rays (paper's future work): on | off")
-      ->capture_default_str();
-  render->add_option("--stats", a.stats, "table | json | none")->capture_default_str();
-  render->add_option("--stats-json", a.stats_json,
-                     "Also write the statistics as JSON to this file");
-  render->add_option("--stats-csv", a.stats_csv,
-                     "Also write one row per pass (kernel, fragments, fetches, query) as CSV");
-  render->add_option("--report", a.report,
-                     "Write an HTML report of the frame (timeline, cost maps, pixel history)");
-  render->add_option("--aov", a.aovs,
-                     "depth=FILE.exr (distance to primary hit) or hit=FILE.exr (triangle id)");
-  render->add_option("--trace-pixel", a.trace_pixel,
-                     "X,Y: print every pass this pixel took part in and its state");
-  render->add_flag("--quiet,-q", a.quiet, "No progress on stderr");
-  render
-      ->add_option("--precision", a.precision,
-                   "Ray-state textures and kernel arithmetic, every group: fp32 | fp24 | fp16 | "
-                   "auto (per group, the fewest bits this scene needs; the report says why)")
-      ->capture_default_str();
-  render->add_option("--formats", a.formats,
-                     "Per group, over --precision: GROUP=FORMAT,... with GROUP rays, traversal, "
-                     "voxel, hits, colour (e.g. colour=fp16,voxel=fp16)");
-  render
-      ->add_option("--engine", a.engine,
-                   "stream (the vgpu pipeline) | gl (the same passes on an OpenGL driver) | cpu "
-                   "(double-precision reference)")
-      ->capture_default_str();
-  render
-      ->add_option("--gl-device", a.gl_device,
-                   "With --engine gl: auto, or an EGL device index (see vgpu-rt gl-devices)")
-      ->capture_default_str();
-  render->add_flag("--predict", a.predict,
-                   "Print the cost model's predicted time for --profile, with its breakdown");
+  add_render_options(*render, a);
   auto* scenes = app.add_subcommand("scenes", "List the scenes in scenes/");
   std::string kernel_name;
   bool kernel_glsl = false;
@@ -431,9 +543,10 @@ int main(int argc, char** argv) {
   double threshold = 1.0 / 255.0;
   auto* compare = app.add_subcommand(
       "compare", "Compare two images (OpenImageIO): differing pixels, RMS, PSNR");
-  compare->add_option("a", ca, "First image")->required();
-  compare->add_option("b", cb, "Second image")->required();
+  compare->add_option("a", ca, "First image")->required()->check(CLI::ExistingFile);
+  compare->add_option("b", cb, "Second image")->required()->check(CLI::ExistingFile);
   compare->add_option("--threshold", threshold, "Per-channel difference that makes a pixel differ")
+      ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
 
   std::string da, db;
@@ -453,7 +566,7 @@ int main(int argc, char** argv) {
     return 2;
   }
   try {
-    if (*render) return run_render(a);
+    if (*render) return run_render(a, render->count("--lanes") > 0);
     if (*scenes) {
       for (const auto& [name, path] : host::list_scenes()) {
         try {

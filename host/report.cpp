@@ -8,7 +8,6 @@
 #pragma GCC diagnostic ignored "-Wrestrict"
 #include "host/report.h"
 
-#include <OpenImageIO/strutil.h>
 #include <zlib.h>
 
 #include <algorithm>
@@ -26,6 +25,12 @@
 #include "host/scene.h"
 #include "kernels/registry.h"
 #include "vgpu/glsl.h"
+
+// tinygltf's base64 encoder (tiny_gltf.h, compiled once in gltf_loader.cpp): no second copy here
+// and no OpenImageIO in the report.
+namespace tinygltf {
+std::string base64_encode(unsigned char const* bytes, unsigned int len);
+}
 
 namespace host {
 
@@ -51,7 +56,8 @@ std::string pack(const void* data, size_t bytes) {
   out.resize(z.total_out);
   deflateEnd(&z);
   if (rc != Z_STREAM_END) throw std::runtime_error("report: zlib could not compress");
-  return OIIO::Strutil::base64_encode(out);
+  return tinygltf::base64_encode(reinterpret_cast<const unsigned char*>(out.data()),
+                                 static_cast<unsigned int>(out.size()));
 }
 
 template <class T>
@@ -84,13 +90,6 @@ const char* kind_name(PassObserver::TraceKind k) {
 }
 
 }  // namespace
-
-void check_output_path(const std::string& path, const std::string& ext) {
-  std::string e = std::filesystem::path(path).extension().string();
-  std::transform(e.begin(), e.end(), e.begin(), [](unsigned char ch) { return std::tolower(ch); });
-  if (e != ext) throw InputError(path + ": expected a " + ext + " file name");
-  check_output_dir(path);
-}
 
 vgpu::Counters minus(const vgpu::Counters& a, const vgpu::Counters& b) {
   vgpu::Counters c;

@@ -121,9 +121,6 @@ class FrameRecorder final : public PassObserver {
   std::vector<std::vector<float>> hist_;
 };
 
-// Checks an output file's extension (lower case, e.g. ".html") and directory before any work.
-// Throws host::InputError.
-void check_output_path(const std::string& path, const std::string& ext);
 
 // The counters of `a` minus those of `b`, field by field (host_ms too).
 vgpu::Counters minus(const vgpu::Counters& a, const vgpu::Counters& b);

@@ -7,6 +7,7 @@
 #include <bit>
 #include <chrono>
 #include <cstring>
+#include <vector>
 
 namespace vgpu {
 
@@ -15,61 +16,123 @@ namespace {
 // Batch flags per fragment: kTook took the branch, kIdle sat idle in it, 0 not shaded.
 constexpr uint8_t kTook = kBranchTook, kIdle = kBranchIdle;
 
-// Idle fragments in the 8x4 and the 32x32 tiles of a w x h flag map where no fragment took the
-// branch: {in 8x4 tiles, in 32x32 tiles}. Eight flags are tested at once as one 64-bit word.
-std::array<uint64_t, 2> idle_in_batches(const std::vector<uint8_t>& flags, int w, int h) {
-  constexpr uint64_t took_bits = 0x0101010101010101ull * kTook;
-  constexpr uint64_t idle_bits = 0x0101010101010101ull * kIdle;
-  const int cols8 = (w + 7) / 8, cols32 = (w + 31) / 32;
-  std::vector<uint64_t> idle8(static_cast<size_t>(cols8)), idle32(static_cast<size_t>(cols32));
-  std::vector<uint8_t> busy8(static_cast<size_t>(cols8)), busy32(static_cast<size_t>(cols32));
-  std::array<uint64_t, 2> total{0, 0};
-  for (int y = 0; y < h; ++y) {
-    const uint8_t* row = flags.data() + size_t(y) * size_t(w);
-    for (int c = 0; c < cols8; ++c) {
-      uint64_t v = 0;
-      std::memcpy(&v, row + 8 * c, size_t(std::min(8, w - 8 * c)));  // the tail reads 0s
-      busy8[size_t(c)] |= (v & took_bits) != 0;
-      idle8[size_t(c)] += uint64_t(std::popcount(v & idle_bits));
-    }
-    const bool band8_end = y % 4 == 3 || y == h - 1;
-    if (band8_end)
-      for (int c = 0; c < cols8; ++c) {
-        if (!busy8[size_t(c)]) total[0] += idle8[size_t(c)];
-        busy32[size_t(c / 4)] |= busy8[size_t(c)];
-        idle32[size_t(c / 4)] += idle8[size_t(c)];
-        busy8[size_t(c)] = 0;
-        idle8[size_t(c)] = 0;
-      }
-    if (y % 32 == 31 || y == h - 1)
-      for (int c = 0; c < cols32; ++c) {
-        if (!busy32[size_t(c)]) total[1] += idle32[size_t(c)];
-        busy32[size_t(c)] = 0;
-        idle32[size_t(c)] = 0;
-      }
+constexpr uint64_t kOnes = 0x0101010101010101ull, kHighs = 0x8080808080808080ull;
+
+// The high bit of every non-zero byte of v.
+constexpr uint64_t nonzero_bytes(uint64_t v) {
+  return (((v & ~kHighs) + ~kHighs) | v) & kHighs;
+}
+
+// Up to eight bytes from p (n of them; the rest read as 0).
+inline uint64_t load_bytes(const uint8_t* p, int n) {
+  uint64_t v = 0;
+  if (n >= 8) {
+    std::memcpy(&v, p, 8);  // a fixed size: one load, no call
+    return v;
   }
+  for (int i = 0; i < n; ++i) v |= uint64_t(p[i]) << (8 * i);
+  return v;
+}
+
+// Idle fragments in the 8x4 and the 32x32 tiles of the drawn rectangle where no fragment took
+// the branch: {in 8x4 tiles, in 32x32 tiles}. That is every idle fragment (`idle_flags` of them)
+// less those in tiles with work, so only the 32x32 tiles `took32` marks are scanned, eight
+// fragments at a time. A fragment is idle when it passed the stencil test and the work mask
+// left it idle (unless that counts as masked), or when it ran and its flag says so; flags of
+// fragments that did not run are stale and ignored.
+std::array<uint64_t, 2> idle_in_batches(const Rect& r, const uint8_t* flags, const Stencil* work,
+                                        const Stencil* test, bool work_masked, uint64_t idle_flags,
+                                        const uint8_t* took8, const uint8_t* took32) {
+  const int w = r.width(), h = r.height();
+  const int cols8 = (w + 7) / 8, cols32 = (w + 31) / 32, rows32 = (h + 31) / 32;
+  std::array<uint64_t, 2> total{idle_flags, idle_flags};
+  std::vector<uint64_t> idle8(
+      static_cast<size_t>(cols8));  // per 8x4 tile of the current band of 4 rows
+  for (int ty = 0; ty < rows32; ++ty)
+    for (int tx = 0; tx < cols32; ++tx) {
+      if (!took32[size_t(ty) * size_t(cols32) + size_t(tx)]) continue;
+      const int c0 = tx * 4, c1 = std::min(cols8, c0 + 4);
+      for (int band = ty * 8; band < std::min((h + 3) / 4, ty * 8 + 8); ++band) {
+        for (int c = c0; c < c1; ++c) idle8[size_t(c)] = 0;
+        for (int y = band * 4; y < std::min(h, band * 4 + 4); ++y) {
+          const uint8_t* fl = flags + size_t(y) * size_t(w);
+          const uint8_t* st = test ? test->row(r.y0 + y) + r.x0 : nullptr;
+          const uint8_t* wk = work ? work->row(r.y0 + y) + r.x0 : nullptr;
+          for (int c = c0; c < c1; ++c) {
+            const int x = 8 * c, n = std::min(8, w - x);
+            // Fragments of the rectangle that passed the stencil test.
+            uint64_t live = st ? nonzero_bytes(load_bytes(st + x, n)) : kHighs;
+            if (n < 8) live &= kHighs >> (8 * (8 - n));
+            const uint64_t ran = wk ? nonzero_bytes(load_bytes(wk + x, n)) : kHighs;
+            const uint64_t flagged_idle = ~nonzero_bytes(load_bytes(fl + x, n) ^ (kOnes * kIdle));
+            const uint64_t idle = live & ((ran & flagged_idle) | (work_masked ? 0 : ~ran & kHighs));
+            idle8[size_t(c)] += uint64_t(std::popcount(idle));
+          }
+        }
+        for (int c = c0; c < c1; ++c) {
+          const uint64_t n = idle8[size_t(c)];
+          if (took8[size_t(band) * size_t(cols8) + size_t(c)]) total[0] -= n;
+          total[1] -= n;
+        }
+      }
+    }
   return total;
 }
 
 // End of a stretch of live idle fragments from `from`: the first i < to with wk[i] != 0 or, when
 // there is a stencil test, st[i] == 0. Eight bytes at a time, the row's hottest loop.
 int stretch_end(const uint8_t* wk, const uint8_t* st, int from, int to) {
-  constexpr uint64_t ones = 0x0101010101010101ull, highs = 0x8080808080808080ull;
-  int i = from;
-  for (; i + 8 <= to; i += 8) {
-    uint64_t w = 0, s = ~0ull;
-    std::memcpy(&w, wk + i, 8);
-    if (st) std::memcpy(&s, st + i, 8);
-    if (w != 0 || ((s - ones) & ~s & highs) != 0) break;  // a set work byte or a zero stencil byte
+  for (int i = from; i < to; i += 8) {
+    const int n = std::min(8, to - i);
+    uint64_t stop = nonzero_bytes(load_bytes(wk + i, n));
+    if (st) stop |= ~nonzero_bytes(load_bytes(st + i, n)) & kHighs;
+    if (n < 8) stop |= kHighs << (8 * n);  // past the end
+    if (stop) return std::min(to, i + std::countr_zero(stop) / 8);
   }
-  while (i < to && wk[i] == 0 && (!st || st[i] != 0)) ++i;
-  return i;
+  return to;
 }
 
 }  // namespace
 
 struct Gpu::Chunk {
   uint64_t launched = 0, shaded = 0, masked = 0, discarded = 0, idle = 0;
+  uint64_t idle_flags = 0;  // fragments flagged kIdle (for the batch counters)
+  // Texel indices, ascending: the fragments that ran (DrawPlan::list_runs) and those whose
+  // stencil write is 1 (DrawPlan::list_survivors).
+  std::vector<uint32_t> runs, survivors;
+  void reset() {
+    std::vector<uint32_t> keep_runs = std::move(runs), keep_survivors = std::move(survivors);
+    *this = Chunk{};
+    runs = std::move(keep_runs);
+    survivors = std::move(keep_survivors);
+    runs.clear();
+    survivors.clear();
+  }
+};
+
+// What one draw's row workers share: where outputs go, where idle fragments' outputs come from,
+// and the batch-flag maps. Built once per draw on the calling thread.
+struct Gpu::DrawPlan {
+  struct Out {
+    float* data = nullptr;  // the target's texels
+    int width = 0, ch = 0;
+    Format fmt = Format::fp32;
+    const float* idle_src = nullptr;  // passthrough texels to copy for idle fragments, or null
+    bool exact = false;               // same format: already rounded, a plain copy
+  };
+  Out out[kMaxOutputs];
+  uint64_t idle_branches = 0;
+  // Per fragment of the rectangle that ran: kTook or kIdle (others are not written; see
+  // idle_in_batches). Null: the program has no branches.
+  uint8_t* flags = nullptr;
+  bool list_runs = false;       // collect Chunk::runs (for a PairRecord)
+  bool list_survivors = false;  // collect Chunk::survivors (the stencil write's non-zero list)
+  // The work mask's non-zero list (Stencil::nonzero_): only these fragments are visited. Set only
+  // for a whole-target draw without stencil test; idle fragments are then settled in draw().
+  const std::vector<uint32_t>* list = nullptr;
+  uint8_t* stencil = nullptr;                   // the stencil write's bits, or null
+  uint8_t *took8 = nullptr, *took32 = nullptr;  // tiles holding a kTook fragment
+  int cols8 = 0, cols32 = 0;
 };
 
 Gpu::Gpu(const Profile& profile, int threads, int lanes) : profile_(profile), lanes_(lanes) {
@@ -162,12 +225,14 @@ const PassRecord& Gpu::draw() {
 }
 
 template <class L>
-void Gpu::run_rows(const Program& p, const Rect& r, int y0, int y1, uint64_t idle_branches,
-                   uint8_t* flags, Chunk& result) const {
+void Gpu::run_rows(const Program& p, const Rect& r, int y0, int y1, const DrawPlan& plan,
+                   Chunk& result) const {
   constexpr int W = L::width;
   // Counted in a local and stored once: neighbouring chunks share cache lines, and other
   // threads are counting into them.
   Chunk out;
+  out.runs = std::move(result.runs);
+  out.survivors = std::move(result.survivors);
   using F = typename L::F;
   using M = typename L::M;
   BoundTexture views[kMaxTextureUnits];
@@ -183,147 +248,278 @@ void Gpu::run_rows(const Program& p, const Rect& r, int y0, int y1, uint64_t idl
   alignas(64) float lanes_out[4][W];
   bool bools[W] = {};
 
-  // Where idle fragments' outputs come from: the passthrough unit's texel at the same place.
-  struct CopyPlan {
-    const float* src = nullptr;
-    float* dst = nullptr;
-    int width = 0, ch = 0;
-    Format fmt = Format::fp32;
-    bool exact = false;  // same format: already rounded, a plain copy
+  auto flag_row = [&](int y) {
+    return plan.flags ? plan.flags + size_t(y - r.y0) * size_t(r.width()) : nullptr;
   };
-  CopyPlan copies[kMaxOutputs];
-  if (work_mask_ && !idle_kill)  // draw() checked that each passthrough is shaped like its target
-    for (int o = 0; o < nout; ++o) {
-      const Texture& src = *units_[p.passthrough(o)];
-      Texture& dst = *targets_[o];
-      copies[o] = {src.data().data(), dst.texel_mut(0, 0),
-                   dst.width(),       dst.channels(),
-                   dst.format(),      src.format() == dst.format() || dst.format() == Format::fp32};
+  // Batch flag of fragment (x, y) once it ran: kTook also marks its tiles (shared with the
+  // chunks above and below, hence the atomic stores of the same value).
+  auto flag_ran = [&](uint8_t* fl, int x, int y, bool idle) {
+    if (!fl) return;
+    fl[x - r.x0] = idle ? kIdle : kTook;
+    if (idle) {
+      ++out.idle_flags;
+      return;
     }
+    const size_t dx = size_t(x - r.x0), dy = size_t(y - r.y0);
+    std::atomic_ref<uint8_t>(plan.took8[(dy / 4) * size_t(plan.cols8) + dx / 8])
+        .store(1, std::memory_order_relaxed);
+    std::atomic_ref<uint8_t>(plan.took32[(dy / 32) * size_t(plan.cols32) + dx / 32])
+        .store(1, std::memory_order_relaxed);
+  };
   // k live fragments from (x, y) on that skip the program: their outputs keep their previous
-  // values, copied from the passthrough units (or nothing, for a program that discards them).
-  // Returns how many are discarded.
-  auto idle_run = [&](int x, int y, int k) -> uint64_t {
-    const uint64_t n = uint64_t(k);
+  // values, copied from the passthrough units where the plan says so (or nothing, for a program
+  // that discards them). Returns how many are discarded.
+  auto idle_counts = [&](uint64_t n) -> uint64_t {
     if (work_masked_) {
       // Modeled as an early-z/stencil reject: masked, not shaded, never counted.
       out.shaded -= n;
       out.masked += n;
     } else {
-      out.idle += idle_branches * n;  // an idle fragment takes none of the program's branches
+      out.idle += plan.idle_branches * n;  // an idle fragment takes none of the program's branches
     }
-    if (idle_kill) return work_masked_ ? 0 : n;
+    return idle_kill && !work_masked_ ? n : 0;
+  };
+  auto idle_run = [&](int x, int y, int k) -> uint64_t {
+    const uint64_t n = uint64_t(k);
+    if (idle_kill) return idle_counts(n);
+    idle_counts(n);
     for (int o = 0; o < nout; ++o) {
-      const CopyPlan& cp = copies[o];
+      const DrawPlan::Out& cp = plan.out[o];
+      if (!cp.idle_src) continue;  // the target already holds these texels (PairRecord)
       const size_t off = (size_t(y) * size_t(cp.width) + size_t(x)) * size_t(cp.ch);
       const size_t count = n * size_t(cp.ch);
       if (cp.exact)
-        std::memcpy(cp.dst + off, cp.src + off, count * sizeof(float));
+        std::memcpy(cp.data + off, cp.idle_src + off, count * sizeof(float));
       else  // rounded as the program's own store would be: the source is a wider format
-        for (size_t i = 0; i < count; ++i) cp.dst[off + i] = round_to(cp.fmt, cp.src[off + i]);
+        for (size_t i = 0; i < count; ++i)
+          cp.data[off + i] = round_to(cp.fmt, cp.idle_src[off + i]);
     }
     return 0;
   };
-
-  for (int y = y0; y < y1; ++y) {
-    const uint8_t* st = stencil_test_ ? stencil_test_->row(y) : nullptr;
-    const uint8_t* wk = work_mask_ ? work_mask_->row(y) : nullptr;
-    uint8_t* sw = stencil_write_ ? stencil_write_->row_mut(y) : nullptr;
-    // This row's flags; fragment x sits at fl[x - r.x0].
-    uint8_t* fl = flags ? flags + size_t(y - r.y0) * size_t(r.width()) : nullptr;
-    for (int x = r.x0, n = 0; x < r.x1; x += n) {
-      // A stretch of live idle fragments (the usual case late in a loop) is handled at once,
-      // exactly as the per-block path below would (fragments are independent).
-      if (wk && wk[x] == 0 && (!st || st[x] != 0)) {
-        n = stretch_end(wk, st, x, r.x1) - x;
-        out.launched += uint64_t(n);
-        out.shaded += uint64_t(n);
-        out.discarded += idle_run(x, y, n);
-        if (sw) std::memset(sw + x, idle_kill ? 0 : 1, size_t(n));
-        if (fl && !work_masked_) std::memset(fl + (x - r.x0), kIdle, size_t(n));
+  // Stores the program's outputs for the lanes in `write`; lane i is fragment (px[i], py[i]).
+  // `row_run`: the W lanes are W neighbours of one row, all written.
+  auto store = [&](const int* px, const int* py, int n, const M& write, bool row_run) {
+    for (int o = 0; o < nout; ++o) {
+      const DrawPlan::Out& t = plan.out[o];
+      const Vec4<F>& v = f.output(o);
+      v.x.copy_to(lanes_out[0], stdx::element_aligned);
+      v.y.copy_to(lanes_out[1], stdx::element_aligned);
+      v.z.copy_to(lanes_out[2], stdx::element_aligned);
+      v.w.copy_to(lanes_out[3], stdx::element_aligned);
+      auto at = [&](int i) {
+        return t.data + (size_t(py[i]) * size_t(t.width) + size_t(px[i])) * size_t(t.ch);
+      };
+      if (row_run && t.ch == 4 && t.fmt == Format::fp32) {
+        // The common case: W whole fp32x4 texels, interleaved from the four registers.
+        texels::join<W>(lanes_out, at(0));
         continue;
       }
-      n = std::min(W, r.x1 - x);
-      out.launched += uint64_t(n);
-      // live: fragments in the quad that pass the stencil test.
-      M live = iota < float(n);
-      if (st) {
-        for (int i = 0; i < n; ++i) bools[i] = st[x + i] != 0;
-        live = live && M(bools, stdx::element_aligned);
+      if (t.fmt == Format::fp32) {  // already exact: no rounding
+        for (int i = 0; i < n; ++i) {
+          if (!write[i]) continue;
+          float* dst = at(i);
+          for (int c = 0; c < t.ch; ++c) dst[c] = lanes_out[c][i];
+        }
+        continue;
       }
-      const int nlive = lanes_on(live);
-      out.masked += uint64_t(n - nlive);
-      out.shaded += uint64_t(nlive);
-      if (nlive == 0) continue;
-      // run: live fragments the host actually executes (all of them unless a work mask says idle).
-      M run = live;
-      if (wk) {
-        for (int i = 0; i < n; ++i) bools[i] = wk[x + i] != 0;
-        run = run && M(bools, stdx::element_aligned);
+      for (int i = 0; i < n; ++i) {
+        if (!write[i]) continue;
+        float* dst = at(i);
+        for (int c = 0; c < t.ch; ++c) dst[c] = round_to(t.fmt, lanes_out[c][i]);
       }
-      M kill(false);
-      if (any(run)) {
-        f.reset(iota + float(x) + 0.5f, F(float(y) + 0.5f), run, nout);
+    }
+  };
+
+  // Masks are as wide as the target; indices of fragments are y * tw + x.
+  const uint32_t tw = uint32_t(plan.out[0].width);
+  auto stencil_row = [&](int y) {
+    return plan.stencil ? plan.stencil + size_t(y) * size_t(tw) : nullptr;
+  };
+  if (!work_mask_) {
+    // Every live fragment runs: blocks of W neighbours along each row.
+    int px[W], py[W];
+    for (int y = y0; y < y1; ++y) {
+      const uint8_t* st = stencil_test_ ? stencil_test_->row(y) : nullptr;
+      uint8_t* sw = stencil_row(y);
+      uint8_t* fl = flag_row(y);
+      for (int x = r.x0; x < r.x1; x += W) {
+        const int n = std::min(W, r.x1 - x);
+        out.launched += uint64_t(n);
+        // live: fragments in the quad that pass the stencil test.
+        M live = iota < float(n);
+        if (st) {
+          for (int i = 0; i < n; ++i) bools[i] = st[x + i] != 0;
+          live = live && M(bools, stdx::element_aligned);
+        }
+        const int nlive = lanes_on(live);
+        out.masked += uint64_t(n - nlive);
+        out.shaded += uint64_t(nlive);
+        if (nlive == 0) continue;
+        f.reset(iota + float(x) + 0.5f, F(float(y) + 0.5f), live, nout);
         p.run(f);
-        kill = f.killed() && run;
-        const M write = run && !kill;
-        const bool every = all(write);  // W fragments, all in the rectangle, none killed
-        for (int o = 0; o < nout; ++o) {
-          Texture& t = *targets_[o];
-          const Vec4<F>& v = f.output(o);
-          v.x.copy_to(lanes_out[0], stdx::element_aligned);
-          v.y.copy_to(lanes_out[1], stdx::element_aligned);
-          v.z.copy_to(lanes_out[2], stdx::element_aligned);
-          v.w.copy_to(lanes_out[3], stdx::element_aligned);
-          const int ch = t.channels();
-          const Format fmt = t.format();
-          float* row = t.texel_mut(x, y);
-          if (every && ch == 4 && fmt == Format::fp32) {
-            // The common case: W whole fp32x4 texels, interleaved from the four registers.
-            texels::join<W>(lanes_out, row);
-            continue;
-          }
-          for (int i = 0; i < n; ++i) {
-            if (!write[i]) continue;
-            float* dst = row + i * ch;
-            for (int c = 0; c < ch; ++c) dst[c] = round_to(fmt, lanes_out[c][i]);
-          }
+        const M kill = f.killed() && live;
+        const M write = live && !kill;
+        for (int i = 0; i < W; ++i) px[i] = x + i, py[i] = y;
+        store(px, py, n, write, all(write));  // all(write): W fragments, none killed
+        out.discarded += uint64_t(lanes_on(kill));
+        bool lv[W], killed[W], idle[W];
+        live.copy_to(lv, stdx::element_aligned);
+        kill.copy_to(killed, stdx::element_aligned);
+        f.idle_lanes().copy_to(idle, stdx::element_aligned);
+        for (int i = 0; i < n; ++i) {
+          if (!lv[i]) continue;
+          flag_ran(fl, x + i, y, idle[i]);
+          if (sw) sw[x + i] = killed[i] ? 0 : 1;
+          if (plan.list_survivors && !killed[i])
+            out.survivors.push_back(uint32_t(y) * tw + uint32_t(x + i));
         }
       }
-      int nkill = lanes_on(kill);
-      if (wk)  // contiguous runs of live fragments the work mask leaves idle
-        for (int i = 0; i < n;) {
-          if (!live[i] || run[i]) {
-            ++i;
-            continue;
-          }
-          int j = i + 1;
-          while (j < n && live[j] && !run[j]) ++j;
-          nkill += int(idle_run(x + i, y, j - i));
-          i = j;
-        }
-      if (fl) {
-        const M idle = f.idle_lanes();
-        for (int i = 0; i < n; ++i)
-          fl[x - r.x0 + i] = !live[i] ? 0
-                             : run[i] ? (idle[i] ? kIdle : kTook)
-                                      : (work_masked_ ? 0 : kIdle);
+    }
+    result = std::move(out);
+    return;
+  }
+
+  // With a work mask, the live fragments it marks are gathered into batches of W (across rows),
+  // so a pass costs host time for the fragments that work, not for the screen; idle stretches
+  // are handled at once, exactly as running them would (fragments are independent).
+  // The batch being gathered: lane i is fragment (px[i], py[i]), index pi[i] = py * tw + px,
+  // window position (fx[i], fy[i]).
+  int px[W], py[W];
+  uint32_t pi[W];
+  alignas(64) float fx[W], fy[W];
+  int pending = 0;
+  auto push = [&](int x, int y, uint32_t i) {
+    px[pending] = x;
+    py[pending] = y;
+    pi[pending] = i;
+    fx[pending] = float(x) + 0.5f;
+    fy[pending] = float(y) + 0.5f;
+    return ++pending == W;
+  };
+  auto flush = [&] {
+    if (pending == 0) return;
+    const int n = pending;
+    pending = 0;
+    const M run = iota < float(n);
+    // Unused lanes repeat lane 0's position: they fetch in range and are never stored.
+    for (int i = n; i < W; ++i) fx[i] = fx[0], fy[i] = fy[0];
+    f.reset(F([&](auto i) { return fx[i]; }), F([&](auto i) { return fy[i]; }), run, nout);
+    p.run(f);
+    const M kill = f.killed() && run;
+    const M write = run && !kill;
+    const bool row_run = n == W && pi[W - 1] - pi[0] == W - 1 && py[0] == py[W - 1];
+    store(px, py, n, write, row_run && all(write));
+    // Per-lane bookkeeping from plain arrays (one store per mask, not one extraction per lane).
+    bool killed[W], idle[W];
+    kill.copy_to(killed, stdx::element_aligned);
+    f.idle_lanes().copy_to(idle, stdx::element_aligned);
+    out.discarded += uint64_t(lanes_on(kill));
+    if (plan.flags) {
+      const bool whole_flags = r.x0 == 0 && r.y0 == 0 && uint32_t(r.x1) == tw;
+      for (int i = 0; i < n; ++i)
+        flag_ran(whole_flags ? plan.flags + (pi[i] - uint32_t(px[i])) : flag_row(py[i]), px[i],
+                 py[i], idle[i]);
+    }
+    if (plan.stencil)
+      for (int i = 0; i < n; ++i) plan.stencil[pi[i]] = killed[i] ? 0 : 1;
+    if (plan.list_survivors)
+      for (int i = 0; i < n; ++i)
+        if (!killed[i]) out.survivors.push_back(pi[i]);
+  };
+  if (plan.list) {
+    // Only the listed fragments of rows [y0, y1) are visited; draw() settled the idle ones'
+    // outputs and stencil writes, here they are only counted.
+    const uint32_t* b = std::lower_bound(plan.list->data(), plan.list->data() + plan.list->size(),
+                                         uint32_t(y0) * tw);
+    const uint32_t* e =
+        std::lower_bound(b, plan.list->data() + plan.list->size(), uint32_t(y1) * tw);
+    const uint64_t area = uint64_t(y1 - y0) * tw, nidle = area - uint64_t(e - b);
+    out.launched += area;
+    out.shaded += area;
+    out.discarded += idle_counts(nidle);
+    if (plan.flags && !work_masked_) out.idle_flags += nidle;  // flags unwritten
+    // A W-aligned block of a row where at least half the fragments are listed runs in place, as
+    // the hardware's own quads would (contiguous fetches and stores); sparser ones are gathered.
+    bool on[W];
+    while (b != e) {
+      const int y = int(*b / tw), x0 = int(*b % tw) / W * W, x1 = std::min(int(tw), x0 + W);
+      const uint32_t* k = b;
+      while (k != e && *k < uint32_t(y) * tw + uint32_t(x1)) ++k;
+      if (2 * (k - b) < W) {
+        for (; b != k; ++b)
+          if (push(int(*b % tw), y, *b)) flush();
+        continue;
       }
-      out.discarded += uint64_t(nkill);
-      if (sw)
-        for (int i = 0; i < n; ++i)
-          if (live[i]) sw[x + i] = (run[i] ? !kill[i] : !idle_kill) ? 1 : 0;
+      flush();  // the gathered fragments come first: survivors stay in ascending order
+      for (int i = 0; i < W; ++i) on[i] = false;
+      for (const uint32_t* q = b; q != k; ++q) on[*q - uint32_t(y) * tw - uint32_t(x0)] = true;
+      const M run(on, stdx::element_aligned);
+      f.reset(iota + float(x0) + 0.5f, F(float(y) + 0.5f), run, nout);
+      p.run(f);
+      const M kill = f.killed() && run;
+      const M write = run && !kill;
+      int bx[W], by[W];
+      for (int i = 0; i < W; ++i) bx[i] = x0 + i, by[i] = y;
+      store(bx, by, x1 - x0, write, all(write));
+      out.discarded += uint64_t(lanes_on(kill));
+      bool killed[W], idle[W];
+      kill.copy_to(killed, stdx::element_aligned);
+      f.idle_lanes().copy_to(idle, stdx::element_aligned);
+      uint8_t* fl = flag_row(y);
+      const uint32_t row0 = uint32_t(y) * tw;
+      for (int i = 0; i < x1 - x0; ++i) {
+        if (!on[i]) continue;
+        flag_ran(fl, x0 + i, y, idle[i]);
+        if (plan.stencil) plan.stencil[row0 + uint32_t(x0 + i)] = killed[i] ? 0 : 1;
+        if (plan.list_survivors && !killed[i]) out.survivors.push_back(row0 + uint32_t(x0 + i));
+      }
+      b = k;
+    }
+    flush();
+    result = std::move(out);
+    return;
+  }
+  for (int y = y0; y < y1; ++y) {
+    const uint8_t* st = stencil_test_ ? stencil_test_->row(y) : nullptr;
+    const uint8_t* wk = work_mask_->row(y);
+    uint8_t* sw = stencil_row(y);
+    out.launched += uint64_t(r.width());
+    for (int x = r.x0; x < r.x1;) {
+      if (st && st[x] == 0) {  // masked: not shaded, its flag stays 0
+        ++out.masked;
+        ++x;
+        continue;
+      }
+      ++out.shaded;
+      if (wk[x] != 0) {  // runs, in the next batch
+        if (plan.list_runs) out.runs.push_back(uint32_t(y) * tw + uint32_t(x));
+        if (push(x, y, uint32_t(y) * tw + uint32_t(x))) flush();
+        ++x;
+        continue;
+      }
+      // A stretch of live idle fragments (the usual case late in a loop).
+      const int n = stretch_end(wk, st, x + 1, r.x1) - x;
+      out.shaded += uint64_t(n - 1);
+      out.discarded += idle_run(x, y, n);
+      if (sw) std::memset(sw + x, idle_kill ? 0 : 1, size_t(n));
+      if (plan.flags && !work_masked_) out.idle_flags += uint64_t(n);  // flags unwritten
+      x += n;
     }
   }
-  result = out;
+  flush();
+  result = std::move(out);
 }
 
-void Gpu::parallel_rows(const Rect& r, const std::function<void(int, int, Chunk&)>& body,
+void Gpu::parallel_rows(const Rect& r, uint64_t work,
+                        const std::function<void(int, int, Chunk&)>& body,
                         std::vector<Chunk>& chunks) {
   const int rows = r.height();
-  // Enough chunks to balance uneven rows, few enough to keep scheduling cheap.
-  const int nchunks = std::max(1, std::min(rows, threads() * 8));
-  chunks.assign(size_t(nchunks), Chunk{});
+  // Enough chunks to balance uneven rows, few enough to keep scheduling cheap; a pass that
+  // visits few fragments runs on the calling thread (waking workers would cost more).
+  const bool small = work < 4096;
+  const int nchunks = small ? 1 : std::max(1, std::min(rows, threads() * 8));
+  chunks.resize(size_t(nchunks));
+  for (Chunk& c : chunks) c.reset();
   std::atomic<int> next{0};
   const std::function<void()> job = [&] {
     for (;;) {
@@ -334,7 +530,7 @@ void Gpu::parallel_rows(const Rect& r, const std::function<void(int, int, Chunk&
       body(ya, yb, chunks[size_t(k)]);
     }
   };
-  if (workers_.empty() || nchunks == 1 || r.area() < 4096) {
+  if (workers_.empty() || nchunks == 1) {
     job();
     return;
   }
@@ -363,6 +559,34 @@ void Gpu::worker_loop() {
     (*job)();
     lk.lock();
     if (--busy_ == 0) cv_done_.notify_one();
+  }
+}
+
+// After a pass that carried idle fragments over from passthrough units: each source and target
+// now agree except at the fragments that ran: `runs`, or those the row chunks listed when
+// `chunk_runs`; neither: no record.
+void Gpu::track_pairs(const Program& p, const std::shared_ptr<const std::vector<uint32_t>>& runs,
+                      bool chunk_runs) {
+  for (int o = 0; o < p.outputs(); ++o) {
+    const Texture& dst = *targets_[o];
+    const Texture& src = *units_[p.passthrough(o)];
+    // Forget every record about either texture, then note the new one.
+    std::erase_if(pairs_, [&](const PairRecord& r) {
+      return r.a == &src || r.b == &src || r.a == &dst || r.b == &dst;
+    });
+    if ((!runs && !chunk_runs) || src.format() != dst.format()) continue;
+    PairRecord rec{&src, &dst, src.uid_, src.version_, dst.uid_, dst.version_, {}};
+    if (runs) {
+      rec.differ = runs;
+    } else {
+      size_t n = 0;
+      for (const Chunk& c : chunks_) n += c.runs.size();
+      auto differ = std::make_shared<std::vector<uint32_t>>();
+      differ->reserve(n);
+      for (const Chunk& c : chunks_) differ->insert(differ->end(), c.runs.begin(), c.runs.end());
+      rec.differ = std::move(differ);
+    }
+    pairs_.push_back(std::move(rec));
   }
 }
 
@@ -396,49 +620,150 @@ const PassRecord& Gpu::draw(const Rect& rect) {
   }
 
   in_draw_ = true;
-  std::vector<Chunk> chunks;
-  const uint64_t idle_branches = uint64_t(a.branches);
-  uint8_t* flags = nullptr;
+  std::vector<Chunk>& chunks = chunks_;
+  DrawPlan plan;
+  plan.idle_branches = uint64_t(a.branches);
   if (a.branches > 0) {
-    batch_flags_.assign(size_t(rect.width()) * size_t(rect.height()), 0);
-    flags = batch_flags_.data();
+    // Not cleared: only fragments that run write their flag (idle_in_batches).
+    batch_flags_.resize(size_t(rect.width()) * size_t(rect.height()));
+    plan.flags = batch_flags_.data();
+    plan.cols8 = (rect.width() + 7) / 8;
+    plan.cols32 = (rect.width() + 31) / 32;
+    took8_.assign(size_t(plan.cols8) * size_t((rect.height() + 3) / 4), 0);
+    took32_.assign(size_t(plan.cols32) * size_t((rect.height() + 31) / 32), 0);
+    plan.took8 = took8_.data();
+    plan.took32 = took32_.data();
   } else {
     batch_flags_.clear();
   }
+  // The masks as they were before the pass, for the batch counters: a pass may write the mask
+  // it tests (a query pass counting into the stencil it reads).
+  Stencil work_before, test_before;
+  const Stencil* work_view = work_mask_;
+  const Stencil* test_view = stencil_test_;
+  if (plan.flags && stencil_write_ && stencil_write_ == work_mask_)
+    work_view = &(work_before = *work_mask_);
+  if (plan.flags && stencil_write_ && stencil_write_ == stencil_test_)
+    test_view = &(test_before = *stencil_test_);
+  // Idle fragments keep their previous outputs, copied from the passthrough units. Where the
+  // last pass between the same two textures left them equal outside the fragments it ran (a
+  // PairRecord; every fragment drawn, no stencil test, same format), only the texels that
+  // differ and are idle now are copied, here; the row workers copy nothing.
+  const bool carries = work_mask_ && !p.idle_discards();
+  const bool whole = !stencil_test_ && rect.x0 == 0 && rect.y0 == 0 && rect.x1 == t0tex.width() &&
+                     rect.y1 == t0tex.height();
+  auto same = [](const Texture* t, const Texture* r, uint64_t uid, uint64_t version) {
+    return t == r && t->uid_ == uid && t->version_ == version;
+  };
+  // Under a work mask whose non-zero pixels the last pass that wrote it listed, only those run.
+  // Held here: this pass may write the mask and give it a new list.
+  std::shared_ptr<const std::vector<uint32_t>> listed;
+  if (work_mask_ && whole && work_mask_->listed_version_ == work_mask_->version_) {
+    listed = work_mask_->nonzero_;
+    plan.list = listed.get();
+  }
+  for (int o = 0; o < p.outputs(); ++o) {
+    Texture& dst = *targets_[o];
+    plan.out[o] = {nullptr, dst.width(), dst.channels(), dst.format(), nullptr, false};
+    if (!carries) continue;
+    const Texture& src = *units_[p.passthrough(o)];
+    plan.out[o].idle_src = src.data().data();
+    plan.out[o].exact = src.format() == dst.format() || dst.format() == Format::fp32;
+    if (!whole || src.format() != dst.format()) continue;
+    plan.list_runs = !plan.list;  // the list is the run set
+    for (auto rec = pairs_.begin(); rec != pairs_.end(); ++rec)
+      if ((same(&src, rec->a, rec->uid_a, rec->version_a) &&
+           same(&dst, rec->b, rec->uid_b, rec->version_b)) ||
+          (same(&src, rec->b, rec->uid_b, rec->version_b) &&
+           same(&dst, rec->a, rec->uid_a, rec->version_a))) {
+        plan.out[o].idle_src = nullptr;
+        const size_t ch = size_t(dst.channels());
+        for (const uint32_t i : *rec->differ)  // the mask is as wide as the target
+          if (work_mask_->bits_[i] == 0)
+            std::memcpy(dst.data_.data() + i * ch, src.data_.data() + i * ch, ch * sizeof(float));
+        pairs_.erase(rec);  // used up: if the pass fails, no record claims the textures agree
+        break;
+      }
+  }
+  if (plan.list) {
+    // Idle fragments are settled here: the texels between listed ones get the passthrough's
+    // value (where no PairRecord spared that) and the stencil write its idle value.
+    for (int o = 0; o < p.outputs(); ++o) {
+      DrawPlan::Out& cp = plan.out[o];
+      if (!cp.idle_src) continue;
+      float* dst = targets_[o]->data_.data();
+      const size_t ch = size_t(cp.ch), n = size_t(cp.width) * size_t(targets_[o]->height());
+      auto copy = [&](size_t from, size_t to) {  // texels [from, to)
+        if (cp.exact)
+          std::memcpy(dst + from * ch, cp.idle_src + from * ch, (to - from) * ch * sizeof(float));
+        else
+          for (size_t i = from * ch; i < to * ch; ++i) dst[i] = round_to(cp.fmt, cp.idle_src[i]);
+      };
+      size_t next = 0;
+      for (const uint32_t i : *listed) {
+        if (i > next) copy(next, i);
+        next = size_t(i) + 1;
+      }
+      if (n > next) copy(next, n);
+      cp.idle_src = nullptr;
+    }
+    if (stencil_write_)
+      std::memset(stencil_write_->bits_.data(), p.idle_discards() ? 0 : 1,
+                  stencil_write_->bits_.size());
+  }
+  // The stencil write's non-zero list is known after the pass when every fragment's value is:
+  // the fragments that ran and survived (idle ones, if any, are discarded).
+  plan.list_survivors = stencil_write_ && whole && (!work_mask_ || p.idle_discards());
+  if (stencil_write_) {
+    plan.stencil = stencil_write_->bits_.data();
+    ++stencil_write_->version_;
+  }
+  // Pass writes: one version step per target (the row workers write through plan.out).
+  for (int o = 0; o < p.outputs(); ++o) plan.out[o].data = targets_[o]->texel_mut(0, 0);
   const Format precision = precision_of(p);
   auto body = [&](int ya, int yb, Chunk& c) {
     // Reduced precision runs at width 1 (the scalar reference) or 8.
     if (precision == Format::fp16) {
       if (lanes_ == 1)
-        run_rows<RoundedLanes<1, Format::fp16>>(p, rect, ya, yb, idle_branches, flags, c);
+        run_rows<RoundedLanes<1, Format::fp16>>(p, rect, ya, yb, plan, c);
       else
-        run_rows<RoundedLanes<8, Format::fp16>>(p, rect, ya, yb, idle_branches, flags, c);
+        run_rows<RoundedLanes<8, Format::fp16>>(p, rect, ya, yb, plan, c);
       return;
     }
     if (precision == Format::fp24) {
       if (lanes_ == 1)
-        run_rows<RoundedLanes<1, Format::fp24>>(p, rect, ya, yb, idle_branches, flags, c);
+        run_rows<RoundedLanes<1, Format::fp24>>(p, rect, ya, yb, plan, c);
       else
-        run_rows<RoundedLanes<8, Format::fp24>>(p, rect, ya, yb, idle_branches, flags, c);
+        run_rows<RoundedLanes<8, Format::fp24>>(p, rect, ya, yb, plan, c);
       return;
     }
     switch (lanes_) {
       case 1:
-        run_rows<SimdLanes<1>>(p, rect, ya, yb, idle_branches, flags, c);
+        run_rows<SimdLanes<1>>(p, rect, ya, yb, plan, c);
         break;
       case 4:
-        run_rows<SimdLanes<4>>(p, rect, ya, yb, idle_branches, flags, c);
+        run_rows<SimdLanes<4>>(p, rect, ya, yb, plan, c);
         break;
       case 8:
-        run_rows<SimdLanes<8>>(p, rect, ya, yb, idle_branches, flags, c);
+        run_rows<SimdLanes<8>>(p, rect, ya, yb, plan, c);
         break;
       default:
-        run_rows<SimdLanes<16>>(p, rect, ya, yb, idle_branches, flags, c);
+        run_rows<SimdLanes<16>>(p, rect, ya, yb, plan, c);
         break;
     }
   };
-  parallel_rows(rect, body, chunks);
+  parallel_rows(rect, plan.list ? uint64_t(plan.list->size()) : rect.area(), body, chunks);
   in_draw_ = false;
+  if (carries) track_pairs(p, listed, plan.list_runs);
+  if (plan.list_survivors) {
+    size_t n = 0;
+    for (const Chunk& c : chunks) n += c.survivors.size();
+    auto nz = std::make_shared<std::vector<uint32_t>>();
+    nz->reserve(n);
+    for (const Chunk& c : chunks) nz->insert(nz->end(), c.survivors.begin(), c.survivors.end());
+    stencil_write_->nonzero_ = std::move(nz);
+    stencil_write_->listed_version_ = stencil_write_->version_;
+  }
 
   Chunk sum;
   for (const Chunk& c : chunks) {
@@ -447,14 +772,16 @@ const PassRecord& Gpu::draw(const Rect& rect) {
     sum.masked += c.masked;
     sum.discarded += c.discarded;
     sum.idle += c.idle;
+    sum.idle_flags += c.idle_flags;
   }
   // Static per-fragment costs times shaded fragments: identical at any width and thread count.
   Counters c = pass_counters(a, units_.data(), targets_, sum.launched, sum.shaded, sum.discarded);
   c.fragments_masked = sum.masked;
   c.lanes_idle = sum.idle;
-  if (flags) {
+  if (plan.flags) {
     const std::array<uint64_t, 2> batch =
-        idle_in_batches(batch_flags_, rect.width(), rect.height());
+        idle_in_batches(rect, plan.flags, work_view, test_view, work_masked_, sum.idle_flags,
+                        plan.took8, plan.took32);
     c.idle_in_batch32 = batch[0];
     c.idle_in_batch1024 = batch[1];
   }

@@ -99,11 +99,14 @@ class Gpu final : public Device {
 
  private:
   struct Chunk;
+  struct DrawPlan;
   template <class L>
-  void run_rows(const Program& p, const Rect& r, int y0, int y1, uint64_t idle_branches,
-                uint8_t* flags, Chunk& out) const;
-  void parallel_rows(const Rect& r, const std::function<void(int, int, Chunk&)>& body,
-                     std::vector<Chunk>& chunks);
+  void run_rows(const Program& p, const Rect& r, int y0, int y1, const DrawPlan& plan,
+                Chunk& out) const;
+  void parallel_rows(const Rect& r, uint64_t work,
+                     const std::function<void(int, int, Chunk&)>& body, std::vector<Chunk>& chunks);
+  void track_pairs(const Program& p, const std::shared_ptr<const std::vector<uint32_t>>& runs,
+                   bool chunk_runs);
   void worker_loop();
   [[noreturn]] void fail(const std::string& what) const;
 
@@ -122,6 +125,18 @@ class Gpu final : public Device {
   // Per fragment of the drawn rectangle, for the batch counters: took the branch, idle in it, or
   // not shaded (gpu.cpp). Rebuilt by every draw of a program that branches.
   std::vector<uint8_t> batch_flags_;
+  // Tiles (8x4, 32x32) of the drawn rectangle where some fragment took the branch.
+  std::vector<uint8_t> took8_, took32_;
+  // Emulator bookkeeping: two textures known to hold the same texels everywhere except at
+  // `differ` (texel indices, ascending), as a pass with a work mask leaves its passthrough source
+  // and its target. The next pass between them copies only those texels for its idle fragments.
+  struct PairRecord {
+    const Texture *a = nullptr, *b = nullptr;
+    uint64_t uid_a = 0, version_a = 0, uid_b = 0, version_b = 0;
+    std::shared_ptr<const std::vector<uint32_t>> differ;  // shared with a mask's list
+  };
+  std::vector<PairRecord> pairs_;
+  std::vector<Chunk> chunks_;  // per row chunk of a draw, kept for their run lists' capacity
   bool query_active_ = false;
   uint64_t query_count_ = 0;
   FrameStats stats_;

@@ -7,20 +7,65 @@
 
 namespace vgpu {
 
+uint64_t Texture::fresh_uid() {
+  static std::atomic<uint64_t> next{1};
+  return next.fetch_add(1, std::memory_order_relaxed);
+}
+
+Texture::Texture(const Texture& o)
+    : name_(o.name_),
+      width_(o.width_),
+      height_(o.height_),
+      channels_(o.channels_),
+      format_(o.format_),
+      data_(o.data_),
+      uid_(fresh_uid()) {}
+
+Texture::Texture(Texture&& o) noexcept
+    : name_(std::move(o.name_)),
+      width_(o.width_),
+      height_(o.height_),
+      channels_(o.channels_),
+      format_(o.format_),
+      data_(std::move(o.data_)),
+      uid_(fresh_uid()) {
+  o.uid_ = fresh_uid();
+}
+
+Texture& Texture::operator=(const Texture& o) {
+  if (this == &o) return *this;
+  Texture t(o);
+  return *this = std::move(t);
+}
+
+Texture& Texture::operator=(Texture&& o) noexcept {
+  if (this == &o) return *this;
+  name_ = std::move(o.name_);
+  width_ = o.width_;
+  height_ = o.height_;
+  channels_ = o.channels_;
+  format_ = o.format_;
+  data_ = std::move(o.data_);
+  uid_ = fresh_uid();
+  o.uid_ = fresh_uid();
+  return *this;
+}
+
 Texture::Texture(std::string name, int width, int height, int channels, Format format)
-    : name_(std::move(name)), width_(width), height_(height), channels_(channels), format_(format) {
+    : name_(std::move(name)),
+      width_(width),
+      height_(height),
+      channels_(channels),
+      format_(format),
+      uid_(fresh_uid()) {
   if (width <= 0 || height <= 0) throw std::invalid_argument("texture " + name_ + ": empty size");
   if (channels < 1 || channels > 4)
     throw std::invalid_argument("texture " + name_ + ": texels have 1 to 4 channels");
   data_.assign(size_t(width) * height * channels, 0.0f);
 }
 
-uint64_t Texture::next_id() {
-  static std::atomic<uint64_t> next{1};
-  return next++;
-}
-
 void Texture::fill(std::span<const float> texel) {
+  ++version_;
   for (size_t i = 0; i < data_.size(); ++i) data_[i] = round_to(format_, texel[i % channels_]);
 }
 

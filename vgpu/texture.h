@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <string>
 #include <vector>
@@ -12,19 +13,22 @@
 
 namespace vgpu {
 
+class Gpu;
+
 class Texture {
  public:
-  Texture() = default;
+  Texture() : uid_(fresh_uid()) {}
   // Allocates width x height texels of `channels` channels, all zero.
   Texture(std::string name, int width, int height, int channels, Format format = Format::fp32);
-  // A copy is another texture in video memory (a new id); a move keeps the id.
-  Texture(const Texture& o) : Texture(o, next_id()) {}
-  Texture& operator=(const Texture& o) { return *this = Texture(o); }
-  Texture(Texture&&) = default;
-  Texture& operator=(Texture&&) = default;
+  // A copy or a moved-to texture is a new texture for the Gpu's copy tracking (see uid_).
+  Texture(const Texture& o);
+  Texture(Texture&& o) noexcept;
+  Texture& operator=(const Texture& o);
+  Texture& operator=(Texture&& o) noexcept;
 
-  // Identity for devices that keep their own copy of a texture (the GL device's objects).
-  uint64_t id() const { return id_; }
+  // Identity for devices that keep their own copy of a texture (the GL device's objects): the
+  // same as the emulator's uid, new for a copy or a moved-to texture.
+  uint64_t id() const { return uid_; }
 
   const std::string& name() const { return name_; }
   int width() const { return width_; }
@@ -36,30 +40,33 @@ class Texture {
 
   // Host access (uploads and read-backs): texel (x, y) channel c. Stores round to the format.
   float get(int x, int y, int c = 0) const { return data_[index(x, y) + c]; }
-  void set(int x, int y, int c, float v) { data_[index(x, y) + c] = round_to(format_, v); }
+  void set(int x, int y, int c, float v) {
+    ++version_;
+    data_[index(x, y) + c] = round_to(format_, v);
+  }
   void fill(std::span<const float> texel);  // every texel = texel (channels() values)
   // Raw texel storage: channels() floats per texel, row-major, already rounded.
   std::span<const float> data() const { return data_; }
   const float* texel(int x, int y) const { return data_.data() + index(x, y); }
-  float* texel_mut(int x, int y) { return data_.data() + index(x, y); }
+  float* texel_mut(int x, int y) {
+    ++version_;
+    return data_.data() + index(x, y);
+  }
   size_t index(int x, int y) const { return (size_t(y) * width_ + x) * channels_; }
 
  private:
-  Texture(const Texture& o, uint64_t id)
-      : name_(o.name_),
-        width_(o.width_),
-        height_(o.height_),
-        channels_(o.channels_),
-        format_(o.format_),
-        data_(o.data_),
-        id_(id) {}
-  static uint64_t next_id();
+  friend class Gpu;
+  static uint64_t fresh_uid();
 
   std::string name_;
   int width_ = 0, height_ = 0, channels_ = 0;
   Format format_ = Format::fp32;
   std::vector<float> data_;
-  uint64_t id_ = next_id();
+  // Emulator bookkeeping, not modeled state: the Gpu skips copying texels it knows two textures
+  // already share (gpu.cpp, PairRecord). uid_ is unique per texture object and content lineage
+  // (copies and moves get a new one), version_ counts every host write access; the Gpu bumps it
+  // once per clear or pass that writes the texture.
+  uint64_t uid_ = 0, version_ = 0;
 };
 
 // An early-z / stencil style mask over a render target: one byte per pixel. A pass that tests
@@ -72,15 +79,31 @@ class Stencil {
   int width() const { return width_; }
   int height() const { return height_; }
   uint8_t get(int x, int y) const { return bits_[size_t(y) * width_ + x]; }
-  void set(int x, int y, uint8_t v) { bits_[size_t(y) * width_ + x] = v; }
-  void fill(uint8_t v) { std::fill(bits_.begin(), bits_.end(), v); }
+  void set(int x, int y, uint8_t v) {
+    ++version_;
+    bits_[size_t(y) * width_ + x] = v;
+  }
+  void fill(uint8_t v) {
+    ++version_;
+    std::fill(bits_.begin(), bits_.end(), v);
+  }
   const uint8_t* row(int y) const { return bits_.data() + size_t(y) * width_; }
-  uint8_t* row_mut(int y) { return bits_.data() + size_t(y) * width_; }
+  uint8_t* row_mut(int y) {
+    ++version_;
+    return bits_.data() + size_t(y) * width_;
+  }
   uint64_t count() const;  // pixels with a non-zero value
 
  private:
+  friend class Gpu;
   int width_ = 0, height_ = 0;
   std::vector<uint8_t> bits_;
+  // Emulator bookkeeping, not modeled state: after a pass that wrote this mask, the Gpu lists its
+  // non-zero pixels (indices y * width + x, ascending), so a later pass under it visits only
+  // those. Valid while listed_version_ == version_; every host write access bumps version_.
+  // Copies share the (immutable) list with the bits.
+  uint64_t version_ = 0, listed_version_ = ~uint64_t(0);
+  std::shared_ptr<const std::vector<uint32_t>> nonzero_;
 };
 
 }  // namespace vgpu

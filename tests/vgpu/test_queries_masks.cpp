@@ -237,6 +237,14 @@ Walk walk(const std::string& prof, int threads, int lanes, bool work_mask,
   return r;
 }
 
+// A walk with a host shortcut against the walk that shaded every fragment: same bits, counts.
+void check_same_walk(const Walk& fast, const Walk& full) {
+  CHECK(same_bits(fast.state, full.state));
+  CHECK(same_bits(fast.written, full.written));
+  CHECK(fast.last_query == full.last_query);
+  CHECK(fast.totals.same_counts(full.totals));
+}
+
 }  // namespace
 
 TEST_CASE("the work-mask shortcut gives the same images and counters as shading every fragment") {
@@ -249,10 +257,7 @@ TEST_CASE("the work-mask shortcut gives the same images and counters as shading 
         const Walk full = walk<Step>(prof, threads, lanes, false);
         const Walk fast = walk<Step>(prof, threads, lanes, true);
         CHECK(full.totals.lanes_idle > 0);
-        CHECK(same_bits(fast.state, full.state));
-        CHECK(same_bits(fast.written, full.written));
-        CHECK(fast.last_query == full.last_query);
-        CHECK(fast.totals.same_counts(full.totals));
+        check_same_walk(fast, full);
       }
 }
 
@@ -302,4 +307,71 @@ TEST_CASE("without a stencil test, stretches of idle fragments give the same ima
         CHECK(kfast.last_query == kfull.last_query);
         CHECK(kfast.totals.same_counts(kfull.totals));
       }
+}
+
+namespace {
+
+enum class MaskSource { none, gpu, host };
+
+// The stream tracer's loop in small: a query pass (StepOrKill keeps the fragments whose walk is
+// not finished, as rayosEnGrilla keeps the rays still walking) writes the mask it tests (the Gpu
+// then knows the mask's non-zero pixels and the next pass visits only those), a step pass runs
+// under it.
+// MaskSource::host rewrites the mask from the host before each step (the Gpu must scan it);
+// none runs every fragment.
+Walk query_walk(int threads, int lanes, MaskSource source) {
+  Gpu gpu(profile("gf6600"), threads, lanes);
+  Texture a = gpu.make_texture("a", 75, 61, 4), b = gpu.make_texture("b", 75, 61, 4);
+  Texture g = gpu.make_texture("g", 75, 61, 4), counter = gpu.make_texture("c", 75, 61, 1);
+  fill_pattern(a, 21);
+  fill_pattern(g, 22);
+  uint64_t seed = 23;
+  for (int y = 0; y < 61; ++y)
+    for (int x = 0; x < 75; ++x) a.set(x, y, 3, float(int(vgpu_test::mix(seed) % 6) - 1));
+  KernelProgram<StepOrKill> active;
+  KernelProgram<Step> step;
+  Stencil mask(75, 61, 1);
+  Walk r;
+  Texture* src = &a;
+  Texture* dst = &b;
+  for (int pass = 0; pass < 5; ++pass) {
+    gpu.use_program(active);
+    gpu.bind_texture(0, *src);
+    gpu.set_targets({&counter});
+    gpu.set_work_mask(source == MaskSource::none || pass == 0 ? nullptr : &mask);
+    gpu.set_stencil_write(&mask);
+    gpu.begin_query();
+    gpu.draw();
+    r.last_query += gpu.end_query();
+    gpu.set_stencil_write(nullptr);
+    if (source == MaskSource::host)
+      for (int y = 0; y < 61; ++y)
+        for (int x = 0; x < 75; ++x) mask.set(x, y, mask.get(x, y));
+    gpu.use_program(step);
+    gpu.bind_texture(0, *src);
+    gpu.bind_texture(1, g);
+    gpu.set_targets({dst});
+    gpu.set_work_mask(source == MaskSource::none ? nullptr : &mask);
+    gpu.draw();
+    gpu.unbind_textures();
+    std::swap(src, dst);
+  }
+  return {*src, mask, gpu.stats().totals, r.last_query};
+}
+
+}  // namespace
+
+TEST_CASE("passes under a mask the Gpu wrote visit its listed fragments with the same results") {
+  for (int lanes : {1, 4, 8, 16})
+    for (int threads : {1, 3}) {
+      CAPTURE(lanes);
+      CAPTURE(threads);
+      const Walk full = query_walk(threads, lanes, MaskSource::none);
+      const Walk listed = query_walk(threads, lanes, MaskSource::gpu);
+      const Walk scanned = query_walk(threads, lanes, MaskSource::host);
+      CHECK(full.totals.lanes_idle > 0);
+      CHECK(full.last_query > 0);
+      check_same_walk(listed, full);
+      check_same_walk(scanned, full);
+    }
 }
