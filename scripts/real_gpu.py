@@ -106,7 +106,7 @@ def main():
 
     # Chart: per scene x size, a group of bars (emulator host, each driver's wall and GPU ms,
     # each profile's prediction), log scale; and the fixed costs.
-    fig, axes = plt.subplots(1, 2, figsize=(13, 5), gridspec_kw={"width_ratios": [3, 2]})
+    fig, axes = plt.subplots(1, 2, figsize=(13, 6.2), gridspec_kw={"width_ratios": [3, 2]})
     ax = axes[0]
     cells = []
     for name, d in data.items():
@@ -140,7 +140,7 @@ def main():
     ax.set_yscale("log")
     ax.set_ylabel("frame time, ms (log scale)")
     ax.set_title("One frame at Table 1's settings")
-    ax.legend(fontsize=8)
+    ax.legend(fontsize=7, ncol=3, loc="upper center", bbox_to_anchor=(0.5, -0.13))
     ax.grid(axis="y", which="both", alpha=0.3)
     ax = axes[1]
     kinds = ["pass", "pass + blocking query read-back", "pass, program switched every pass"]
@@ -149,15 +149,17 @@ def main():
             rows = [r for r in d["fixed"] if r["what"] == kind]
             ax.plot([r["size"] for r in rows], [r["wall_us"] for r in rows], marker=marker,
                     label=f"{name}: {kind}")
-        rows = [r for r in d["fixed"] if r["what"].startswith("pass, two")]
-        ax.plot([r["size"] for r in rows], [r["wall_us"] for r in rows], marker="D",
-                label=f"{name}: two RGBA32F targets")
+        for prefix, marker, label in (("pass, one", "v", "one RGBA32F target"),
+                                      ("pass, two", "D", "two RGBA32F targets (MRT)")):
+            rows = [r for r in d["fixed"] if r["what"].startswith(prefix)]
+            ax.plot([r["size"] for r in rows], [r["wall_us"] for r in rows], marker=marker,
+                    label=f"{name}: {label}")
     ax.set_xscale("log", base=2)
     ax.set_yscale("log")
     ax.set_xlabel("pass size, pixels per side")
     ax.set_ylabel("wall time per pass, µs (log scale)")
     ax.set_title("Fixed and per-pixel cost of one pass")
-    ax.legend(fontsize=7)
+    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.13))
     ax.grid(which="both", alpha=0.3)
     fig.tight_layout()
     png = os.path.join(DOCS, "real_gpu.png")
