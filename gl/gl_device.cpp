@@ -165,12 +165,7 @@ void GlDevice::use_program(const vgpu::Program& program) {
   program_ = &program;
   if (program.id() == loaded_program_) return;
   loaded_program_ = program.id();
-  const vgpu::Program::Analysis a = program.analyze();
-  vgpu::Counters c;
-  c.program_loads = 1;
-  c.program_bytes = uint64_t(a.instructions) * profile_.instruction_bytes;
-  stats_.program(program.name(), program.paper_name(), a.instructions).counters += c;
-  stats_.totals += c;
+  vgpu::count_program_load(stats_, program, profile_);
 }
 
 void GlDevice::bind_texture(int unit, const Texture& texture) {
@@ -379,12 +374,7 @@ uint64_t GlDevice::end_query() {
     pending_[i].passed = int64_t(v);
     n += v;
   }
-  vgpu::Counters c;
-  c.queries = 1;
-  c.query_readbacks = 1;
-  stats_.totals += c;
-  if (program_) stats_.program(program_->name(), program_->paper_name(), 0).counters += c;
-  if (!stats_.passes.empty()) stats_.passes.back().query_result = int64_t(n);
+  vgpu::count_readback(stats_, program_, n);
   return n;
 }
 

@@ -77,4 +77,22 @@ Counters pass_counters(const Program::Analysis& a, const Texture* const* units,
   return c;
 }
 
+void count_program_load(FrameStats& stats, const Program& program, const Profile& profile) {
+  const Program::Analysis a = program.analyze();
+  Counters c;
+  c.program_loads = 1;
+  c.program_bytes = uint64_t(a.instructions) * profile.instruction_bytes;
+  stats.program(program.name(), program.paper_name(), a.instructions).counters += c;
+  stats.totals += c;
+}
+
+void count_readback(FrameStats& stats, const Program* program, uint64_t result) {
+  Counters c;
+  c.queries = 1;
+  c.query_readbacks = 1;
+  stats.totals += c;
+  if (program) stats.program(program->name(), program->paper_name(), 0).counters += c;
+  if (!stats.passes.empty()) stats.passes.back().query_result = int64_t(result);
+}
+
 }  // namespace vgpu

@@ -94,4 +94,8 @@ Counters pass_counters(const Program::Analysis& a, const Texture* const* units,
                        const std::vector<Texture*>& targets, uint64_t launched, uint64_t shaded,
                        uint64_t discarded);
 
+// What a program load and a query read-back add to the statistics, on every device.
+void count_program_load(FrameStats& stats, const Program& program, const Profile& profile);
+void count_readback(FrameStats& stats, const Program* program, uint64_t result);
+
 }  // namespace vgpu

@@ -161,12 +161,7 @@ void Gpu::use_program(const Program& program) {
   program_ = &program;
   if (program.id() == loaded_program_) return;
   loaded_program_ = program.id();
-  const Program::Analysis a = program.analyze();
-  Counters c;
-  c.program_loads = 1;
-  c.program_bytes = uint64_t(a.instructions) * profile_.instruction_bytes;
-  stats_.program(program.name(), program.paper_name(), a.instructions).counters += c;
-  stats_.totals += c;
+  count_program_load(stats_, program, profile_);
 }
 
 void Gpu::bind_texture(int unit, const Texture& texture) {
@@ -207,12 +202,7 @@ void Gpu::begin_query() {
 uint64_t Gpu::end_query() {
   if (!query_active_) fail("end_query: no query is active");
   query_active_ = false;
-  Counters c;
-  c.queries = 1;
-  c.query_readbacks = 1;
-  stats_.totals += c;
-  if (program_) stats_.program(program_->name(), program_->paper_name(), 0).counters += c;
-  if (!stats_.passes.empty()) stats_.passes.back().query_result = int64_t(query_count_);
+  count_readback(stats_, program_, query_count_);
   return query_count_;
 }
 
