@@ -38,8 +38,8 @@ inline uint64_t load_bytes(const uint8_t* p, int n) {
 // the branch: {in 8x4 tiles, in 32x32 tiles}. That is every idle fragment (`idle_flags` of them)
 // less those in tiles with work, so only the 32x32 tiles `took32` marks are scanned, eight
 // fragments at a time. A fragment is idle when it passed the stencil test and the work mask
-// left it idle (unless that counts as masked), or when it ran and its flag says so; flags of
-// fragments that did not run are stale and ignored.
+// left it idle (unless that counts as masked), or when it ran and its flag says so (the masks,
+// not the flags, decide for fragments that did not run).
 std::array<uint64_t, 2> idle_in_batches(const Rect& r, const uint8_t* flags, const Stencil* work,
                                         const Stencil* test, bool work_masked, uint64_t idle_flags,
                                         const uint8_t* took8, const uint8_t* took32) {
@@ -122,8 +122,8 @@ struct Gpu::DrawPlan {
   };
   Out out[kMaxOutputs];
   uint64_t idle_branches = 0;
-  // Per fragment of the rectangle that ran: kTook or kIdle (others are not written; see
-  // idle_in_batches). Null: the program has no branches.
+  // Per fragment of the rectangle: kTook, kIdle or 0 (not shaded). Null: the program has no
+  // branches.
   uint8_t* flags = nullptr;
   bool list_runs = false;       // collect Chunk::runs (for a PairRecord)
   bool list_survivors = false;  // collect Chunk::survivors (the stencil write's non-zero list)
@@ -473,6 +473,7 @@ void Gpu::run_rows(const Program& p, const Rect& r, int y0, int y1, const DrawPl
     const uint8_t* st = stencil_test_ ? stencil_test_->row(y) : nullptr;
     const uint8_t* wk = work_mask_->row(y);
     uint8_t* sw = stencil_row(y);
+    uint8_t* fl = flag_row(y);
     out.launched += uint64_t(r.width());
     for (int x = r.x0; x < r.x1;) {
       if (st && st[x] == 0) {  // masked: not shaded, its flag stays 0
@@ -492,7 +493,10 @@ void Gpu::run_rows(const Program& p, const Rect& r, int y0, int y1, const DrawPl
       out.shaded += uint64_t(n - 1);
       out.discarded += idle_run(x, y, n);
       if (sw) std::memset(sw + x, idle_kill ? 0 : 1, size_t(n));
-      if (plan.flags && !work_masked_) out.idle_flags += uint64_t(n);  // flags unwritten
+      if (fl && !work_masked_) {
+        std::memset(fl + (x - r.x0), kIdle, size_t(n));
+        out.idle_flags += uint64_t(n);
+      }
       x += n;
     }
   }
@@ -614,8 +618,8 @@ const PassRecord& Gpu::draw(const Rect& rect) {
   DrawPlan plan;
   plan.idle_branches = uint64_t(a.branches);
   if (a.branches > 0) {
-    // Not cleared: only fragments that run write their flag (idle_in_batches).
-    batch_flags_.resize(size_t(rect.width()) * size_t(rect.height()));
+    // Complete after the pass (branch flags are a per-fragment map): masked fragments stay 0.
+    batch_flags_.assign(size_t(rect.width()) * size_t(rect.height()), 0);
     plan.flags = batch_flags_.data();
     plan.cols8 = (rect.width() + 7) / 8;
     plan.cols32 = (rect.width() + 31) / 32;
@@ -624,7 +628,7 @@ const PassRecord& Gpu::draw(const Rect& rect) {
     plan.took8 = took8_.data();
     plan.took32 = took32_.data();
   } else {
-    batch_flags_.clear();
+    batch_flags_.clear();  // no branches: no flags
   }
   // The masks as they were before the pass, for the batch counters: a pass may write the mask
   // it tests (a query pass counting into the stencil it reads).
@@ -651,6 +655,8 @@ const PassRecord& Gpu::draw(const Rect& rect) {
   if (work_mask_ && whole && work_mask_->listed_version_ == work_mask_->version_) {
     listed = work_mask_->nonzero_;
     plan.list = listed.get();
+    // Every fragment but the listed ones is idle; those overwrite their flag when they run.
+    if (plan.flags && !work_masked_) std::memset(plan.flags, kIdle, batch_flags_.size());
   }
   for (int o = 0; o < p.outputs(); ++o) {
     Texture& dst = *targets_[o];
