@@ -185,22 +185,23 @@ Context::Context(const std::string& device) {
     }
     const EGLint pb_attribs[] = {EGL_WIDTH, 1, EGL_HEIGHT, 1, EGL_NONE};
     EGLSurface surf = eglCreatePbufferSurface(c.display, config, pb_attribs);
-    if (!eglMakeCurrent(c.display, surf, surf, ctx)) {
-      note("eglMakeCurrent failed (" + egl_error() + ")");
+    // A candidate that fails after its context exists gives everything back.
+    auto drop = [&](const std::string& why) {
+      note(why);
+      eglMakeCurrent(c.display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
       if (surf != EGL_NO_SURFACE) eglDestroySurface(c.display, surf);
       eglDestroyContext(c.display, ctx);
       release_display(c.display);
+    };
+    if (!eglMakeCurrent(c.display, surf, surf, ctx)) {
+      drop("eglMakeCurrent failed (" + egl_error() + ")");
       continue;
     }
     GLint gl_major = 0, gl_minor = 0;
     glGetIntegerv(GL_MAJOR_VERSION, &gl_major);
     glGetIntegerv(GL_MINOR_VERSION, &gl_minor);
     if (gl_major * 10 + gl_minor < 33) {
-      note("OpenGL " + std::to_string(gl_major) + "." + std::to_string(gl_minor) + " (3.3 needed)");
-      eglMakeCurrent(c.display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
-      if (surf != EGL_NO_SURFACE) eglDestroySurface(c.display, surf);
-      eglDestroyContext(c.display, ctx);
-      release_display(c.display);
+      drop("OpenGL " + std::to_string(gl_major) + "." + std::to_string(gl_minor) + " (3.3 needed)");
       continue;
     }
     display_ = c.display;
@@ -209,11 +210,6 @@ Context::Context(const std::string& device) {
     platform_ = c.how;
     renderer_ = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
     version_ = reinterpret_cast<const char*>(glGetString(GL_VERSION));
-    GLint n = 0;
-    glGetIntegerv(GL_NUM_EXTENSIONS, &n);
-    for (GLint i = 0; i < n; ++i)
-      extensions_.emplace_back(
-          reinterpret_cast<const char*>(glGetStringi(GL_EXTENSIONS, GLuint(i))));
     return;
   }
   throw Unavailable("no usable OpenGL 3.3 device: " + tried);
@@ -231,12 +227,6 @@ void Context::make_current() const {
   if (eglGetCurrentContext() == context_) return;
   if (!eglMakeCurrent(display_, surface_, surface_, context_))
     throw Unavailable("cannot make the GL context current (" + egl_error() + ")");
-}
-
-bool Context::has_extension(const std::string& name) const {
-  for (const std::string& e : extensions_)
-    if (e == name) return true;
-  return false;
 }
 
 }  // namespace gl

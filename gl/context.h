@@ -31,7 +31,6 @@ class Context {
   const std::string& renderer() const { return renderer_; }  // GL_RENDERER
   const std::string& version() const { return version_; }    // GL_VERSION
   const std::string& platform() const { return platform_; }  // how the display was opened
-  bool has_extension(const std::string& name) const;
   // Makes this context current on the calling thread if it is not (several devices in one
   // process each have their own context).
   void make_current() const;
@@ -43,7 +42,6 @@ class Context {
   void* context_ = nullptr;
   void* surface_ = nullptr;
   std::string renderer_, version_, platform_;
-  std::vector<std::string> extensions_;
 };
 
 }  // namespace gl

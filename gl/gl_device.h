@@ -50,8 +50,6 @@ class GlDevice final : public vgpu::Device {
 
   // Waits for every pass issued so far (glFinish) and settles their counters and times.
   void finish();
-  // The GLSL this device compiled for a program with its current uniforms.
-  vgpu::GlslProgram glsl(const vgpu::Program& p) const { return vgpu::to_glsl(p); }
 
  private:
   struct GlTexture;
