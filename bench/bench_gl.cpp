@@ -73,6 +73,14 @@ struct CopyTwice {
   }
 };
 
+// The cost model's parameters for a profile. The h200 runs the GLSL the recorder prints, which
+// has no branches (every f.branch() block runs, under a select): no batch skips a branch body.
+host::CostParams params_for(const vgpu::Profile& p) {
+  host::CostParams c = host::defaults_for(p);
+  if (p.name == "h200") c.branch_body_share = 0;
+  return c;
+}
+
 struct Fixed {
   double wall_us = 0, gpu_us = 0;
 };
@@ -113,7 +121,7 @@ Fixed time_passes(gl::GlDevice& d, int size, int n, int runs, bool readback, con
 }
 
 struct FrameRun {
-  std::vector<double> wall, gpu, host;
+  std::vector<double> wall, gpu, host, wait;
   std::map<std::string, std::vector<double>> kernel_gpu, kernel_host;
   vgpu::FrameStats stats;
   std::string device;
@@ -124,9 +132,12 @@ FrameRun run_frames(const host::Scene& scene, const host::Grid& grid, const host
   FrameRun fr;
   host::StreamTracer tracer(scene, grid, opt);
   fr.device = tracer.device().description();
+  auto* gld = dynamic_cast<gl::GlDevice*>(&tracer.device());
   for (int r = 0; r <= runs; ++r) {  // run 0 warms up (the GL device compiles its programs)
+    const double wait0 = gld ? gld->readback_wait_ms() : 0;
     const host::RenderResult res = tracer.render(cam);
     if (r == 0) continue;
+    fr.wait.push_back(gld ? gld->readback_wait_ms() - wait0 : 0);
     fr.wall.push_back(res.render_ms);
     fr.gpu.push_back(res.stats.totals.device_ms);
     for (const auto& p : res.stats.programs) {
@@ -147,6 +158,7 @@ int main(int argc, char** argv) {
   std::vector<int> sizes = {256};
   int runs = 3, micro_passes = 200, threads = 0;
   bool no_stream = false, no_frames = false;
+  std::string wait_mode = "block";
   app.add_option("--gl-device", device, "auto, or an EGL device index")->capture_default_str();
   app.add_option("--scenes", scenes, "Scene names or .gltf paths")->capture_default_str();
   app.add_option("--sizes", sizes, "Image sizes (square)")
@@ -163,6 +175,11 @@ int main(int argc, char** argv) {
       ->capture_default_str()
       ->check(CLI::Range(0, 256));
   app.add_flag("--no-stream", no_stream, "Skip the vgpu (emulator) runs");
+  app.add_option("--readback-wait", wait_mode,
+                 "GL frames: block (GL_QUERY_RESULT), poll (spin on GL_QUERY_RESULT_AVAILABLE), "
+                 "both, or none (no GL frames: the emulator's counts and predictions only)")
+      ->check(CLI::IsMember({"block", "poll", "both", "none"}))
+      ->capture_default_str();
   app.add_flag("--no-frames", no_frames, "Only the fixed costs");
   app.add_option("--json", json_path, "Also write every figure as JSON to this file");
   CLI11_PARSE(app, argc, argv);
@@ -170,8 +187,8 @@ int main(int argc, char** argv) {
   try {
     json out;
     // Fixed costs first, on a device of its own (gf6600: two outputs for the MRT pass).
-    {
-      gl::GlDevice d(vgpu::profile("gf6600"), device);
+    if (wait_mode != "none") {
+      gl::GlDevice d(vgpu::profile("gf6600"), device, gl::GlDevice::ReadbackWait::block);
       out["device"] = d.description();
       out["renderer"] = d.context().renderer();
       out["gl_version"] = d.context().version();
@@ -200,9 +217,17 @@ int main(int argc, char** argv) {
           out["program_switch_us"] = sw.wall_us - pass.wall_us;
         }
       }
+      gl::GlDevice dp(vgpu::profile("gf6600"), device, gl::GlDevice::ReadbackWait::poll);
+      for (int size : {1, 256})
+        row("pass + polled query read-back", size,
+            time_passes(dp, size, micro_passes, runs, true, copy, nullptr));
       for (int size : {1024, 2048}) {
-        row("pass, one RGBA32F target", size,
-            time_passes(d, size, std::max(10, micro_passes / 10), runs, false, copy, nullptr));
+        const int n = std::max(10, micro_passes / 10);
+        row("pass, one RGBA32F target", size, time_passes(d, size, n, runs, false, copy, nullptr));
+        row("pass + blocking query read-back", size,
+            time_passes(d, size, n, runs, true, copy, nullptr));
+        row("pass + polled query read-back", size,
+            time_passes(dp, size, n, runs, true, copy, nullptr));
         row("pass, two RGBA32F targets (MRT)", size,
             time_passes(d, size, std::max(10, micro_passes / 10), runs, false, twice, nullptr, 2));
       }
@@ -213,6 +238,10 @@ int main(int argc, char** argv) {
           out["program_switch_us"].get<double>());
       out["fixed"] = fixed;
     }
+    std::vector<std::string> engines;
+    if (wait_mode == "block" || wait_mode == "both") engines.push_back("gl");
+    if (wait_mode == "poll" || wait_mode == "both") engines.push_back("gl-poll");
+    if (!no_stream) engines.push_back("stream");
     if (!no_frames) {
       json frames = json::array();
       for (const std::string& name : scenes) {
@@ -230,9 +259,10 @@ int main(int argc, char** argv) {
                                                           vgpu::profile(opt.profile)));
           const host::Camera cam =
               scene.camera ? *scene.camera : host::frame_bounds(scene.bounds(), 1.0f);
-          for (const char* engine : {"gl", "stream"}) {
-            if (no_stream && std::string(engine) == "stream") continue;
-            opt.device = std::string(engine) == "gl" ? "gl" : "vgpu";
+          for (const std::string& engine : engines) {
+            const bool gl = engine != "stream";
+            opt.device = gl ? "gl" : "vgpu";
+            opt.gl_readback = engine == "gl-poll" ? "poll" : "block";
             const FrameRun fr = run_frames(scene, grid, cam, opt, runs);
             json f = {{"scene", scene.name},
                       {"size", size},
@@ -240,28 +270,48 @@ int main(int argc, char** argv) {
                       {"device", fr.device},
                       {"runs", runs},
                       {"wall_ms", median(fr.wall)},
-                      {"gpu_ms", std::string(engine) == "gl" ? json(median(fr.gpu)) : json()},
+                      {"gpu_ms", gl ? json(median(fr.gpu)) : json()},
+                      {"readback_wait_ms", gl ? json(median(fr.wait)) : json()},
                       {"passes", fr.stats.totals.passes},
                       {"query_readbacks", fr.stats.totals.query_readbacks},
                       {"program_loads", fr.stats.totals.program_loads},
                       {"fragments_shaded", fr.stats.totals.fragments_shaded}};
             json kernels = json::array();
-            for (const auto& p : fr.stats.programs)
-              kernels.push_back({{"name", p.name},
-                                 {"paper_name", p.paper_name},
-                                 {"passes", p.counters.passes},
-                                 {"gpu_ms", median(fr.kernel_gpu.at(p.name))},
-                                 {"host_ms", median(fr.kernel_host.at(p.name))}});
+            for (const auto& p : fr.stats.programs) {
+              json k = {{"name", p.name},
+                        {"paper_name", p.paper_name},
+                        {"passes", p.counters.passes},
+                        {"gpu_ms", gl ? json(median(fr.kernel_gpu.at(p.name))) : json()},
+                        {"host_ms", median(fr.kernel_host.at(p.name))}};
+              if (!gl) {  // the cost model per kernel: its passes' work and fixed costs
+                vgpu::FrameStats one;
+                one.programs = {p};
+                one.totals = p.counters;
+                const vgpu::Profile& hp = vgpu::profile("h200");
+                const host::CostBreakdown b = host::predict(one, hp, params_for(hp));
+                k["predicted_h200_ms"] = b.total_ms;
+                k["predicted_h200_work_ms"] = b.arithmetic_ms + b.texture_ms + b.memory_ms;
+              }
+              kernels.push_back(k);
+            }
             f["kernels"] = kernels;
-            if (std::string(engine) == "stream") {
+            if (!gl) {
               json pred;
               for (const vgpu::Profile& p : vgpu::profiles())
-                pred[p.name] = host::predict(fr.stats, p).total_ms;
+                pred[p.name] = host::predict(fr.stats, p, params_for(p)).total_ms;
               f["predicted_ms"] = pred;
+              json h200 = json::object();
+              const vgpu::Profile& hp = vgpu::profile("h200");
+              for (const auto& [k, v] : host::predict(fr.stats, hp, params_for(hp)).items())
+                h200[k] = v;
+              f["predicted_h200"] = h200;
             }
-            std::printf("%-14s %4dx%-4d %-6s wall %9.1f ms", scene.name.c_str(), size, size, engine,
-                        median(fr.wall));
-            if (std::string(engine) == "gl") std::printf("  gpu %9.1f ms", median(fr.gpu));
+            std::printf("%-14s %4dx%-4d %-7s wall %9.1f ms", scene.name.c_str(), size, size,
+                        engine.c_str(), median(fr.wall));
+            if (gl)
+              std::printf("  gpu %9.1f ms  wait %8.1f ms", median(fr.gpu), median(fr.wait));
+            else
+              std::printf("  h200 predicted %8.1f ms", f["predicted_ms"]["h200"].get<double>());
             std::printf("  passes %6llu  read-backs %5llu\n",
                         static_cast<unsigned long long>(fr.stats.totals.passes),
                         static_cast<unsigned long long>(fr.stats.totals.query_readbacks));

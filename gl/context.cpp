@@ -93,6 +93,7 @@ Context::Context(const std::string& device) {
   struct Candidate {
     EGLDisplay display;
     std::string how;
+    bool software = false;
   };
   std::vector<Candidate> candidates;
   std::string tried;
@@ -110,7 +111,7 @@ Context::Context(const std::string& device) {
                         std::to_string(e.devices.size() - 1) + ")");
     candidates.push_back(
         {e.platform_display(EGL_PLATFORM_DEVICE_EXT, e.devices[size_t(idx)], nullptr),
-         "EGL device " + device + " (" + e.info(int(idx)).name + ")"});
+         "EGL device " + device + " (" + e.info(int(idx)).name + ")", e.info(int(idx)).software});
   } else {
     if (e.platform_display) {
       // Hardware devices first, then software ones.
@@ -120,13 +121,13 @@ Context::Context(const std::string& device) {
           if (d.software != (pass == 1)) continue;
           candidates.push_back(
               {e.platform_display(EGL_PLATFORM_DEVICE_EXT, e.devices[size_t(i)], nullptr),
-               "EGL device " + std::to_string(i) + " (" + d.name + ")"});
+               "EGL device " + std::to_string(i) + " (" + d.name + ")", d.software});
         }
       const char* client = eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
       if (has_word(client, "EGL_MESA_platform_surfaceless"))
         candidates.push_back(
             {e.platform_display(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr),
-             "EGL surfaceless platform"});
+             "EGL surfaceless platform", true});
     }
   }
   if (candidates.empty())
@@ -208,6 +209,7 @@ Context::Context(const std::string& device) {
     context_ = ctx;
     surface_ = surf;
     platform_ = c.how;
+    software_ = c.software;
     renderer_ = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
     version_ = reinterpret_cast<const char*>(glGetString(GL_VERSION));
     return;

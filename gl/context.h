@@ -31,6 +31,8 @@ class Context {
   const std::string& renderer() const { return renderer_; }  // GL_RENDERER
   const std::string& version() const { return version_; }    // GL_VERSION
   const std::string& platform() const { return platform_; }  // how the display was opened
+  // A software renderer (Mesa's software device or the surfaceless platform: llvmpipe).
+  bool software() const { return software_; }
   // Makes this context current on the calling thread if it is not (several devices in one
   // process each have their own context).
   void make_current() const;
@@ -42,6 +44,7 @@ class Context {
   void* context_ = nullptr;
   void* surface_ = nullptr;
   std::string renderer_, version_, platform_;
+  bool software_ = false;
 };
 
 }  // namespace gl

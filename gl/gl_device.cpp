@@ -79,8 +79,10 @@ GLuint compile(GLenum kind, const std::string& source, const std::string& what) 
 
 }  // namespace
 
-GlDevice::GlDevice(const vgpu::Profile& profile, const std::string& device)
-    : profile_(profile), ctx_(std::make_unique<Context>(device)) {
+GlDevice::GlDevice(const vgpu::Profile& profile, const std::string& device, ReadbackWait wait)
+    : profile_(profile), wait_(wait), ctx_(std::make_unique<Context>(device)) {
+  if (wait_ == ReadbackWait::automatic)
+    wait_ = ctx_->software() ? ReadbackWait::block : ReadbackWait::poll;
   glGenVertexArrays(1, &vao_);
   glBindVertexArray(vao_);
   glGenFramebuffers(1, &clear_fbo_);
@@ -367,6 +369,14 @@ uint64_t GlDevice::end_query() {
   if (!query_active_) throw Error("end_query: no query is active");
   query_active_ = false;
   // The read-back: wait for the passes drawn inside the query and sum what survived them.
+  const auto t0 = std::chrono::steady_clock::now();
+  if (wait_ == ReadbackWait::poll && query_first_ < pending_.size()) {
+    glFlush();
+    for (size_t i = query_first_; i < pending_.size(); ++i) {
+      GLuint ready = 0;
+      while (!ready) glGetQueryObjectuiv(pending_[i].samples, GL_QUERY_RESULT_AVAILABLE, &ready);
+    }
+  }
   uint64_t n = 0;
   for (size_t i = query_first_; i < pending_.size(); ++i) {
     GLuint64 v = 0;
@@ -374,6 +384,8 @@ uint64_t GlDevice::end_query() {
     pending_[i].passed = int64_t(v);
     n += v;
   }
+  wait_ms_ +=
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   vgpu::count_readback(stats_, program_, n);
   return n;
 }

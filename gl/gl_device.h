@@ -22,8 +22,16 @@ class Context;
 
 class GlDevice final : public vgpu::Device {
  public:
+  // How the host waits for an occlusion query's result: `block` asks GL for GL_QUERY_RESULT
+  // (the driver decides how to wait: NVIDIA's may sleep and wake up late after a long pass),
+  // `poll` flushes and spins on GL_QUERY_RESULT_AVAILABLE (a CPU core busy, no wake-up delay),
+  // `automatic` polls on a hardware driver and blocks on a software one (whose rasterizer
+  // threads need the core a poll would spin on).
+  enum class ReadbackWait { block, poll, automatic };
+
   // device: "auto" or an EGL device index (gl::Context). Throws gl::Unavailable.
-  GlDevice(const vgpu::Profile& profile, const std::string& device = "auto");
+  GlDevice(const vgpu::Profile& profile, const std::string& device = "auto",
+           ReadbackWait wait = ReadbackWait::automatic);
   ~GlDevice() override;
 
   const vgpu::Profile& profile() const override { return profile_; }
@@ -50,6 +58,10 @@ class GlDevice final : public vgpu::Device {
 
   // Waits for every pass issued so far (glFinish) and settles their counters and times.
   void finish();
+  ReadbackWait readback_wait() const { return wait_; }  // block or poll, never automatic
+  // Host milliseconds spent waiting in end_query() since the device was made (a frame's share:
+  // the difference of two readings).
+  double readback_wait_ms() const { return wait_ms_; }
 
  private:
   struct GlTexture;
@@ -61,6 +73,8 @@ class GlDevice final : public vgpu::Device {
   void settle(size_t keep);
 
   vgpu::Profile profile_;
+  ReadbackWait wait_ = ReadbackWait::block;
+  double wait_ms_ = 0;
   std::unique_ptr<Context> ctx_;
   unsigned vao_ = 0, clear_fbo_ = 0;
   std::map<uint64_t, std::unique_ptr<GlTexture>> textures_;

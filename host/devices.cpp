@@ -34,7 +34,14 @@ std::unique_ptr<vgpu::Device> make_device(const RenderOptions& opt) {
       throw vgpu::Error(
           "the GL device computes in fp32 only (GLSL floats); use --engine stream for --precision "
           "fp24/fp16");
-    return std::make_unique<gl::GlDevice>(profile, opt.gl_device);
+    using Wait = gl::GlDevice::ReadbackWait;
+    const Wait wait = opt.gl_readback == "auto"    ? Wait::automatic
+                      : opt.gl_readback == "block" ? Wait::block
+                      : opt.gl_readback == "poll"
+                          ? Wait::poll
+                          : throw vgpu::Error("unknown GL read-back wait '" + opt.gl_readback +
+                                              "' (known: auto, block, poll)");
+    return std::make_unique<gl::GlDevice>(profile, opt.gl_device, wait);
 #else
     throw vgpu::Error(
         "this build has no GL device: EGL and OpenGL (libegl-dev, libopengl-dev, libgl-dev) were "

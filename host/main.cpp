@@ -56,6 +56,7 @@ struct RenderArgs {
   bool predict = false;
   std::string engine = "stream";
   std::string gl_device = "auto";
+  std::string gl_readback = "auto";
   std::string precision = "fp32";
   std::string formats;
 };
@@ -232,6 +233,13 @@ void add_render_options(CLI::App& render, RenderArgs& a) {
       .add_option("--gl-device", a.gl_device,
                   "With --engine gl: auto, or an EGL device index (see vgpu-rt gl-devices)")
       ->capture_default_str();
+  render
+      .add_option("--gl-readback", a.gl_readback,
+                  "With --engine gl: how the host waits for an occlusion query: block (the "
+                  "driver's GL_QUERY_RESULT wait), poll (spin on GL_QUERY_RESULT_AVAILABLE), "
+                  "auto (poll on a hardware driver, block on a software one)")
+      ->check(CLI::IsMember({"auto", "block", "poll"}))
+      ->capture_default_str();
   render.add_flag("--predict", a.predict,
                   "Print the cost model's predicted time for --profile, with its breakdown");
 }
@@ -308,6 +316,10 @@ int run_render(const RenderArgs& a, bool lanes_given) {
           "--masks on and --precision fp24/fp16 need --engine stream");
     opt.device = "gl";
     opt.gl_device = a.gl_device;
+    opt.gl_readback = a.gl_readback;
+  } else if (a.gl_device != "auto" || a.gl_readback != "auto") {
+    throw UsageError(std::string(a.gl_device != "auto" ? "--gl-device" : "--gl-readback") +
+                     " needs --engine gl");
   }
   if (!a.report.empty() && int64_t(opt.width) * opt.height > host::kReportMaxPixels)
     throw UsageError("--report: at most " + std::to_string(host::kReportMaxPixels) +

@@ -62,6 +62,10 @@ struct RenderOptions {
   // device gl_device: "auto" or an index).
   std::string device = "vgpu";
   std::string gl_device = "auto";
+  // How the GL device waits for a query result: "block" (GL_QUERY_RESULT, the driver's wait),
+  // "poll" (spin on GL_QUERY_RESULT_AVAILABLE) or "auto" (poll on a hardware driver, block on
+  // a software one; see gl::GlDevice::ReadbackWait).
+  std::string gl_readback = "auto";
   int threads = 0;  // 0: every host core
   int lanes = vgpu::kLanes;
   // Formats of the ray-state textures and of the arithmetic of the kernels writing them, per

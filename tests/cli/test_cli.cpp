@@ -94,6 +94,12 @@ TEST_CASE("output files need a known extension and an existing directory") {
   CHECK(s.status == 2);
 }
 
+TEST_CASE("GL device settings are refused without the GL engine and checked against their set") {
+  check_refused("--gl-readback poll", "--gl-readback");
+  check_refused("--engine cpu --gl-device 0", "--gl-device");
+  check_refused("--engine gl --gl-readback spin", "--gl-readback");
+}
+
 TEST_CASE("settings the cpu engine does not use are refused instead of recorded") {
   check_refused("--engine cpu --lanes 8", "--lanes");
   check_refused("--engine cpu --precision fp16", "--precision");

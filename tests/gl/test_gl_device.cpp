@@ -23,11 +23,13 @@ struct Frame {
   std::string device;
 };
 
-Frame render(const std::string& scene_name, const std::string& device, int size, bool keep_passes) {
+Frame render(const std::string& scene_name, const std::string& device, int size, bool keep_passes,
+             const std::string& readback = "auto") {
   const host::Scene scene = host::load_scene(host::resolve_scene(scene_name));
   host::RenderOptions opt;
   opt.width = opt.height = size;
   opt.device = device;
+  opt.gl_readback = readback;
   opt.threads = 2;
   opt.keep_pass_records = keep_passes;
   const host::Grid grid =
@@ -101,10 +103,13 @@ TEST_CASE("the GL device refuses what it cannot do, naming it") {
   CHECK_THROWS_AS(gl::Context("first"), gl::Unavailable);
 }
 
-TEST_CASE("every occlusion-query count of a bunny and a bunny-refl frame equals the vgpu's") {
-  for (const char* name : {"bunny", "bunny-refl"}) {
+TEST_CASE(
+    "every occlusion-query count of a bunny and a bunny-refl frame equals the vgpu's, blocking "
+    "or polling for the result") {
+  for (const auto& [name, wait] : {std::pair{"bunny", "block"}, std::pair{"bunny-refl", "poll"}}) {
     CAPTURE(name);
-    const Frame v = render(name, "vgpu", 64, true), g = render(name, "gl", 64, true);
+    CAPTURE(wait);
+    const Frame v = render(name, "vgpu", 64, true), g = render(name, "gl", 64, true, wait);
     const auto& pv = v.result.stats.passes;
     const auto& pg = g.result.stats.passes;
     size_t queries = 0;
