@@ -60,9 +60,13 @@ void add_passes(const vgpu::Counters& c, double n, const vgpu::Profile& hw, cons
   const double rate_ops = ops32 / hw.rate(vgpu::Format::fp32) +
                           ops24 / hw.rate(vgpu::Format::fp24) + ops16 / hw.rate(vgpu::Format::fp16);
   const double arith_s = rate_ops * keep / packing / (hw.pipelines * hz * hw.alu_per_clock);
-  const double tex_s = fetches * keep / (hw.pipelines * hz * hw.texels_per_clock);
-  const double mem_s =
+  double tex_s = fetches * keep / (hw.pipelines * hz * hw.texels_per_clock);
+  if (hw.texture_bytes_per_clock > 0)
+    tex_s = std::max(tex_s, double(c.bytes_read) / n * keep / (hw.texture_bytes_per_clock * hz));
+  double mem_s =
       (double(c.bytes_read) / n * keep + double(c.bytes_written) / n) / (hw.mem_gbps * 1e9);
+  if (hw.output_bytes_per_clock > 0)
+    mem_s = std::max(mem_s, double(c.bytes_written) / n / (hw.output_bytes_per_clock * hz));
   const double work_s = std::max({arith_s, tex_s, mem_s});
 
   const double ms = 1e3 * n;

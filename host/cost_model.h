@@ -6,8 +6,10 @@
 //   arithmetic = ALU instructions / (pipelines x clock x alu_per_clock x precision rate), each
 //                at the rate of the precision it ran at (Counters::alu_fp24 / alu_fp16,
 //                Profile::rate: NV3x fp16 full speed, fp32 and fp24 half)
-//   texture    = texel fetches / (pipelines x clock x texels_per_clock)
-//   memory     = (bytes read + bytes written) / bandwidth
+//   texture    = texel fetches / (pipelines x clock x texels_per_clock), or where the profile
+//                gives one, texel bytes / (texture_bytes_per_clock x clock) if that is longer
+//   memory     = (bytes read + bytes written) / bandwidth, or where the profile gives one,
+//                bytes written / (output_bytes_per_clock x clock) if that is longer (the ROPs)
 // Per frame:  + program loads (bytes over the bus + program_load_us each)
 //             + query read-backs (readback_us each: a pipeline drain and a CPU round trip)
 //             + clears (bytes / bandwidth, counted with memory)

@@ -1,11 +1,13 @@
 #!/usr/bin/env bash
-# The H200 measurement of docs/real_gpu.md, as one command for a GPU host that has a driver and
-# nothing of this project's packages (the workplace's device machine). Prepare here:
+# The H200 measurement of docs/real_gpu.md, as one command for a GPU host that has an NVIDIA
+# driver and none of this project's packages. Prepare on a Debian 12 machine:
 #   cmake --build build --target bench_gl && mkdir -p .bin && cp build/bench/bench_gl .bin/
-#   (and the glvnd GL/EGL .deb files in .gl/, as the device notes say)
-# then run there, from the repository root, carrying .bin and .gl:
-#   scripts/h200_bench.sh "$OUT"
-# and here:  /usr/bin/python3 scripts/real_gpu.py --reuse --add h200=docs/real_gpu_h200.json
+#   mkdir -p .gl && (cd .gl && apt-get download libegl1 libglvnd0 libopengl0 libgl1 libglx0)
+# copy the repository with .bin and .gl to the GPU host and run there, from its root:
+#   scripts/h200_bench.sh OUTPUT_DIR
+# then copy OUTPUT_DIR's real_gpu_h200.json and gpu_clocks.csv to docs/ (the clocks as
+# real_gpu_h200_clocks.csv) and run here:
+#   /usr/bin/python3 scripts/real_gpu.py --reuse --add h200=docs/real_gpu_h200.json
 set -euo pipefail
 out="${1:?usage: scripts/h200_bench.sh OUTPUT_DIR}"
 cd "$(dirname "$0")/.."
@@ -23,6 +25,12 @@ smi --query-gpu=timestamp,clocks.sm,clocks.mem,utilization.gpu --format=csv -lms
   > "$out/gpu_clocks.csv" &
 sampler=$!
 trap 'kill $sampler 2>/dev/null || true' EXIT
-.bin/bench_gl --runs 5 --sizes 256 1024 --threads 16 \
+# Frames with both read-back waits (the emulator's counts and the predictions are the same on
+# every machine: scripts/real_gpu.py computes them here with --readback-wait none).
+.bin/bench_gl --runs 5 --sizes 256 1024 --threads 16 --no-stream --readback-wait both \
   --scenes scenes/sphere-alone.gltf scenes/bunny.gltf scenes/bunny-mirror.gltf \
   --json "$out/real_gpu_h200.json" 2>&1 | tee "$out/bench_gl.log"
+# NVIDIA's driver reads __GL_YIELD for how a waiting thread yields; NOTHING never yields.
+__GL_YIELD=NOTHING .bin/bench_gl --runs 5 --sizes 256 --no-stream --readback-wait block \
+  --micro-passes 50 --scenes scenes/bunny.gltf --json "$out/real_gpu_h200_yield.json" 2>&1 |
+  tee "$out/bench_gl_yield.log"

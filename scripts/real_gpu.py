@@ -1,18 +1,25 @@
 #!/usr/bin/env python3
 """The paper's passes on real OpenGL drivers, beside the emulator and the cost model.
 
-Runs bench/bench_gl on this machine's EGL device (Mesa llvmpipe here), or reads JSON it wrote
-elsewhere (a GPU host: --add NAME=FILE.json), and writes docs/real_gpu.md with its chart
-docs/real_gpu.png (matplotlib): per scene and size, the frame's wall and GPU ms on each driver,
-the emulator's host ms, the cost model's prediction for each profile, passes and read-backs;
-per kernel, GPU ms; and the fixed costs of a pass, a query read-back and a program switch.
+Writes docs/real_gpu.md and its chart docs/real_gpu.png (matplotlib) from JSON that
+bench/bench_gl wrote:
+  docs/real_gpu_llvmpipe.json     this machine's EGL device (Mesa llvmpipe); measured again
+                                  unless --reuse
+  docs/real_gpu_predictions.json  the emulator's counts and the cost model's predictions
+                                  (bench_gl --readback-wait none); computed again unless --reuse
+  --add NAME=FILE.json            figures measured on another machine (the H200:
+                                  scripts/h200_bench.sh), with NAME_clocks.csv beside it if
+                                  nvidia-smi sampled the clocks there
+  --add-run NAME=FILE.json        an earlier run on that machine, shown for its clocks only
 
-Usage: /usr/bin/python3 scripts/real_gpu.py [--bench build/bench/bench_gl] [--runs 3]
-         [--reuse] [--add h200=docs/real_gpu_h200.json]
+Usage: /usr/bin/python3 scripts/real_gpu.py [--bench build/bench/bench_gl] [--runs 3] [--reuse]
+         [--add h200=docs/real_gpu_h200.json] [--add-run h200-run1=docs/real_gpu_h200_run1.json]
 """
 import argparse
+import csv
 import json
 import os
+import statistics
 import subprocess
 import sys
 
@@ -25,8 +32,7 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 DOCS = os.path.join(ROOT, "docs")
 
 
-def run_bench(exe, runs, out):
-    cmd = [exe, "--runs", str(runs), "--json", out]
+def run(cmd):
     print("real_gpu:", " ".join(cmd), file=sys.stderr, flush=True)
     subprocess.run(cmd, check=True, cwd=ROOT)
 
@@ -35,29 +41,75 @@ def fmt(v, digits=1):
     return "—" if v is None else f"{v:,.{digits}f}"
 
 
+def pct(pred, meas):
+    return "—" if not pred or not meas else f"{100 * (pred / meas - 1):+.0f}%"
+
+
+def load(path):
+    with open(path) as f:
+        return json.load(f)
+
+
+def clocks(path):
+    """SM clock samples (MHz) taken while the GPU was busy (utilization > 0)."""
+    if not os.path.exists(path):
+        return None
+    busy = []
+    with open(path) as f:
+        for row in csv.reader(f, skipinitialspace=True):
+            if len(row) < 4 or not row[1].endswith("MHz"):
+                continue
+            mhz, util = float(row[1].split()[0]), float(row[3].split()[0])
+            if util > 0:
+                busy.append(mhz)
+    return busy or None
+
+
+def frames_by(d):
+    return {(f["scene"], f["size"], f["engine"]): f for f in d.get("frames", [])}
+
+
+def fixed_table(d):
+    lines = ["| pass | size | wall µs | GPU µs |", "|---|---|---|---|"]
+    for r in d["fixed"]:
+        lines.append(f"| {r['what']} | {r['size']}² | {fmt(r['wall_us'], 2)} | "
+                     f"{fmt(r['gpu_us'], 2)} |")
+    return lines
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--bench", default=os.path.join(ROOT, "build/bench/bench_gl"))
     ap.add_argument("--runs", type=int, default=3)
     ap.add_argument("--reuse", action="store_true",
-                    help="keep docs/real_gpu_llvmpipe.json instead of measuring again")
+                    help="keep the llvmpipe and prediction JSON instead of measuring again")
     ap.add_argument("--add", action="append", default=[],
                     help="NAME=FILE.json: bench_gl figures measured on another machine")
+    ap.add_argument("--add-run", action="append", default=[],
+                    help="NAME=FILE.json: an earlier run there, for its frame times and clocks")
     args = ap.parse_args()
 
     local = os.path.join(DOCS, "real_gpu_llvmpipe.json")
+    preds = os.path.join(DOCS, "real_gpu_predictions.json")
     if not args.reuse or not os.path.exists(local):
-        run_bench(args.bench, args.runs, local)
-    sources = [("llvmpipe", local)]
-    for a in args.add:
-        name, _, path = a.partition("=")
-        if not path or not os.path.exists(path):
-            sys.exit(f"real_gpu: --add {a}: expected NAME=FILE.json with an existing file")
-        sources.append((name, path))
-    data = {}
-    for name, path in sources:
-        with open(path) as f:
-            data[name] = json.load(f)
+        run([args.bench, "--runs", str(args.runs), "--json", local])
+    if not args.reuse or not os.path.exists(preds):
+        run([args.bench, "--runs", "1", "--sizes", "256", "1024", "--readback-wait", "none",
+             "--json", preds])
+
+    def named(specs):
+        out = {}
+        for a in specs:
+            name, _, path = a.partition("=")
+            if not path or not os.path.exists(path):
+                sys.exit(f"real_gpu: {a}: expected NAME=FILE.json with an existing file")
+            out[name] = (load(path), clocks(path.replace(".json", "_clocks.csv")))
+        return out
+
+    remote = named(args.add)
+    earlier = named(args.add_run)
+    llvm = load(local)
+    pred = frames_by(load(preds))
 
     lines = ["# The paper's passes on real OpenGL drivers",
              "",
@@ -65,77 +117,118 @@ def main():
              "device (`gl/`) runs the stream tracer's host loop unchanged, with fragment shaders",
              "generated from the same C++ kernels the emulator runs. Frames use `docs/table1.md`'s",
              "settings (3 iterations, phong, no shadow rays, a 15³ grid); every figure is the median",
-             f"of the runs after one warm-up (which compiles the programs).",
+             "of the runs after one warm-up (which compiles the programs). Predictions are the cost",
+             "model's (`host/cost_model.cpp`) from the emulator's counts of the same frame, which",
+             "equal the GL device's (`tests/gl`).",
              ""]
-    for name, d in data.items():
+
+    for name, (d, clk) in remote.items():
+        fb = frames_by(d)
         lines += [f"## {name}: {d['device']}", ""]
-        lines += ["Fixed costs (1x1 passes, wall clock per pass; each pass also carries the GL",
-                  "device's own non-blocking sample and timer queries):", "",
-                  f"- one pass: **{fmt(d['pass_us'], 2)} µs**",
-                  f"- one blocking occlusion-query read-back: **{fmt(d['readback_us'], 2)} µs** "
-                  "beyond the pass",
-                  f"- one program switch: **{fmt(d['program_switch_us'], 2)} µs** beyond the pass",
-                  "", "| pass | size | wall µs | GPU µs |", "|---|---|---|---|"]
-        for r in d["fixed"]:
-            lines.append(f"| {r['what']} | {r['size']}² | {fmt(r['wall_us'], 2)} | "
-                         f"{fmt(r['gpu_us'], 2)} |")
-        lines += ["", "| scene | size | engine | wall ms | GPU ms | passes | read-backs | "
-                  "predicted ms (gf5700 / gf6600 / h200) |", "|---|---|---|---|---|---|---|---|"]
-        for f in d.get("frames", []):
-            pred = f.get("predicted_ms")
-            p = " / ".join(fmt(pred.get(k)) for k in ("gf5700", "gf6600", "h200")) if pred else ""
-            eng = "emulator (host)" if f["engine"] == "stream" else "GL device"
-            lines.append(f"| {f['scene']} | {f['size']}² | {eng} | {fmt(f['wall_ms'])} | "
-                         f"{fmt(f['gpu_ms'])} | {f['passes']:,} | {f['query_readbacks']:,} | {p} |")
-        lines += ["", "Per kernel (GL device GPU ms, emulator host ms), first size:", ""]
-        gl_frames = [f for f in d.get("frames", []) if f["engine"] == "gl"]
-        if gl_frames:
-            size0 = gl_frames[0]["size"]
-            names = [k["name"] for k in gl_frames[0]["kernels"]]
-            lines += ["| scene | " + " | ".join(names) + " |",
-                      "|---|" + "---|" * len(names)]
-            for f in d["frames"]:
-                if f["size"] != size0:
-                    continue
-                ks = {k["name"]: k for k in f["kernels"]}
-                key = "gpu_ms" if f["engine"] == "gl" else "host_ms"
-                label = f"{f['scene']} ({'GL GPU' if f['engine'] == 'gl' else 'emulator host'})"
-                lines.append(f"| {label} | " + " | ".join(
-                    fmt(ks[n][key], 2) if n in ks else "—" for n in names) + " |")
+        if clk:
+            lines += [f"SM clock while the GPU was busy (nvidia-smi every 200 ms): median "
+                      f"**{statistics.median(clk):.0f} MHz**, {min(clk):.0f}–{max(clk):.0f} MHz "
+                      f"over {len(clk)} samples.", ""]
+        lines += ["### Fixed costs", "",
+                  "Tiny passes (copy the own texel), wall clock per pass; each pass also carries",
+                  "the GL device's own non-blocking sample and timer queries. *Blocking*: the host",
+                  "asks for GL_QUERY_RESULT and the driver waits; *polled*: it spins on",
+                  "GL_QUERY_RESULT_AVAILABLE.", "",
+                  f"- one pass: **{fmt(d['pass_us'], 2)} µs**; a blocking read-back "
+                  f"**{fmt(d['readback_us'], 2)} µs** more; a program switch "
+                  f"{fmt(d['program_switch_us'], 2)} µs (noise)", ""]
+        lines += fixed_table(d) + [""]
+        lines += ["### Frames, measured and predicted", "",
+                  "| scene | size | wall ms, blocking | wall ms, polled | GPU ms | passes | "
+                  "read-backs | predicted ms | predicted vs polled | vs blocking |",
+                  "|---|---|---|---|---|---|---|---|---|---|"]
+        for (scene, size, eng), f in fb.items():
+            if eng != "gl":
+                continue
+            p = fb.get((scene, size, "gl-poll"))
+            pr = pred.get((scene, size, "stream"))
+            pm = pr["predicted_ms"].get(name) if pr else None
+            lines.append(
+                f"| {scene} | {size}² | {fmt(f['wall_ms'])} | {fmt(p and p['wall_ms'])} | "
+                f"{fmt(f['gpu_ms'])} | {f['passes']:,} | {f['query_readbacks']:,} | {fmt(pm)} | "
+                f"{pct(pm, p and p['wall_ms'])} | {pct(pm, f['wall_ms'])} |")
+        lines += ["", "Per kernel at the largest size, GPU ms (timer queries, polled run) beside "
+                  "the predicted fragment work (the fixed costs apart):", ""]
+        big = max((k[1] for k in fb), default=None)
+        rows = [f for (s, z, e), f in fb.items() if z == big and e == "gl-poll"]
+        if rows:
+            lines += ["| scene | kernel | passes | GPU ms | predicted work ms | measured / "
+                      "predicted |", "|---|---|---|---|---|---|"]
+            for f in rows:
+                pr = pred.get((f["scene"], big, "stream"))
+                pk = {k["name"]: k for k in pr["kernels"]} if pr else {}
+                for k in f["kernels"]:
+                    w = pk.get(k["name"], {}).get(f"predicted_{name}_work_ms")
+                    if k["gpu_ms"] < 1:
+                        continue
+                    ratio = f"{k['gpu_ms'] / w:.2f}" if w else "—"
+                    lines.append(f"| {f['scene']} | {k['name']} | {k['passes']:,} | "
+                                 f"{fmt(k['gpu_ms'], 2)} | {fmt(w, 2)} | {ratio} |")
+            lines.append("")
+    for name, (d, clk) in earlier.items():
+        fb = frames_by(d)
+        lines += [f"### An earlier run ({name}): the emulator's runs between the GL frames", ""]
+        if clk:
+            lines += [f"SM clock while busy: median {statistics.median(clk):.0f} MHz, "
+                      f"{min(clk):.0f}–{max(clk):.0f} MHz over {len(clk)} samples.", ""]
+        lines += ["| scene | size | GL wall ms (blocking) | GL GPU ms | emulator host ms "
+                  "(16 threads) |", "|---|---|---|---|---|"]
+        for (scene, size, eng), f in fb.items():
+            if eng != "gl":
+                continue
+            s = fb.get((scene, size, "stream"))
+            lines.append(f"| {scene} | {size}² | {fmt(f['wall_ms'])} | {fmt(f['gpu_ms'])} | "
+                         f"{fmt(s and s['wall_ms'])} |")
         lines.append("")
 
-    # Chart: per scene x size, a group of bars (emulator host, each driver's wall and GPU ms,
-    # each profile's prediction), log scale; and the fixed costs.
-    fig, axes = plt.subplots(1, 2, figsize=(13, 6.2), gridspec_kw={"width_ratios": [3, 2]})
+    lines += [f"## llvmpipe: {llvm['device']}", "",
+              f"- one pass: **{fmt(llvm['pass_us'], 2)} µs**; a blocking read-back "
+              f"**{fmt(llvm['readback_us'], 2)} µs** more; a program switch "
+              f"**{fmt(llvm['program_switch_us'], 2)} µs** more", ""]
+    lines += fixed_table(llvm) + [""]
+    lines += ["| scene | size | engine | wall ms | GPU ms | passes | read-backs |",
+              "|---|---|---|---|---|---|---|"]
+    for f in llvm.get("frames", []):
+        eng = "emulator (host, this machine)" if f["engine"] == "stream" else "GL device"
+        lines.append(f"| {f['scene']} | {f['size']}² | {eng} | {fmt(f['wall_ms'])} | "
+                     f"{fmt(f.get('gpu_ms'))} | {f['passes']:,} | {f['query_readbacks']:,} |")
+    lines.append("")
+
+    # Chart: per scene x size, bars for each measured and predicted figure (log scale); and the
+    # fixed cost of a pass against its size.
+    fig, axes = plt.subplots(1, 2, figsize=(14, 6.4), gridspec_kw={"width_ratios": [3, 2]})
     ax = axes[0]
-    cells = []
-    for name, d in data.items():
-        for f in d.get("frames", []):
-            key = (f["scene"], f["size"])
-            if key not in cells:
-                cells.append(key)
-    series = []
-    first = next(iter(data.values()))
-    series.append(("emulator host ms (this machine)",
-                   {(f["scene"], f["size"]): f["wall_ms"] for f in first.get("frames", [])
-                    if f["engine"] == "stream"}))
-    for name, d in data.items():
-        series.append((f"{name} wall ms", {(f["scene"], f["size"]): f["wall_ms"]
-                                             for f in d.get("frames", []) if f["engine"] == "gl"}))
-        series.append((f"{name} GPU ms", {(f["scene"], f["size"]): f["gpu_ms"]
-                                            for f in d.get("frames", []) if f["engine"] == "gl"}))
-    for prof in ("gf5700", "gf6600", "h200"):
-        series.append((f"predicted {prof}", {(f["scene"], f["size"]): f["predicted_ms"].get(prof)
-                                             for f in first.get("frames", [])
-                                             if f["engine"] == "stream"
-                                             and f["predicted_ms"].get(prof)}))
+    cells = sorted({(s, z) for (s, z, e) in pred}, key=lambda c: (c[1], c[0]))
+    series = [("emulator host ms (2-core dev machine)",
+               {(s, z): f["wall_ms"] for (s, z, e), f in pred.items() if e == "stream"}),
+              ("llvmpipe wall ms", {(f["scene"], f["size"]): f["wall_ms"]
+                                    for f in llvm.get("frames", []) if f["engine"] == "gl"})]
+    for name, (d, _) in remote.items():
+        fb = frames_by(d)
+        for eng, label in (("gl", "wall ms, blocking"), ("gl-poll", "wall ms, polled")):
+            series.append((f"{name} {label}", {(s, z): f["wall_ms"]
+                                                for (s, z, e), f in fb.items() if e == eng}))
+        series.append((f"{name} GPU ms", {(s, z): f["gpu_ms"]
+                                          for (s, z, e), f in fb.items() if e == "gl-poll"}))
+        series.append((f"predicted {name}", {(s, z): f["predicted_ms"][name]
+                                             for (s, z, e), f in pred.items()
+                                             if e == "stream" and name in f["predicted_ms"]}))
+    for name, (d, _) in earlier.items():
+        series.append((f"{name} wall ms (clock dropped)",
+                       {(f["scene"], f["size"]): f["wall_ms"] for f in d.get("frames", [])
+                        if f["engine"] == "gl"}))
     series = [s for s in series if s[1]]
-    width = 0.8 / max(1, len(series))
+    width = 0.84 / max(1, len(series))
     for i, (label, values) in enumerate(series):
         xs = [c + i * width for c in range(len(cells)) if cells[c] in values]
         ys = [values[cells[c]] for c in range(len(cells)) if cells[c] in values]
         ax.bar(xs, ys, width, label=label)
-    ax.set_xticks([c + 0.4 - width / 2 for c in range(len(cells))])
+    ax.set_xticks([c + 0.42 - width / 2 for c in range(len(cells))])
     ax.set_xticklabels([f"{s}\n{n}²" for s, n in cells])
     ax.set_yscale("log")
     ax.set_ylabel("frame time, ms (log scale)")
@@ -143,17 +236,16 @@ def main():
     ax.legend(fontsize=7, ncol=3, loc="upper center", bbox_to_anchor=(0.5, -0.13))
     ax.grid(axis="y", which="both", alpha=0.3)
     ax = axes[1]
-    kinds = ["pass", "pass + blocking query read-back", "pass, program switched every pass"]
-    for name, d in data.items():
-        for kind, marker in zip(kinds, "os^"):
-            rows = [r for r in d["fixed"] if r["what"] == kind]
-            ax.plot([r["size"] for r in rows], [r["wall_us"] for r in rows], marker=marker,
-                    label=f"{name}: {kind}")
-        for prefix, marker, label in (("pass, one", "v", "one RGBA32F target"),
-                                      ("pass, two", "D", "two RGBA32F targets (MRT)")):
-            rows = [r for r in d["fixed"] if r["what"].startswith(prefix)]
-            ax.plot([r["size"] for r in rows], [r["wall_us"] for r in rows], marker=marker,
-                    label=f"{name}: {label}")
+    kinds = [("pass", "o"), ("pass + blocking query read-back", "s"),
+             ("pass + polled query read-back", "^"), ("pass, two RGBA32F targets (MRT)", "D")]
+    for name, d in [("llvmpipe", llvm)] + [(n, d) for n, (d, _) in remote.items()]:
+        for kind, marker in kinds:
+            rows = sorted((r for r in d["fixed"]
+                           if r["what"] == kind or (kind == "pass" and r["what"].startswith(
+                               "pass, one"))), key=lambda r: r["size"])
+            if rows:
+                ax.plot([r["size"] for r in rows], [r["wall_us"] for r in rows], marker=marker,
+                        label=f"{name}: {kind}")
     ax.set_xscale("log", base=2)
     ax.set_yscale("log")
     ax.set_xlabel("pass size, pixels per side")

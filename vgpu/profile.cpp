@@ -119,26 +119,39 @@ const std::vector<Profile>& profiles() {
     m.name = "h200";
     m.display = "NVIDIA H200 SXM (GH100), through OpenGL 3.3";
     m.cg_profile = "GLSL 3.30 (generated)";
-    m.pipelines = 16896;  // 132 SMs x 128 FP32 cores (NVIDIA H100/H200 Hopper whitepaper)
-    m.core_mhz = 1980;    // boost clock, SXM (NVIDIA H100 SXM5 specifications; H200 same GH100)
-    m.mem_gbps = 4800;    // HBM3e, 4.8 TB/s (NVIDIA H200 datasheet)
-    m.max_outputs = 8;    // GL_MAX_DRAW_BUFFERS on NVIDIA drivers
+    // GH100 is a compute part: of its 66 TPCs (132 SMs) only 2 TPCs, 4 SMs, can run vertex and
+    // pixel shaders (NVIDIA H100 Tensor Core GPU Architecture whitepaper, 2022). Fragment
+    // programs run on those: 4 SMs x 128 FP32 cores.
+    m.pipelines = 512;
+    m.core_mhz = 1980;  // boost clock, SXM (NVIDIA H100 SXM5 specifications; H200 same GH100);
+                        // nvidia-smi showed 1980 MHz through the measured runs, but ~1 GHz when
+                        // the GPU sat idle between passes (docs/real_gpu.md)
+    m.mem_gbps = 4800;  // HBM3e, 4.8 TB/s (NVIDIA H200 datasheet)
+    m.max_outputs = 8;  // GL_MAX_DRAW_BUFFERS on NVIDIA drivers
     m.max_instructions = 1 << 20;  // effectively unlimited (model parameter)
     m.branching = Branching::dynamic;
     m.branch_granularity = 32;   // one warp (NVIDIA CUDA programming guide)
     m.max_texture_size = 32768;  // GL_MAX_TEXTURE_SIZE on NVIDIA drivers
     m.precision = Format::fp32;
     m.bus_mbps = 64000;  // PCI Express 5.0 x16, one direction (H200 datasheet)
-    // Fixed costs: a 64x64 to 256x256 pass with a blocking occlusion-query read-back was measured
-    // at 25 to 33 us on this H200 through EGL (issue 12's figures); pass_us + readback_us is its
-    // midpoint, 29 us. The split between them is assumed until bench_gl measures it there.
-    m.pass_us = 8;          // model parameter (assumed split of the measured 29 us)
-    m.readback_us = 21;     // model parameter (assumed split of the measured 29 us)
-    m.program_load_us = 2;  // model parameter (assumed; a glUseProgram of a linked program)
-    m.alu_lanes = 1;        // scalar CUDA cores: every scalar operation is one instruction
-    m.alu_per_clock = 1;    // one FP32 FMA per core per clock (Hopper whitepaper)
+    // Fixed costs measured by bench_gl on this H200 (NVIDIA 580 driver, EGL, 1x1 passes, medians
+    // of two runs, docs/real_gpu.md): a pass 10.0 and 10.8 us, a polled query read-back 11 to
+    // 14 us more, a program switch under 1 us. The blocking GL_QUERY_RESULT wait costs up to
+    // 140 us more after a long pass (the driver sleeps); the model prices the polled wait.
+    m.pass_us = 10.4;         // measured (bench_gl)
+    m.readback_us = 12;       // measured (bench_gl, polled)
+    m.program_load_us = 0.5;  // measured (bench_gl: within noise of 0)
+    m.alu_lanes = 1;          // scalar CUDA cores: every scalar operation is one instruction
+    m.alu_per_clock = 1;      // one FP32 FMA per core per clock (Hopper whitepaper)
     m.fp32_rate = 1;
-    m.texels_per_clock = 528.0 / 16896;  // 4 texture units per SM, 528 (Hopper whitepaper)
+    m.texels_per_clock = 4.0 / 128;  // 4 texture units per SM (Hopper whitepaper)
+    // 16 texture units fetching one 32-bit component a clock each (an RGBA32F texel in 4):
+    // model parameter (assumed: one 32-bit component per unit per clock, 4 for an RGBA32F).
+    m.texture_bytes_per_clock = 64;
+    // The ROPs: bench_gl's 1024x1024 copy pass writes 16 MB in 301.6 us of GPU time at 1980 MHz
+    // and two targets take twice as long (28 bytes a clock). Model parameter, measured on tiny
+    // programs, not on the frames it predicts.
+    m.output_bytes_per_clock = 28;
     t.push_back(m);
     return t;
   }();

@@ -42,6 +42,11 @@ struct Profile {
   double fp24_rate = 1;         // fp24 throughput relative to fp16 (a part without fp24 units
                                 // computes fp24 values in fp32: its fp32 rate)
   double texels_per_clock = 1;  // texture fetches per pipeline per clock
+  // Whole-chip bandwidths in bytes per clock where a part is bound by them rather than by the
+  // figures above (0: not modelled). A modern part fetches 32-bit texel components, not texels,
+  // per clock, and writes its render targets through a few raster-output units.
+  double texture_bytes_per_clock = 0;  // texel bytes fetched per clock, all texture units
+  double output_bytes_per_clock = 0;   // render-target bytes written per clock, all ROPs
 
   // Arithmetic throughput at format f, relative to alu_per_clock (the fp16 rate).
   double rate(Format f) const {

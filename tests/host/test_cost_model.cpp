@@ -87,6 +87,25 @@ TEST_CASE("Known counters give the hand-computed time of every term") {
   CHECK(b.total_ms == doctest::Approx(0.400 + 0.100 + 0.020 + 0.040992 + 0.040));
 }
 
+TEST_CASE("Texel-byte and output-byte rates bound a pass where a profile gives them") {
+  // Two passes of 4000 fragments reading and writing 16 B each: 64000 B a pass.
+  vgpu::Profile hw = card();
+  hw.mem_gbps = 1000;  // memory out of the way: 128 ns a pass
+  const host::CostBreakdown before = host::predict(frame(kernel_passes(2), 1, 0), hw, params());
+  CHECK(before.arithmetic_ms == doctest::Approx(0.400));  // ALU bound, as above
+  // 4 texel bytes a clock at 100 MHz: 64000 B / 4e8 B/s = 160 us a pass, still under the ALU.
+  hw.texture_bytes_per_clock = 4;
+  const host::CostBreakdown tex = host::predict(frame(kernel_passes(2), 1, 0), hw, params());
+  CHECK(tex.texture_demand_ms == doctest::Approx(0.320));
+  CHECK(tex.arithmetic_ms == doctest::Approx(0.400));
+  // 1 output byte a clock: 64000 B / 1e8 B/s = 640 us a pass, now the bound (memory term).
+  hw.output_bytes_per_clock = 1;
+  const host::CostBreakdown rop = host::predict(frame(kernel_passes(2), 1, 0), hw, params());
+  CHECK(rop.memory_ms == doctest::Approx(1.280));
+  CHECK(rop.arithmetic_ms == doctest::Approx(0.0));
+  CHECK(rop.total_ms == doctest::Approx(1.280 + 0.020 + 0.040992 + 0.040));
+}
+
 TEST_CASE("Pass records and per-program totals predict the same for identical passes") {
   vgpu::FrameStats s = frame(kernel_passes(2));
   const host::CostBreakdown totals = host::predict(s, card(), params());
