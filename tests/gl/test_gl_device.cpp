@@ -152,8 +152,8 @@ TEST_CASE("the fused MRT passes on the GL device give the vgpu's query counts, h
                                   std::max(1.0f, std::abs(v.result.depth[i])));
     for (size_t i = 0; i < v.result.rgb.size(); ++i)
       worst = std::max(worst, std::abs(v.result.rgb[i] - g.result.rgb[i]));
-    MESSAGE(name << " with mrt on: largest depth (relative) or colour difference GL - vgpu "
-                 << worst);
+    MESSAGE(std::string(name)
+            << " with mrt on: largest depth (relative) or colour difference GL - vgpu " << worst);
     CHECK(worst <= 1e-5f);
   }
 }
