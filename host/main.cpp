@@ -46,6 +46,7 @@ struct RenderArgs {
   int threads = 0;
   int lanes = vgpu::kLanes;
   std::string masks = "off";
+  std::string mrt = "off";
   std::string stats = "table";
   std::string stats_json;
   std::string stats_csv;
@@ -191,6 +192,13 @@ void add_render_options(CLI::App& render, RenderArgs& a) {
                   "Early-z masks for finished rays (paper's future work), stream engine")
       ->check(CLI::IsMember(on_off))
       ->capture_default_str();
+  render
+      .add_option("--mrt", a.mrt,
+                  "Multiple render targets (paper's future work): fused two-output passes for "
+                  "intersecciones + proximoTriangulo and traversal + actualizarVoxel; needs a "
+                  "profile with more than one output (not gf5700); off: the paper's pipeline")
+      ->check(CLI::IsMember(on_off))
+      ->capture_default_str();
   render.add_option("--stats", a.stats, "Statistics on stdout")
       ->check(CLI::IsMember({"table", "json", "none"}))
       ->capture_default_str();
@@ -254,6 +262,7 @@ int run_render(const RenderArgs& a, bool lanes_given) {
   opt.shading = host::parse_shading(a.shading);
   opt.shadows = a.shadows == "on";
   opt.masks = a.masks == "on";
+  opt.mrt = a.mrt == "on";
   opt.profile = vgpu::profile(a.profile).name;
   opt.threads = a.threads;
   opt.lanes = a.lanes;
@@ -287,6 +296,7 @@ int run_render(const RenderArgs& a, bool lanes_given) {
                          : !a.trace_pixel.empty() ? "--trace-pixel"
                          : lanes_given            ? "--lanes"
                          : opt.masks              ? "--masks on"
+                         : opt.mrt                ? "--mrt on"
                          : a.precision != "fp32"  ? "--precision"
                          : !a.formats.empty()     ? "--formats"
                                                   : nullptr;
@@ -300,6 +310,12 @@ int run_render(const RenderArgs& a, bool lanes_given) {
   if (reduced && opt.lanes != 1 && opt.lanes != 8)
     throw UsageError("--lanes " + std::to_string(opt.lanes) + ": --precision " + a.precision +
                      " runs at 1 or 8 lanes");
+  // The profile's output limit, before any work (the formats are checked once resolved).
+  if (opt.mrt) {
+    const std::string why =
+        host::mrt_refusal(vgpu::profile(opt.profile), host::Formats::all(vgpu::Format::fp32));
+    if (!why.empty()) throw UsageError(why);
+  }
   if (a.engine != "stream" && (!a.report.empty() || !a.stats_csv.empty()))
     throw UsageError(
         "--report and --stats-csv need --engine stream (the report reads the "
@@ -340,6 +356,10 @@ int run_render(const RenderArgs& a, bool lanes_given) {
   const host::Grid grid =
       host::build_grid(scene, host::grid_spec_for(grid_spec, scene, vgpu::profile(opt.profile)));
   opt.formats = host::resolve(formats, scene, grid, vgpu::profile(opt.profile));
+  if (opt.mrt) {
+    const std::string why = host::mrt_refusal(vgpu::profile(opt.profile), opt.formats);
+    if (!why.empty()) throw UsageError(why);
+  }
   const float aspect = float(opt.width) / float(opt.height);
   const host::Camera cam =
       scene.camera ? *scene.camera : host::frame_bounds(scene.bounds(), aspect);
@@ -381,6 +401,8 @@ int run_render(const RenderArgs& a, bool lanes_given) {
   j["shading"] = a.shading;
   j["shadows"] = opt.shadows;
   j["masks"] = opt.masks;
+  j["mrt"] = opt.mrt;  // fused two-output passes (kernels/fused.h)
+  j["fused_programs"] = opt.mrt ? host::mrt_programs() : std::vector<std::string>{};
   j["threads"] = opt.threads;
   j["lanes"] = opt.lanes;
   j["precision"] = a.precision;
@@ -453,9 +475,9 @@ int run_render(const RenderArgs& a, bool lanes_given) {
         "scene %s: %zu triangles (%u dropped as degenerate), grid %dx%dx%d (%llu references)\n",
         scene.name.c_str(), scene.triangle_count(), scene.dropped_degenerate, grid.res.x,
         grid.res.y, grid.res.z, static_cast<unsigned long long>(grid.references()));
-    std::printf("%s %s, %dx%d, %d iteration(s), %s shading, shadows %s, masks %s\n",
+    std::printf("%s %s, %dx%d, %d iteration(s), %s shading, shadows %s, masks %s, mrt %s\n",
                 cpu ? "engine" : "profile", cpu ? "cpu" : opt.profile.c_str(), r.width, r.height,
-                r.iterations, a.shading.c_str(), a.shadows.c_str(), a.masks.c_str());
+                r.iterations, a.shading.c_str(), a.shadows.c_str(), a.masks.c_str(), a.mrt.c_str());
     if (!cpu)
       std::cout << "formats (texture and arithmetic, per group):\n" << describe(opt.formats);
     std::printf("initialization %.1f ms (grid %.1f ms), render %.1f ms (%s)\n", init_ms,

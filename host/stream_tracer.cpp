@@ -2,6 +2,7 @@
 #include "host/stream_tracer.h"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -40,6 +41,9 @@ struct StreamTracer::State {
   KernelProgram<ReflectionOrigin> origin;
   KernelProgram<ReflectionDirection> direction;
   KernelProgram<ShadowRays> shadow;
+  // Fused programs for --mrt on (kernels/fused.h).
+  KernelProgram<IntersectNext> intersect_next;
+  KernelProgram<TraverseUpdate> traverse_update;
   uint64_t rays_traced = 0;
   uint64_t rays_unfinished = 0;
   int max_list = 0;  // longest voxel list: a ray tests at most this many triangles per voxel
@@ -56,6 +60,46 @@ GridSpec grid_spec_for(const GridSpec& spec, const Scene& scene, const vgpu::Pro
   }
   r.z = std::min(r.z, profile.max_texture_size);
   return GridSpec{r};
+}
+
+namespace {
+
+// The fused programs, each with its two kernels' groups (their arithmetic must agree).
+struct FusedInfo {
+  const char* name;
+  int outputs;
+  Group first, second;
+};
+const std::array<FusedInfo, 2>& fused_programs() {
+  static const std::array<FusedInfo, 2> f{
+      FusedInfo{IntersectNext::name, IntersectNext::outputs, Group::hits, Group::voxel},
+      FusedInfo{TraverseUpdate::name, TraverseUpdate::outputs, Group::traversal, Group::voxel}};
+  return f;
+}
+
+}  // namespace
+
+std::string mrt_refusal(const vgpu::Profile& profile, const Formats& formats) {
+  for (const FusedInfo& f : fused_programs()) {
+    if (f.outputs > profile.max_outputs)
+      return "--mrt on: program '" + std::string(f.name) + "' writes " + std::to_string(f.outputs) +
+             " outputs; profile " + profile.name + " allows " +
+             std::to_string(profile.max_outputs) + " (no multiple render targets)";
+    if (formats.arithmetic(f.first) != formats.arithmetic(f.second))
+      return "--mrt on: program '" + std::string(f.name) + "' computes in one format, but groups " +
+             std::string(group_name(f.first)) + " (" +
+             std::string(vgpu::format_name(formats.arithmetic(f.first))) + ") and " +
+             std::string(group_name(f.second)) + " (" +
+             std::string(vgpu::format_name(formats.arithmetic(f.second))) +
+             ") differ; give them one arithmetic format (--formats)";
+  }
+  return {};
+}
+
+std::vector<std::string> mrt_programs() {
+  std::vector<std::string> v;
+  for (const FusedInfo& f : fused_programs()) v.push_back(f.name);
+  return v;
 }
 
 kernels::ShadingModel parse_shading(const std::string& name) {
@@ -96,6 +140,13 @@ StreamTracer::StreamTracer(const Scene& scene, const Grid& grid, const RenderOpt
                                                                {&s_->shader, Group::colour},
                                                                {&s_->reflected, Group::colour}})
     prog->set_precision(fm.arithmetic(g));
+  if (opt_.mrt) {
+    const std::string why = mrt_refusal(gpu.profile(), fm);
+    if (!why.empty()) throw vgpu::Error(why);
+    // mrt_refusal checked that both kernels' groups compute alike.
+    s_->intersect_next.set_precision(fm.arithmetic(Group::hits));
+    s_->traverse_update.set_precision(fm.arithmetic(Group::traversal));
+  }
   const int maxs = gpu.profile().max_texture_size;
 
   // Scene textures: triangle i at texel (i mod width, i div width).
@@ -208,6 +259,9 @@ StreamTracer::StreamTracer(const Scene& scene, const Grid& grid, const RenderOpt
   s_->intersect.kernel.grid = g;
   s_->intersect.kernel.scene = su;
   s_->next.kernel.grid = g;
+  s_->intersect_next.kernel.grid = g;
+  s_->intersect_next.kernel.scene = su;
+  s_->traverse_update.kernel.grid = g;
   s_->shader.kernel.scene = su;
   s_->shader.kernel.model = opt_.shading;
   s_->shader.kernel.shadows = opt_.shadows;
@@ -236,12 +290,19 @@ uint64_t StreamTracer::texture_bytes() const {
 const vgpu::PassRecord& StreamTracer::pass(const vgpu::Program& p,
                                            std::initializer_list<const Texture*> in, Texture& out,
                                            const Stencil* work) {
+  return pass(p, in, {&out}, work);
+}
+
+const vgpu::PassRecord& StreamTracer::pass(const vgpu::Program& p,
+                                           std::initializer_list<const Texture*> in,
+                                           std::initializer_list<Texture*> outs,
+                                           const Stencil* work) {
   vgpu::Device& gpu = *gpu_;
   gpu.use_program(p);
   gpu.unbind_textures();
   int unit = 0;
   for (const Texture* t : in) gpu.bind_texture(unit++, *t);
-  gpu.set_targets({&out});
+  gpu.set_targets(outs);
   // The same finished-ray mask either skips fragments on the modeled hardware (masks on) or
   // only saves the emulator's host work (masks off: every fragment is charged).
   if (gpu.has_stencil()) {
@@ -252,16 +313,19 @@ const vgpu::PassRecord& StreamTracer::pass(const vgpu::Program& p,
   const bool traced = traces_pixel(work);
   if (opt_.observer) opt_.observer->pass_begin(work);
   const vgpu::PassRecord& rec = gpu.draw();
-  if (opt_.observer) opt_.observer->pass({p, rec, out, gpu.branch_flags(), gpu.stats()});
+  // The observer sees the first target (a fused pass's other targets are the same pass).
+  if (opt_.observer) opt_.observer->pass({p, rec, **outs.begin(), gpu.branch_flags(), gpu.stats()});
   if (traced && !p.idle_discards()) {
     const int x = opt_.trace_pixel->x, y = opt_.trace_pixel->y;
-    const float* t = out.texel(x, y);
-    char line[256];
-    int n = std::snprintf(line, sizeof line, "  %-22s %-24s -> %-14s (", p.paper_name(), p.name(),
-                          out.name().c_str());
-    for (int c = 0; c < out.channels(); ++c)
-      n += std::snprintf(line + n, sizeof line - size_t(n), "%s%g", c ? ", " : "", t[c]);
-    *opt_.trace_out << line << ")\n";
+    for (const Texture* out : outs) {
+      const float* t = out->texel(x, y);
+      char line[256];
+      int n = std::snprintf(line, sizeof line, "  %-22s %-24s -> %-14s (", p.paper_name(), p.name(),
+                            out->name().c_str());
+      for (int c = 0; c < out->channels(); ++c)
+        n += std::snprintf(line + n, sizeof line - size_t(n), "%s%g", c ? ", " : "", t[c]);
+      *opt_.trace_out << line << ")\n";
+    }
   }
   return rec;
 }
@@ -320,28 +384,51 @@ void StreamTracer::trace(Texture& origins, Texture& rays, bool primary, const Ca
       s.rays_unfinished += walking;
       break;
     }
-    // The first triangle of each ray's new voxel.
-    pass(s.update, {&s.trav[s.cur_trav], &s.vs[s.cur_vs], &s.pointers, &s.lists},
-         s.vs[s.cur_vs ^ 1], &s.grid_mask);
-    swap(s.cur_vs);
+    // The first triangle of each ray's new voxel (under --mrt on, only at the first step: later
+    // ones come from the fused traversal + update voxel pass).
+    if (!opt_.mrt || step == 0) {
+      pass(s.update, {&s.trav[s.cur_trav], &s.vs[s.cur_vs], &s.pointers, &s.lists},
+           s.vs[s.cur_vs ^ 1], &s.grid_mask);
+      swap(s.cur_vs);
+    }
     uint64_t testing =
         count(s.intersecting, s.vs[s.cur_vs], &s.grid_mask, &(s.isect_mask = s.grid_mask));
     // One triangle per pass, until no ray has a triangle left in its voxel.
     for (int k = 0; testing > 0; ++k) {
       if (k == s.max_list + 1) break;  // lists cannot be longer: stuck positions (fp16)
-      pass(s.intersect,
-           {&origins, &rays, &s.trav[s.cur_trav], &s.vs[s.cur_vs], &s.isect[s.cur_isect], &s.v[0],
-            &s.v[1], &s.v[2]},
-           s.isect[s.cur_isect ^ 1], &s.isect_mask);
-      swap(s.cur_isect);
-      pass(s.next, {&s.vs[s.cur_vs], &s.lists}, s.vs[s.cur_vs ^ 1], &s.isect_mask);
-      swap(s.cur_vs);
+      if (opt_.mrt) {
+        // intersecciones + proximoTriangulo in one pass, two targets.
+        pass(s.intersect_next,
+             {&origins, &rays, &s.trav[s.cur_trav], &s.vs[s.cur_vs], &s.isect[s.cur_isect], &s.v[0],
+              &s.v[1], &s.v[2], &s.lists},
+             {&s.isect[s.cur_isect ^ 1], &s.vs[s.cur_vs ^ 1]}, &s.isect_mask);
+        swap(s.cur_isect);
+        swap(s.cur_vs);
+      } else {
+        pass(s.intersect,
+             {&origins, &rays, &s.trav[s.cur_trav], &s.vs[s.cur_vs], &s.isect[s.cur_isect], &s.v[0],
+              &s.v[1], &s.v[2]},
+             s.isect[s.cur_isect ^ 1], &s.isect_mask);
+        swap(s.cur_isect);
+        pass(s.next, {&s.vs[s.cur_vs], &s.lists}, s.vs[s.cur_vs ^ 1], &s.isect_mask);
+        swap(s.cur_vs);
+      }
       testing = count(s.intersecting, s.vs[s.cur_vs], &s.isect_mask, &s.isect_mask);
     }
-    // One voxel step for every ray still walking.
-    pass(s.traversal, {&origins, &rays, &s.trav[s.cur_trav], &s.isect[s.cur_isect]},
-         s.trav[s.cur_trav ^ 1], &s.grid_mask);
-    swap(s.cur_trav);
+    // One voxel step for every ray still walking (under --mrt on, with the next voxel's first
+    // triangle in the same pass).
+    if (opt_.mrt) {
+      pass(s.traverse_update,
+           {&origins, &rays, &s.trav[s.cur_trav], &s.isect[s.cur_isect], &s.vs[s.cur_vs],
+            &s.pointers, &s.lists},
+           {&s.trav[s.cur_trav ^ 1], &s.vs[s.cur_vs ^ 1]}, &s.grid_mask);
+      swap(s.cur_trav);
+      swap(s.cur_vs);
+    } else {
+      pass(s.traversal, {&origins, &rays, &s.trav[s.cur_trav], &s.isect[s.cur_isect]},
+           s.trav[s.cur_trav ^ 1], &s.grid_mask);
+      swap(s.cur_trav);
+    }
     walking = count(s.in_grid, s.trav[s.cur_trav], &s.grid_mask, &s.grid_mask);
   }
 }

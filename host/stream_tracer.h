@@ -75,6 +75,11 @@ struct RenderOptions {
   // Early-z/stencil masks for finished rays (the paper's future work): masked fragments cost
   // nothing. Off: every fragment runs every pass, as on the paper's GeForce FX.
   bool masks = false;
+  // Multiple render targets (the paper's future work, kernels/fused.h): the host loop runs
+  // intersecciones + proximoTriangulo and traversal + actualizarVoxel as one pass each, writing
+  // two targets. Needs a profile with max_outputs >= 2 (the constructor throws naming the fused
+  // program and the limit, see mrt_refusal). Off: the paper's one-output multipass pipeline.
+  bool mrt = false;
   // Emulator shortcut: skip host work for fragments whose result cannot change (finished rays);
   // their statistics are charged as if run. Off only to check that it changes nothing.
   bool host_shortcut = true;
@@ -115,6 +120,11 @@ class StreamTracer {
   const vgpu::PassRecord& pass(const vgpu::Program& p,
                                std::initializer_list<const vgpu::Texture*> in, vgpu::Texture& out,
                                const vgpu::Stencil* work = nullptr);
+  // A pass writing several render targets (MRT): outs[i] is the program's output i.
+  const vgpu::PassRecord& pass(const vgpu::Program& p,
+                               std::initializer_list<const vgpu::Texture*> in,
+                               std::initializer_list<vgpu::Texture*> outs,
+                               const vgpu::Stencil* work = nullptr);
   uint64_t count(const vgpu::Program& p, const vgpu::Texture& in, const vgpu::Stencil* work,
                  vgpu::Stencil* write);
   // Whether --trace-pixel output is on and the traced pixel takes part in a pass under `work`
@@ -133,6 +143,14 @@ class StreamTracer {
 // voxel pointer texture (sizeX*sizeY by sizeZ texels) fits the profile's largest texture; an
 // explicit one is kept (and refused at initialization if it does not fit).
 GridSpec grid_spec_for(const GridSpec& spec, const Scene& scene, const vgpu::Profile& profile);
+
+// Why RenderOptions::mrt cannot run with this profile and these formats (empty: it can): a
+// fused program writes more outputs than the profile allows, or computes in one arithmetic
+// format where its two kernels' groups differ (host/formats.h). Names the fused program.
+std::string mrt_refusal(const vgpu::Profile& profile, const Formats& formats);
+
+// The fused programs --mrt on runs (kernels/fused.h), by statistics name.
+std::vector<std::string> mrt_programs();
 
 // Names of the shading models as the CLI spells them.
 kernels::ShadingModel parse_shading(const std::string& name);

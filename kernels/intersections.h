@@ -8,6 +8,36 @@
 
 namespace kernels {
 
+// Texture units of the inputs nearest_hit fetches besides the voxel and intersection states.
+struct HitUnits {
+  int origins, rays, traversal, v0;  // v0, v0 + 1, v0 + 2: the three vertex textures
+};
+
+// The intersection state `best` after testing triangle vs.w, for the lanes where `testing`;
+// other lanes keep `best`. Shared with the fused intersections + next triangle program
+// (kernels/fused.h).
+template <class L>
+inline Vec4<typename L::F> nearest_hit(const Fragments<L>& f, const HitUnits& u,
+                                       const Vec4<typename L::F>& vs,
+                                       const Vec4<typename L::F>& best,
+                                       const typename L::M& testing, const GridUniforms& grid,
+                                       const SceneUniforms& scene) {
+  using F = typename L::F;
+  const Vec3<F> o = f.fetch_own(u.origins).xyz();
+  const Vec4<F> ray = f.fetch_own(u.rays);
+  const Vec4<F> trav = f.fetch_own(u.traversal);
+  const Vec3<F> d = ray.xyz();
+  const Vec3<F> p0 = fetch_id(f, u.v0, vs.w, scene.width).xyz();
+  const Vec3<F> p1 = fetch_id(f, u.v0 + 1, vs.w, scene.width).xyz();
+  const Vec3<F> p2 = fetch_id(f, u.v0 + 2, vs.w, scene.width).xyz();
+  F bu, bv;
+  const F t = intersect_triangle(o, d, p0, p1, p2, bu, bv);
+  const F t_exit = min3(voxel_exits(o, d, trav.xyz(), grid));
+  const auto in_voxel = (t >= trav.w - F(grid.t_slack)) && (t <= t_exit + F(grid.t_slack));
+  const auto nearer = testing && in_voxel && (t < best.x) && (t < ray.w);
+  return select(nearer, Vec4<F>{t, bu, bv, vs.w}, best);
+}
+
 struct Intersections {
   static constexpr const char* name = "intersections";
   static constexpr const char* paper_name = "intersecciones";
@@ -28,21 +58,8 @@ struct Intersections {
     const Vec4<F> best = f.fetch_own(kIntersection);
     const auto testing = vs.w >= F(0.0f);
     Vec4<F> next = best;
-    if (f.branch(testing)) {
-      const Vec3<F> o = f.fetch_own(kOrigins).xyz();
-      const Vec4<F> ray = f.fetch_own(kRays);
-      const Vec4<F> trav = f.fetch_own(kTraversal);
-      const Vec3<F> d = ray.xyz();
-      const Vec3<F> p0 = fetch_id(f, kV0, vs.w, scene.width).xyz();
-      const Vec3<F> p1 = fetch_id(f, kV1, vs.w, scene.width).xyz();
-      const Vec3<F> p2 = fetch_id(f, kV2, vs.w, scene.width).xyz();
-      F u, v;
-      const F t = intersect_triangle(o, d, p0, p1, p2, u, v);
-      const F t_exit = min3(voxel_exits(o, d, trav.xyz(), grid));
-      const auto in_voxel = (t >= trav.w - F(grid.t_slack)) && (t <= t_exit + F(grid.t_slack));
-      const auto nearer = testing && in_voxel && (t < best.x) && (t < ray.w);
-      next = select(nearer, Vec4<F>{t, u, v, vs.w}, best);
-    }
+    if (f.branch(testing))
+      next = nearest_hit(f, {kOrigins, kRays, kTraversal, kV0}, vs, best, testing, grid, scene);
     f.out(0) = next;
   }
 };

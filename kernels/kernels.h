@@ -1,6 +1,8 @@
-// The paper's fragment programs (and the shadow-ray extension), one functor per file.
+// The paper's fragment programs (and the shadow-ray extension), one functor per file, and the
+// fused two-output programs --mrt on runs (kernels/fused.h).
 #pragma once
 
+#include "kernels/fused.h"
 #include "kernels/generate_rays.h"
 #include "kernels/init_traversal.h"
 #include "kernels/intersections.h"

@@ -6,6 +6,18 @@
 
 namespace kernels {
 
+// The voxel state `vs` moved on to the next list entry, for the lanes where `testing`; other
+// lanes keep it. Shared with the fused intersections + next triangle program (kernels/fused.h).
+template <class L>
+inline Vec4<typename L::F> next_in_list(const Fragments<L>& f, int unit_lists,
+                                        const Vec4<typename L::F>& vs, const typename L::M& testing,
+                                        const GridUniforms& grid) {
+  using F = typename L::F;
+  const F pos = vs.x + F(1.0f);
+  const F tri = fetch_id(f, unit_lists, pos, grid.list_width).x;
+  return select(testing, Vec4<F>{pos, F(0.0f), F(0.0f), tri}, vs);
+}
+
 struct NextTriangle {
   static constexpr const char* name = "next triangle";
   static constexpr const char* paper_name = "proximoTriangulo";
@@ -22,11 +34,7 @@ struct NextTriangle {
     const Vec4<F> vs = f.fetch_own(kVoxelState);
     const auto testing = vs.w >= F(0.0f);
     Vec4<F> next = vs;
-    if (f.branch(testing)) {
-      const F pos = vs.x + F(1.0f);
-      const F tri = fetch_id(f, kLists, pos, grid.list_width).x;
-      next = select(testing, Vec4<F>{pos, F(0.0f), F(0.0f), tri}, vs);
-    }
+    if (f.branch(testing)) next = next_in_list(f, kLists, vs, testing, grid);
     f.out(0) = next;
   }
 };

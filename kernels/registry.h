@@ -1,5 +1,5 @@
 // Every kernel as a program with its default uniforms, in the order a frame first runs them:
-// what `vgpu-rt kernels` lists and prints as GLSL.
+// what `vgpu-rt kernels` lists and prints as GLSL; then the fused programs of --mrt on.
 #pragma once
 
 #include <memory>
@@ -26,6 +26,9 @@ inline std::vector<std::unique_ptr<vgpu::Program>> all_programs() {
   v.push_back(std::make_unique<vgpu::KernelProgram<ReflectedRays>>());
   v.push_back(std::make_unique<vgpu::KernelProgram<ReflectionDirection>>());
   v.push_back(std::make_unique<vgpu::KernelProgram<ResetTraversal>>());
+  // The fused programs of --mrt on (kernels/fused.h), two outputs each.
+  v.push_back(std::make_unique<vgpu::KernelProgram<IntersectNext>>());
+  v.push_back(std::make_unique<vgpu::KernelProgram<TraverseUpdate>>());
   return v;
 }
 

@@ -8,6 +8,30 @@
 
 namespace kernels {
 
+// One DDA step of the traversal state `trav` of a ray from o along d whose intersection state
+// is `hit`, for the lanes where `walking`; other lanes keep `trav`. Shared with the fused
+// traversal + update voxel program (kernels/fused.h).
+template <class L, class F = typename L::F>
+inline Vec4<F> dda_step(const Vec4<F>& trav, const Vec4<F>& hit, const Vec3<F>& o, const Vec3<F>& d,
+                        const typename L::M& walking, const GridUniforms& grid) {
+  const Vec3<F> vox = trav.xyz();
+  const Vec3<F> exits = voxel_exits(o, d, vox, grid);
+  const F t_exit = min3(exits);
+  auto step = [&](const F& da, const F& ta) {
+    return select(ta == t_exit, select(da > F(0.0f), F(1.0f), F(-1.0f)), F(0.0f));
+  };
+  const Vec3<F> nv{vox.x + step(d.x, exits.x), vox.y + step(d.y, exits.y),
+                   vox.z + step(d.z, exits.z)};
+  const auto outside = (nv.x < F(0.0f)) || (nv.y < F(0.0f)) || (nv.z < F(0.0f)) ||
+                       (nv.x >= F(grid.res.x)) || (nv.y >= F(grid.res.y)) ||
+                       (nv.z >= F(grid.res.z));
+  const auto found = hit.w >= F(0.0f);  // a hit inside this voxel ends the walk
+  const auto done = found || outside;
+  const Vec4<F> stepped{nv.x, nv.y, nv.z, t_exit};
+  const Vec4<F> finished{F(kNone), F(0.0f), F(0.0f), trav.w};
+  return select(walking, select(done, finished, stepped), trav);
+}
+
 struct Traversal {
   static constexpr const char* name = "traversal";
   static constexpr const char* paper_name = "traversal";
@@ -26,24 +50,7 @@ struct Traversal {
     const Vec3<F> o = f.fetch_own(kOrigins).xyz(), d = f.fetch_own(kRays).xyz();
     const auto walking = trav.x >= F(0.0f);
     Vec4<F> next = trav;
-    if (f.branch(walking)) {
-      const Vec3<F> vox = trav.xyz();
-      const Vec3<F> exits = voxel_exits(o, d, vox, grid);
-      const F t_exit = min3(exits);
-      auto step = [&](const F& da, const F& ta) {
-        return select(ta == t_exit, select(da > F(0.0f), F(1.0f), F(-1.0f)), F(0.0f));
-      };
-      const Vec3<F> nv{vox.x + step(d.x, exits.x), vox.y + step(d.y, exits.y),
-                       vox.z + step(d.z, exits.z)};
-      const auto outside = (nv.x < F(0.0f)) || (nv.y < F(0.0f)) || (nv.z < F(0.0f)) ||
-                           (nv.x >= F(grid.res.x)) || (nv.y >= F(grid.res.y)) ||
-                           (nv.z >= F(grid.res.z));
-      const auto found = hit.w >= F(0.0f);  // a hit inside this voxel ends the walk
-      const auto done = found || outside;
-      const Vec4<F> stepped{nv.x, nv.y, nv.z, t_exit};
-      const Vec4<F> finished{F(kNone), F(0.0f), F(0.0f), trav.w};
-      next = select(walking, select(done, finished, stepped), trav);
-    }
+    if (f.branch(walking)) next = dda_step<L>(trav, hit, o, d, walking, grid);
     f.out(0) = next;
   }
 };

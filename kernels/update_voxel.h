@@ -7,6 +7,22 @@
 
 namespace kernels {
 
+// The first list entry of the voxel `trav` stands in, for the lanes where `load`; other lanes
+// keep the voxel state `vs`. Shared with the fused traversal + update voxel program
+// (kernels/fused.h).
+template <class L>
+inline Vec4<typename L::F> first_in_voxel(const Fragments<L>& f, int unit_pointers, int unit_lists,
+                                          const Vec4<typename L::F>& trav,
+                                          const Vec4<typename L::F>& vs, const typename L::M& load,
+                                          const GridUniforms& grid) {
+  using F = typename L::F;
+  // Voxel (X, Y, Z) lives at texel (X * sizeY + Y, Z).
+  const F px = trav.x * F(grid.res.y) + trav.y + F(0.5f), py = trav.z + F(0.5f);
+  const F start = f.fetch(unit_pointers, px, py).x;
+  const F tri = fetch_id(f, unit_lists, start, grid.list_width).x;
+  return select(load, Vec4<F>{start, F(0.0f), F(0.0f), tri}, vs);
+}
+
 struct UpdateVoxel {
   static constexpr const char* name = "update voxel";
   static constexpr const char* paper_name = "actualizarVoxel";
@@ -25,13 +41,7 @@ struct UpdateVoxel {
     const Vec4<F> vs = f.fetch_own(kVoxelState);
     const auto load = (trav.x >= F(0.0f)) && (vs.w < F(0.0f));
     Vec4<F> next = vs;
-    if (f.branch(load)) {
-      // Voxel (X, Y, Z) lives at texel (X * sizeY + Y, Z).
-      const F px = trav.x * F(grid.res.y) + trav.y + F(0.5f), py = trav.z + F(0.5f);
-      const F start = f.fetch(kPointers, px, py).x;
-      const F tri = fetch_id(f, kLists, start, grid.list_width).x;
-      next = select(load, Vec4<F>{start, F(0.0f), F(0.0f), tri}, vs);
-    }
+    if (f.branch(load)) next = first_in_voxel(f, kPointers, kLists, trav, vs, load, grid);
     f.out(0) = next;
   }
 };

@@ -5,6 +5,7 @@
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #pragma GCC diagnostic ignored "-Wrestrict"
 
+#include <algorithm>
 #include <cstdio>
 #include <nlohmann/json.hpp>
 
@@ -89,14 +90,20 @@ static std::string human(uint64_t v) {
 std::string FrameStats::to_table() const {
   std::string out;
   char line[512];
-  std::snprintf(line, sizeof line, "%-24s %-22s %7s %9s %9s %9s %9s %9s %9s %6s %6s %9s%s\n",
-                "kernel", "paper name", "passes", "launched", "shaded", "discarded", "fetches",
+  // Name columns as wide as the longest name (fused programs have long ones), at least 24 / 22.
+  int nw = 24, pw = 22;
+  for (const ProgramTotals& p : programs) {
+    nw = std::max(nw, int(p.name.size()));
+    pw = std::max(pw, int(p.paper_name.size()));
+  }
+  std::snprintf(line, sizeof line, "%-*s %-*s %7s %9s %9s %9s %9s %9s %9s %6s %6s %9s%s\n", nw,
+                "kernel", pw, "paper name", "passes", "launched", "shaded", "discarded", "fetches",
                 "read B", "written B", "loads", "reads", "host ms",
                 device_timed ? "    gpu ms" : "");
   out += line;
   auto row = [&](const std::string& n, const std::string& pn, const Counters& c) {
-    std::snprintf(line, sizeof line, "%-24s %-22s %7s %9s %9s %9s %9s %9s %9s %6s %6s %9.2f",
-                  n.c_str(), pn.c_str(), human(c.passes).c_str(),
+    std::snprintf(line, sizeof line, "%-*s %-*s %7s %9s %9s %9s %9s %9s %9s %6s %6s %9.2f", nw,
+                  n.c_str(), pw, pn.c_str(), human(c.passes).c_str(),
                   human(c.fragments_launched).c_str(), human(c.fragments_shaded).c_str(),
                   human(c.fragments_discarded).c_str(), human(c.texture_fetches).c_str(),
                   human(c.bytes_read).c_str(), human(c.bytes_written).c_str(),

@@ -106,6 +106,15 @@ TEST_CASE("settings the cpu engine does not use are refused instead of recorded"
   check_refused("--engine cpu --masks on", "--masks");
   check_refused("--engine cpu --predict", "--predict");
   check_refused("--engine cpu --trace-pixel 1,1", "--trace-pixel");
+  check_refused("--engine cpu --mrt on", "--mrt");
+}
+
+TEST_CASE("mrt on a profile with one output is refused, naming the fused program and the limit") {
+  check_refused("--mrt on --profile gf5700", "program 'intersections + next triangle' writes 2");
+  check_refused("--mrt on --profile gf5700", "gf5700 allows 1");
+  check_refused("--mrt maybe", "--mrt");
+  // Mixed arithmetic in the fused groups: refused once the formats are known.
+  check_refused("--mrt on --profile gf6600 --lanes 8 --formats hits=fp16", "hits (fp16)");
 }
 
 TEST_CASE("reduced precision refuses lane widths it does not run at") {

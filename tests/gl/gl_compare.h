@@ -23,6 +23,12 @@ inline gl::GlDevice& device() {
   return d;
 }
 
+// A second context whose profile has multiple render targets, for the fused programs.
+inline gl::GlDevice& mrt_device() {
+  static gl::GlDevice d(vgpu::profile("gf6600"));
+  return d;
+}
+
 // Ulps each kernel's outputs may differ by, and why. Kernels made of +, -, *, compares, selects,
 // floor and fetches must be bit-exact: IEEE fp32 gives one answer and the shader forbids fusing
 // a*b+c (precise). Kernels that divide or take square roots get a few ulps: GLSL (4.60, sec.
@@ -42,6 +48,8 @@ inline int ulps_allowed(const std::string& kernel) {
       {"reflection direction", 16},
       {"shader", 64},  // normalised normals, light vectors, a 32nd power of the specular term
       {"shadow rays", 4},
+      {"intersections + next triangle", 16},  // as intersections
+      {"traversal + update voxel", 4},        // as traversal
   };
   const auto it = allowed.find(kernel);
   return it == allowed.end() ? 0 : it->second;
@@ -65,39 +73,58 @@ inline std::map<std::string, uint64_t>& worst_ulps() {
   return w;
 }
 
-inline void check_same_pass(const vgpu::Program& p, const std::vector<const vgpu::Texture*>& units,
-                            const vgpu::Texture& before, const vgpu::Texture& vgpu_out,
-                            const uint64_t* vgpu_query) {
-  gl::GlDevice& d = device();
-  vgpu::Texture out = before;  // a copy: a new texture, created on the device from these texels
+// The pass of program p that the vgpu made (units bound in order, targets starting from
+// `before`, ending as `vgpu_outs`), made again on the GL device and compared channel by channel.
+inline void check_same_targets(const vgpu::Program& p,
+                               const std::vector<const vgpu::Texture*>& units,
+                               const std::vector<const vgpu::Texture*>& before,
+                               const std::vector<const vgpu::Texture*>& vgpu_outs,
+                               const uint64_t* vgpu_query) {
+  gl::GlDevice& d = p.outputs() > 1 ? mrt_device() : device();
+  std::vector<vgpu::Texture> outs;  // copies: new textures, created on the device from these texels
+  outs.reserve(before.size());
+  for (const vgpu::Texture* t : before) outs.push_back(*t);
   d.use_program(p);
   d.unbind_textures();
   for (size_t i = 0; i < units.size(); ++i) d.bind_texture(int(i), *units[i]);
-  d.set_targets({&out});
+  if (outs.size() == 1)
+    d.set_targets({&outs[0]});
+  else
+    d.set_targets({&outs[0], &outs[1]});
   if (vgpu_query) d.begin_query();
   d.draw();
   const uint64_t n = vgpu_query ? d.end_query() : 0;
-  d.download(out);
   const std::string name = p.name();
   const uint64_t allowed = uint64_t(ulps_allowed(name));
   uint64_t& worst = worst_ulps()[name];
-  for (int y = 0; y < out.height(); ++y)
-    for (int x = 0; x < out.width(); ++x)
-      for (int c = 0; c < out.channels(); ++c) {
-        const float g = out.get(x, y, c), v = vgpu_out.get(x, y, c);
-        const uint64_t u = ulp_distance(g, v);
-        worst = std::max(worst, u);
-        if (u > allowed) {
-          INFO("GL device against vgpu: program '"
-               << name << "' texel (" << x << ", " << y << ") channel " << c << ": GL " << g
-               << ", vgpu " << v << ", " << u << " ulps (allowed " << allowed << ")");
-          CHECK(u <= allowed);
+  for (size_t o = 0; o < outs.size(); ++o) {
+    vgpu::Texture& out = outs[o];
+    d.download(out);
+    for (int y = 0; y < out.height(); ++y)
+      for (int x = 0; x < out.width(); ++x)
+        for (int c = 0; c < out.channels(); ++c) {
+          const float g = out.get(x, y, c), v = vgpu_outs[o]->get(x, y, c);
+          const uint64_t u = ulp_distance(g, v);
+          worst = std::max(worst, u);
+          if (u > allowed) {
+            INFO("GL device against vgpu: program '"
+                 << name << "' target " << o << " texel (" << x << ", " << y << ") channel " << c
+                 << ": GL " << g << ", vgpu " << v << ", " << u << " ulps (allowed " << allowed
+                 << ")");
+            CHECK(u <= allowed);
+          }
         }
-      }
+  }
   if (vgpu_query) {
     INFO("GL device against vgpu: program '" << name << "' occlusion query");
     CHECK(n == *vgpu_query);
   }
+}
+
+inline void check_same_pass(const vgpu::Program& p, const std::vector<const vgpu::Texture*>& units,
+                            const vgpu::Texture& before, const vgpu::Texture& vgpu_out,
+                            const uint64_t* vgpu_query) {
+  check_same_targets(p, units, {&before}, {&vgpu_out}, vgpu_query);
 }
 
 }  // namespace gltest

@@ -7,6 +7,7 @@
 
 #include <doctest/doctest.h>
 
+#include <array>
 #include <cstdint>
 #include <glm/glm.hpp>
 #include <string>
@@ -104,6 +105,42 @@ Texture run(const K& k, const std::vector<const Texture*>& units, int w, int h,
             glm::vec4 fill = glm::vec4(0.0f), uint64_t* query = nullptr) {
   vgpu::Gpu gpu(gf5700(), 1, 1);
   return run(gpu, k, units, w, h, fill, query);
+}
+
+// A profile with multiple render targets, for the fused programs (kernels/fused.h).
+inline const vgpu::Profile& gf6600() {
+  return vgpu::profile("gf6600");
+}
+
+// One pass of a fused kernel k (K::outputs targets) through a gf6600 vgpu, over fresh w x h
+// targets of 4 channels, target i cleared to fills[i]. Compared on the GL device like run().
+template <class K>
+std::array<Texture, K::outputs> run_targets(const K& k, const std::vector<const Texture*>& units,
+                                            int w, int h,
+                                            const std::array<glm::vec4, K::outputs>& fills = {}) {
+  vgpu::Gpu gpu(gf6600(), 1, 1);
+  vgpu::KernelProgram<K> program(k);
+  std::array<Texture, K::outputs> outs;
+  for (int i = 0; i < K::outputs; ++i) {
+    outs[size_t(i)] = gpu.make_texture(std::string(K::name) + " out" + std::to_string(i), w, h, 4);
+    const glm::vec4& v = fills[size_t(i)];
+    const float f[4] = {v.x, v.y, v.z, v.w};
+    outs[size_t(i)].fill(f);
+  }
+#ifdef KTEST_GL
+  const std::array<Texture, K::outputs> before = outs;
+#endif
+  gpu.use_program(program);
+  gpu.unbind_textures();
+  for (size_t i = 0; i < units.size(); ++i) gpu.bind_texture(int(i), *units[i]);
+  static_assert(K::outputs == 2, "run_targets binds two targets");
+  gpu.set_targets({&outs[0], &outs[1]});
+  gpu.draw();
+#ifdef KTEST_GL
+  gltest::check_same_targets(program, units, {&before[0], &before[1]}, {&outs[0], &outs[1]},
+                             nullptr);
+#endif
+  return outs;
 }
 
 // A grid uniform block: box corner lo, voxel size cell, res voxels per axis.

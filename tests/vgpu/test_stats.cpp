@@ -3,6 +3,7 @@
 
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "helpers.h"
 #include "vgpu/vgpu.h"
@@ -243,4 +244,19 @@ TEST_CASE("the table report has a row for every program and the total") {
   int lines = 0;
   for (char ch : table) lines += ch == '\n';
   CHECK(lines == 1 + 3 + 1);  // header, programs, total
+}
+
+TEST_CASE("the table's name columns widen to the longest name, so every row stays aligned") {
+  vgpu::FrameStats s;
+  s.program("intersections + next triangle", "intersecciones+proximoTriangulo", 148)
+      .counters.passes = 3;
+  s.program("copy", "copia", 2).counters.passes = 12345;
+  s.totals.passes = 12348;
+  const std::string table = s.to_table();
+  std::vector<size_t> widths;
+  size_t from = 0;
+  for (size_t nl; (nl = table.find('\n', from)) != std::string::npos; from = nl + 1)
+    widths.push_back(nl - from);
+  REQUIRE(widths.size() == 4);                    // header, two programs, total
+  for (size_t w : widths) CHECK(w == widths[0]);  // fixed-width columns: equal rows, aligned
 }
