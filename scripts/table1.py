@@ -122,6 +122,8 @@ def parse_parameters():
             continue
         if "fitted" in source:
             status = "fitted"
+        elif "measured" in source:
+            status = "measured"
         elif "model parameter" in source:
             status = "assumed"
         else:

@@ -122,10 +122,10 @@ const std::vector<Profile>& profiles() {
     // GH100 is a compute part: of its 66 TPCs (132 SMs) only 2 TPCs, 4 SMs, can run vertex and
     // pixel shaders (NVIDIA H100 Tensor Core GPU Architecture whitepaper, 2022). Fragment
     // programs run on those: 4 SMs x 128 FP32 cores.
-    m.pipelines = 512;
-    m.core_mhz = 1980;  // boost clock, SXM (NVIDIA H100 SXM5 specifications; H200 same GH100);
-                        // nvidia-smi showed 1980 MHz through the measured runs, but ~1 GHz when
-                        // the GPU sat idle between passes (docs/real_gpu.md)
+    // nvidia-smi showed the boost clock through the measured frames, ~1 GHz when the GPU sat
+    // idle between passes (docs/real_gpu.md).
+    m.pipelines = 512;  // 4 graphics-capable SMs x 128 FP32 cores (H100 architecture whitepaper)
+    m.core_mhz = 1980;  // boost clock, SXM (NVIDIA H100 SXM5 specifications; H200 same GH100)
     m.mem_gbps = 4800;  // HBM3e, 4.8 TB/s (NVIDIA H200 datasheet)
     m.max_outputs = 8;  // GL_MAX_DRAW_BUFFERS on NVIDIA drivers
     m.max_instructions = 1 << 20;  // effectively unlimited (model parameter)
@@ -138,20 +138,19 @@ const std::vector<Profile>& profiles() {
     // of two runs, docs/real_gpu.md): a pass 10.0 and 10.8 us, a polled query read-back 11 to
     // 14 us more, a program switch under 1 us. The blocking GL_QUERY_RESULT wait costs up to
     // 140 us more after a long pass (the driver sleeps); the model prices the polled wait.
-    m.pass_us = 10.4;         // measured (bench_gl)
-    m.readback_us = 12;       // measured (bench_gl, polled)
-    m.program_load_us = 0.5;  // measured (bench_gl: within noise of 0)
-    m.alu_lanes = 1;          // scalar CUDA cores: every scalar operation is one instruction
-    m.alu_per_clock = 1;      // one FP32 FMA per core per clock (Hopper whitepaper)
-    m.fp32_rate = 1;
+    m.pass_us = 10.4;                // measured (bench_gl)
+    m.readback_us = 12;              // measured (bench_gl, polled)
+    m.program_load_us = 0.5;         // measured (bench_gl: within noise of 0)
+    m.alu_lanes = 1;                 // scalar CUDA cores: every scalar operation is one instruction
+    m.alu_per_clock = 1;             // one FP32 FMA per core per clock (Hopper whitepaper)
+    m.fp32_rate = 1;                 // FP32 is the full rate (Hopper whitepaper)
     m.texels_per_clock = 4.0 / 128;  // 4 texture units per SM (Hopper whitepaper)
-    // 16 texture units fetching one 32-bit component a clock each (an RGBA32F texel in 4):
-    // model parameter (assumed: one 32-bit component per unit per clock, 4 for an RGBA32F).
-    m.texture_bytes_per_clock = 64;
+    // 16 texture units (4 SMs) fetching one 32-bit component a clock each (RGBA32F in 4).
+    m.texture_bytes_per_clock = 64;  // model parameter (assumed rate per texture unit)
     // The ROPs: bench_gl's 1024x1024 copy pass writes 16 MB in 301.6 us of GPU time at 1980 MHz
-    // and two targets take twice as long (28 bytes a clock). Model parameter, measured on tiny
-    // programs, not on the frames it predicts.
-    m.output_bytes_per_clock = 28;
+    // and two targets take twice as long: 28 bytes a clock. Measured on tiny programs, not on the
+    // frames it predicts.
+    m.output_bytes_per_clock = 28;  // model parameter (measured by bench_gl's copy pass)
     t.push_back(m);
     return t;
   }();
