@@ -58,6 +58,9 @@ struct RenderArgs {
   std::string gl_device = "auto";
   std::string precision = "fp32";
   std::string formats;
+  std::string kernels = "multipass";
+  int steps_per_pass = 32;
+  bool steps_given = false;
 };
 
 struct UsageError : std::runtime_error {
@@ -232,6 +235,20 @@ void add_render_options(CLI::App& render, RenderArgs& a) {
       .add_option("--gl-device", a.gl_device,
                   "With --engine gl: auto, or an EGL device index (see vgpu-rt gl-devices)")
       ->capture_default_str();
+  render
+      .add_option("--kernels", a.kernels,
+                  "How rays walk the grid: multipass (the paper's kernels, one pass per step) | "
+                  "looping (one data-dependent loop, Purcell's branching variant; needs dynamic "
+                  "branching, e.g. --profile gf6600), stream engine")
+      ->check(CLI::IsMember({"multipass", "looping"}))
+      ->capture_default_str();
+  render
+      .add_option("--steps-per-pass", a.steps_per_pass,
+                  "With --kernels looping: loop iterations per pass before the host's occlusion "
+                  "query (the profile's loop limit applies: gf6600 255)")
+      ->check(CLI::Range(1, 4096))
+      ->each([&a](const std::string&) { a.steps_given = true; })
+      ->capture_default_str();
   render.add_flag("--predict", a.predict,
                   "Print the cost model's predicted time for --profile, with its breakdown");
 }
@@ -246,6 +263,8 @@ int run_render(const RenderArgs& a, bool lanes_given) {
   opt.shading = host::parse_shading(a.shading);
   opt.shadows = a.shadows == "on";
   opt.masks = a.masks == "on";
+  opt.looping = a.kernels == "looping";
+  opt.steps_per_pass = a.steps_per_pass;
   opt.profile = vgpu::profile(a.profile).name;
   opt.threads = a.threads;
   opt.lanes = a.lanes;
@@ -281,12 +300,14 @@ int run_render(const RenderArgs& a, bool lanes_given) {
                          : opt.masks              ? "--masks on"
                          : a.precision != "fp32"  ? "--precision"
                          : !a.formats.empty()     ? "--formats"
+                         : opt.looping            ? "--kernels looping"
                                                   : nullptr;
     if (unused)
       throw UsageError(std::string(unused) +
                        " needs --engine stream (the cpu engine is a double-precision reference "
                        "without passes, lanes or masks)");
   }
+  if (a.steps_given && !opt.looping) throw UsageError("--steps-per-pass needs --kernels looping");
   // Reduced precision runs at 1 or 8 lanes (vgpu/gpu.cpp): refuse another width.
   const bool reduced = a.precision != "fp32" || !a.formats.empty();
   if (reduced && opt.lanes != 1 && opt.lanes != 8)
@@ -296,6 +317,10 @@ int run_render(const RenderArgs& a, bool lanes_given) {
     throw UsageError(
         "--report and --stats-csv need --engine stream (the report reads the "
         "emulator's per-fragment state)");
+  if (gl && opt.looping)
+    throw UsageError(
+        "--engine gl --kernels looping: the recorder and GLSL printer have no loops yet; use "
+        "--engine stream");
   if (gl) {
     // The GL device runs every fragment in fp32 GLSL; the emulator-only features are refused.
     if (!host::have_gl_device())
@@ -369,6 +394,8 @@ int run_render(const RenderArgs& a, bool lanes_given) {
   j["shading"] = a.shading;
   j["shadows"] = opt.shadows;
   j["masks"] = opt.masks;
+  j["kernels"] = a.kernels;
+  if (opt.looping) j["steps_per_pass"] = opt.steps_per_pass;
   j["threads"] = opt.threads;
   j["lanes"] = opt.lanes;
   j["precision"] = a.precision;
@@ -397,6 +424,10 @@ int run_render(const RenderArgs& a, bool lanes_given) {
   nlohmann::ordered_json predicted_ms, predicted_breakdown;
   for (const vgpu::Profile& p : vgpu::profiles()) {
     if (cpu || gl) break;  // no passes, or no SIMD counters to predict from
+    if (opt.looping && p.max_loop_iterations < opt.steps_per_pass) {
+      predicted_ms[p.name] = nullptr;  // the looping program cannot run there
+      continue;
+    }
     const host::CostBreakdown c = host::predict(r.stats, p);
     predicted_ms[p.name] = c.total_ms;
     for (const auto& [key, v] : c.items()) predicted_breakdown[p.name][key] = v;

@@ -71,6 +71,11 @@ struct RenderOptions {
   // Early-z/stencil masks for finished rays (the paper's future work): masked fragments cost
   // nothing. Off: every fragment runs every pass, as on the paper's GeForce FX.
   bool masks = false;
+  // The kernels that walk the grid: false, the paper's multipass pipeline (one pass per voxel
+  // step and per triangle); true, one looping program (kernels/looping_traversal.h, fp40 and
+  // later) drawn again while rays walk, `steps_per_pass` loop iterations per pass.
+  bool looping = false;
+  int steps_per_pass = 32;
   // Emulator shortcut: skip host work for fragments whose result cannot change (finished rays);
   // their statistics are charged as if run. Off only to check that it changes nothing.
   bool host_shortcut = true;
@@ -111,6 +116,8 @@ class StreamTracer {
   const vgpu::PassRecord& pass(const vgpu::Program& p,
                                std::initializer_list<const vgpu::Texture*> in, vgpu::Texture& out,
                                const vgpu::Stencil* work = nullptr);
+  // The looping variant of the walk (RenderOptions::looping): the looping program's passes.
+  void walk_looping(vgpu::Texture& origins, vgpu::Texture& rays, uint64_t walking);
   uint64_t count(const vgpu::Program& p, const vgpu::Texture& in, const vgpu::Stencil* work,
                  vgpu::Stencil* write);
   // Whether --trace-pixel output is on and the traced pixel takes part in a pass under `work`

@@ -42,6 +42,11 @@ struct Profile {
   double fp24_rate = 1;         // fp24 throughput relative to fp16 (a part without fp24 units
                                 // computes fp24 values in fp32: its fp32 rate)
   double texels_per_clock = 1;  // texture fetches per pipeline per clock
+  // Data-dependent loops (Fragments::loop): 0 where the profile has none (fp30, ps_2_0), else the
+  // most iterations one loop may be given. A looping program's batch is branch_granularity
+  // pixels: it iterates until its last pixel leaves the loop.
+  int max_loop_iterations = 0;
+  double loop_overhead_clocks = 0;  // clocks a pixel spends on one iteration's loop/break
 
   // Arithmetic throughput at format f, relative to alu_per_clock (the fp16 rate).
   double rate(Format f) const {

@@ -35,7 +35,7 @@ FrameStats::ProgramTotals& FrameStats::program(const std::string& name,
                                                const std::string& paper_name, int instructions) {
   for (ProgramTotals& p : programs)
     if (p.name == name) return p;
-  programs.push_back({name, paper_name, instructions, {}});
+  programs.push_back({name, paper_name, instructions, {}, {}, {}, 0, 0});
   return programs.back();
 }
 
@@ -63,6 +63,12 @@ nlohmann::ordered_json FrameStats::json() const {
     e["static_instructions"] = p.instructions;
     const nlohmann::ordered_json c = vgpu::to_json(p.counters, device_timed);  // items() needs it
     for (auto& [k, v] : c.items()) e[k] = v;
+    if (p.loop_budget > 0) {  // a looping program: its loop per iteration
+      e["loop_budget"] = p.loop_budget;
+      e["loop_body_instructions"] = p.loop_body_instructions;
+      e["loop_active_per_iteration"] = p.loop_active;
+      e["loop_idle_per_iteration"] = p.loop_idle;
+    }
     progs.push_back(e);
   }
   j["programs"] = progs;
