@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <fstream>
 #include <iostream>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <regex>
@@ -317,10 +318,6 @@ int run_render(const RenderArgs& a, bool lanes_given) {
     throw UsageError(
         "--report and --stats-csv need --engine stream (the report reads the "
         "emulator's per-fragment state)");
-  if (gl && opt.looping)
-    throw UsageError(
-        "--engine gl --kernels looping: the recorder and GLSL printer have no loops yet; use "
-        "--engine stream");
   if (gl) {
     // The GL device runs every fragment in fp32 GLSL; the emulator-only features are refused.
     if (!host::have_gl_device())
@@ -413,7 +410,10 @@ int run_render(const RenderArgs& a, bool lanes_given) {
   {
     nlohmann::ordered_json stats = r.stats.json();
     if (gl)  // the emulator's SIMD model: a driver does not show its lanes
-      for (const char* key : {"lanes_idle", "idle_in_batch32", "idle_in_batch1024"}) {
+      for (const char* key :
+           {"lanes_idle", "idle_in_batch32", "idle_in_batch1024", "loop_iterations",
+            "loop_lane_slots", "loop_lanes_idle", "loop_batch_iterations", "loop_idle_instructions",
+            "loop_idle_fetches"}) {
         stats["totals"][key] = nullptr;
         for (auto& k : stats["programs"]) k[key] = nullptr;
       }
@@ -495,7 +495,9 @@ int run_render(const RenderArgs& a, bool lanes_given) {
 
 // `vgpu-rt kernels [NAME] [--glsl]`: what a fragment program is, per kernel.
 int run_kernels(const std::string& name, bool glsl) {
-  const auto programs = kernels::all_programs();
+  auto programs = kernels::all_programs();
+  // The looping variant's program (--kernels looping) is listed after the paper's.
+  programs.push_back(std::make_unique<vgpu::KernelProgram<kernels::LoopingTraversal>>());
   auto spelled = [](std::string n) {
     for (char& c : n)
       if (c == ' ') c = '-';

@@ -8,7 +8,6 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
-#include <stdexcept>
 
 #include "vgpu/lanes.h"
 #include "vgpu/record.h"
@@ -229,7 +228,21 @@ class Fragments {
       }
       return more;
     } else if constexpr (L::recording) {
-      throw std::runtime_error("the recorder and the GLSL printer have no loops (f.loop)");
+      // The body twice: the second iteration's operands tell which values the first one
+      // carries (RecLoop); the printer writes one GLSL loop from the first.
+      Recording& rec = *Recorder::current;
+      RecLoop lp;
+      lp.begin = int(rec.nodes.size());
+      lp.max_iterations = max_iterations;
+      lp.entry = active.id;
+      const M more = body(active);
+      const M next = M::node(Recorder::emit(Op::mask_and, active.id, more.id));
+      lp.mid = int(rec.nodes.size());
+      const M more2 = body(next);
+      const M after = M::node(Recorder::emit(Op::mask_and, next.id, more2.id));
+      lp.end = int(rec.nodes.size());
+      rec.loops.push_back(lp);
+      return after;
     } else {
       active = active && live_;
       bool on[W];

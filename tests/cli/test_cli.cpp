@@ -139,7 +139,6 @@ TEST_CASE("the looping kernels' options are checked before any work") {
   check_refused("--kernels looping --steps-per-pass 5000", "--steps-per-pass");
   check_refused("--steps-per-pass 8", "--steps-per-pass");
   check_refused("--engine cpu --kernels looping", "--kernels looping");
-  check_refused("--engine gl --kernels looping", "--kernels looping");
 }
 
 TEST_CASE("a looping render on a profile without loops or past its loop limit names the program") {
