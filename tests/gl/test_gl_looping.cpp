@@ -51,7 +51,7 @@ TEST_CASE("the looping program prints as one GLSL loop with its budget and a bre
 }
 
 TEST_CASE("looping frames on the GL device give the vgpu's queries and hit ids") {
-  for (const char* name : {"sphere", "bunny-refl"}) {
+  for (const std::string name : {"sphere", "bunny-refl"}) {
     CAPTURE(name);
     const host::RenderResult v = render(name, "vgpu", 64), g = render(name, "gl", 64);
     REQUIRE(v.stats.passes.size() == g.stats.passes.size());
