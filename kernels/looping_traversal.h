@@ -23,7 +23,7 @@ namespace kernels {
 
 struct LoopingTraversal {
   static constexpr const char* name = "looping traversal";
-  static constexpr const char* paper_name = "recorridoIterativo (extension)";
+  static constexpr const char* paper_name = "recorridoIterativo";  // an extension: not in the paper
   static constexpr int outputs = 3;  // -> traversal, voxel state, intersection (MRT, fp40)
   enum Unit {
     kOrigins,

@@ -33,8 +33,7 @@ const std::vector<Profile>& profiles() {
     fx.fp24_rate = 0.5;        // no fp24 units: fp24 values need the fp32 path
     fx.texels_per_clock = 1;   // hexus.net FX 5700 Ultra review p.2: one texture unit per pipe
 
-    // Loops: NVIDIA Cg docs, fp30: loops must unroll (no data-dependent exit).
-    fx.max_loop_iterations = 0;
+    fx.max_loop_iterations = 0;  // NVIDIA Cg docs, fp30: loops unroll, no data-dependent exit
     t.push_back(fx);
 
     // The fp24 part of 2004: every fragment operation in s7e16, no fp32 and no separate half
@@ -67,8 +66,7 @@ const std::vector<Profile>& profiles() {
     ati.fp24_rate = 1;          // native format
     ati.texels_per_clock = 1;   // 8 TMUs for 8 pipes (guru3d.com: 2600 Mtexel/s at 325 MHz)
 
-    // Loops: ps_2_0 has no flow control in fragment programs.
-    ati.max_loop_iterations = 0;
+    ati.max_loop_iterations = 0;  // ps_2_0: no flow control in fragment programs
     t.push_back(ati);
 
     Profile g6;
@@ -97,10 +95,10 @@ const std::vector<Profile>& profiles() {
 
     // Loops: the NV_fragment_program2 spec (NVIDIA, 2004) clamps REP/LOOP counts to
     // MAX_PROGRAM_LOOP_COUNT_NV, 255 on NV4x (as ps_3_0's loop/rep count range [0, 255]).
-    g6.max_loop_iterations = 255;
+    g6.max_loop_iterations = 255;  // NV_fragment_program2 spec: MAX_PROGRAM_LOOP_COUNT_NV
     // GPU Gems 2 ch. 34 (Harris & Buck, "GPU Flow-Control Idioms"), the GeForce 6800's cost of
     // flow-control instructions: a loop/endloop pair about 4 clocks.
-    g6.loop_overhead_clocks = 4;
+    g6.loop_overhead_clocks = 4;  // GPU Gems 2 ch. 34: loop/endloop about 4 clocks (6800)
     t.push_back(g6);
 
     Profile m;
@@ -125,10 +123,8 @@ const std::vector<Profile>& profiles() {
     m.fp32_rate = 1;
     m.texels_per_clock = 512.0 / 16384;  // 512 texture units for 16384 cores (Ada whitepaper)
 
-    // Loops: ps_5_0 / GLSL set no loop count limit; the overhead is assumed (a compare and a
-    // branch). Both model parameters.
-    m.max_loop_iterations = 1 << 20;
-    m.loop_overhead_clocks = 1;
+    m.max_loop_iterations = 1 << 20;  // model parameter: no loop count limit
+    m.loop_overhead_clocks = 1;       // model parameter (assumed: a compare and a branch)
     t.push_back(m);
 
     // The H200 the GL device is measured on (docs/real_gpu.md): a 2026 GPU running the paper's
@@ -158,10 +154,8 @@ const std::vector<Profile>& profiles() {
     m.fp32_rate = 1;
     m.texels_per_clock = 528.0 / 16896;  // 4 texture units per SM, 528 (Hopper whitepaper)
 
-    // Loops: GLSL 3.30 sets no loop count limit; the overhead is assumed (a compare and a
-    // branch). Both model parameters.
-    m.max_loop_iterations = 1 << 20;
-    m.loop_overhead_clocks = 1;
+    m.max_loop_iterations = 1 << 20;  // model parameter: no loop count limit
+    m.loop_overhead_clocks = 1;       // model parameter (assumed: a compare and a branch)
     t.push_back(m);
     return t;
   }();

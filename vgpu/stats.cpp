@@ -116,6 +116,18 @@ std::string FrameStats::to_table() const {
   };
   for (const ProgramTotals& p : programs) row(p.name, p.paper_name, p.counters);
   row("total", "", totals);
+  for (const ProgramTotals& p : programs) {
+    const Counters& c = p.counters;
+    if (c.loop_lane_slots == 0) continue;
+    std::snprintf(line, sizeof line,
+                  "%s: loop of %d iterations a pass, %s batch iterations, %s lane slots, %s "
+                  "active, %s idle (%.1f%%)\n",
+                  p.name.c_str(), p.loop_budget, human(c.loop_batch_iterations).c_str(),
+                  human(c.loop_lane_slots).c_str(), human(c.loop_iterations).c_str(),
+                  human(c.loop_lanes_idle).c_str(),
+                  100.0 * double(c.loop_lanes_idle) / double(c.loop_lane_slots));
+    out += line;
+  }
   return out;
 }
 

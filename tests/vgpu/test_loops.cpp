@@ -4,6 +4,7 @@
 // executed-instruction limit), each refusal naming the program.
 #include <doctest/doctest.h>
 
+#include <string>
 #include <vector>
 
 #include "vgpu/vgpu.h"
@@ -145,6 +146,10 @@ TEST_CASE("lanes needing 1, 3 and 7 iterations in one batch give exact loop coun
   CHECK(t->loop_body_instructions == 3);
   CHECK(t->loop_active == rec.loop_active);
   CHECK(t->loop_idle == rec.loop_idle);
+  CHECK_MESSAGE(gpu.stats().to_table().find(
+                    "count to: loop of 16 iterations a pass, 7 batch iterations, 21 lane slots, "
+                    "11 active, 10 idle (47.6%)") != std::string::npos,
+                gpu.stats().to_table());
 }
 
 TEST_CASE("the iteration budget stops every lane and the counters stop with it") {
