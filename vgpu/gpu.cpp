@@ -865,8 +865,9 @@ const PassRecord& Gpu::draw(const Rect& rect) {
     add(totals.loop_idle, loop_idle);
   }
   stats_.totals += c;
-  PassRecord rec{pname, rect.width(),           rect.height(),       c,
-                 -1,    std::move(loop_active), std::move(loop_idle)};
+  PassRecord rec{pname, rect.width(), rect.height(), c, -1};
+  rec.loop_active = std::move(loop_active);
+  rec.loop_idle = std::move(loop_idle);
   if (stats_.keep_pass_records) {
     stats_.passes.push_back(std::move(rec));
     return stats_.passes.back();
