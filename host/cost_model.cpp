@@ -23,6 +23,8 @@ std::vector<std::pair<std::string, double>> CostBreakdown::items() const {
           {"bus_ms", bus_ms},
           {"readback_ms", readback_ms},
           {"wasted_ms", wasted_ms},
+          {"loop_idle_ms", loop_idle_ms},
+          {"loop_overhead_ms", loop_overhead_ms},
           {"total_ms", total_ms},
           {"arithmetic_demand_ms", arithmetic_demand_ms},
           {"texture_demand_ms", texture_demand_ms},
@@ -39,6 +41,13 @@ void add_passes(const vgpu::Counters& c, double n, const vgpu::Profile& hw, cons
   const double shaded = double(c.fragments_shaded) / n;
   const double fetches = double(c.texture_fetches) / n;
   const double ops = std::max(0.0, double(c.instructions) / n - fetches);  // fetches are TEX
+  // A looping program: lanes already out of the loop still hold their slots while their batch
+  // iterates. They are issued the body's instructions and fetches (ALU and texture-unit time)
+  // but move no bytes; each lane slot also pays the profile's loop/break overhead.
+  const double idle_fetches = double(c.loop_idle_fetches) / n;
+  const double idle_ops = std::max(0.0, double(c.loop_idle_instructions) / n - idle_fetches);
+  const double overhead_s =
+      double(c.loop_lane_slots) / n * hw.loop_overhead_clocks / (hw.pipelines * hz);
   // Finished rays: fragments idle in the program's branch, or discarded by a counting program
   // (one branch per program, as every kernel has; a second branch would count them twice).
   const double idle = std::min(shaded, double(c.lanes_idle) / n);
@@ -59,10 +68,17 @@ void add_passes(const vgpu::Counters& c, double n, const vgpu::Profile& hw, cons
   const double ops32 = ops - ops24 - ops16;
   const double rate_ops = ops32 / hw.rate(vgpu::Format::fp32) +
                           ops24 / hw.rate(vgpu::Format::fp24) + ops16 / hw.rate(vgpu::Format::fp16);
-  const double arith_s = rate_ops * keep / packing / (hw.pipelines * hz * hw.alu_per_clock);
-  double tex_s = fetches * keep / (hw.pipelines * hz * hw.texels_per_clock);
-  if (hw.texture_bytes_per_clock > 0)
-    tex_s = std::max(tex_s, double(c.bytes_read) / n * keep / (hw.texture_bytes_per_clock * hz));
+  // Idle loop lanes run at the rate the rest of the arithmetic ran at (the pass has one format).
+  const double idle_rate_ops = ops > 0 ? idle_ops * rate_ops / ops : idle_ops;
+  const double arith_s =
+      (rate_ops * keep + idle_rate_ops) / packing / (hw.pipelines * hz * hw.alu_per_clock) +
+      overhead_s;
+  double tex_s = (fetches * keep + idle_fetches) / (hw.pipelines * hz * hw.texels_per_clock);
+  if (hw.texture_bytes_per_clock > 0) {  // idle loop lanes fetch texels of the average size
+    const double per_fetch = fetches > 0 ? double(c.bytes_read) / n / fetches : 0.0;
+    tex_s = std::max(tex_s, (double(c.bytes_read) / n * keep + idle_fetches * per_fetch) /
+                                (hw.texture_bytes_per_clock * hz));
+  }
   double mem_s =
       (double(c.bytes_read) / n * keep + double(c.bytes_written) / n) / (hw.mem_gbps * 1e9);
   if (hw.output_bytes_per_clock > 0)
@@ -82,7 +98,19 @@ void add_passes(const vgpu::Counters& c, double n, const vgpu::Profile& hw, cons
   // Work units: a full fragment is 1, a skipping one 1 - body share.
   const double units = shaded - p.branch_body_share * skipped;
   const double finished_units = finished - p.branch_body_share * skipped;
-  if (units > 0) out.wasted_ms += work_s * ms * std::clamp(finished_units / units, 0.0, 1.0);
+  double wasted = units > 0 ? std::clamp(finished_units / units, 0.0, 1.0) : 0.0;
+  if (c.loop_lane_slots > 0) {
+    // Of a looping pass: the idle lanes' share of its bottleneck's demand.
+    const double idle_arith = idle_rate_ops / packing / (hw.pipelines * hz * hw.alu_per_clock) +
+                              overhead_s * double(c.loop_lanes_idle) / double(c.loop_lane_slots);
+    const double idle_tex = idle_fetches / (hw.pipelines * hz * hw.texels_per_clock);
+    const double idle_s = work_s == arith_s ? idle_arith : work_s == tex_s ? idle_tex : 0.0;
+    const double share = work_s > 0 ? idle_s / work_s : 0.0;
+    out.loop_idle_ms += work_s * ms * share;
+    out.loop_overhead_ms += overhead_s * ms;
+    wasted = std::clamp(wasted + share, 0.0, 1.0);
+  }
+  out.wasted_ms += work_s * ms * wasted;
 }
 
 }  // namespace
@@ -139,7 +167,15 @@ std::string describe(const CostBreakdown& c, const vgpu::Profile& profile) {
       pct(c.texture_ms), c.memory_ms, pct(c.memory_ms), c.per_pass_ms, pct(c.per_pass_ms),
       c.program_load_ms, pct(c.program_load_ms), c.readback_ms, pct(c.readback_ms), c.wasted_ms,
       pct(c.wasted_ms));
-  return buf;
+  std::string out = buf;
+  if (c.loop_idle_ms > 0 || c.loop_overhead_ms > 0) {
+    std::snprintf(buf, sizeof buf,
+                  "  looping passes: lanes out of the loop while their batch iterates %.1f ms "
+                  "(%.0f%%), loop overhead %.1f ms (%.0f%%)\n",
+                  c.loop_idle_ms, pct(c.loop_idle_ms), c.loop_overhead_ms, pct(c.loop_overhead_ms));
+    out += buf;
+  }
+  return out;
 }
 
 namespace {

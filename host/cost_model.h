@@ -10,6 +10,9 @@
 //                gives one, texel bytes / (texture_bytes_per_clock x clock) if that is longer
 //   memory     = (bytes read + bytes written) / bandwidth, or where the profile gives one,
 //                bytes written / (output_bytes_per_clock x clock) if that is longer (the ROPs)
+// Looping passes add, per lane slot of a batch still iterating (Counters::loop_lane_slots),
+// the body's instructions and fetches for lanes already out (ALU and texture time, no bytes)
+// and Profile::loop_overhead_clocks of the pipeline.
 // Per frame:  + program loads (bytes over the bus + program_load_us each)
 //             + query read-backs (readback_us each: a pipeline drain and a CPU round trip)
 //             + clears (bytes / bandwidth, counted with memory)
@@ -65,6 +68,10 @@ struct CostBreakdown {
   double bus_ms = 0;           // of program_load_ms: the program bytes over the bus alone
   double readback_ms = 0;      // query read-backs x readback_us
   double wasted_ms = 0;        // of the pass work: idle fragments (finished rays)
+  // Looping passes (Counters::loop_*): of the pass work, the lanes already out of the loop while
+  // their batch iterates; of the arithmetic, the loop/break overhead (Profile).
+  double loop_idle_ms = 0;
+  double loop_overhead_ms = 0;
   double total_ms = 0;
   // Each unit's whole demand, overlapped or not (how close the other bottlenecks are).
   double arithmetic_demand_ms = 0, texture_demand_ms = 0, memory_demand_ms = 0;

@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <fstream>
 #include <iostream>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <regex>
@@ -60,6 +61,9 @@ struct RenderArgs {
   std::string gl_readback = "auto";
   std::string precision = "fp32";
   std::string formats;
+  std::string kernels = "multipass";
+  int steps_per_pass = 32;
+  bool steps_given = false;
 };
 
 struct UsageError : std::runtime_error {
@@ -248,6 +252,20 @@ void add_render_options(CLI::App& render, RenderArgs& a) {
                   "auto (poll on a hardware driver, block on a software one)")
       ->check(CLI::IsMember({"auto", "block", "poll"}))
       ->capture_default_str();
+  render
+      .add_option("--kernels", a.kernels,
+                  "How rays walk the grid: multipass (the paper's kernels, one pass per step) | "
+                  "looping (one data-dependent loop, Purcell's branching variant; needs dynamic "
+                  "branching, e.g. --profile gf6600), stream engine")
+      ->check(CLI::IsMember({"multipass", "looping"}))
+      ->capture_default_str();
+  render
+      .add_option("--steps-per-pass", a.steps_per_pass,
+                  "With --kernels looping: loop iterations per pass before the host's occlusion "
+                  "query (the profile's loop limit applies: gf6600 255)")
+      ->check(CLI::Range(1, 4096))
+      ->each([&a](const std::string&) { a.steps_given = true; })
+      ->capture_default_str();
   render.add_flag("--predict", a.predict,
                   "Print the cost model's predicted time for --profile, with its breakdown");
 }
@@ -263,6 +281,12 @@ int run_render(const RenderArgs& a, bool lanes_given) {
   opt.shadows = a.shadows == "on";
   opt.masks = a.masks == "on";
   opt.mrt = a.mrt == "on";
+  opt.looping = a.kernels == "looping";
+  opt.steps_per_pass = a.steps_per_pass;
+  if (opt.mrt && opt.looping)
+    throw UsageError(
+        "--mrt on with --kernels looping: the looping program already writes the traversal, "
+        "voxel and hit targets in one pass; there are no separate passes left to fuse");
   opt.profile = vgpu::profile(a.profile).name;
   opt.threads = a.threads;
   opt.lanes = a.lanes;
@@ -299,12 +323,14 @@ int run_render(const RenderArgs& a, bool lanes_given) {
                          : opt.mrt                ? "--mrt on"
                          : a.precision != "fp32"  ? "--precision"
                          : !a.formats.empty()     ? "--formats"
+                         : opt.looping            ? "--kernels looping"
                                                   : nullptr;
     if (unused)
       throw UsageError(std::string(unused) +
                        " needs --engine stream (the cpu engine is a double-precision reference "
                        "without passes, lanes or masks)");
   }
+  if (a.steps_given && !opt.looping) throw UsageError("--steps-per-pass needs --kernels looping");
   // Reduced precision runs at 1 or 8 lanes (vgpu/gpu.cpp): refuse another width.
   const bool reduced = a.precision != "fp32" || !a.formats.empty();
   if (reduced && opt.lanes != 1 && opt.lanes != 8)
@@ -403,6 +429,8 @@ int run_render(const RenderArgs& a, bool lanes_given) {
   j["masks"] = opt.masks;
   j["mrt"] = opt.mrt;  // fused two-output passes (kernels/fused.h)
   j["fused_programs"] = opt.mrt ? host::mrt_programs() : std::vector<std::string>{};
+  j["kernel_variant"] = a.kernels;  // multipass | looping ("kernels" lists the programs)
+  if (opt.looping) j["steps_per_pass"] = opt.steps_per_pass;
   j["threads"] = opt.threads;
   j["lanes"] = opt.lanes;
   j["precision"] = a.precision;
@@ -420,7 +448,10 @@ int run_render(const RenderArgs& a, bool lanes_given) {
   {
     nlohmann::ordered_json stats = r.stats.json();
     if (gl)  // the emulator's SIMD model: a driver does not show its lanes
-      for (const char* key : {"lanes_idle", "idle_in_batch32", "idle_in_batch1024"}) {
+      for (const char* key :
+           {"lanes_idle", "idle_in_batch32", "idle_in_batch1024", "loop_iterations",
+            "loop_lane_slots", "loop_lanes_idle", "loop_batch_iterations", "loop_idle_instructions",
+            "loop_idle_fetches"}) {
         stats["totals"][key] = nullptr;
         for (auto& k : stats["programs"]) k[key] = nullptr;
       }
@@ -431,6 +462,10 @@ int run_render(const RenderArgs& a, bool lanes_given) {
   nlohmann::ordered_json predicted_ms, predicted_breakdown;
   for (const vgpu::Profile& p : vgpu::profiles()) {
     if (cpu || gl) break;  // no passes, or no SIMD counters to predict from
+    if (opt.looping && p.max_loop_iterations < opt.steps_per_pass) {
+      predicted_ms[p.name] = nullptr;  // the looping program cannot run there
+      continue;
+    }
     const host::CostBreakdown c = host::predict(r.stats, p);
     predicted_ms[p.name] = c.total_ms;
     for (const auto& [key, v] : c.items()) predicted_breakdown[p.name][key] = v;
@@ -498,7 +533,9 @@ int run_render(const RenderArgs& a, bool lanes_given) {
 
 // `vgpu-rt kernels [NAME] [--glsl]`: what a fragment program is, per kernel.
 int run_kernels(const std::string& name, bool glsl) {
-  const auto programs = kernels::all_programs();
+  auto programs = kernels::all_programs();
+  // The looping variant's program (--kernels looping) is listed after the paper's.
+  programs.push_back(std::make_unique<vgpu::KernelProgram<kernels::LoopingTraversal>>());
   auto spelled = [](std::string n) {
     for (char& c : n)
       if (c == ' ') c = '-';

@@ -44,6 +44,7 @@ struct StreamTracer::State {
   // Fused programs for --mrt on (kernels/fused.h).
   KernelProgram<IntersectNext> intersect_next;
   KernelProgram<TraverseUpdate> traverse_update;
+  KernelProgram<LoopingTraversal> looping;
   uint64_t rays_traced = 0;
   uint64_t rays_unfinished = 0;
   int max_list = 0;  // longest voxel list: a ray tests at most this many triangles per voxel
@@ -147,6 +148,13 @@ StreamTracer::StreamTracer(const Scene& scene, const Grid& grid, const RenderOpt
     s_->intersect_next.set_precision(fm.arithmetic(Group::hits));
     s_->traverse_update.set_precision(fm.arithmetic(Group::traversal));
   }
+  // The looping program does the traversal, voxel and hits groups' work: it computes in the
+  // finest of their arithmetic formats (their textures keep their own formats).
+  Format loop_arith = fm.arithmetic(Group::traversal);
+  for (Group g : {Group::voxel, Group::hits})
+    if (vgpu::significand_bits(fm.arithmetic(g)) > vgpu::significand_bits(loop_arith))
+      loop_arith = fm.arithmetic(g);
+  s_->looping.set_precision(loop_arith);
   const int maxs = gpu.profile().max_texture_size;
 
   // Scene textures: triangle i at texel (i mod width, i div width).
@@ -262,6 +270,9 @@ StreamTracer::StreamTracer(const Scene& scene, const Grid& grid, const RenderOpt
   s_->intersect_next.kernel.grid = g;
   s_->intersect_next.kernel.scene = su;
   s_->traverse_update.kernel.grid = g;
+  s_->looping.kernel.grid = g;
+  s_->looping.kernel.scene = su;
+  s_->looping.kernel.steps = opt_.steps_per_pass;
   s_->shader.kernel.scene = su;
   s_->shader.kernel.model = opt_.shading;
   s_->shader.kernel.shadows = opt_.shadows;
@@ -378,6 +389,10 @@ void StreamTracer::trace(Texture& origins, Texture& rays, bool primary, const Ca
   // In exact arithmetic a ray crosses at most nx+ny+nz voxels and tests each voxel's list once.
   // Reduced precision can break both (fp16 cannot count past 2048): the host stops there and
   // reports the rays left unfinished instead of looping forever.
+  if (opt_.looping) {
+    walk_looping(origins, rays, walking);
+    return;
+  }
   const int max_steps = grid_.res.x + grid_.res.y + grid_.res.z + 2;
   for (int step = 0; walking > 0; ++step) {
     if (step == max_steps) {
@@ -428,6 +443,57 @@ void StreamTracer::trace(Texture& origins, Texture& rays, bool primary, const Ca
       pass(s.traversal, {&origins, &rays, &s.trav[s.cur_trav], &s.isect[s.cur_isect]},
            s.trav[s.cur_trav ^ 1], &s.grid_mask);
       swap(s.cur_trav);
+    }
+    walking = count(s.in_grid, s.trav[s.cur_trav], &s.grid_mask, &s.grid_mask);
+  }
+}
+
+void StreamTracer::walk_looping(Texture& origins, Texture& rays, uint64_t walking) {
+  vgpu::Device& gpu = *gpu_;
+  State& s = *s_;
+  const vgpu::Program& p = s.looping;
+  // A ray iterates once per triangle it tests and once per voxel it steps through: at most
+  // (nx + ny + nz + 2) voxels of (longest list + 1) iterations each. Past that many passes the
+  // host stops, as the multipass loop does, and reports the rays left unfinished.
+  const int64_t max_iterations =
+      int64_t(grid_.res.x + grid_.res.y + grid_.res.z + 2) * int64_t(s.max_list + 1);
+  const int64_t max_passes = (max_iterations + opt_.steps_per_pass - 1) / opt_.steps_per_pass;
+  for (int64_t k = 0; walking > 0; ++k) {
+    if (k == max_passes) {
+      s.rays_unfinished += walking;
+      break;
+    }
+    Texture& trav = s.trav[s.cur_trav ^ 1];
+    gpu.use_program(p);
+    gpu.unbind_textures();
+    int unit = 0;
+    for (const Texture* t :
+         {&origins, &rays, &s.trav[s.cur_trav], &s.vs[s.cur_vs], &s.isect[s.cur_isect], &s.v[0],
+          &s.v[1], &s.v[2], &s.pointers, &s.lists})
+      gpu.bind_texture(unit++, *t);
+    gpu.set_targets({&trav, &s.vs[s.cur_vs ^ 1], &s.isect[s.cur_isect ^ 1]});
+    // The walking rays' mask, as for the multipass kernels (finished rays keep their state).
+    if (gpu.has_stencil()) {
+      gpu.set_stencil_test(nullptr);
+      gpu.set_work_mask(opt_.masks || opt_.host_shortcut ? &s.grid_mask : nullptr);
+      gpu.set_work_mask_counts_as_masked(opt_.masks);
+    }
+    const bool traced = traces_pixel(&s.grid_mask);
+    if (opt_.observer) opt_.observer->pass_begin(&s.grid_mask);
+    const vgpu::PassRecord& rec = gpu.draw();
+    if (opt_.observer) opt_.observer->pass({p, rec, trav, gpu.branch_flags(), gpu.stats()});
+    s.cur_trav ^= 1;
+    s.cur_vs ^= 1;
+    s.cur_isect ^= 1;
+    if (traced) {
+      const int x = opt_.trace_pixel->x, y = opt_.trace_pixel->y;
+      for (const Texture* t : {&s.trav[s.cur_trav], &s.vs[s.cur_vs], &s.isect[s.cur_isect]}) {
+        const float* v = t->texel(x, y);
+        char line[256];
+        std::snprintf(line, sizeof line, "  %-22s %-24s -> %-14s (%g, %g, %g, %g)\n",
+                      p.paper_name(), p.name(), t->name().c_str(), v[0], v[1], v[2], v[3]);
+        *opt_.trace_out << line;
+      }
     }
     walking = count(s.in_grid, s.trav[s.cur_trav], &s.grid_mask, &s.grid_mask);
   }

@@ -80,6 +80,11 @@ struct RenderOptions {
   // two targets. Needs a profile with max_outputs >= 2 (the constructor throws naming the fused
   // program and the limit, see mrt_refusal). Off: the paper's one-output multipass pipeline.
   bool mrt = false;
+  // The kernels that walk the grid: false, the paper's multipass pipeline (one pass per voxel
+  // step and per triangle); true, one looping program (kernels/looping_traversal.h, fp40 and
+  // later) drawn again while rays walk, `steps_per_pass` loop iterations per pass.
+  bool looping = false;
+  int steps_per_pass = 32;
   // Emulator shortcut: skip host work for fragments whose result cannot change (finished rays);
   // their statistics are charged as if run. Off only to check that it changes nothing.
   bool host_shortcut = true;
@@ -125,6 +130,8 @@ class StreamTracer {
                                std::initializer_list<const vgpu::Texture*> in,
                                std::initializer_list<vgpu::Texture*> outs,
                                const vgpu::Stencil* work = nullptr);
+  // The looping variant of the walk (RenderOptions::looping): the looping program's passes.
+  void walk_looping(vgpu::Texture& origins, vgpu::Texture& rays, uint64_t walking);
   uint64_t count(const vgpu::Program& p, const vgpu::Texture& in, const vgpu::Stencil* work,
                  vgpu::Stencil* write);
   // Whether --trace-pixel output is on and the traced pixel takes part in a pass under `work`

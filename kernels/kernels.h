@@ -6,6 +6,7 @@
 #include "kernels/generate_rays.h"
 #include "kernels/init_traversal.h"
 #include "kernels/intersections.h"
+#include "kernels/looping_traversal.h"
 #include "kernels/next_triangle.h"
 #include "kernels/rays_in_grid.h"
 #include "kernels/rays_intersecting.h"

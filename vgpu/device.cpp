@@ -27,6 +27,29 @@ void check_pass(const Profile& profile, const Program& p, const Program::Analysi
                 const Rect& rect) {
   const std::string pname = p.name();
   auto fail = [](const std::string& what) { throw Error(what); };
+  // Loops first: a looping program cannot run at all on a profile without them.
+  const LoopTally& lp = a.loop;
+  if (lp.loops > 0) {
+    if (profile.branching != Branching::dynamic || profile.max_loop_iterations <= 0)
+      fail("program '" + pname + "' has a data-dependent loop; profile " + profile.name + " (" +
+           profile.cg_profile + ") has no dynamic branching or loops");
+    if (lp.loops > 1)
+      fail("program '" + pname + "' has " + std::to_string(lp.loops) +
+           " loops; the vgpu models one loop per program");
+    if (lp.branch_inside)
+      fail("program '" + pname + "' branches inside its loop body; write the body with selects");
+    if (lp.max_iterations > profile.max_loop_iterations)
+      fail("program '" + pname + "' loops up to " + std::to_string(lp.max_iterations) +
+           " iterations; profile " + profile.name + " allows " +
+           std::to_string(profile.max_loop_iterations) + " (loop count limit)");
+    const int64_t executed =
+        int64_t(a.instructions) + int64_t(lp.max_iterations - 1) * int64_t(lp.body_instructions);
+    if (executed > int64_t(profile.max_instructions))
+      fail("program '" + pname + "' executes up to " + std::to_string(executed) +
+           " instructions per fragment (" + std::to_string(lp.body_instructions) +
+           " in its loop body x " + std::to_string(lp.max_iterations) + " iterations); profile " +
+           profile.name + " allows " + std::to_string(profile.max_instructions));
+  }
   if (p.outputs() > profile.max_outputs)
     fail("program '" + pname + "' writes " + std::to_string(p.outputs()) + " outputs; profile " +
          profile.name + " allows " + std::to_string(profile.max_outputs) +
@@ -75,6 +98,27 @@ Counters pass_counters(const Program::Analysis& a, const Texture* const* units,
   for (const Texture* t : targets) write_per_frag += uint64_t(t->bytes_per_texel());
   c.bytes_written = (shaded - discarded) * write_per_frag;
   return c;
+}
+
+void add_loop_counters(Counters& c, const Program::Analysis& a, const Texture* const* units,
+                       const LoopCounts& n) {
+  const LoopTally& lp = a.loop;
+  const uint64_t body = uint64_t(lp.body_instructions), fetches = uint64_t(lp.body_fetches.total());
+  uint64_t bytes = 0;
+  for (int u = 0; u < kMaxTextureUnits; ++u)
+    if (lp.body_fetches.per_unit[size_t(u)])
+      bytes +=
+          uint64_t(lp.body_fetches.per_unit[size_t(u)]) * uint64_t(units[u]->bytes_per_texel());
+  // pass_counters charged the body once per shaded fragment; it runs once per active iteration.
+  c.instructions = c.instructions - n.shaded * body + n.iterations * body;
+  c.texture_fetches = c.texture_fetches - n.shaded * fetches + n.iterations * fetches;
+  c.bytes_read = c.bytes_read - n.shaded * bytes + n.iterations * bytes;
+  c.loop_iterations = n.iterations;
+  c.loop_lane_slots = n.slots;
+  c.loop_lanes_idle = n.slots - n.iterations;
+  c.loop_batch_iterations = n.batch_iterations;
+  c.loop_idle_instructions = c.loop_lanes_idle * body;
+  c.loop_idle_fetches = c.loop_lanes_idle * fetches;
 }
 
 void count_program_load(FrameStats& stats, const Program& program, const Profile& profile) {

@@ -94,6 +94,16 @@ Counters pass_counters(const Program::Analysis& a, const Texture* const* units,
                        const std::vector<Texture*>& targets, uint64_t launched, uint64_t shaded,
                        uint64_t discarded);
 
+// A looping pass (Program::Analysis::loop): its shaded fragments' active iterations, the lane
+// slots its batches issued (shaded fragments x the batch's iterations) and the batches'
+// iterations. add_loop_counters turns a pass_counters() result into the looping pass's: the
+// body's instructions, fetches and bytes once per active iteration, the loop counters set.
+struct LoopCounts {
+  uint64_t shaded = 0, iterations = 0, slots = 0, batch_iterations = 0;
+};
+void add_loop_counters(Counters& c, const Program::Analysis& a, const Texture* const* units,
+                       const LoopCounts& n);
+
 // What a program load and a query read-back add to the statistics, on every device.
 void count_program_load(FrameStats& stats, const Program& program, const Profile& profile);
 void count_readback(FrameStats& stats, const Program* program, uint64_t result);

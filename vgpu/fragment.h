@@ -33,6 +33,15 @@ struct FetchTally {
   }
 };
 
+// The counting run's record of a program's data-dependent loops (Fragments::loop).
+struct LoopTally {
+  int loops = 0;               // f.loop() calls
+  int max_iterations = 0;      // the largest iteration budget one was given
+  int body_instructions = 0;   // static instructions of the bodies, once each
+  FetchTally body_fetches;     // fetches per iteration of the bodies, per unit
+  bool branch_inside = false;  // an f.branch() inside a body (not supported)
+};
+
 // Transposes between texels (4 channels each, contiguous) and registers (one per channel), for
 // W consecutive fragments. Width 8 and 16 use in-lane shuffles of 8-float vectors (GCC/Clang
 // vector extensions); other widths a per-lane loop. Pure data movement: bits are unchanged.
@@ -180,6 +189,7 @@ class Fragments {
   bool branch(const M& m) {
     if constexpr (L::counting) {
       ++*idle_;  // the counting run tallies branch() calls
+      if (in_loop_ && loop_tally_) loop_tally_->branch_inside = true;
       return true;
     } else if constexpr (L::recording) {
       return true;  // recorded straight-line: both sides run, results go through select
@@ -189,6 +199,65 @@ class Fragments {
       return !dynamic_ || any(live_ && m);
     }
   }
+
+  // A data-dependent loop, the fp40 LOOP/BRK shape:
+  //   while (any(active) && iterations < max_iterations) active = active && body(active);
+  // `body(active)` returns the lanes that go on; it must write its results through
+  // select(active, ...) so lanes that left keep their values (they ride along in the batch).
+  // Returns the lanes still looping when the budget ran out. Each fragment's own iteration count
+  // (the iterations it was active in) is kept for the statistics: the fragment processor turns
+  // them into per-batch counts at the profile's branch granularity, so the host's lane width
+  // changes no statistic. The counting run runs the body once: its static instructions and
+  // fetches per iteration. The body may not use f.branch() (its selects are the branches).
+  template <class Body>
+  M loop(int max_iterations, M active, Body&& body) {
+    if constexpr (L::counting) {
+      const uint64_t ops0 = OpCounter::ops;
+      const FetchTally f0 = *tally_;
+      in_loop_ = true;
+      const M more = body(active);
+      in_loop_ = false;
+      if (loop_tally_) {
+        LoopTally& t = *loop_tally_;
+        ++t.loops;
+        t.max_iterations = std::max(t.max_iterations, max_iterations);
+        t.body_instructions += int(OpCounter::ops - ops0);
+        for (int u = 0; u < kMaxTextureUnits; ++u)
+          t.body_fetches.per_unit[size_t(u)] +=
+              uint16_t(tally_->per_unit[size_t(u)] - f0.per_unit[size_t(u)]);
+      }
+      return more;
+    } else if constexpr (L::recording) {
+      // The body twice: the second iteration's operands tell which values the first one
+      // carries (RecLoop); the printer writes one GLSL loop from the first.
+      Recording& rec = *Recorder::current;
+      RecLoop lp;
+      lp.begin = int(rec.nodes.size());
+      lp.max_iterations = max_iterations;
+      lp.entry = active.id;
+      const M more = body(active);
+      const M next = M::node(Recorder::emit(Op::mask_and, active.id, more.id));
+      lp.mid = int(rec.nodes.size());
+      const M more2 = body(next);
+      const M after = M::node(Recorder::emit(Op::mask_and, next.id, more2.id));
+      lp.end = int(rec.nodes.size());
+      rec.loops.push_back(lp);
+      return after;
+    } else {
+      active = active && live_;
+      bool on[W];
+      for (int k = 0; k < max_iterations && any(active); ++k) {
+        active.copy_to(on, stdx::element_aligned);
+        for (int i = 0; i < W; ++i) loop_count_[size_t(i)] += on[i] ? 1u : 0u;
+        active = active && body(active);
+      }
+      return active;
+    }
+  }
+  // Iterations lane i spent in this batch's loop (0 without one).
+  uint32_t loop_count(int i) const { return loop_count_[size_t(i)]; }
+  // The counting run's loop record (Program::analyze).
+  void set_loop_tally(LoopTally* t) { loop_tally_ = t; }
 
   const M& live() const { return live_; }
   // Live fragments idle in some branch of this batch (for the batch-coherence counters).
@@ -206,6 +275,7 @@ class Fragments {
     idle_any_ = M(false);
     cleared_ = 0;
     clear_outputs(outputs);
+    loop_count_.fill(0);
   }
   const M& killed() const { return kill_; }
   const Vec4<F>& output(int i) const { return out_[i]; }
@@ -218,6 +288,9 @@ class Fragments {
   M live_{false}, kill_{false}, idle_any_{false};
   std::array<Vec4<F>, kMaxOutputs> out_;
   int cleared_ = 0;  // out_[0, cleared_) hold zero or what the program wrote in this batch
+  std::array<uint32_t, W> loop_count_{};
+  LoopTally* loop_tally_ = nullptr;
+  bool in_loop_ = false;
 
   // Any texel coordinates: clamp in float first (NaN goes to 0), then convert (no undefined
   // conversions), then one load per lane and channel.

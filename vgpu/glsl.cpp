@@ -61,29 +61,157 @@ const char* fullscreen_vertex_shader() {
 GlslProgram to_glsl(const Program& p, const Recording& rec, bool annotate) {
   const std::vector<RecNode>& nodes = rec.nodes;
   const int n = int(nodes.size());
-  // Live nodes: reachable from the outputs and the kill mask (operands precede their users).
+  auto operand = [](const RecNode& nd, int slot) {
+    return slot == 0 ? nd.a : slot == 1 ? nd.b : nd.c;
+  };
+  // A loop (RecLoop): the first copy of its body [b, m) is printed inside a GLSL loop, the second
+  // [m, e) only tells which values are carried. A value is carried where the second copy reads a
+  // node of the first (`next`) where the first read a node from before the loop (`init`); each
+  // becomes a variable lv<j>. After the loop, a read of the second copy's node is a read of the
+  // variable whose `next` is the corresponding node of the first.
+  if (rec.loops.size() > 1)
+    throw std::runtime_error(std::string("program '") + p.name() + "': more than one loop");
+  const bool has_loop = !rec.loops.empty();
+  const RecLoop lp = has_loop ? rec.loops[0] : RecLoop{};
+  const int b = lp.begin, m = lp.mid, e = has_loop ? lp.end : 0, d = m - b;
+  struct Carried {
+    int init, next;
+  };
+  std::vector<Carried> vars;
+  std::map<int, int> var_of_next;  // next node -> variable
+  std::map<int, int> var_at;       // 4 * node + slot of the first copy -> variable read there
+  auto fail_loop = [&](const std::string& why) {
+    throw std::runtime_error(std::string("program '") + p.name() +
+                             "': its loop cannot be printed as GLSL (" + why + ")");
+  };
+  if (has_loop) {
+    if (e - m != d) fail_loop("the two recorded iterations differ");
+    for (int k = b; k < m; ++k) {
+      const RecNode &na = nodes[size_t(k)], &nb = nodes[size_t(k + d)];
+      if (na.op != nb.op || na.unit != nb.unit) fail_loop("the two recorded iterations differ");
+      for (int slot = 0; slot < 3; ++slot) {
+        const int oa = operand(na, slot), ob = operand(nb, slot);
+        if (oa == ob) continue;                           // a value from before the loop, or none
+        if (oa >= b && oa < m && ob == oa + d) continue;  // within the iteration
+        if (oa >= 0 && oa < b && ob >= b && ob < m) {     // carried
+          auto [it, fresh] = var_of_next.try_emplace(ob, int(vars.size()));
+          if (fresh) vars.push_back({oa, ob});
+          if (vars[size_t(it->second)].init != oa) fail_loop("one value, two starting values");
+          var_at[4 * k + slot] = it->second;
+          continue;
+        }
+        fail_loop("an operand the printer cannot place");
+      }
+    }
+    if (!var_of_next.count(m - 1)) fail_loop("no loop mask");
+  }
+  // A reference from node `user` (n: the outputs and kill) to node `id`, slot `slot`: the loop
+  // variable it reads, or -1.
+  auto var_read = [&](int user, int slot, int id) -> int {
+    if (!has_loop || id < 0) return -1;
+    if (user >= b && user < m) {
+      auto it = var_at.find(4 * user + slot);
+      return it == var_at.end() ? -1 : it->second;
+    }
+    if (user >= e && id >= m && id < e) {
+      auto it = var_of_next.find(id - d);
+      if (it == var_of_next.end()) fail_loop("a value of the body read after the loop");
+      return it->second;
+    }
+    if (user >= e && id >= b && id < m && nodes[size_t(id)].op != Op::constant &&
+        nodes[size_t(id)].op != Op::mask_const)
+      fail_loop("a value of the body read after the loop");
+    return -1;
+  };
+  // Live nodes: reachable from the outputs and the kill mask (operands precede their users). The
+  // whole first copy of a loop body is kept; the second never is.
   std::vector<char> live(size_t(n), 0);
   auto mark = [&](int id) {
     if (id >= 0) live[size_t(id)] = 1;
   };
-  for (const auto& o : rec.outputs)
-    for (int id : o) mark(id);
-  mark(rec.kill);
-  for (int i = n - 1; i >= 0; --i)
-    if (live[size_t(i)]) {
-      mark(nodes[size_t(i)].a);
-      mark(nodes[size_t(i)].b);
-      mark(nodes[size_t(i)].c);
+  auto mark_ref = [&](int user, int slot, int id) {
+    const int v = var_read(user, slot, id);
+    if (v >= 0) {
+      mark(vars[size_t(v)].init);
+      mark(vars[size_t(v)].next);
+    } else {
+      mark(id);
     }
+  };
+  for (const auto& o : rec.outputs)
+    for (int id : o) mark_ref(n, 0, id);
+  mark_ref(n, 0, rec.kill);
+  if (has_loop) {
+    for (int k = b; k < m; ++k) live[size_t(k)] = 1;
+    for (const Carried& c : vars) mark(c.init);
+    mark(lp.entry);
+  }
+  for (int i = n - 1; i >= 0; --i) {
+    if (has_loop && i >= m && i < e) continue;
+    if (live[size_t(i)])
+      for (int slot = 0; slot < 3; ++slot) mark_ref(i, slot, operand(nodes[size_t(i)], slot));
+  }
+  auto is_mask = [&](int id) {
+    switch (nodes[size_t(id)].op) {
+      case Op::lt:
+      case Op::le:
+      case Op::gt:
+      case Op::ge:
+      case Op::eq:
+      case Op::ne:
+      case Op::mask_const:
+      case Op::mask_and:
+      case Op::mask_or:
+      case Op::mask_not:
+        return true;
+      default:
+        return false;
+    }
+  };
 
   GlslProgram out;
   std::map<int, int> sampler_of_unit;  // unit -> index in out.units
   std::vector<std::string> expr(static_cast<size_t>(n));
   std::string body;
+  auto lv = [](int v) { return "lv" + std::to_string(v); };
+  std::string indent = "  ";
   for (int i = 0; i < n; ++i) {
+    if (has_loop && i == b) {
+      // The carried values, then the loop: at most max_iterations, left once no longer active.
+      for (size_t v = 0; v < vars.size(); ++v)
+        body += indent + (is_mask(vars[v].next) ? "bool " : "float ") + lv(int(v)) + " = " +
+                expr[size_t(vars[v].init)] + ";\n";
+      body += indent + "for (int it = 0; it < " + std::to_string(lp.max_iterations) + "; ++it) {\n";
+      indent = "    ";
+      body += indent + "if (!" + lv(var_of_next.at(m - 1)) + ") break;\n";
+      out.statements += int(vars.size()) + 2;
+    }
+    if (has_loop && i == m) {
+      for (size_t v = 0; v < vars.size(); ++v)
+        body += indent + lv(int(v)) + " = " + expr[size_t(vars[v].next)] + ";\n";
+      out.statements += int(vars.size());
+      indent = "  ";
+      body += indent + "}\n";
+    }
+    if (has_loop && i >= m && i < e) continue;
     if (!live[size_t(i)]) continue;
     const RecNode& nd = nodes[size_t(i)];
-    auto e = [&](int id) -> const std::string& { return expr[size_t(id)]; };
+    // Operand `id` in slot `slot` of this node: its expression, or the loop variable it reads.
+    std::string op_text;
+    auto ref = [&](int id) -> const std::string& {
+      const int slot = id == nd.a ? 0 : id == nd.b ? 1 : 2;
+      const int v = var_read(i, slot, id);
+      if (v < 0) return expr[size_t(id)];
+      op_text = lv(v);
+      return op_text;
+    };
+    std::string ta, tb, tc;
+    auto e = [&](int id) -> const std::string& {
+      // Each slot keeps its own text: one expression may name several operands.
+      std::string& keep = id == nd.a ? ta : id == nd.b ? tb : tc;
+      keep = ref(id);
+      return keep;
+    };
     auto sampler = [&](int unit) -> const std::string& {
       auto [it, fresh] = sampler_of_unit.try_emplace(unit, int(out.units.size()));
       if (fresh) {
@@ -92,17 +220,17 @@ GlslProgram to_glsl(const Program& p, const Recording& rec, bool annotate) {
       }
       return out.samplers[size_t(it->second)];
     };
-    std::string t = std::to_string(i), m = t;
+    std::string t = std::to_string(i), mname = t;
     t.insert(0, 1, 't');
-    m.insert(0, 1, 'm');
+    mname.insert(0, 1, 'm');
     auto def_float = [&](const std::string& rhs) {
-      body += "  EXACT float " + t + " = " + rhs + ";\n";
+      body += indent + "EXACT float " + t + " = " + rhs + ";\n";
       expr[size_t(i)] = t;
       ++out.statements;
     };
     auto def_mask = [&](const std::string& rhs) {
-      body += "  bool " + m + " = " + rhs + ";\n";
-      expr[size_t(i)] = m;
+      body += indent + "bool " + mname + " = " + rhs + ";\n";
+      expr[size_t(i)] = mname;
       ++out.statements;
     };
     switch (nd.op) {
@@ -169,7 +297,7 @@ GlslProgram to_glsl(const Program& p, const Recording& rec, bool annotate) {
         const std::string at = nd.op == Op::fetch_own
                                    ? "own_texel(" + s + ")"
                                    : "texel_at(" + s + ", " + e(nd.a) + ", " + e(nd.b) + ")";
-        body += "  vec4 " + v + " = texelFetch(" + s + ", " + at + ", 0);\n";
+        body += indent + "vec4 " + v + " = texelFetch(" + s + ", " + at + ", 0);\n";
         expr[size_t(i)] = v;
         ++out.statements;
         break;
@@ -179,14 +307,19 @@ GlslProgram to_glsl(const Program& p, const Recording& rec, bool annotate) {
         break;
     }
   }
+  // After the loop, a read of its second copy is a read of a loop variable.
+  auto final_ref = [&](int id) {
+    const int v = var_read(n, 0, id);
+    return v < 0 ? expr[size_t(id)] : lv(v);
+  };
   if (rec.kill >= 0) {
-    body += "  if (" + expr[size_t(rec.kill)] + ") discard;\n";
+    body += "  if (" + final_ref(rec.kill) + ") discard;\n";
     ++out.statements;
   }
   for (size_t o = 0; o < rec.outputs.size(); ++o) {
     const auto& c = rec.outputs[o];
-    body += "  out" + std::to_string(o) + " = vec4(" + expr[size_t(c[0])] + ", " +
-            expr[size_t(c[1])] + ", " + expr[size_t(c[2])] + ", " + expr[size_t(c[3])] + ");\n";
+    body += "  out" + std::to_string(o) + " = vec4(" + final_ref(c[0]) + ", " + final_ref(c[1]) +
+            ", " + final_ref(c[2]) + ", " + final_ref(c[3]) + ");\n";
   }
 
   std::string s;

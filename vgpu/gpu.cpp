@@ -92,6 +92,49 @@ int stretch_end(const uint8_t* wk, const uint8_t* st, int from, int to) {
   return to;
 }
 
+// A looping pass's batches: the profile's branch granularity as a tile of the drawn rectangle
+// (2^k pixels: 2^ceil(k/2) wide, 2^floor(k/2) high, so 32 is 8x4 and 1024 is 32x32), aligned to
+// its corner. A batch iterates as long as its busiest shaded fragment: every shaded fragment of
+// it holds a lane slot for each of those iterations, active while it still loops. `iters`: per
+// texel of the target (tw wide), the iterations each fragment ran. Per iteration k of the
+// budget, the active and idle lanes of the batches still iterating go to active[k-1], idle[k-1].
+LoopCounts loop_batches(const Rect& r, const uint32_t* iters, uint32_t tw, const Stencil* work,
+                        const Stencil* test, bool work_masked, int granularity, int budget,
+                        std::vector<uint64_t>& active, std::vector<uint64_t>& idle) {
+  const int k = std::bit_width(unsigned(std::max(granularity, 1))) - 1;
+  const int bw = 1 << ((k + 1) / 2), bh = 1 << (k / 2);
+  active.assign(size_t(budget), 0);
+  idle.assign(size_t(budget), 0);
+  std::vector<uint64_t> exactly(size_t(budget) + 1);  // fragments of the batch with c iterations
+  LoopCounts n;
+  for (int ty = r.y0; ty < r.y1; ty += bh)
+    for (int tx = r.x0; tx < r.x1; tx += bw) {
+      std::fill(exactly.begin(), exactly.end(), 0);
+      uint64_t lanes = 0;
+      uint32_t most = 0;
+      for (int y = ty; y < std::min(r.y1, ty + bh); ++y)
+        for (int x = tx; x < std::min(r.x1, tx + bw); ++x) {
+          if (test && test->get(x, y) == 0) continue;                 // masked before shading
+          if (work_masked && work && work->get(x, y) == 0) continue;  // early-z: not shaded
+          const uint32_t c = std::min(iters[size_t(y) * tw + size_t(x)], uint32_t(budget));
+          ++lanes;
+          ++exactly[c];
+          n.iterations += c;
+          most = std::max(most, c);
+        }
+      n.shaded += lanes;
+      n.slots += lanes * most;
+      n.batch_iterations += most;
+      uint64_t out = exactly[0];  // fragments out of the loop before iteration j + 1
+      for (uint32_t j = 0; j < most; ++j) {
+        active[j] += lanes - out;
+        idle[j] += out;
+        out += exactly[j + 1];
+      }
+    }
+  return n;
+}
+
 }  // namespace
 
 struct Gpu::Chunk {
@@ -133,6 +176,8 @@ struct Gpu::DrawPlan {
   uint8_t* stencil = nullptr;                   // the stencil write's bits, or null
   uint8_t *took8 = nullptr, *took32 = nullptr;  // tiles holding a kTook fragment
   int cols8 = 0, cols32 = 0;
+  // A looping program: per texel of the target, the iterations its fragment ran (0 if none).
+  uint32_t* loop_map = nullptr;
 };
 
 Gpu::Gpu(const Profile& profile, int threads, int lanes) : profile_(profile), lanes_(lanes) {
@@ -358,6 +403,7 @@ void Gpu::run_rows(const Program& p, const Rect& r, int y0, int y1, const DrawPl
         f.idle_lanes().copy_to(idle, stdx::element_aligned);
         for (int i = 0; i < n; ++i) {
           if (!lv[i]) continue;
+          if (plan.loop_map) plan.loop_map[uint32_t(y) * tw + uint32_t(x + i)] = f.loop_count(i);
           flag_ran(fl, x + i, y, idle[i]);
           if (sw) sw[x + i] = killed[i] ? 0 : 1;
           if (plan.list_survivors && !killed[i])
@@ -404,6 +450,8 @@ void Gpu::run_rows(const Program& p, const Rect& r, int y0, int y1, const DrawPl
     kill.copy_to(killed, stdx::element_aligned);
     f.idle_lanes().copy_to(idle, stdx::element_aligned);
     out.discarded += uint64_t(lanes_on(kill));
+    if (plan.loop_map)
+      for (int i = 0; i < n; ++i) plan.loop_map[pi[i]] = f.loop_count(i);
     if (plan.flags) {
       const bool whole_flags = r.x0 == 0 && r.y0 == 0 && uint32_t(r.x1) == tw;
       for (int i = 0; i < n; ++i)
@@ -459,6 +507,7 @@ void Gpu::run_rows(const Program& p, const Rect& r, int y0, int y1, const DrawPl
       const uint32_t row0 = uint32_t(y) * tw;
       for (int i = 0; i < x1 - x0; ++i) {
         if (!on[i]) continue;
+        if (plan.loop_map) plan.loop_map[row0 + uint32_t(x0 + i)] = f.loop_count(i);
         flag_ran(fl, x0 + i, y, idle[i]);
         if (plan.stencil) plan.stencil[row0 + uint32_t(x0 + i)] = killed[i] ? 0 : 1;
         if (plan.list_survivors && !killed[i]) out.survivors.push_back(row0 + uint32_t(x0 + i));
@@ -635,9 +684,14 @@ const PassRecord& Gpu::draw(const Rect& rect) {
   Stencil work_before, test_before;
   const Stencil* work_view = work_mask_;
   const Stencil* test_view = stencil_test_;
-  if (plan.flags && stencil_write_ && stencil_write_ == work_mask_)
+  const bool looping = a.loop.loops > 0;
+  if (looping) {
+    loop_map_.assign(size_t(t0tex.width()) * size_t(t0tex.height()), 0);
+    plan.loop_map = loop_map_.data();
+  }
+  if ((plan.flags || looping) && stencil_write_ && stencil_write_ == work_mask_)
     work_view = &(work_before = *work_mask_);
-  if (plan.flags && stencil_write_ && stencil_write_ == stencil_test_)
+  if ((plan.flags || looping) && stencil_write_ && stencil_write_ == stencil_test_)
     test_view = &(test_before = *stencil_test_);
   // Idle fragments keep their previous outputs, copied from the passthrough units. Where the
   // last pass between the same two textures left them equal outside the fragments it ran (a
@@ -774,6 +828,14 @@ const PassRecord& Gpu::draw(const Rect& rect) {
   Counters c = pass_counters(a, units_.data(), targets_, sum.launched, sum.shaded, sum.discarded);
   c.fragments_masked = sum.masked;
   c.lanes_idle = sum.idle;
+  std::vector<uint64_t> loop_active, loop_idle;
+  if (looping) {
+    const LoopCounts n = loop_batches(rect, plan.loop_map, uint32_t(t0tex.width()), work_view,
+                                      test_view, work_masked_, profile_.branch_granularity,
+                                      a.loop.max_iterations, loop_active, loop_idle);
+    if (n.shaded != sum.shaded) fail("program '" + pname + "': loop batches miscounted");
+    add_loop_counters(c, a, units_.data(), n);
+  }
   if (plan.flags) {
     const std::array<uint64_t, 2> batch =
         idle_in_batches(rect, plan.flags, work_view, test_view, work_masked_, sum.idle_flags,
@@ -792,8 +854,20 @@ const PassRecord& Gpu::draw(const Rect& rect) {
   FrameStats::ProgramTotals& totals = stats_.program(pname, p.paper_name(), a.instructions);
   totals.counters += c;
   totals.instructions = a.instructions;
+  if (looping) {
+    totals.loop_budget = std::max(totals.loop_budget, a.loop.max_iterations);
+    totals.loop_body_instructions = a.loop.body_instructions;
+    auto add = [](std::vector<uint64_t>& to, const std::vector<uint64_t>& v) {
+      if (to.size() < v.size()) to.resize(v.size(), 0);
+      for (size_t i = 0; i < v.size(); ++i) to[i] += v[i];
+    };
+    add(totals.loop_active, loop_active);
+    add(totals.loop_idle, loop_idle);
+  }
   stats_.totals += c;
   PassRecord rec{pname, rect.width(), rect.height(), c, -1};
+  rec.loop_active = std::move(loop_active);
+  rec.loop_idle = std::move(loop_idle);
   if (stats_.keep_pass_records) {
     stats_.passes.push_back(std::move(rec));
     return stats_.passes.back();

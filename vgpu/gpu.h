@@ -127,6 +127,7 @@ class Gpu final : public Device {
   std::vector<uint8_t> batch_flags_;
   // Tiles (8x4, 32x32) of the drawn rectangle where some fragment took the branch.
   std::vector<uint8_t> took8_, took32_;
+  std::vector<uint32_t> loop_map_;  // a looping pass: iterations per texel of the target
   // Emulator bookkeeping: two textures known to hold the same texels everywhere except at
   // `differ` (texel indices, ascending), as a pass with a work mask leaves its passthrough source
   // and its target. The next pass between them copies only those texels for its idle fragments.

@@ -32,6 +32,8 @@ const std::vector<Profile>& profiles() {
     fx.fp32_rate = 0.5;        // model parameter: NV3x slow at fp32 (Tom's Hardware NV40 review)
     fx.fp24_rate = 0.5;        // no fp24 units: fp24 values need the fp32 path
     fx.texels_per_clock = 1;   // hexus.net FX 5700 Ultra review p.2: one texture unit per pipe
+
+    fx.max_loop_iterations = 0;  // NVIDIA Cg docs, fp30: loops unroll, no data-dependent exit
     t.push_back(fx);
 
     // The fp24 part of 2004: every fragment operation in s7e16, no fp32 and no separate half
@@ -63,6 +65,8 @@ const std::vector<Profile>& profiles() {
     ati.fp32_rate = 1;          // fp32 requests compute in fp24 (Profile::computes), full speed
     ati.fp24_rate = 1;          // native format
     ati.texels_per_clock = 1;   // 8 TMUs for 8 pipes (guru3d.com: 2600 Mtexel/s at 325 MHz)
+
+    ati.max_loop_iterations = 0;  // ps_2_0: no flow control in fragment programs
     t.push_back(ati);
 
     Profile g6;
@@ -88,6 +92,13 @@ const std::vector<Profile>& profiles() {
     g6.fp32_rate = 1;          // NVIDIA CineFX 3.0 brief: FP32 and FP16 equal speed
     g6.fp24_rate = 1;          // computed on the fp32 units, at their speed
     g6.texels_per_clock = 1;   // one texture unit per pipe (NV4x pipe, GPU Gems 2 ch. 30)
+
+    // Loops: the NV_fragment_program2 spec (NVIDIA, 2004) clamps REP/LOOP counts to
+    // MAX_PROGRAM_LOOP_COUNT_NV, 255 on NV4x (as ps_3_0's loop/rep count range [0, 255]).
+    g6.max_loop_iterations = 255;  // NV_fragment_program2 spec: MAX_PROGRAM_LOOP_COUNT_NV
+    // GPU Gems 2 ch. 34 (Harris & Buck, "GPU Flow-Control Idioms"), the GeForce 6800's cost of
+    // flow-control instructions: a loop/endloop pair about 4 clocks.
+    g6.loop_overhead_clocks = 4;  // GPU Gems 2 ch. 34: loop/endloop about 4 clocks (6800)
     t.push_back(g6);
 
     Profile m;
@@ -111,6 +122,9 @@ const std::vector<Profile>& profiles() {
     m.alu_per_clock = 1;    // one FP32 FMA per core per clock (NVIDIA Ada whitepaper)
     m.fp32_rate = 1;
     m.texels_per_clock = 512.0 / 16384;  // 512 texture units for 16384 cores (Ada whitepaper)
+
+    m.max_loop_iterations = 1 << 20;  // model parameter: no loop count limit
+    m.loop_overhead_clocks = 1;       // model parameter (assumed: a compare and a branch)
     t.push_back(m);
 
     // The H200 the GL device is measured on (docs/real_gpu.md): a 2026 GPU running the paper's
@@ -151,6 +165,9 @@ const std::vector<Profile>& profiles() {
     // and two targets take twice as long: 28 bytes a clock. Measured on tiny programs, not on the
     // frames it predicts.
     m.output_bytes_per_clock = 28;  // model parameter (measured by bench_gl's copy pass)
+
+    m.max_loop_iterations = 1 << 20;  // model parameter: no loop count limit
+    m.loop_overhead_clocks = 1;       // model parameter (assumed: a compare and a branch)
     t.push_back(m);
     return t;
   }();

@@ -47,6 +47,11 @@ struct Profile {
   // per clock, and writes its render targets through a few raster-output units.
   double texture_bytes_per_clock = 0;  // texel bytes fetched per clock, all texture units
   double output_bytes_per_clock = 0;   // render-target bytes written per clock, all ROPs
+  // Data-dependent loops (Fragments::loop): 0 where the profile has none (fp30, ps_2_0), else the
+  // most iterations one loop may be given. A looping program's batch is branch_granularity
+  // pixels: it iterates until its last pixel leaves the loop.
+  int max_loop_iterations = 0;
+  double loop_overhead_clocks = 0;  // clocks a pixel spends on one iteration's loop/break
 
   // Arithmetic throughput at format f, relative to alu_per_clock (the fp16 rate).
   double rate(Format f) const {

@@ -16,6 +16,7 @@ Program::Analysis Program::analyze() const {
   uint64_t idle = 0;
   Fragments<CountingLanes> f(none, false, &idle, &a.fetches);
   f.reset(CFloat(0.5f), CFloat(0.5f), CMask{true});
+  f.set_loop_tally(&a.loop);
   const uint64_t before = OpCounter::ops;
   run(f);
   a.instructions = int(OpCounter::ops - before);

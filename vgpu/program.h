@@ -63,6 +63,7 @@ class Program {
     int instructions = 0;
     int branches = 0;  // f.branch() calls, every branch taken (what a work-masked fragment skips)
     FetchTally fetches;
+    LoopTally loop;  // data-dependent loops (f.loop): their bodies are inside the counts above
   };
   Analysis analyze() const;
   // The recording run: every operation of the program, with the current uniforms.

@@ -4,7 +4,8 @@
 // the emulator runs: one kernel source, two devices.
 //
 // Like the counting run, every f.branch() block is taken (the fp30 model: both sides execute and
-// results go through select), so the recorded program is straight-line code.
+// results go through select), so the recorded program is straight-line code but for one
+// data-dependent loop (RecLoop).
 #pragma once
 
 #include <array>
@@ -53,12 +54,23 @@ struct RecNode {
   float value = 0;
 };
 
+// A data-dependent loop (Fragments::loop) as recorded: its body twice, nodes [begin, mid) and
+// [mid, end), each ending with the mask of lanes still looping (active && the body's answer).
+// Where the second copy reads a node of the first instead of the value the first read, that
+// value is carried from one iteration to the next (vgpu/glsl.cpp prints one loop from this).
+struct RecLoop {
+  int begin = 0, mid = 0, end = 0;
+  int max_iterations = 0;
+  int entry = -1;  // mask node: the lanes entering the loop
+};
+
 // One program's operations in the order the functor performed them.
 struct Recording {
   std::vector<RecNode> nodes;
   std::vector<std::array<int, 4>> outputs;  // node of each channel of each output register
   int kill = -1;                            // mask node: the fragment is discarded (-1: never)
   int mask_false = -1, mask_true = -1;
+  std::vector<RecLoop> loops;  // at most one (the vgpu refuses more)
 
   int push(const RecNode& n) {
     nodes.push_back(n);

@@ -36,7 +36,7 @@ FrameStats::ProgramTotals& FrameStats::program(const std::string& name,
                                                const std::string& paper_name, int instructions) {
   for (ProgramTotals& p : programs)
     if (p.name == name) return p;
-  programs.push_back({name, paper_name, instructions, {}});
+  programs.push_back({name, paper_name, instructions, {}, {}, {}, 0, 0});
   return programs.back();
 }
 
@@ -64,6 +64,12 @@ nlohmann::ordered_json FrameStats::json() const {
     e["static_instructions"] = p.instructions;
     const nlohmann::ordered_json c = vgpu::to_json(p.counters, device_timed);  // items() needs it
     for (auto& [k, v] : c.items()) e[k] = v;
+    if (p.loop_budget > 0) {  // a looping program: its loop per iteration
+      e["loop_budget"] = p.loop_budget;
+      e["loop_body_instructions"] = p.loop_body_instructions;
+      e["loop_active_per_iteration"] = p.loop_active;
+      e["loop_idle_per_iteration"] = p.loop_idle;
+    }
     progs.push_back(e);
   }
   j["programs"] = progs;
@@ -117,6 +123,18 @@ std::string FrameStats::to_table() const {
   };
   for (const ProgramTotals& p : programs) row(p.name, p.paper_name, p.counters);
   row("total", "", totals);
+  for (const ProgramTotals& p : programs) {
+    const Counters& c = p.counters;
+    if (c.loop_lane_slots == 0) continue;
+    std::snprintf(line, sizeof line,
+                  "%s: loop of %d iterations a pass, %s batch iterations, %s lane slots, %s "
+                  "active, %s idle (%.1f%%)\n",
+                  p.name.c_str(), p.loop_budget, human(c.loop_batch_iterations).c_str(),
+                  human(c.loop_lane_slots).c_str(), human(c.loop_iterations).c_str(),
+                  human(c.loop_lanes_idle).c_str(),
+                  100.0 * double(c.loop_lanes_idle) / double(c.loop_lane_slots));
+    out += line;
+  }
   return out;
 }
 

@@ -42,6 +42,18 @@ struct Counters {
   // Time the passes took on a real device (GL timer queries); 0 on the emulator, which has no
   // device time of its own (the cost model predicts one).
   double device_ms = 0;
+  // Data-dependent loops (Fragments::loop), per hardware batch: branch_granularity pixels of
+  // the drawn rectangle (Gpu: tiles aligned to its corner) iterate together until the last of
+  // their shaded fragments leaves the loop (or the budget runs out).
+  uint64_t loop_iterations = 0;        // iterations shaded fragments were active in (lane work)
+  uint64_t loop_lane_slots = 0;        // per batch: shaded fragments x the batch's iterations
+  uint64_t loop_lanes_idle = 0;        // slots - iterations: lanes already out of the loop
+  uint64_t loop_batch_iterations = 0;  // per batch: the iterations it ran, summed
+  // What the idle lanes were issued: loop_lanes_idle x the body's instructions and fetches
+  // (instructions and texture_fetches count the active lanes' work: a loop body once per
+  // iteration a fragment was active in).
+  uint64_t loop_idle_instructions = 0;
+  uint64_t loop_idle_fetches = 0;
 
   Counters& operator+=(const Counters& o);
   // Every integer counter equal (host_ms excluded).
@@ -69,7 +81,13 @@ inline constexpr std::pair<const char*, uint64_t Counters::*> kCounterFields[] =
     {"program_bytes", &Counters::program_bytes},
     {"clears", &Counters::clears},
     {"queries", &Counters::queries},
-    {"query_readbacks", &Counters::query_readbacks}};
+    {"query_readbacks", &Counters::query_readbacks},
+    {"loop_iterations", &Counters::loop_iterations},
+    {"loop_lane_slots", &Counters::loop_lane_slots},
+    {"loop_lanes_idle", &Counters::loop_lanes_idle},
+    {"loop_batch_iterations", &Counters::loop_batch_iterations},
+    {"loop_idle_instructions", &Counters::loop_idle_instructions},
+    {"loop_idle_fetches", &Counters::loop_idle_fetches}};
 
 // The counters as a JSON object: every field of kCounterFields, then host_ms, then device_ms
 // (null unless the device measured it).
@@ -81,6 +99,9 @@ struct PassRecord {
   int width = 0, height = 0;  // drawn rectangle, fragments
   Counters counters;          // counters.passes == 1
   int64_t query_result = -1;  // fragments that passed, if the pass ran inside a query
+  // A looping program's pass: per iteration k (index k - 1) of its budget, the lanes of the
+  // batches still iterating that were active / already out of the loop (idle). Empty otherwise.
+  std::vector<uint64_t> loop_active{}, loop_idle{};
 };
 
 // A frame's statistics: every pass, and per-program totals in order of first use.
@@ -90,6 +111,10 @@ struct FrameStats {
     std::string paper_name;
     int instructions = 0;  // static instruction count
     Counters counters;
+    // A looping program: its passes' loop_active / loop_idle summed per iteration (PassRecord).
+    std::vector<uint64_t> loop_active{}, loop_idle{};
+    int loop_budget = 0;             // the largest iteration budget its passes had
+    int loop_body_instructions = 0;  // static instructions of one iteration
   };
   std::vector<PassRecord> passes;
   std::vector<ProgramTotals> programs;

@@ -94,6 +94,10 @@ TEST_CASE("output files need a known extension and an existing directory") {
   CHECK(s.status == 2);
 }
 
+TEST_CASE("MRT fusion is refused with the looping kernels, which have no passes left to fuse") {
+  check_refused("--profile gf6600 --kernels looping --mrt on", "--mrt on");
+}
+
 TEST_CASE("GL device settings are refused without the GL engine and checked against their set") {
   check_refused("--gl-readback poll", "--gl-readback");
   check_refused("--engine cpu --gl-device 0", "--gl-device");
@@ -141,8 +145,31 @@ TEST_CASE("help lists each option's allowed values and exits with 0") {
   ss << f.rdbuf();
   fs::remove(help);
   const std::string text = ss.str();
-  for (const char* allowed : {"{diffuse,phong,phong-atten}", "[0 - 256]", "{1,4,8,16}",
-                              "{gf5700,r300,gf6600,rtx4090,h200}", "{stream,gl,cpu}",
-                              "1x1..16384x16384", "depth=FILE.exr"})
+  for (const char* allowed :
+       {"{diffuse,phong,phong-atten}", "[0 - 256]", "{1,4,8,16}",
+        "{gf5700,r300,gf6600,rtx4090,h200}", "{stream,gl,cpu}", "1x1..16384x16384",
+        "depth=FILE.exr", "{multipass,looping}", "[1 - 4096]"})
     CHECK_MESSAGE(text.find(allowed) != std::string::npos, allowed);
+}
+
+TEST_CASE("the looping kernels' options are checked before any work") {
+  check_refused("--kernels loops", "--kernels");
+  check_refused("--kernels looping --steps-per-pass 0", "--steps-per-pass");
+  check_refused("--kernels looping --steps-per-pass 5000", "--steps-per-pass");
+  check_refused("--steps-per-pass 8", "--steps-per-pass");
+  check_refused("--engine cpu --kernels looping", "--kernels looping");
+}
+
+TEST_CASE("a looping render on a profile without loops or past its loop limit names the program") {
+  for (const char* args : {"--kernels looping", "--kernels looping --profile r300",
+                           "--kernels looping --profile gf6600 --steps-per-pass 256"}) {
+    const Outcome o = run(std::string("render bunny-low -q --stats none --size 16x16 ") + args);
+    INFO("vgpu-rt render " << args << " -> " << o.err);
+    CHECK(o.status != 0);
+    CHECK(o.err.find("program 'looping traversal'") != std::string::npos);
+    CHECK(std::count(o.err.begin(), o.err.end(), '\n') == 1);
+  }
+  CHECK(run("render bunny-low -q --stats none --size 16x16 --kernels looping --profile gf6600 "
+            "--steps-per-pass 255")
+            .status == 0);
 }

@@ -250,3 +250,26 @@ TEST_CASE(
   CHECK(demand(vgpu::Format::fp16, "gf6600") ==
         doctest::Approx(demand(vgpu::Format::fp32, "gf6600")).epsilon(0.02));
 }
+
+TEST_CASE("A looping pass pays for its idle lane slots and its loop overhead") {
+  vgpu::Profile hw = card();
+  hw.loop_overhead_clocks = 2;
+  vgpu::Counters k = kernel_passes(1, 0);
+  // 4000 fragments in batches that issued 8000 lane slots; 6000 active iterations are in the
+  // counts above, the 2000 idle slots were issued the body: 31 operations, 1 fetch each.
+  k.loop_lane_slots = 8000;
+  k.loop_iterations = 6000;
+  k.loop_lanes_idle = 2000;
+  k.loop_idle_instructions = 2000 * 31;
+  k.loop_idle_fetches = 2000;
+  const host::CostBreakdown b = host::predict(frame(k), hw, params());
+  // Active work 200 us as above; idle lanes 2000 x 30 operations / 3 per instruction over
+  // 4 pipes x 1e8 Hz x 0.5 = 100 us; overhead 8000 slots x 2 clocks / (4 x 1e8 Hz) = 40 us.
+  CHECK(b.arithmetic_demand_ms == doctest::Approx(0.340));
+  CHECK(b.texture_demand_ms == doctest::Approx(0.015));         // (4000 + 2000) fetches / 4e8
+  CHECK(b.memory_demand_ms == doctest::Approx(0.128 + 0.100));  // idle lanes move no bytes
+  CHECK(b.loop_overhead_ms == doctest::Approx(0.040));
+  CHECK(b.loop_idle_ms == doctest::Approx(0.110));  // 100 us + the idle slots' 10 us overhead
+  CHECK(b.wasted_ms == doctest::Approx(0.110));
+  CHECK(b.arithmetic_ms == doctest::Approx(0.340));
+}
