@@ -1,7 +1,9 @@
 // Benchmark: the stream engine's host time against the project's CPU tracer, scene by scene, at
 // 1 and 2 threads (render ms, initialization apart, median of repetitions). The scenes: bunny
 // (primary rays), bunny-refl (2 bounces), a 2000-triangle fan whose centre crowds one voxel
-// column, and a generated 320k-triangle terrain; 256x256, no shadows. Figures in docs/speed.md.
+// column, and a generated 320k-triangle terrain; 256x256, no shadows. Also the work the stream
+// engine cannot skip: its passes and the fragments that ran (fragment-steps, counted with the
+// finished-ray mask as an early-z test). Figures in docs/speed.md.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -117,11 +119,24 @@ int main(int argc, char** argv) {
   // `bench_speed quick`: the first case only; `bench_speed case K`: case K (0-based) only.
   const bool quick = argc > 1 && std::strcmp(argv[1], "quick") == 0;
   const int only = argc > 2 && std::strcmp(argv[1], "case") == 0 ? std::atoi(argv[2]) : -1;
-  std::printf("%-28s %7s %7s %10s %10s %7s\n", "scene (256x256, no shadows)", "tris", "threads",
-              "stream ms", "cpu ms", "ratio");
+  std::printf("%-28s %7s %7s %10s %10s %7s %7s %10s\n", "scene (256x256, no shadows)", "tris",
+              "threads", "stream ms", "cpu ms", "ratio", "passes", "ran");
   for (size_t k = 0; k < (quick ? 1 : makers.size()); ++k) {
     if (only >= 0 && int(k) != only) continue;
     const Case c = makers[k]();
+    // The work the stream engine cannot skip: its passes, and the fragments that ran (the
+    // shaded ones when the finished-ray mask is an early-z test instead of a host shortcut).
+    uint64_t passes = 0, ran = 0;
+    {
+      host::RenderOptions opt;
+      opt.bounces = c.bounces;
+      opt.shadows = false;
+      opt.masks = true;
+      const vgpu::Counters t =
+          host::StreamTracer(c.scene, c.grid, opt).render(c.camera).stats.totals;
+      passes = t.passes;
+      ran = t.fragments_shaded;
+    }
     for (int threads : {1, 2}) {
       host::RenderOptions opt;
       opt.bounces = c.bounces;
@@ -135,8 +150,9 @@ int main(int argc, char** argv) {
         cpu.push_back(host::render_cpu(c.scene, c.grid, c.camera, opt).render_ms);
       }
       const double s = median(stream), p = median(cpu);
-      std::printf("%-28s %7zu %7d %10.1f %10.1f %6.2fx\n", c.label.c_str(),
-                  c.scene.triangle_count(), threads, s, p, s / p);
+      std::printf("%-28s %7zu %7d %10.1f %10.1f %6.2fx %7llu %9.2fM\n", c.label.c_str(),
+                  c.scene.triangle_count(), threads, s, p, s / p,
+                  static_cast<unsigned long long>(passes), double(ran) / 1e6);
       std::fflush(stdout);
     }
   }

@@ -8,6 +8,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
+#include <type_traits>
 
 #include "vgpu/lanes.h"
 #include "vgpu/record.h"
@@ -119,6 +120,68 @@ inline void join(const float (&lanes)[4][W], float* p) {
     for (int i = 0; i < W; ++i)
       for (int c = 0; c < 4; ++c) p[4 * i + c] = lanes[c][i];
   }
+}
+
+// Eight texels of four floats from eight addresses into x0..x7, y.., z.., w..: one 16-byte load
+// each, then the same in-lane transpose as split8.
+inline void gather8(const float* const* p, float* x, float* y, float* z, float* w) {
+  using V4 = float __attribute__((vector_size(16)));
+  V4 t[8];
+  for (int i = 0; i < 8; ++i) std::memcpy(&t[i], p[i], sizeof(V4));
+  const V8 a0 = __builtin_shufflevector(t[0], t[4], 0, 1, 2, 3, 4, 5, 6, 7);
+  const V8 a1 = __builtin_shufflevector(t[1], t[5], 0, 1, 2, 3, 4, 5, 6, 7);
+  const V8 a2 = __builtin_shufflevector(t[2], t[6], 0, 1, 2, 3, 4, 5, 6, 7);
+  const V8 a3 = __builtin_shufflevector(t[3], t[7], 0, 1, 2, 3, 4, 5, 6, 7);
+  const V8 u0 = __builtin_shufflevector(a0, a1, 0, 8, 1, 9, 4, 12, 5, 13);
+  const V8 u1 = __builtin_shufflevector(a0, a1, 2, 10, 3, 11, 6, 14, 7, 15);
+  const V8 u2 = __builtin_shufflevector(a2, a3, 0, 8, 1, 9, 4, 12, 5, 13);
+  const V8 u3 = __builtin_shufflevector(a2, a3, 2, 10, 3, 11, 6, 14, 7, 15);
+  const V8 vx = __builtin_shufflevector(u0, u2, 0, 1, 8, 9, 4, 5, 12, 13);
+  const V8 vy = __builtin_shufflevector(u0, u2, 2, 3, 10, 11, 6, 7, 14, 15);
+  const V8 vz = __builtin_shufflevector(u1, u3, 0, 1, 8, 9, 4, 5, 12, 13);
+  const V8 vw = __builtin_shufflevector(u1, u3, 2, 3, 10, 11, 6, 7, 14, 15);
+  std::memcpy(x, &vx, sizeof vx);
+  std::memcpy(y, &vy, sizeof vy);
+  std::memcpy(z, &vz, sizeof vz);
+  std::memcpy(w, &vw, sizeof vw);
+}
+
+// Texel indices (first float of each texel) of lanes at clamped texel coordinates u[i], v[i]
+// (floats in [0, w - 1] x [0, h - 1]): truncated like the scalar path, clamped again as integers.
+// W a multiple of 8; the caller checked that w * h * ch fits in 32 bits.
+template <int W>
+inline void indices(int width, int height, int ch, const float* u, const float* v, int32_t* idx) {
+  using V8i = int32_t __attribute__((vector_size(32)));
+  const V8i wm = V8i{} + (width - 1), hm = V8i{} + (height - 1);
+  for (int g = 0; g < W; g += 8) {
+    V8i iu = __builtin_convertvector(load8(u + g), V8i);
+    V8i iv = __builtin_convertvector(load8(v + g), V8i);
+    iu = iu < wm ? iu : wm;
+    iv = iv < hm ? iv : hm;
+    const V8i i = (iv * width + iu) * ch;
+    std::memcpy(idx + g, &i, sizeof i);
+  }
+}
+
+// Texels of a texture of 3 or 4 channels (w x h, rows of w * ch floats) at clamped texel
+// coordinates u[i], v[i] into lanes[c][i] (W a multiple of 8); channel 3 of a 3-channel texture is
+// left undefined. Each texel is one 16-byte load; the last texel of a 3-channel texture, whose 16
+// bytes would run past the end, is read from a padded copy.
+template <int W>
+inline void gather(const float* d, int width, int height, int ch, const float* u, const float* v,
+                   float (&lanes)[4][W]) {
+  static_assert(W % 8 == 0);
+  const int64_t size = int64_t(width) * height * ch;
+  // Clamped fetches of triangle id -1 (no triangle) land on the last texel often.
+  alignas(16) float tail[4] = {};
+  if (ch == 3)
+    for (int c = 0; c < 3; ++c) tail[c] = d[size - 3 + c];
+  int32_t idx[W];
+  indices<W>(width, height, ch, u, v, idx);
+  const float* p[W];
+  for (int i = 0; i < W; ++i) p[i] = int64_t(idx[i]) + 4 <= size ? d + idx[i] : tail;
+  for (int g = 0; g < W; g += 8)
+    gather8(p + g, lanes[0] + g, lanes[1] + g, lanes[2] + g, lanes[3] + g);
 }
 
 }  // namespace texels
@@ -293,7 +356,8 @@ class Fragments {
   bool in_loop_ = false;
 
   // Any texel coordinates: clamp in float first (NaN goes to 0), then convert (no undefined
-  // conversions), then one load per lane and channel.
+  // conversions), then one load per lane and channel (the scalar reference). Widths 8 and 16
+  // compute the indices as vectors and load 3- and 4-channel texels whole (texels::gather).
   [[gnu::noinline]] static Vec4<F> fetch_clamped(const BoundTexture& t, F fu, F fv) {
     const F wmax = F(float(t.width - 1)), hmax = F(float(t.height - 1));
     fu = select(fu >= F(0.0f), fu, F(0.0f));
@@ -302,6 +366,28 @@ class Fragments {
     fv = select(fv <= hmax, fv, hmax);
     const float* d = t.data;
     const int ch = t.channels;
+    if constexpr (W % 8 == 0 && std::is_same_v<L, SimdLanes<W>>) {
+      if (int64_t(t.width) * t.height * ch < (int64_t(1) << 31)) {
+        alignas(64) float au[W], av[W];
+        fu.copy_to(au, stdx::vector_aligned);
+        fv.copy_to(av, stdx::vector_aligned);
+        if (ch >= 3) {
+          alignas(64) float lanes[4][W];
+          texels::gather<W>(d, t.width, t.height, ch, au, av, lanes);
+          Vec4<F> r;
+          r.x.copy_from(lanes[0], stdx::vector_aligned);
+          r.y.copy_from(lanes[1], stdx::vector_aligned);
+          r.z.copy_from(lanes[2], stdx::vector_aligned);
+          r.w = ch == 4 ? F(lanes[3], stdx::vector_aligned) : F(1.0f);
+          return r;
+        }
+        int32_t idx[W];
+        texels::indices<W>(t.width, t.height, ch, au, av, idx);
+        Vec4<F> r{F([&](auto i) { return d[idx[i]]; }), F(0.0f), F(0.0f), F(1.0f)};
+        if (ch > 1) r.y = F([&](auto i) { return d[idx[i] + 1]; });
+        return r;
+      }
+    }
     std::array<int64_t, W> idx;
     // Clamped again as integers: a reduced-precision wmax may round past the last texel.
     for (int i = 0; i < W; ++i)

@@ -79,6 +79,48 @@ std::array<uint64_t, 2> idle_in_batches(const Rect& r, const uint8_t* flags, con
   return total;
 }
 
+// The same counters for a pass under a listed mask (a whole-target draw, no stencil test), from
+// the list instead of a scan of the tiles: there a tile's idle fragments are its fragments (or,
+// when idle ones count as masked, its listed ones) less those that took the branch, so per-tile
+// counts of listed and kTook fragments give them. `w` x `h`: the target, texel index y * w + x.
+std::array<uint64_t, 2> idle_in_batches_listed(int w, int h, const uint8_t* flags,
+                                               const std::vector<uint32_t>& listed,
+                                               bool work_masked, uint64_t idle_flags) {
+  const int cols8 = (w + 7) / 8, rows4 = (h + 3) / 4, cols32 = (w + 31) / 32;
+  const int rows32 = (h + 31) / 32;
+  // Per 8x4 and 32x32 tile: {listed, took}.
+  thread_local std::vector<std::array<uint32_t, 2>> t8, t32;
+  t8.assign(size_t(cols8) * size_t(rows4), {0, 0});
+  t32.assign(size_t(cols32) * size_t(rows32), {0, 0});
+  int y = 0;
+  uint32_t row0 = 0;
+  for (const uint32_t i : listed) {
+    if (i - row0 >= uint32_t(w)) {
+      y = int(i / uint32_t(w));
+      row0 = uint32_t(y) * uint32_t(w);
+    }
+    const int x = int(i - row0);
+    const uint32_t took = flags[i] == kTook ? 1 : 0;
+    auto& a = t8[size_t(y / 4) * size_t(cols8) + size_t(x / 8)];
+    auto& b = t32[size_t(y / 32) * size_t(cols32) + size_t(x / 32)];
+    ++a[0], ++b[0];
+    a[1] += took, b[1] += took;
+  }
+  std::array<uint64_t, 2> total{idle_flags, idle_flags};
+  auto settle = [&](const std::vector<std::array<uint32_t, 2>>& t, int cols, int tw, int th,
+                    uint64_t& sum) {
+    for (size_t k = 0; k < t.size(); ++k) {
+      if (t[k][1] == 0) continue;  // no fragment took the branch: its idle ones stay counted
+      const int c = int(k % size_t(cols)), r = int(k / size_t(cols));
+      const uint64_t area = uint64_t(std::min(tw, w - c * tw)) * uint64_t(std::min(th, h - r * th));
+      sum -= (work_masked ? t[k][0] : area) - t[k][1];
+    }
+  };
+  settle(t8, cols8, 8, 4, total[0]);
+  settle(t32, cols32, 32, 32, total[1]);
+  return total;
+}
+
 // End of a stretch of live idle fragments from `from`: the first i < to with wk[i] != 0 or, when
 // there is a stencil test, st[i] == 0. Eight bytes at a time, the row's hottest loop.
 int stretch_end(const uint8_t* wk, const uint8_t* st, int from, int to) {
@@ -333,20 +375,30 @@ void Gpu::run_rows(const Program& p, const Rect& r, int y0, int y1, const DrawPl
   };
   // Stores the program's outputs for the lanes in `write`; lane i is fragment (px[i], py[i]).
   // `row_run`: the W lanes are W neighbours of one row, all written.
-  auto store = [&](const int* px, const int* py, int n, const M& write, bool row_run) {
+  auto store = [&](const int* px, const int* py, int n, const M& write_mask, bool row_run) {
+    bool write[W];
+    write_mask.copy_to(write, stdx::element_aligned);
     for (int o = 0; o < nout; ++o) {
       const DrawPlan::Out& t = plan.out[o];
       const Vec4<F>& v = f.output(o);
-      v.x.copy_to(lanes_out[0], stdx::element_aligned);
-      v.y.copy_to(lanes_out[1], stdx::element_aligned);
-      v.z.copy_to(lanes_out[2], stdx::element_aligned);
-      v.w.copy_to(lanes_out[3], stdx::element_aligned);
+      v.x.copy_to(lanes_out[0], stdx::element_aligned);  // the channels the target has
+      if (t.ch > 1) v.y.copy_to(lanes_out[1], stdx::element_aligned);
+      if (t.ch > 2) v.z.copy_to(lanes_out[2], stdx::element_aligned);
+      if (t.ch > 3) v.w.copy_to(lanes_out[3], stdx::element_aligned);
       auto at = [&](int i) {
         return t.data + (size_t(py[i]) * size_t(t.width) + size_t(px[i])) * size_t(t.ch);
       };
       if (row_run && t.ch == 4 && t.fmt == Format::fp32) {
         // The common case: W whole fp32x4 texels, interleaved from the four registers.
         texels::join<W>(lanes_out, at(0));
+        continue;
+      }
+      if (t.ch == 4 && t.fmt == Format::fp32) {
+        // Gathered lanes: interleaved once, then one 16-byte texel per written lane.
+        alignas(64) float texels_out[4 * W];
+        texels::join<W>(lanes_out, texels_out);
+        for (int i = 0; i < n; ++i)
+          if (write[i]) std::memcpy(at(i), texels_out + 4 * i, 4 * sizeof(float));
         continue;
       }
       if (t.fmt == Format::fp32) {  // already exact: no rounding
@@ -460,9 +512,15 @@ void Gpu::run_rows(const Program& p, const Rect& r, int y0, int y1, const DrawPl
     }
     if (plan.stencil)
       for (int i = 0; i < n; ++i) plan.stencil[pi[i]] = killed[i] ? 0 : 1;
-    if (plan.list_survivors)
-      for (int i = 0; i < n; ++i)
-        if (!killed[i]) out.survivors.push_back(pi[i]);
+    if (plan.list_survivors) {
+      uint32_t keep[W];
+      int m = 0;
+      for (int i = 0; i < n; ++i) {
+        keep[m] = pi[i];
+        m += killed[i] ? 0 : 1;
+      }
+      out.survivors.insert(out.survivors.end(), keep, keep + m);
+    }
   };
   if (plan.list) {
     // Only the listed fragments of rows [y0, y1) are visited; draw() settled the idle ones'
@@ -479,13 +537,19 @@ void Gpu::run_rows(const Program& p, const Rect& r, int y0, int y1, const DrawPl
     // A W-aligned block of a row where at least half the fragments are listed runs in place, as
     // the hardware's own quads would (contiguous fetches and stores); sparser ones are gathered.
     bool on[W];
+    int y = 0;
+    uint32_t row0 = 0;  // y * tw: a division only where the list changes rows
     while (b != e) {
-      const int y = int(*b / tw), x0 = int(*b % tw) / W * W, x1 = std::min(int(tw), x0 + W);
+      if (*b - row0 >= tw) {
+        y = int(*b / tw);
+        row0 = uint32_t(y) * tw;
+      }
+      const int x0 = int(*b - row0) / W * W, x1 = std::min(int(tw), x0 + W);
       const uint32_t* k = b;
-      while (k != e && *k < uint32_t(y) * tw + uint32_t(x1)) ++k;
+      while (k != e && *k < row0 + uint32_t(x1)) ++k;
       if (2 * (k - b) < W) {
         for (; b != k; ++b)
-          if (push(int(*b % tw), y, *b)) flush();
+          if (push(int(*b - row0), y, *b)) flush();
         continue;
       }
       flush();  // the gathered fragments come first: survivors stay in ascending order
@@ -504,13 +568,35 @@ void Gpu::run_rows(const Program& p, const Rect& r, int y0, int y1, const DrawPl
       kill.copy_to(killed, stdx::element_aligned);
       f.idle_lanes().copy_to(idle, stdx::element_aligned);
       uint8_t* fl = flag_row(y);
-      const uint32_t row0 = uint32_t(y) * tw;
-      for (int i = 0; i < x1 - x0; ++i) {
-        if (!on[i]) continue;
-        if (plan.loop_map) plan.loop_map[row0 + uint32_t(x0 + i)] = f.loop_count(i);
-        flag_ran(fl, x0 + i, y, idle[i]);
-        if (plan.stencil) plan.stencil[row0 + uint32_t(x0 + i)] = killed[i] ? 0 : 1;
-        if (plan.list_survivors && !killed[i]) out.survivors.push_back(row0 + uint32_t(x0 + i));
+      if (plan.loop_map)
+        for (int i = 0; i < x1 - x0; ++i)
+          if (on[i]) plan.loop_map[row0 + uint32_t(x0 + i)] = f.loop_count(i);
+      if (fl) {  // flag_ran, with each 8x4 tile of the block marked once
+        int marked = -1;
+        for (int i = 0; i < x1 - x0; ++i) {
+          if (!on[i]) continue;
+          if (idle[i]) {
+            fl[x0 + i] = kIdle;
+            ++out.idle_flags;
+          } else if ((x0 + i) / 8 != marked) {
+            flag_ran(fl, x0 + i, y, false);
+            marked = (x0 + i) / 8;
+          } else {
+            fl[x0 + i] = kTook;
+          }
+        }
+      }
+      if (plan.stencil)
+        for (int i = 0; i < x1 - x0; ++i)
+          if (on[i]) plan.stencil[row0 + uint32_t(x0 + i)] = killed[i] ? 0 : 1;
+      if (plan.list_survivors) {
+        uint32_t keep[W];
+        int m = 0;
+        for (int i = 0; i < x1 - x0; ++i) {
+          keep[m] = row0 + uint32_t(x0 + i);
+          m += on[i] && !killed[i] ? 1 : 0;
+        }
+        out.survivors.insert(out.survivors.end(), keep, keep + m);
       }
       b = k;
     }
@@ -666,9 +752,26 @@ const PassRecord& Gpu::draw(const Rect& rect) {
   std::vector<Chunk>& chunks = chunks_;
   DrawPlan plan;
   plan.idle_branches = uint64_t(a.branches);
+  // Under a work mask whose non-zero pixels the last pass that wrote it listed, only those run
+  // (a whole-target draw without stencil test).
+  const bool whole = !stencil_test_ && rect.x0 == 0 && rect.y0 == 0 && rect.x1 == t0tex.width() &&
+                     rect.y1 == t0tex.height();
+  const bool use_list = work_mask_ && whole && work_mask_->listed_version_ == work_mask_->version_;
   if (a.branches > 0) {
     // Complete after the pass (branch flags are a per-fragment map): masked fragments stay 0.
-    batch_flags_.assign(size_t(rect.width()) * size_t(rect.height()), 0);
+    // Under a listed mask every fragment but the listed ones is idle (those overwrite their flag
+    // when they run): one fill with the right value.
+    const size_t n = size_t(rect.width()) * size_t(rect.height());
+    const uint8_t base = use_list && !work_masked_ ? kIdle : 0;
+    if (use_list && flags_ran_ && flags_base_ == base && batch_flags_.size() == n) {
+      // The buffer holds `base` but where the last listed pass ran: reset those only.
+      for (const uint32_t i : *flags_ran_) batch_flags_[i] = base;
+    } else {
+      batch_flags_.assign(n, base);
+    }
+    flags_ran_.reset();  // set again after the pass, if it is listed
+    flags_base_ = base;
+    flags_size_ = n;
     plan.flags = batch_flags_.data();
     plan.cols8 = (rect.width() + 7) / 8;
     plan.cols32 = (rect.width() + 31) / 32;
@@ -677,7 +780,7 @@ const PassRecord& Gpu::draw(const Rect& rect) {
     plan.took8 = took8_.data();
     plan.took32 = took32_.data();
   } else {
-    batch_flags_.clear();  // no branches: no flags
+    flags_size_ = 0;  // no branches: no flags (the buffer keeps its contents for later)
   }
   // The masks as they were before the pass, for the batch counters: a pass may write the mask
   // it tests (a query pass counting into the stencil it reads).
@@ -689,7 +792,9 @@ const PassRecord& Gpu::draw(const Rect& rect) {
     loop_map_.assign(size_t(t0tex.width()) * size_t(t0tex.height()), 0);
     plan.loop_map = loop_map_.data();
   }
-  if ((plan.flags || looping) && stencil_write_ && stencil_write_ == work_mask_)
+  // (a listed pass's branch counters read only the flags; the loop counters read the mask)
+  if ((plan.flags || looping) && (!use_list || looping) && stencil_write_ &&
+      stencil_write_ == work_mask_)
     work_view = &(work_before = *work_mask_);
   if ((plan.flags || looping) && stencil_write_ && stencil_write_ == stencil_test_)
     test_view = &(test_before = *stencil_test_);
@@ -698,19 +803,15 @@ const PassRecord& Gpu::draw(const Rect& rect) {
   // PairRecord; every fragment drawn, no stencil test, same format), only the texels that
   // differ and are idle now are copied, here; the row workers copy nothing.
   const bool carries = work_mask_ && !p.idle_discards();
-  const bool whole = !stencil_test_ && rect.x0 == 0 && rect.y0 == 0 && rect.x1 == t0tex.width() &&
-                     rect.y1 == t0tex.height();
   auto same = [](const Texture* t, const Texture* r, uint64_t uid, uint64_t version) {
     return t == r && t->uid_ == uid && t->version_ == version;
   };
   // Under a work mask whose non-zero pixels the last pass that wrote it listed, only those run.
   // Held here: this pass may write the mask and give it a new list.
   std::shared_ptr<const std::vector<uint32_t>> listed;
-  if (work_mask_ && whole && work_mask_->listed_version_ == work_mask_->version_) {
+  if (use_list) {
     listed = work_mask_->nonzero_;
     plan.list = listed.get();
-    // Every fragment but the listed ones is idle; those overwrite their flag when they run.
-    if (plan.flags && !work_masked_) std::memset(plan.flags, kIdle, batch_flags_.size());
   }
   for (int o = 0; o < p.outputs(); ++o) {
     Texture& dst = *targets_[o];
@@ -728,9 +829,16 @@ const PassRecord& Gpu::draw(const Rect& rect) {
            same(&dst, rec->a, rec->uid_a, rec->version_a))) {
         plan.out[o].idle_src = nullptr;
         const size_t ch = size_t(dst.channels());
-        for (const uint32_t i : *rec->differ)  // the mask is as wide as the target
-          if (work_mask_->bits_[i] == 0)
-            std::memcpy(dst.data_.data() + i * ch, src.data_.data() + i * ch, ch * sizeof(float));
+        const uint8_t* bits = work_mask_->bits_.data();
+        float* dd = dst.data_.data();
+        const float* sd = src.data_.data();
+        if (ch == 4) {                           // a fixed-size copy: inlined
+          for (const uint32_t i : *rec->differ)  // the mask is as wide as the target
+            if (bits[i] == 0) std::memcpy(dd + i * 4, sd + i * 4, 4 * sizeof(float));
+        } else {
+          for (const uint32_t i : *rec->differ)
+            if (bits[i] == 0) std::memcpy(dd + i * ch, sd + i * ch, ch * sizeof(float));
+        }
         pairs_.erase(rec);  // used up: if the pass fails, no record claims the textures agree
         break;
       }
@@ -757,9 +865,20 @@ const PassRecord& Gpu::draw(const Rect& rect) {
       if (n > next) copy(next, n);
       cp.idle_src = nullptr;
     }
-    if (stencil_write_)
-      std::memset(stencil_write_->bits_.data(), p.idle_discards() ? 0 : 1,
-                  stencil_write_->bits_.size());
+    if (stencil_write_) {
+      const uint8_t value = p.idle_discards() ? 0 : 1;
+      std::vector<uint8_t>& bits = stencil_write_->bits_;
+      const auto* nz = stencil_write_->listed_version_ == stencil_write_->version_
+                           ? stencil_write_->nonzero_.get()
+                           : nullptr;
+      if (value == 0 && nz && nz->size() < bits.size() / 16) {
+        // Only the listed pixels are non-zero: clear those (the usual case, a query pass
+        // narrowing the mask it reads).
+        for (const uint32_t i : *nz) bits[i] = 0;
+      } else {
+        std::memset(bits.data(), value, bits.size());
+      }
+    }
   }
   // The stencil write's non-zero list is known after the pass when every fragment's value is:
   // the fragments that ran and survived (idle ones, if any, are discarded).
@@ -804,6 +923,7 @@ const PassRecord& Gpu::draw(const Rect& rect) {
   };
   parallel_rows(rect, plan.list ? uint64_t(plan.list->size()) : rect.area(), body, chunks);
   in_draw_ = false;
+  if (plan.flags && plan.list) flags_ran_ = listed;  // the only flags this pass wrote
   if (carries) track_pairs(p, listed, plan.list_runs);
   if (plan.list_survivors) {
     size_t n = 0;
@@ -838,8 +958,14 @@ const PassRecord& Gpu::draw(const Rect& rect) {
   }
   if (plan.flags) {
     const std::array<uint64_t, 2> batch =
-        idle_in_batches(rect, plan.flags, work_view, test_view, work_masked_, sum.idle_flags,
-                        plan.took8, plan.took32);
+        // From the list where it is short; otherwise a scan of the tiles (eight flags a step),
+        // where under a listed mask the flags alone decide (no stencil test; fragments off the
+        // list hold kIdle, or 0 where that counts as masked), as if every fragment ran.
+        plan.list && plan.list->size() * 16 < rect.area()
+            ? idle_in_batches_listed(rect.width(), rect.height(), plan.flags, *plan.list,
+                                     work_masked_, sum.idle_flags)
+            : idle_in_batches(rect, plan.flags, plan.list ? nullptr : work_view, test_view,
+                              work_masked_, sum.idle_flags, plan.took8, plan.took32);
     c.idle_in_batch32 = batch[0];
     c.idle_in_batch1024 = batch[1];
   }

@@ -92,7 +92,9 @@ class Gpu final : public Device {
 
   // After a draw of a program that branches: per fragment of the drawn rectangle, row by row,
   // kBranchTook, kBranchIdle or 0 (not shaded). Empty after a draw of one that does not.
-  std::span<const uint8_t> branch_flags() const override { return batch_flags_; }
+  std::span<const uint8_t> branch_flags() const override {
+    return {batch_flags_.data(), flags_size_};
+  }
 
   FrameStats& stats() override { return stats_; }
   const FrameStats& stats() const { return stats_; }
@@ -123,8 +125,14 @@ class Gpu final : public Device {
   bool work_masked_ = false;
   bool in_draw_ = false;
   // Per fragment of the drawn rectangle, for the batch counters: took the branch, idle in it, or
-  // not shaded (gpu.cpp). Rebuilt by every draw of a program that branches.
+  // not shaded (gpu.cpp). Rebuilt by every draw of a program that branches; the first
+  // flags_size_ bytes are the map (0: the last draw's program has no branches).
   std::vector<uint8_t> batch_flags_;
+  size_t flags_size_ = 0;
+  // Where the buffer is known to hold flags_base_ everywhere but at flags_ran_ (the fragments a
+  // listed pass ran): the next listed pass of the same size resets only those.
+  std::shared_ptr<const std::vector<uint32_t>> flags_ran_;
+  uint8_t flags_base_ = 0;
   // Tiles (8x4, 32x32) of the drawn rectangle where some fragment took the branch.
   std::vector<uint8_t> took8_, took32_;
   std::vector<uint32_t> loop_map_;  // a looping pass: iterations per texel of the target

@@ -83,7 +83,7 @@ Run run_mixed(const std::string& prof, int threads, int lanes, const Rect* rect,
 // Lanes of the same value as each width's min and max see them.
 template <int W>
 void check_min_max_at_width() {
-  using F = stdx::fixed_size_simd<float, W>;
+  using F = typename vgpu::SimdLanes<W>::F;
   const float nan = std::numeric_limits<float>::quiet_NaN();
   auto bits = [](float v) { return std::bit_cast<uint32_t>(v); };
   CAPTURE(W);

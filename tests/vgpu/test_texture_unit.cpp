@@ -3,7 +3,9 @@
 #include <doctest/doctest.h>
 
 #include <array>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <limits>
 #include <stdexcept>
@@ -159,6 +161,41 @@ TEST_CASE("texRECT clamps coordinates outside the texture, NaN and infinities to
       CHECK(r[size_t(i)][1] == float(want[i][1]));
     }
   }
+}
+
+TEST_CASE("texRECT at scattered coordinates reads at every width what the scalar path reads") {
+  // Widths 8 and 16 load whole texels by vector indices (texels::gather); width 1 is the scalar
+  // reference. Coordinates in and out of range, NaN, and the last texel, whose 16-byte load would
+  // run past the end of a 3-channel texture, in every lane position.
+  std::vector<std::pair<float, float>> uv;
+  const float us[] = {4.5f, 0.5f, 2.25f, -3.0f, 9.0f, kNaN, 4.0f, 3.999f, 1.5f, kInf, 4.75f};
+  const float vs[] = {2.5f, 0.0f, 1.75f, -kInf, 2.0f, 7.5f, kNaN, 2.999f};
+  for (int i = 0; i < 43; ++i) uv.push_back({us[i % 11], vs[(i * 3) % 8]});
+  for (int channels = 1; channels <= 4; ++channels) {
+    CAPTURE(channels);
+    const Texture t = numbered(channels);
+    const auto want = sample(t, uv, 1);
+    for (int lanes : {4, 8, 16}) {
+      CAPTURE(lanes);
+      const auto got = sample(t, uv, lanes);
+      for (size_t i = 0; i < uv.size(); ++i)
+        for (size_t c = 0; c < 4; ++c) {
+          CAPTURE(i);
+          CAPTURE(c);
+          CHECK(std::bit_cast<uint32_t>(got[i][c]) == std::bit_cast<uint32_t>(want[i][c]));
+        }
+    }
+  }
+  // The last texel of the 3-channel texture itself, at width 8: (4, 2, 42) and w = 1.
+  const auto last = sample(numbered(3), {{0.5f, 0.5f}, {4.5f, 2.5f}, {1e9f, 1e9f}}, 8);
+  for (size_t i : {size_t(1), size_t(2)}) {
+    CAPTURE(i);
+    CHECK(last[i][0] == 4.0f);
+    CHECK(last[i][1] == 2.0f);
+    CHECK(last[i][2] == 42.0f);
+    CHECK(last[i][3] == 1.0f);
+  }
+  CHECK(last[0][2] == 0.0f);
 }
 
 TEST_CASE("channels a texture lacks read as (0, 0, 0, 1)") {
