@@ -293,7 +293,8 @@ GlslProgram to_glsl(const Program& p, const Recording& rec, bool annotate) {
       case Op::fetch_own:
       case Op::fetch: {
         const std::string& s = sampler(nd.unit);
-        const std::string v = "f" + std::to_string(i);
+        std::string v = "f";  // (not "f" + to_string: GCC 12's false -Wrestrict, PR 105651)
+        v += std::to_string(i);
         const std::string at = nd.op == Op::fetch_own
                                    ? "own_texel(" + s + ")"
                                    : "texel_at(" + s + ", " + e(nd.a) + ", " + e(nd.b) + ")";
