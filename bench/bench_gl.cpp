@@ -159,6 +159,7 @@ int main(int argc, char** argv) {
   int runs = 3, micro_passes = 200, threads = 0;
   bool no_stream = false, no_frames = false;
   std::string wait_mode = "block";
+  std::vector<std::string> variants = {"multipass"};
   app.add_option("--gl-device", device, "auto, or an EGL device index")->capture_default_str();
   app.add_option("--scenes", scenes, "Scene names or .gltf paths")->capture_default_str();
   app.add_option("--sizes", sizes, "Image sizes (square)")
@@ -175,6 +176,12 @@ int main(int argc, char** argv) {
       ->capture_default_str()
       ->check(CLI::Range(0, 256));
   app.add_flag("--no-stream", no_stream, "Skip the vgpu (emulator) runs");
+  app.add_option("--variants", variants,
+                 "Pipelines per frame: multipass (the paper's, Table 1's gf5700 profile), mrt "
+                 "(fused two-output passes) and looping (the looping kernels), both on the h200 "
+                 "profile")
+      ->check(CLI::IsMember({"multipass", "mrt", "looping"}))
+      ->capture_default_str();
   app.add_option("--readback-wait", wait_mode,
                  "GL frames: block (GL_QUERY_RESULT), poll (spin on GL_QUERY_RESULT_AVAILABLE), "
                  "both, or none (no GL frames: the emulator's counts and predictions only)")
@@ -259,64 +266,72 @@ int main(int argc, char** argv) {
                                                           vgpu::profile(opt.profile)));
           const host::Camera cam =
               scene.camera ? *scene.camera : host::frame_bounds(scene.bounds(), 1.0f);
-          for (const std::string& engine : engines) {
-            const bool gl = engine != "stream";
-            opt.device = gl ? "gl" : "vgpu";
-            opt.gl_readback = engine == "gl-poll" ? "poll" : "block";
-            const FrameRun fr = run_frames(scene, grid, cam, opt, runs);
-            json f = {{"scene", scene.name},
-                      {"size", size},
-                      {"engine", engine},
-                      {"device", fr.device},
-                      {"runs", runs},
-                      {"wall_ms", median(fr.wall)},
-                      {"gpu_ms", gl ? json(median(fr.gpu)) : json()},
-                      {"readback_wait_ms", gl ? json(median(fr.wait)) : json()},
-                      {"passes", fr.stats.totals.passes},
-                      {"query_readbacks", fr.stats.totals.query_readbacks},
-                      {"program_loads", fr.stats.totals.program_loads},
-                      {"fragments_shaded", fr.stats.totals.fragments_shaded}};
-            json kernels = json::array();
-            for (const auto& p : fr.stats.programs) {
-              json k = {{"name", p.name},
-                        {"paper_name", p.paper_name},
-                        {"passes", p.counters.passes},
-                        {"gpu_ms", gl ? json(median(fr.kernel_gpu.at(p.name))) : json()},
-                        {"host_ms", median(fr.kernel_host.at(p.name))}};
-              if (!gl) {  // the cost model per kernel: its passes' work and fixed costs
-                vgpu::FrameStats one;
-                one.programs = {p};
-                one.totals = p.counters;
-                const vgpu::Profile& hp = vgpu::profile("h200");
-                const host::CostBreakdown b = host::predict(one, hp, params_for(hp));
-                k["predicted_h200_ms"] = b.total_ms;
-                k["predicted_h200_work_ms"] = b.arithmetic_ms + b.texture_ms + b.memory_ms;
+          for (const std::string& variant : variants) {
+            // The paper's pipeline at Table 1's profile; its future work (MRT fused passes, the
+            // looping kernels) needs a profile with several outputs and loops: the h200's.
+            opt.mrt = variant == "mrt";
+            opt.looping = variant == "looping";
+            opt.profile = variant == "multipass" ? "gf5700" : "h200";
+            for (const std::string& engine : engines) {
+              const bool gl = engine != "stream";
+              opt.device = gl ? "gl" : "vgpu";
+              opt.gl_readback = engine == "gl-poll" ? "poll" : "block";
+              const FrameRun fr = run_frames(scene, grid, cam, opt, runs);
+              json f = {{"scene", scene.name},
+                        {"variant", variant},
+                        {"size", size},
+                        {"engine", engine},
+                        {"device", fr.device},
+                        {"runs", runs},
+                        {"wall_ms", median(fr.wall)},
+                        {"gpu_ms", gl ? json(median(fr.gpu)) : json()},
+                        {"readback_wait_ms", gl ? json(median(fr.wait)) : json()},
+                        {"passes", fr.stats.totals.passes},
+                        {"query_readbacks", fr.stats.totals.query_readbacks},
+                        {"program_loads", fr.stats.totals.program_loads},
+                        {"fragments_shaded", fr.stats.totals.fragments_shaded}};
+              json kernels = json::array();
+              for (const auto& p : fr.stats.programs) {
+                json k = {{"name", p.name},
+                          {"paper_name", p.paper_name},
+                          {"passes", p.counters.passes},
+                          {"gpu_ms", gl ? json(median(fr.kernel_gpu.at(p.name))) : json()},
+                          {"host_ms", median(fr.kernel_host.at(p.name))}};
+                if (!gl) {  // the cost model per kernel: its passes' work and fixed costs
+                  vgpu::FrameStats one;
+                  one.programs = {p};
+                  one.totals = p.counters;
+                  const vgpu::Profile& hp = vgpu::profile("h200");
+                  const host::CostBreakdown b = host::predict(one, hp, params_for(hp));
+                  k["predicted_h200_ms"] = b.total_ms;
+                  k["predicted_h200_work_ms"] = b.arithmetic_ms + b.texture_ms + b.memory_ms;
+                }
+                kernels.push_back(k);
               }
-              kernels.push_back(k);
+              f["kernels"] = kernels;
+              if (!gl) {
+                json pred;
+                for (const vgpu::Profile& p : vgpu::profiles())
+                  pred[p.name] = host::predict(fr.stats, p, params_for(p)).total_ms;
+                f["predicted_ms"] = pred;
+                json h200 = json::object();
+                const vgpu::Profile& hp = vgpu::profile("h200");
+                for (const auto& [k, v] : host::predict(fr.stats, hp, params_for(hp)).items())
+                  h200[k] = v;
+                f["predicted_h200"] = h200;
+              }
+              std::printf("%-14s %4dx%-4d %-9s %-7s wall %9.1f ms", scene.name.c_str(), size, size,
+                          variant.c_str(), engine.c_str(), median(fr.wall));
+              if (gl)
+                std::printf("  gpu %9.1f ms  wait %8.1f ms", median(fr.gpu), median(fr.wait));
+              else
+                std::printf("  h200 predicted %8.1f ms", f["predicted_ms"]["h200"].get<double>());
+              std::printf("  passes %6llu  read-backs %5llu\n",
+                          static_cast<unsigned long long>(fr.stats.totals.passes),
+                          static_cast<unsigned long long>(fr.stats.totals.query_readbacks));
+              std::fflush(stdout);
+              frames.push_back(f);
             }
-            f["kernels"] = kernels;
-            if (!gl) {
-              json pred;
-              for (const vgpu::Profile& p : vgpu::profiles())
-                pred[p.name] = host::predict(fr.stats, p, params_for(p)).total_ms;
-              f["predicted_ms"] = pred;
-              json h200 = json::object();
-              const vgpu::Profile& hp = vgpu::profile("h200");
-              for (const auto& [k, v] : host::predict(fr.stats, hp, params_for(hp)).items())
-                h200[k] = v;
-              f["predicted_h200"] = h200;
-            }
-            std::printf("%-14s %4dx%-4d %-7s wall %9.1f ms", scene.name.c_str(), size, size,
-                        engine.c_str(), median(fr.wall));
-            if (gl)
-              std::printf("  gpu %9.1f ms  wait %8.1f ms", median(fr.gpu), median(fr.wait));
-            else
-              std::printf("  h200 predicted %8.1f ms", f["predicted_ms"]["h200"].get<double>());
-            std::printf("  passes %6llu  read-backs %5llu\n",
-                        static_cast<unsigned long long>(fr.stats.totals.passes),
-                        static_cast<unsigned long long>(fr.stats.totals.query_readbacks));
-            std::fflush(stdout);
-            frames.push_back(f);
           }
         }
       }

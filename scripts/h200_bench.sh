@@ -7,9 +7,11 @@
 #   scripts/h200_bench.sh OUTPUT_DIR
 # then copy OUTPUT_DIR's real_gpu_h200.json and gpu_clocks.csv to docs/ (the clocks as
 # real_gpu_h200_clocks.csv) and run here:
-#   /usr/bin/python3 scripts/real_gpu.py --reuse --add h200=docs/real_gpu_h200.json
+#   /usr/bin/python3 scripts/real_gpu.py --reuse --add h200=docs/real_gpu_h200.json \
+#     --add-variants h200=docs/real_gpu_h200_variants.json --add-run h200-run1=docs/real_gpu_h200_run1.json
 set -euo pipefail
-out="${1:?usage: scripts/h200_bench.sh OUTPUT_DIR}"
+out="${1:?usage: scripts/h200_bench.sh OUTPUT_DIR [all|frames|variants]}"
+phase="${2:-all}"
 cd "$(dirname "$0")/.."
 if [ -d .gl ]; then
   for f in .gl/*.deb; do dpkg -x "$f" /; done
@@ -25,6 +27,7 @@ smi --query-gpu=timestamp,clocks.sm,clocks.mem,utilization.gpu --format=csv -lms
   > "$out/gpu_clocks.csv" &
 sampler=$!
 trap 'kill $sampler 2>/dev/null || true' EXIT
+if [ "$phase" != variants ]; then
 # Frames with both read-back waits (the emulator's counts and the predictions are the same on
 # every machine: scripts/real_gpu.py computes them here with --readback-wait none).
 .bin/bench_gl --runs 5 --sizes 256 1024 --threads 16 --no-stream --readback-wait both \
@@ -34,3 +37,13 @@ trap 'kill $sampler 2>/dev/null || true' EXIT
 __GL_YIELD=NOTHING .bin/bench_gl --runs 5 --sizes 256 --no-stream --readback-wait block \
   --micro-passes 50 --scenes scenes/bunny.gltf --json "$out/real_gpu_h200_yield.json" 2>&1 |
   tee "$out/bench_gl_yield.log"
+fi
+# The paper's future work executed on the GPU: MRT fused passes and the looping kernels beside
+# the multipass pipeline, polled read-backs (real_gpu.py: --variants).
+if [ "$phase" != frames ]; then
+  .bin/bench_gl --runs 5 --sizes 256 1024 --threads 16 --no-stream --readback-wait poll \
+    --variants multipass mrt looping --micro-passes 50 \
+    --scenes scenes/sphere-alone.gltf scenes/bunny.gltf scenes/bunny-mirror.gltf \
+    --json "$out/real_gpu_h200_variants.json" 2>&1 | tee "$out/bench_gl_variants.log"
+fi
+

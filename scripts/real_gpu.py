@@ -41,6 +41,11 @@ def fmt(v, digits=1):
     return "—" if v is None else f"{v:,.{digits}f}"
 
 
+def fps(ms):
+    x = 1e3 / ms
+    return f"{x:.1f}" if x < 10 else f"{x:,.0f}"
+
+
 def pct(pred, meas):
     return "—" if not pred or not meas else f"{100 * (pred / meas - 1):+.0f}%"
 
@@ -65,8 +70,9 @@ def clocks(path):
     return busy or None
 
 
-def frames_by(d):
-    return {(f["scene"], f["size"], f["engine"]): f for f in d.get("frames", [])}
+def frames_by(d, variant="multipass"):
+    return {(f["scene"], f["size"], f["engine"]): f for f in d.get("frames", [])
+            if f.get("variant", "multipass") == variant}
 
 
 def fixed_table(d):
@@ -85,6 +91,8 @@ def main():
                     help="keep the llvmpipe and prediction JSON instead of measuring again")
     ap.add_argument("--add", action="append", default=[],
                     help="NAME=FILE.json: bench_gl figures measured on another machine")
+    ap.add_argument("--add-variants", action="append", default=[],
+                    help="NAME=FILE.json: that machine's frames with --variants (MRT, looping)")
     ap.add_argument("--add-run", action="append", default=[],
                     help="NAME=FILE.json: an earlier run there, for its frame times and clocks")
     args = ap.parse_args()
@@ -96,6 +104,10 @@ def main():
     if not args.reuse or not os.path.exists(preds):
         run([args.bench, "--runs", "1", "--sizes", "256", "1024", "--readback-wait", "none",
              "--json", preds])
+    preds_var = os.path.join(DOCS, "real_gpu_predictions_variants.json")
+    if args.add_variants and (not args.reuse or not os.path.exists(preds_var)):
+        run([args.bench, "--runs", "1", "--sizes", "256", "1024", "--readback-wait", "none",
+             "--variants", "mrt", "looping", "--json", preds_var])
 
     def named(specs):
         out = {}
@@ -108,6 +120,7 @@ def main():
 
     remote = named(args.add)
     earlier = named(args.add_run)
+    variants = named(args.add_variants)
     llvm = load(local)
     pred = frames_by(load(preds))
 
@@ -170,6 +183,37 @@ def main():
                     lines.append(f"| {f['scene']} | {k['name']} | {k['passes']:,} | "
                                  f"{fmt(k['gpu_ms'], 2)} | {fmt(w, 2)} | {ratio} |")
             lines.append("")
+    for name, (d, clk) in variants.items():
+        pv = load(preds_var) if os.path.exists(preds_var) else {"frames": []}
+        lines += [f"### The paper's future work on the {name}: MRT and looping kernels", "",
+                  "The same frames with the fused two-output passes (`--mrt on`) and with the "
+                  "looping kernels (`--kernels looping`, 32 steps a pass), on the `h200` profile, "
+                  "polled read-backs, measured in one run beside the multipass pipeline "
+                  f"(`docs/{os.path.basename(args.add_variants[0].partition('=')[2])}`)."]
+        if clk:
+            lines[-1] += (f" SM clock while busy: median {statistics.median(clk):.0f} MHz, "
+                          f"{min(clk):.0f}–{max(clk):.0f} MHz.")
+        lines += ["", "| scene | size | pipeline | wall ms | GPU ms | passes | read-backs | "
+                  "predicted ms | predicted vs wall | frames per second | x multipass |",
+                  "|---|---|---|---|---|---|---|---|---|---|---|"]
+        base = frames_by(d, "multipass")
+        cells = sorted({(f["scene"], f["size"]) for f in d["frames"]}, key=lambda c: (c[1], c[0]))
+        for scene, size in cells:
+            for v in ("multipass", "mrt", "looping"):
+                f = frames_by(d, v).get((scene, size, "gl-poll"))
+                if not f:
+                    continue
+                src = pred if v == "multipass" else frames_by(pv, v)
+                pr = src.get((scene, size, "stream"))
+                # multipass predictions are the gf5700-profile run's counts priced on the h200
+                pm = pr["predicted_ms"].get(name) if pr else None
+                b = base.get((scene, size, "gl-poll"))
+                lines.append(
+                    f"| {scene} | {size}² | {v} | {fmt(f['wall_ms'])} | {fmt(f['gpu_ms'])} | "
+                    f"{f['passes']:,} | {f['query_readbacks']:,} | {fmt(pm)} | "
+                    f"{pct(pm, f['wall_ms'])} | {fps(f['wall_ms'])} | "
+                    f"{b['wall_ms'] / f['wall_ms']:.1f}x |")
+        lines.append("")
     for name, (d, clk) in earlier.items():
         fb = frames_by(d)
         lines += [f"### An earlier run ({name}): the emulator's runs between the GL frames", ""]
