@@ -228,6 +228,28 @@ int main(int argc, char** argv) {
       for (int size : {1, 256})
         row("pass + polled query read-back", size,
             time_passes(dp, size, micro_passes, runs, true, copy, nullptr));
+      // Texture work outside passes: a clear, and a read-back of one RGBA32F texture to the host
+      // (glGetTexImage; the image at the end of a frame), each after a glFinish.
+      for (int size : {256, 1024, 2048}) {
+        vgpu::Texture t = d.make_texture("readback", size, size, 4);
+        d.upload(t);
+        std::vector<double> clear_us, down_us;
+        for (int r = 0; r <= runs; ++r) {
+          d.finish();
+          auto t0 = Clock::now();
+          d.clear(t, {0.f, 0.f, 0.f, 0.f});
+          d.finish();
+          const double c = 1e3 * ms_since(t0);
+          t0 = Clock::now();
+          d.download(t);
+          const double w = 1e3 * ms_since(t0);
+          if (r == 0) continue;
+          clear_us.push_back(c);
+          down_us.push_back(w);
+        }
+        row("clear one RGBA32F texture", size, {median(clear_us), 0});
+        row("download one RGBA32F texture", size, {median(down_us), 0});
+      }
       for (int size : {1024, 2048}) {
         const int n = std::max(10, micro_passes / 10);
         row("pass, one RGBA32F target", size, time_passes(d, size, n, runs, false, copy, nullptr));

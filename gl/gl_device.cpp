@@ -161,6 +161,7 @@ void GlDevice::download(Texture& t) {
   glActiveTexture(kScratchUnit);
   glBindTexture(GL_TEXTURE_2D, g.name);
   glGetTexImage(GL_TEXTURE_2D, 0, g.format, GL_FLOAT, t.texel_mut(0, 0));
+  vgpu::count_download(stats_, t);
 }
 
 void GlDevice::use_program(const vgpu::Program& program) {

@@ -22,6 +22,7 @@ std::vector<std::pair<std::string, double>> CostBreakdown::items() const {
           {"program_load_ms", program_load_ms},
           {"bus_ms", bus_ms},
           {"readback_ms", readback_ms},
+          {"download_ms", download_ms},
           {"wasted_ms", wasted_ms},
           {"loop_idle_ms", loop_idle_ms},
           {"loop_overhead_ms", loop_overhead_ms},
@@ -138,8 +139,11 @@ CostBreakdown predict(const vgpu::FrameStats& stats, const vgpu::Profile& hw, co
   }
   // Clears write whole textures without a program: the frame's bytes no pass wrote.
   if (t.bytes_written > pass_bytes_written) {
-    const double clear_ms =
-        1e3 * double(t.bytes_written - pass_bytes_written) / (hw.mem_gbps * 1e9);
+    const double clear_bytes = double(t.bytes_written - pass_bytes_written);
+    double clear_ms = 1e3 * clear_bytes / (hw.mem_gbps * 1e9);
+    if (hw.output_bytes_per_clock > 0)  // a clear writes through the ROPs too
+      clear_ms =
+          std::max(clear_ms, 1e3 * clear_bytes / (hw.output_bytes_per_clock * hw.core_mhz * 1e6));
     b.memory_ms += clear_ms;
     b.memory_demand_ms += clear_ms;
   }
@@ -147,8 +151,11 @@ CostBreakdown predict(const vgpu::FrameStats& stats, const vgpu::Profile& hw, co
   b.bus_ms = 1e3 * double(t.program_bytes) / (hw.bus_mbps * 1e6);
   b.program_load_ms = b.bus_ms + 1e-3 * p.program_load_us * double(t.program_loads);
   b.readback_ms = 1e-3 * p.readback_us * double(t.query_readbacks);
+  if (hw.download_gbps > 0)
+    b.download_ms = 1e-3 * hw.download_us * double(stats.downloads) +
+                    1e3 * double(stats.download_bytes) / (hw.download_gbps * 1e9);
   b.total_ms = b.arithmetic_ms + b.texture_ms + b.memory_ms + b.per_pass_ms + b.program_load_ms +
-               b.readback_ms;
+               b.readback_ms + b.download_ms;
   return b;
 }
 

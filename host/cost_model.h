@@ -15,6 +15,7 @@
 // and Profile::loop_overhead_clocks of the pipeline.
 // Per frame:  + program loads (bytes over the bus + program_load_us each)
 //             + query read-backs (readback_us each: a pipeline drain and a CPU round trip)
+//             + texture downloads (download_us each + bytes / download_gbps, where modelled)
 //             + clears (bytes / bandwidth, counted with memory)
 #pragma once
 
@@ -67,6 +68,7 @@ struct CostBreakdown {
   double program_load_ms = 0;  // program bytes over the bus + program_load_us per load
   double bus_ms = 0;           // of program_load_ms: the program bytes over the bus alone
   double readback_ms = 0;      // query read-backs x readback_us
+  double download_ms = 0;      // texture read-backs: download_us each + bytes / download_gbps
   double wasted_ms = 0;        // of the pass work: idle fragments (finished rays)
   // Looping passes (Counters::loop_*): of the pass work, the lanes already out of the loop while
   // their batch iterates; of the arithmetic, the loop/break overhead (Profile).

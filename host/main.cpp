@@ -456,6 +456,8 @@ int run_render(const RenderArgs& a, bool lanes_given) {
         for (auto& k : stats["programs"]) k[key] = nullptr;
       }
     j["totals"] = std::move(stats["totals"]);
+    j["downloads"] = stats["downloads"];
+    j["download_bytes"] = stats["download_bytes"];
     j["kernels"] = std::move(stats["programs"]);
   }
   // The cost model's prediction for every built-in profile (the counters do not depend on it).

@@ -10,7 +10,7 @@
 #   /usr/bin/python3 scripts/real_gpu.py --reuse --add h200=docs/real_gpu_h200.json \
 #     --add-variants h200=docs/real_gpu_h200_variants.json --add-run h200-run1=docs/real_gpu_h200_run1.json
 set -euo pipefail
-out="${1:?usage: scripts/h200_bench.sh OUTPUT_DIR [all|frames|variants]}"
+out="${1:?usage: scripts/h200_bench.sh OUTPUT_DIR [all|frames|variants|texture-io]}"
 phase="${2:-all}"
 cd "$(dirname "$0")/.."
 if [ -d .gl ]; then
@@ -27,7 +27,7 @@ smi --query-gpu=timestamp,clocks.sm,clocks.mem,utilization.gpu --format=csv -lms
   > "$out/gpu_clocks.csv" &
 sampler=$!
 trap 'kill $sampler 2>/dev/null || true' EXIT
-if [ "$phase" != variants ]; then
+if [ "$phase" = all ] || [ "$phase" = frames ]; then
 # Frames with both read-back waits (the emulator's counts and the predictions are the same on
 # every machine: scripts/real_gpu.py computes them here with --readback-wait none).
 .bin/bench_gl --runs 5 --sizes 256 1024 --threads 16 --no-stream --readback-wait both \
@@ -40,10 +40,15 @@ __GL_YIELD=NOTHING .bin/bench_gl --runs 5 --sizes 256 --no-stream --readback-wai
 fi
 # The paper's future work executed on the GPU: MRT fused passes and the looping kernels beside
 # the multipass pipeline, polled read-backs (real_gpu.py: --variants).
-if [ "$phase" != frames ]; then
+if [ "$phase" = all ] || [ "$phase" = variants ]; then
   .bin/bench_gl --runs 5 --sizes 256 1024 --threads 16 --no-stream --readback-wait poll \
     --variants multipass mrt looping --micro-passes 50 \
     --scenes scenes/sphere-alone.gltf scenes/bunny.gltf scenes/bunny-mirror.gltf \
     --json "$out/real_gpu_h200_variants.json" 2>&1 | tee "$out/bench_gl_variants.log"
 fi
-
+# Texture work outside passes (clears, read-backs of a frame's image to the host), for the cost
+# model's download term; the fixed costs again beside them.
+if [ "$phase" = all ] || [ "$phase" = texture-io ]; then
+  .bin/bench_gl --runs 5 --micro-passes 50 --no-frames --readback-wait block \
+    --json "$out/real_gpu_h200_texture_io.json" 2>&1 | tee "$out/bench_gl_texture_io.log"
+fi

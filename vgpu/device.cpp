@@ -139,4 +139,9 @@ void count_readback(FrameStats& stats, const Program* program, uint64_t result) 
   if (!stats.passes.empty()) stats.passes.back().query_result = int64_t(result);
 }
 
+void count_download(FrameStats& stats, const Texture& t) {
+  ++stats.downloads;
+  stats.download_bytes += uint64_t(t.width()) * uint64_t(t.height()) * t.bytes_per_texel();
+}
+
 }  // namespace vgpu

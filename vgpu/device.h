@@ -107,5 +107,7 @@ void add_loop_counters(Counters& c, const Program::Analysis& a, const Texture* c
 // What a program load and a query read-back add to the statistics, on every device.
 void count_program_load(FrameStats& stats, const Program& program, const Profile& profile);
 void count_readback(FrameStats& stats, const Program* program, uint64_t result);
+// What reading a texture back to the host adds (Device::download), on every device.
+void count_download(FrameStats& stats, const Texture& t);
 
 }  // namespace vgpu

@@ -54,7 +54,7 @@ class Gpu final : public Device {
 
   // The emulator's textures live in host memory: nothing to copy.
   void upload(const Texture&) override {}
-  void download(Texture&) override {}
+  void download(Texture& t) override { count_download(stats_, t); }  // host memory: a count
 
   // Pipeline state.
   void use_program(const Program& program) override;

@@ -165,6 +165,10 @@ const std::vector<Profile>& profiles() {
     // and two targets take twice as long: 28 bytes a clock. Measured on tiny programs, not on the
     // frames it predicts.
     m.output_bytes_per_clock = 28;  // model parameter (measured by bench_gl's copy pass)
+    // A glGetTexImage of one RGBA32F texture to the host: 330 us for 1 MB, 5.43 ms for 16 MB,
+    // 28.1 ms for 64 MB (bench_gl, docs/real_gpu_h200_texture_io.json): 3.1 GB/s, no fixed part.
+    m.download_us = 0;      // measured (bench_gl: within noise of 0)
+    m.download_gbps = 3.1;  // measured (bench_gl, 16 MB read-back)
 
     m.max_loop_iterations = 1 << 20;  // model parameter: no loop count limit
     m.loop_overhead_clocks = 1;       // model parameter (assumed: a compare and a branch)

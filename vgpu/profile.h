@@ -34,6 +34,10 @@ struct Profile {
   double program_load_us = 0;  // driver cost of binding another fragment program (model parameter)
   double readback_us = 0;      // occlusion-query read-back: pipeline drain + sync (model parameter)
   double pass_us = 0;          // fixed cost of one render-to-texture pass (model parameter)
+  // Reading a texture back to the host (the image at the end of a frame): a fixed cost and a
+  // rate (0: not modelled; the 2004 cards' read-backs are outside Table 1's timings).
+  double download_us = 0;
+  double download_gbps = 0;
   int instruction_bytes = 16;  // bytes of one encoded instruction (program upload size)
   // Fragment-unit throughput, for the cost model (host/cost_model.h).
   int alu_lanes = 4;            // scalar lanes one arithmetic instruction drives (4: vec4 ALU)

@@ -50,6 +50,7 @@ void FrameStats::clear() {
   passes.clear();
   programs.clear();
   totals = {};
+  downloads = download_bytes = 0;
 }
 
 nlohmann::ordered_json FrameStats::json() const {
@@ -73,6 +74,8 @@ nlohmann::ordered_json FrameStats::json() const {
     progs.push_back(e);
   }
   j["programs"] = progs;
+  j["downloads"] = downloads;
+  j["download_bytes"] = download_bytes;
   return j;
 }
 

@@ -121,6 +121,9 @@ struct FrameStats {
   Counters totals;
   bool keep_pass_records = true;  // off: only per-program and frame totals (long renders)
   bool device_timed = false;      // device_ms holds measured times (the GL device)
+  // Device -> host texture read-backs (the image and AOVs at the end of a frame), outside passes.
+  uint64_t downloads = 0;
+  uint64_t download_bytes = 0;
 
   ProgramTotals& program(const std::string& name, const std::string& paper_name, int instructions);
   const ProgramTotals* find(const std::string& name) const;

@@ -1,9 +1,9 @@
 // The virtual GPU's public header: include this one to use it.
 #pragma once
 
+#include "vgpu/device.h"
 #include "vgpu/format.h"
 #include "vgpu/fragment.h"
-#include "vgpu/device.h"
 #include "vgpu/glsl.h"
 #include "vgpu/gpu.h"
 #include "vgpu/lanes.h"

@@ -129,6 +129,10 @@ TEST_CASE(
     CHECK(queries == v.result.stats.totals.query_readbacks);
     CHECK(same_driver_counts(v.result.stats.totals, g.result.stats.totals));
     CHECK(g.result.stats.totals.device_ms > 0);
+    // The image and hit textures read back at the end: counted alike on both devices.
+    CHECK(v.result.stats.downloads >= 2);
+    CHECK(v.result.stats.downloads == g.result.stats.downloads);
+    CHECK(v.result.stats.download_bytes == g.result.stats.download_bytes);
   }
 }
 

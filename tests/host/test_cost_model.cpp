@@ -106,6 +106,20 @@ TEST_CASE("Texel-byte and output-byte rates bound a pass where a profile gives t
   CHECK(rop.total_ms == doctest::Approx(1.280 + 0.020 + 0.040992 + 0.040));
 }
 
+TEST_CASE("Texture downloads cost their fixed part and their bytes where a profile prices them") {
+  vgpu::FrameStats s = frame(kernel_passes(2));
+  s.downloads = 2;
+  s.download_bytes = 3000000;
+  vgpu::Profile hw = card();
+  CHECK(host::predict(s, hw, params()).download_ms == doctest::Approx(0.0));  // not modelled
+  hw.download_gbps = 1;  // 3 MB at 1 GB/s: 3 ms
+  hw.download_us = 250;  // and 0.25 ms each
+  const host::CostBreakdown b = host::predict(s, hw, params());
+  CHECK(b.download_ms == doctest::Approx(3.5));
+  const host::CostBreakdown without = host::predict(frame(kernel_passes(2)), hw, params());
+  CHECK(b.total_ms == doctest::Approx(without.total_ms + 3.5));
+}
+
 TEST_CASE("Pass records and per-program totals predict the same for identical passes") {
   vgpu::FrameStats s = frame(kernel_passes(2));
   const host::CostBreakdown totals = host::predict(s, card(), params());
