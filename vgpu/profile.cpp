@@ -149,7 +149,7 @@ const std::vector<Profile>& profiles() {
     m.precision = Format::fp32;
     m.bus_mbps = 64000;  // PCI Express 5.0 x16, one direction (H200 datasheet)
     // Fixed costs measured by bench_gl on this H200 (NVIDIA 580 driver, EGL, 1x1 passes, medians
-    // of two runs, docs/real_gpu.md): a pass 10.0 and 10.8 us, a polled query read-back 11 to
+    // of two runs, docs/real_gpu.md): a pass 10.0 and 10.8 us, a polled query read-back 9 to
     // 14 us more, a program switch under 1 us. The blocking GL_QUERY_RESULT wait costs up to
     // 140 us more after a long pass (the driver sleeps); the model prices the polled wait.
     m.pass_us = 10.4;                // measured (bench_gl)
