@@ -286,8 +286,7 @@ int main(int argc, char** argv) {
           const host::Grid grid =
               host::build_grid(scene, host::grid_spec_for(host::parse_grid_spec(grid_text), scene,
                                                           vgpu::profile(opt.profile)));
-          const host::Camera cam =
-              scene.camera ? *scene.camera : host::frame_bounds(scene.bounds(), 1.0f);
+          const host::Camera cam = host::scene_camera(scene);
           for (const std::string& variant : variants) {
             // The paper's pipeline at Table 1's profile; its future work (MRT fused passes, the
             // looping kernels) needs a profile with several outputs and loops: the h200's.

@@ -67,7 +67,7 @@ void bench(const std::string& label, const host::Scene& scene, int bounces, int 
   opt.bounces = bounces;
   opt.threads = threads;
   host::StreamTracer tracer(scene, grid, opt);
-  const host::Camera cam = scene.camera ? *scene.camera : host::frame_bounds(scene.bounds(), 1.0f);
+  const host::Camera cam = host::scene_camera(scene);
   std::vector<double> ms;
   host::RenderResult last;
   for (int i = 0; i < reps; ++i) {

@@ -49,7 +49,7 @@ Case scene_file(const std::string& name, int bounces) {
   c.label = name + (bounces ? ", " + std::to_string(bounces) + " bounces" : ", primary");
   c.scene = host::load_scene(host::resolve_scene(name));
   c.grid = auto_grid(c.scene);
-  c.camera = c.scene.camera ? *c.scene.camera : host::frame_bounds(c.scene.bounds(), 1.0f);
+  c.camera = host::scene_camera(c.scene);
   c.bounces = bounces;
   return c;
 }

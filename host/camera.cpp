@@ -31,6 +31,10 @@ Camera frame_bounds(const Bounds& b, float aspect) {
   return cam;
 }
 
+Camera scene_camera(const Scene& scene, float aspect) {
+  return scene.camera ? *scene.camera : frame_bounds(scene.bounds(), aspect);
+}
+
 glm::vec3 primary_dir(const Camera& cam, int W, int H, float x, float y) {
   const glm::vec3 right = glm::normalize(glm::cross(cam.forward, cam.up));
   const float t = std::tan(cam.yfov / 2.0f);

@@ -20,6 +20,9 @@ namespace host {
 // A non-positive or non-finite aspect counts as 1.
 Camera frame_bounds(const Bounds& b, float aspect);
 
+// The camera a render of `scene` uses: the file's own, else frame_bounds() of its bounds.
+Camera scene_camera(const Scene& scene, float aspect = 1.0f);
+
 // The primary ray direction (world space, unit) through pixel (x, y) of a W x H image; the top
 // row is y = 0 and the ray passes through the pixel centre (x + 0.5, y + 0.5):
 //   right = normalize(cross(forward, up)); t = tan(yfov / 2); a = W / H;

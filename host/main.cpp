@@ -387,8 +387,7 @@ int run_render(const RenderArgs& a, bool lanes_given) {
     if (!why.empty()) throw UsageError(why);
   }
   const float aspect = float(opt.width) / float(opt.height);
-  const host::Camera cam =
-      scene.camera ? *scene.camera : host::frame_bounds(scene.bounds(), aspect);
+  const host::Camera cam = host::scene_camera(scene, aspect);
   const bool tty = ::isatty(2) && !a.quiet;
   if (!a.quiet)
     opt.progress = [&](int it, int n) {

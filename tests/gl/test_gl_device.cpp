@@ -38,7 +38,7 @@ Frame render(const std::string& scene_name, const std::string& device, int size,
   opt.keep_pass_records = keep_passes;
   const host::Grid grid =
       host::build_grid(scene, host::grid_spec_for({}, scene, vgpu::profile(opt.profile)));
-  const host::Camera cam = scene.camera ? *scene.camera : host::frame_bounds(scene.bounds(), 1.0f);
+  const host::Camera cam = host::scene_camera(scene);
   host::StreamTracer tracer(scene, grid, opt);
   Frame f{tracer.render(cam), tracer.device().description()};
   return f;

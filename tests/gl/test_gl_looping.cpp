@@ -24,7 +24,7 @@ host::RenderResult render(const std::string& scene_name, const std::string& devi
   opt.keep_pass_records = true;
   const host::Grid grid =
       host::build_grid(scene, host::grid_spec_for({}, scene, vgpu::profile(opt.profile)));
-  const host::Camera cam = scene.camera ? *scene.camera : host::frame_bounds(scene.bounds(), 1.0f);
+  const host::Camera cam = host::scene_camera(scene);
   host::StreamTracer tracer(scene, grid, opt);
   return tracer.render(cam);
 }

@@ -91,9 +91,7 @@ struct Agreement {
 Agreement compare_with_stream(const std::string& file, const RenderOptions& opt) {
   const Scene scene = host::load_scene(file);
   const host::Grid grid = host::build_grid(scene, host::GridSpec{});
-  const Camera cam = scene.camera
-                         ? *scene.camera
-                         : host::frame_bounds(scene.bounds(), float(opt.width) / float(opt.height));
+  const Camera cam = host::scene_camera(scene, float(opt.width) / float(opt.height));
   const RenderResult cpu = host::render_cpu(scene, grid, cam, opt);
   host::StreamTracer stream_tracer(scene, grid, opt);
   const RenderResult gpu = stream_tracer.render(cam);

@@ -64,8 +64,7 @@ TEST_CASE("looping kernels give the multipass hit ids, depths and colours on the
   for (const std::string& path : scenes) {
     CAPTURE(path);
     const host::Scene scene = host::load_scene(path);
-    const host::Camera cam =
-        scene.camera ? *scene.camera : host::frame_bounds(scene.bounds(), 1.0f);
+    const host::Camera cam = host::scene_camera(scene);
     const host::Grid grid = host::build_grid(
         scene, host::grid_spec_for(host::GridSpec{}, scene, vgpu::profile("gf6600")));
     const RenderResult multi = render(scene, grid, cam, on_gf6600(64, 64, false));

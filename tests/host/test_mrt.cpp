@@ -96,8 +96,7 @@ TEST_CASE("every bundled scene at 64x64 gives identical hit ids, depths and imag
     opt.threads = 2;
     const host::Grid grid =
         host::build_grid(scene, host::grid_spec_for({}, scene, vgpu::profile(opt.profile)));
-    const host::Camera cam =
-        scene.camera ? *scene.camera : host::frame_bounds(scene.bounds(), 1.0f);
+    const host::Camera cam = host::scene_camera(scene);
     const host::RenderResult off = render(scene, grid, cam, opt, false);
     const host::RenderResult on = render(scene, grid, cam, opt, true);
     MESSAGE(name << ": passes " << off.stats.totals.passes << " -> " << on.stats.totals.passes

@@ -47,7 +47,7 @@ Frame render(host::FrameRecorder& rec, bool masks, std::optional<glm::ivec2> tra
   const host::Grid grid = host::build_grid(
       scene, host::grid_spec_for(host::GridSpec{}, scene, vgpu::profile(opt.profile)));
   host::StreamTracer tracer(scene, grid, opt);
-  const host::Camera cam = scene.camera ? *scene.camera : host::frame_bounds(scene.bounds(), 1.2f);
+  const host::Camera cam = host::scene_camera(scene, 1.2f);
   Frame f{tracer.render(cam), ""};
   rec.finish(f.result.stats);
   f.trace = trace.str();
