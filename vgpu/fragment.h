@@ -56,14 +56,10 @@ inline V8 load8(const float* p) {
   return v;
 }
 
-// p: 8 texels xyzw. Out: x0..x7, y0..y7, z0..z7, w0..w7.
-inline void split8(const float* p, float* x, float* y, float* z, float* w) {
-  const V8 l0 = load8(p), l1 = load8(p + 8), l2 = load8(p + 16), l3 = load8(p + 24);
-  // a0 = [texel 0 | texel 4], a1 = [1 | 5], a2 = [2 | 6], a3 = [3 | 7]: then in-lane 4x4.
-  const V8 a0 = __builtin_shufflevector(l0, l2, 0, 1, 2, 3, 8, 9, 10, 11);
-  const V8 a1 = __builtin_shufflevector(l0, l2, 4, 5, 6, 7, 12, 13, 14, 15);
-  const V8 a2 = __builtin_shufflevector(l1, l3, 0, 1, 2, 3, 8, 9, 10, 11);
-  const V8 a3 = __builtin_shufflevector(l1, l3, 4, 5, 6, 7, 12, 13, 14, 15);
+// a0 = [texel 0 | texel 4], a1 = [1 | 5], a2 = [2 | 6], a3 = [3 | 7] (xyzw each): the in-lane
+// 4x4 transpose into x0..x7, y.., z.., w.. (split8 and gather8 share it).
+[[gnu::always_inline]] inline void transpose4x4_lanes(V8 a0, V8 a1, V8 a2, V8 a3, float* x,
+                                                      float* y, float* z, float* w) {
   const V8 u0 = __builtin_shufflevector(a0, a1, 0, 8, 1, 9, 4, 12, 5, 13);
   const V8 u1 = __builtin_shufflevector(a0, a1, 2, 10, 3, 11, 6, 14, 7, 15);
   const V8 u2 = __builtin_shufflevector(a2, a3, 0, 8, 1, 9, 4, 12, 5, 13);
@@ -76,6 +72,17 @@ inline void split8(const float* p, float* x, float* y, float* z, float* w) {
   std::memcpy(y, &vy, sizeof vy);
   std::memcpy(z, &vz, sizeof vz);
   std::memcpy(w, &vw, sizeof vw);
+}
+
+// p: 8 texels xyzw. Out: x0..x7, y0..y7, z0..z7, w0..w7.
+inline void split8(const float* p, float* x, float* y, float* z, float* w) {
+  const V8 l0 = load8(p), l1 = load8(p + 8), l2 = load8(p + 16), l3 = load8(p + 24);
+  // a0 = [texel 0 | texel 4], a1 = [1 | 5], a2 = [2 | 6], a3 = [3 | 7]: then in-lane 4x4.
+  const V8 a0 = __builtin_shufflevector(l0, l2, 0, 1, 2, 3, 8, 9, 10, 11);
+  const V8 a1 = __builtin_shufflevector(l0, l2, 4, 5, 6, 7, 12, 13, 14, 15);
+  const V8 a2 = __builtin_shufflevector(l1, l3, 0, 1, 2, 3, 8, 9, 10, 11);
+  const V8 a3 = __builtin_shufflevector(l1, l3, 4, 5, 6, 7, 12, 13, 14, 15);
+  transpose4x4_lanes(a0, a1, a2, a3, x, y, z, w);
 }
 
 // The inverse: x0..x7, y.., z.., w.. into 8 texels xyzw at p.
@@ -132,18 +139,7 @@ inline void gather8(const float* const* p, float* x, float* y, float* z, float* 
   const V8 a1 = __builtin_shufflevector(t[1], t[5], 0, 1, 2, 3, 4, 5, 6, 7);
   const V8 a2 = __builtin_shufflevector(t[2], t[6], 0, 1, 2, 3, 4, 5, 6, 7);
   const V8 a3 = __builtin_shufflevector(t[3], t[7], 0, 1, 2, 3, 4, 5, 6, 7);
-  const V8 u0 = __builtin_shufflevector(a0, a1, 0, 8, 1, 9, 4, 12, 5, 13);
-  const V8 u1 = __builtin_shufflevector(a0, a1, 2, 10, 3, 11, 6, 14, 7, 15);
-  const V8 u2 = __builtin_shufflevector(a2, a3, 0, 8, 1, 9, 4, 12, 5, 13);
-  const V8 u3 = __builtin_shufflevector(a2, a3, 2, 10, 3, 11, 6, 14, 7, 15);
-  const V8 vx = __builtin_shufflevector(u0, u2, 0, 1, 8, 9, 4, 5, 12, 13);
-  const V8 vy = __builtin_shufflevector(u0, u2, 2, 3, 10, 11, 6, 7, 14, 15);
-  const V8 vz = __builtin_shufflevector(u1, u3, 0, 1, 8, 9, 4, 5, 12, 13);
-  const V8 vw = __builtin_shufflevector(u1, u3, 2, 3, 10, 11, 6, 7, 14, 15);
-  std::memcpy(x, &vx, sizeof vx);
-  std::memcpy(y, &vy, sizeof vy);
-  std::memcpy(z, &vz, sizeof vz);
-  std::memcpy(w, &vw, sizeof vw);
+  transpose4x4_lanes(a0, a1, a2, a3, x, y, z, w);
 }
 
 // Texel indices (first float of each texel) of lanes at clamped texel coordinates u[i], v[i]
