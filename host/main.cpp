@@ -62,6 +62,7 @@ struct RenderArgs {
   std::string precision = "fp32";
   std::string formats;
   std::string kernels = "multipass";
+  std::string walk = "batches";
   int steps_per_pass = 32;
   bool steps_given = false;
 };
@@ -260,6 +261,14 @@ void add_render_options(CLI::App& render, RenderArgs& a) {
       ->check(CLI::IsMember({"multipass", "looping"}))
       ->capture_default_str();
   render
+      .add_option("--walk", a.walk,
+                  "How the emulator runs the multipass grid walk on the host: batches (8 pixels "
+                  "through every pass at a time, their state in registers, then the pass "
+                  "sequence replayed for the statistics) | passes (pass by pass over the "
+                  "target); same images and statistics, stream engine")
+      ->check(CLI::IsMember({"batches", "passes"}))
+      ->capture_default_str();
+  render
       .add_option("--steps-per-pass", a.steps_per_pass,
                   "With --kernels looping: loop iterations per pass before the host's occlusion "
                   "query (the profile's loop limit applies: gf6600 255)")
@@ -283,6 +292,7 @@ int run_render(const RenderArgs& a, bool lanes_given) {
   opt.mrt = a.mrt == "on";
   opt.looping = a.kernels == "looping";
   opt.steps_per_pass = a.steps_per_pass;
+  opt.batch_walk = a.walk == "batches";
   if (opt.mrt && opt.looping)
     throw UsageError(
         "--mrt on with --kernels looping: the looping program already writes the traversal, "

@@ -88,6 +88,12 @@ struct RenderOptions {
   // Emulator shortcut: skip host work for fragments whose result cannot change (finished rays);
   // their statistics are charged as if run. Off only to check that it changes nothing.
   bool host_shortcut = true;
+  // Emulator shortcut: run the multipass grid walk batch by batch (8 neighbouring pixels through
+  // every pass of the walk, their ray state in registers, vgpu/batch.h), then replay the pass
+  // sequence for the statistics. Same images, AOVs and statistics as pass by pass (false). Used
+  // where it applies: the vgpu at 8 lanes, with host_shortcut or masks, the multipass kernels,
+  // no observer and no trace_pixel; elsewhere the walk runs pass by pass.
+  bool batch_walk = true;
   std::optional<glm::ivec2> trace_pixel;  // print every pass this pixel took part in
   std::ostream* trace_out = nullptr;
   bool keep_pass_records = false;
@@ -130,6 +136,16 @@ class StreamTracer {
                                std::initializer_list<const vgpu::Texture*> in,
                                std::initializer_list<vgpu::Texture*> outs,
                                const vgpu::Stencil* work = nullptr);
+  // The multipass walk through the grid, written once for every way it runs: X executes each
+  // pass and query (StreamTracer::DeviceWalker pass by pass on the device, or as the replay of
+  // a batch walk; BatchWalker one batch of pixels at a time; CheckWalker checks the bindings).
+  struct Cursor;
+  struct DeviceWalker;
+  template <class X>
+  void walk_multipass(X& x, Cursor& c);
+  // The walk batch by batch (RenderOptions::batch_walk) and the replay of its passes; false
+  // where it does not apply (the walk then runs pass by pass).
+  bool walk_in_batches(Cursor& c);
   // The looping variant of the walk (RenderOptions::looping): the looping program's passes.
   void walk_looping(vgpu::Texture& origins, vgpu::Texture& rays, uint64_t walking);
   uint64_t count(const vgpu::Program& p, const vgpu::Texture& in, const vgpu::Stencil* work,

@@ -19,6 +19,10 @@ namespace vgpu {
 struct BoundTexture {
   const float* data = nullptr;  // channels floats per texel, row-major
   int width = 0, height = 0, channels = 0;
+  // Emulator shortcut (vgpu/batch.h): the texels of this batch's own fragments, held in registers
+  // between passes, channel-major (4 x W floats). Set only where the program reads the unit at
+  // its own texel alone; fetches then come from here instead of `data`.
+  const float* lanes = nullptr;
 };
 
 inline constexpr int kMaxTextureUnits = 16;  // fp30/fp40 texture image units
@@ -209,6 +213,14 @@ class Fragments {
       };
       return {ch(0), ch(1), ch(2), ch(3)};
     } else {
+      if (t.lanes) {  // resident in registers (a batch's own texels: vgpu/batch.h)
+        Vec4<F> r;
+        r.x.copy_from(t.lanes, stdx::element_aligned);
+        r.y.copy_from(t.lanes + W, stdx::element_aligned);
+        r.z.copy_from(t.lanes + 2 * W, stdx::element_aligned);
+        r.w.copy_from(t.lanes + 3 * W, stdx::element_aligned);
+        return r;
+      }
       const F fu = floor(u), fv = floor(v);
       const float u0 = fu[0], v0 = fv[0];
       if (t.channels == 4 && u0 >= 0.0f && u0 + float(W - 1) <= float(t.width - 1) && v0 >= 0.0f &&

@@ -748,6 +748,8 @@ const PassRecord& Gpu::draw(const Rect& rect) {
     }
   }
 
+  if (const PassTally* t = std::exchange(replay_, nullptr)) return replay(p, a, rect, *t, t0);
+
   in_draw_ = true;
   std::vector<Chunk>& chunks = chunks_;
   DrawPlan plan;
@@ -944,20 +946,17 @@ const PassRecord& Gpu::draw(const Rect& rect) {
     sum.idle += c.idle;
     sum.idle_flags += c.idle_flags;
   }
-  // Static per-fragment costs times shaded fragments: identical at any width and thread count.
-  Counters c = pass_counters(a, units_.data(), targets_, sum.launched, sum.shaded, sum.discarded);
-  c.fragments_masked = sum.masked;
-  c.lanes_idle = sum.idle;
   std::vector<uint64_t> loop_active, loop_idle;
+  LoopCounts loop_n;
   if (looping) {
-    const LoopCounts n = loop_batches(rect, plan.loop_map, uint32_t(t0tex.width()), work_view,
-                                      test_view, work_masked_, profile_.branch_granularity,
-                                      a.loop.max_iterations, loop_active, loop_idle);
-    if (n.shaded != sum.shaded) fail("program '" + pname + "': loop batches miscounted");
-    add_loop_counters(c, a, units_.data(), n);
+    loop_n = loop_batches(rect, plan.loop_map, uint32_t(t0tex.width()), work_view, test_view,
+                          work_masked_, profile_.branch_granularity, a.loop.max_iterations,
+                          loop_active, loop_idle);
+    if (loop_n.shaded != sum.shaded) fail("program '" + pname + "': loop batches miscounted");
   }
-  if (plan.flags) {
-    const std::array<uint64_t, 2> batch =
+  std::array<uint64_t, 2> batch{};
+  if (plan.flags)
+    batch =
         // From the list where it is short; otherwise a scan of the tiles (eight flags a step),
         // where under a listed mask the flags alone decide (no stencil test; fragments off the
         // list hold kIdle, or 0 where that counts as masked), as if every fragment ran.
@@ -966,8 +965,93 @@ const PassRecord& Gpu::draw(const Rect& rect) {
                                      work_masked_, sum.idle_flags)
             : idle_in_batches(rect, plan.flags, plan.list ? nullptr : work_view, test_view,
                               work_masked_, sum.idle_flags, plan.took8, plan.took32);
-    c.idle_in_batch32 = batch[0];
-    c.idle_in_batch1024 = batch[1];
+  return settle(p, a, rect, sum, plan.flags ? &batch : nullptr, looping ? &loop_n : nullptr,
+                std::move(loop_active), std::move(loop_idle), t0, 0.0);
+}
+
+// A pass that a batch walk ran already (Gpu::replay_next): nothing runs, and the statistics
+// come out as the fragment processor's would. The walk ran the fragments of the work mask
+// (every fragment without one); the others are idle, settled as run_rows's listed path settles
+// them; the tally's tile sums give the batch counters as idle_in_batches_listed does.
+const PassRecord& Gpu::replay(const Program& p, const Program::Analysis& a, const Rect& rect,
+                              const PassTally& t, std::chrono::steady_clock::time_point t0) {
+  const Texture& target = *targets_[0];
+  if (stencil_test_ || rect.x0 != 0 || rect.y0 != 0 || rect.x1 != target.width() ||
+      rect.y1 != target.height() || a.loop.loops > 0)
+    fail("program '" + std::string(p.name()) +
+         "': a replayed pass must cover the whole target, without stencil test or loop");
+  const uint64_t area = rect.area();
+  if (t.ran > area || (!work_mask_ && t.ran != area))
+    fail("program '" + std::string(p.name()) + "': replayed tally does not fit the pass");
+  const uint64_t idle = area - t.ran;
+  Chunk sum;
+  sum.launched = area;
+  sum.shaded = area;
+  sum.discarded = t.killed;
+  sum.idle = t.lanes_idle;
+  sum.idle_flags = t.flagged_idle;
+  if (work_masked_) {  // idle fragments: rejected by the early-z test, never shaded
+    sum.shaded -= idle;
+    sum.masked += idle;
+  } else {
+    sum.idle += uint64_t(a.branches) * idle;
+    if (p.idle_discards()) sum.discarded += idle;
+    if (a.branches > 0) sum.idle_flags += idle;
+  }
+  flags_size_ = 0;  // no per-fragment map: nothing ran here
+  flags_ran_.reset();
+  // The walk left the targets and the stencil written: whatever the emulator knew of them is old.
+  for (Texture* target_tex : targets_) ++target_tex->version_;
+  if (stencil_write_) ++stencil_write_->version_;
+  const std::array<uint64_t, 2> batch{sum.idle_flags - t.idle_near_took8x4,
+                                      sum.idle_flags - t.idle_near_took32x32};
+  return settle(p, a, rect, sum, a.branches > 0 ? &batch : nullptr, nullptr, {}, {}, t0, t.host_ms);
+}
+
+void Gpu::parallel_for(int n, const std::function<void(int, int)>& body) {
+  std::atomic<int> next{0}, slot{0};
+  const std::function<void()> job = [&] {
+    const int mine = slot.fetch_add(1);
+    for (;;) {
+      const int k = next.fetch_add(1);
+      if (k >= n) return;
+      body(k, mine);
+    }
+  };
+  if (workers_.empty() || n <= 1) {
+    job();
+    return;
+  }
+  {
+    std::lock_guard lk(mu_);
+    job_ = &job;
+    ++job_serial_;
+    busy_ = int(workers_.size());
+  }
+  cv_work_.notify_all();
+  job();
+  std::unique_lock lk(mu_);
+  cv_done_.wait(lk, [&] { return busy_ == 0; });
+  job_ = nullptr;
+}
+
+// The statistics of a pass from what its fragments did: static per-fragment costs times the
+// fragments shaded (identical at any width and thread count), the batch and loop counters.
+const PassRecord& Gpu::settle(const Program& p, const Program::Analysis& a, const Rect& rect,
+                              const Chunk& sum, const std::array<uint64_t, 2>* batch,
+                              const LoopCounts* loop, std::vector<uint64_t> loop_active,
+                              std::vector<uint64_t> loop_idle,
+                              std::chrono::steady_clock::time_point t0, double extra_ms) {
+  const std::string pname = p.name();
+  const bool looping = loop != nullptr;
+  const Format precision = precision_of(p);
+  Counters c = pass_counters(a, units_.data(), targets_, sum.launched, sum.shaded, sum.discarded);
+  c.fragments_masked = sum.masked;
+  c.lanes_idle = sum.idle;
+  if (looping) add_loop_counters(c, a, units_.data(), *loop);
+  if (batch) {
+    c.idle_in_batch32 = (*batch)[0];
+    c.idle_in_batch1024 = (*batch)[1];
   }
   // Arithmetic (every counted operation but the fetches) by the precision it ran at.
   const uint64_t alu = c.instructions - c.texture_fetches;
@@ -975,7 +1059,8 @@ const PassRecord& Gpu::draw(const Rect& rect) {
   if (precision == Format::fp16) c.alu_fp16 = alu;
   if (query_active_) query_count_ += sum.shaded - sum.discarded;
   c.host_ms =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count() +
+      extra_ms;
 
   FrameStats::ProgramTotals& totals = stats_.program(pname, p.paper_name(), a.instructions);
   totals.counters += c;

@@ -13,6 +13,7 @@
 #pragma once
 
 #include <array>
+#include <chrono>
 #include <condition_variable>
 #include <functional>
 #include <initializer_list>
@@ -23,6 +24,7 @@
 #include <thread>
 #include <vector>
 
+#include "vgpu/batch.h"
 #include "vgpu/device.h"
 
 namespace vgpu {
@@ -99,6 +101,15 @@ class Gpu final : public Device {
   FrameStats& stats() override { return stats_; }
   const FrameStats& stats() const { return stats_; }
 
+  // Emulator shortcut for walks run batch by batch (vgpu/batch.h, host/stream_tracer.cpp): the
+  // next draw() runs no fragment and charges the pass as `t` says its fragments ran (t must
+  // outlive that draw). Every check a draw makes is still made; the targets and the stencil
+  // write hold what the walk left there.
+  void replay_next(const PassTally& t) { replay_ = &t; }
+  // body(item, slot) for items [0, n) on the calling thread and the workers; slot <
+  // threads() is the running thread's own (for per-thread accumulators).
+  void parallel_for(int n, const std::function<void(int, int)>& body);
+
  private:
   struct Chunk;
   struct DrawPlan;
@@ -107,6 +118,13 @@ class Gpu final : public Device {
                 Chunk& out) const;
   void parallel_rows(const Rect& r, uint64_t work,
                      const std::function<void(int, int, Chunk&)>& body, std::vector<Chunk>& chunks);
+  const PassRecord& replay(const Program& p, const Program::Analysis& a, const Rect& rect,
+                           const PassTally& t, std::chrono::steady_clock::time_point t0);
+  const PassRecord& settle(const Program& p, const Program::Analysis& a, const Rect& rect,
+                           const Chunk& sum, const std::array<uint64_t, 2>* batch,
+                           const LoopCounts* loop, std::vector<uint64_t> loop_active,
+                           std::vector<uint64_t> loop_idle,
+                           std::chrono::steady_clock::time_point t0, double extra_ms);
   void track_pairs(const Program& p, const std::shared_ptr<const std::vector<uint32_t>>& runs,
                    bool chunk_runs);
   void worker_loop();
@@ -116,6 +134,7 @@ class Gpu final : public Device {
   int lanes_;
   Format precision_ = Format::fp32;
   const Program* program_ = nullptr;
+  const PassTally* replay_ = nullptr;
   uint32_t loaded_program_ = 0;
   std::array<const Texture*, kMaxTextureUnits> units_{};
   std::vector<Texture*> targets_;
