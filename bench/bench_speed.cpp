@@ -1,9 +1,12 @@
 // Benchmark: the stream engine's host time against the project's CPU tracer, scene by scene, at
-// 1 and 2 threads (render ms, initialization apart, median of repetitions). The scenes: bunny
-// (primary rays), bunny-refl (2 bounces), a 2000-triangle fan whose centre crowds one voxel
-// column, and a generated 320k-triangle terrain; 256x256, no shadows. Also the work the stream
-// engine cannot skip: its passes and the fragments that ran (fragment-steps, counted with the
-// finished-ray mask as an early-z test). Figures in docs/speed.md.
+// 1 and 2 threads (render ms, initialization apart, median of repetitions). The stream engine
+// runs its grid walk both ways (RenderOptions::batch_walk): pass by pass over the target, and in
+// batches of 8 pixels through every pass (the default); the three renders alternate, so a noisy
+// machine slows them alike. The scenes: bunny (primary rays), bunny-refl (2 bounces), a
+// 2000-triangle fan whose centre crowds one voxel column, and a generated 320k-triangle terrain;
+// 256x256, no shadows. Also the work the stream engine cannot skip: its passes and the fragments
+// that ran (fragment-steps, counted with the finished-ray mask as an early-z test). Figures in
+// docs/speed.md.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -119,8 +122,9 @@ int main(int argc, char** argv) {
   // `bench_speed quick`: the first case only; `bench_speed case K`: case K (0-based) only.
   const bool quick = argc > 1 && std::strcmp(argv[1], "quick") == 0;
   const int only = argc > 2 && std::strcmp(argv[1], "case") == 0 ? std::atoi(argv[2]) : -1;
-  std::printf("%-28s %7s %7s %10s %10s %7s %7s %10s\n", "scene (256x256, no shadows)", "tris",
-              "threads", "stream ms", "cpu ms", "ratio", "passes", "ran");
+  std::printf("%-26s %6s %7s %10s %10s %8s %9s %9s %6s %8s\n", "scene (256x256, no shadows)",
+              "tris", "threads", "passes ms", "batches ms", "cpu ms", "batch/cpu", "pass/batch",
+              "passes", "ran");
   for (size_t k = 0; k < (quick ? 1 : makers.size()); ++k) {
     if (only >= 0 && int(k) != only) continue;
     const Case c = makers[k]();
@@ -142,16 +146,18 @@ int main(int argc, char** argv) {
       opt.bounces = c.bounces;
       opt.shadows = false;
       opt.threads = threads;
-      host::StreamTracer tracer(c.scene, c.grid, opt);
-      std::vector<double> stream, cpu;
-      // Alternating engines, so a noisy machine slows both alike.
+      host::RenderOptions by_pass = opt;
+      by_pass.batch_walk = false;
+      host::StreamTracer batched(c.scene, c.grid, opt), passwise(c.scene, c.grid, by_pass);
+      std::vector<double> batch_ms, pass_ms, cpu_ms;
       for (int i = 0; i < c.reps; ++i) {
-        stream.push_back(tracer.render(c.camera).render_ms);
-        cpu.push_back(host::render_cpu(c.scene, c.grid, c.camera, opt).render_ms);
+        pass_ms.push_back(passwise.render(c.camera).render_ms);
+        batch_ms.push_back(batched.render(c.camera).render_ms);
+        cpu_ms.push_back(host::render_cpu(c.scene, c.grid, c.camera, opt).render_ms);
       }
-      const double s = median(stream), p = median(cpu);
-      std::printf("%-28s %7zu %7d %10.1f %10.1f %6.2fx %7llu %9.2fM\n", c.label.c_str(),
-                  c.scene.triangle_count(), threads, s, p, s / p,
+      const double b = median(batch_ms), p = median(pass_ms), u = median(cpu_ms);
+      std::printf("%-26s %6zu %7d %10.1f %10.1f %8.1f %8.2fx %8.2fx %6llu %7.2fM\n",
+                  c.label.c_str(), c.scene.triangle_count(), threads, p, b, u, b / u, p / b,
                   static_cast<unsigned long long>(passes), double(ran) / 1e6);
       std::fflush(stdout);
     }

@@ -65,6 +65,7 @@ struct RenderArgs {
   std::string walk = "batches";
   int steps_per_pass = 32;
   bool steps_given = false;
+  bool walk_given = false;
 };
 
 struct UsageError : std::runtime_error {
@@ -267,6 +268,7 @@ void add_render_options(CLI::App& render, RenderArgs& a) {
                   "sequence replayed for the statistics) | passes (pass by pass over the "
                   "target); same images and statistics, stream engine")
       ->check(CLI::IsMember({"batches", "passes"}))
+      ->each([&a](const std::string&) { a.walk_given = true; })
       ->capture_default_str();
   render
       .add_option("--steps-per-pass", a.steps_per_pass,
@@ -341,6 +343,8 @@ int run_render(const RenderArgs& a, bool lanes_given) {
                        "without passes, lanes or masks)");
   }
   if (a.steps_given && !opt.looping) throw UsageError("--steps-per-pass needs --kernels looping");
+  if (a.walk_given && a.engine != "stream")
+    throw UsageError("--walk needs --engine stream (it says how the emulator runs the walk)");
   // Reduced precision runs at 1 or 8 lanes (vgpu/gpu.cpp): refuse another width.
   const bool reduced = a.precision != "fp32" || !a.formats.empty();
   if (reduced && opt.lanes != 1 && opt.lanes != 8)
@@ -442,6 +446,8 @@ int run_render(const RenderArgs& a, bool lanes_given) {
   if (opt.looping) j["steps_per_pass"] = opt.steps_per_pass;
   j["threads"] = opt.threads;
   j["lanes"] = opt.lanes;
+  // How the emulator ran the grid walks: in batches or pass by pass (same statistics).
+  if (!cpu && !gl) j["walk"] = r.batch_walk ? "batches" : "passes";
   j["precision"] = a.precision;
   if (!cpu) j["formats"] = host::to_json(opt.formats);
   j["init_ms"] = init_ms;
@@ -528,9 +534,10 @@ int run_render(const RenderArgs& a, bool lanes_given) {
       std::cout << "formats (texture and arithmetic, per group):\n" << describe(opt.formats);
     std::printf("initialization %.1f ms (grid %.1f ms), render %.1f ms (%s)\n", init_ms,
                 grid.build_ms, r.render_ms,
-                cpu  ? "host CPU"
-                : gl ? "wall, GL device"
-                     : "host, emulated");
+                cpu            ? "host CPU"
+                : gl           ? "wall, GL device"
+                : r.batch_walk ? "host, emulated, walks in batches"
+                               : "host, emulated");
     if (gl)
       std::printf("device %s: passes %.2f ms of GPU time (timer queries)\n",
                   tracer->device().description().c_str(), r.stats.totals.device_ms);

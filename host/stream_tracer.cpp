@@ -49,7 +49,8 @@ struct StreamTracer::State {
   KernelProgram<LoopingTraversal> looping;
   uint64_t rays_traced = 0;
   uint64_t rays_unfinished = 0;
-  int max_list = 0;  // longest voxel list: a ray tests at most this many triangles per voxel
+  bool batch_walk = false;  // a walk of this frame ran in batches
+  int max_list = 0;         // longest voxel list: a ray tests at most this many triangles per voxel
   // Per program of the walk, the units it reads only at its own texel (batch walks).
   std::vector<std::pair<const vgpu::Program*, uint32_t>> own_only;
 };
@@ -410,12 +411,6 @@ class Keyed {
     auto& by_k = by_step[i];
     if (by_k.size() <= j) by_k.resize(j + 1);
     return by_k[j];
-  }
-  const T* find(const PassKey& key) const {
-    const auto& by_step = v_[size_t(key.site)];
-    const size_t i = size_t(key.step + 1), j = size_t(key.k + 1);
-    if (by_step.size() <= i || by_step[i].size() <= j) return nullptr;
-    return &by_step[i][j];
   }
   // f(key, value) for every pass seen.
   template <class Fn>
@@ -866,6 +861,7 @@ bool StreamTracer::walk_in_batches(Cursor& c) {
   // loads and the query read-backs come out as a pass-by-pass walk's.
   DeviceWalker replay{*this, &tallies};
   walk_multipass(replay, c);
+  s.batch_walk = true;
   return true;
 }
 
@@ -1032,6 +1028,7 @@ RenderResult StreamTracer::render(const Camera& cam) {
   gpu.stats().clear();
   s.rays_traced = 0;
   s.rays_unfinished = 0;
+  s.batch_walk = false;
   const int W = opt_.width, H = opt_.height;
   RenderResult res;
   res.width = W;
@@ -1125,6 +1122,7 @@ RenderResult StreamTracer::render(const Camera& cam) {
   res.stats = gpu.stats();
   res.rays_traced = s.rays_traced;
   res.rays_unfinished = s.rays_unfinished;
+  res.batch_walk = s.batch_walk;
   res.render_ms = ms_since(t0);
   return res;
 }

@@ -112,6 +112,7 @@ struct RenderResult {
   int iterations = 0;            // ray-tracing iterations run (primary included)
   uint64_t rays_traced = 0;      // rays entering a trace (primary, reflected, shadow)
   uint64_t rays_unfinished = 0;  // rays stopped by the pass cap (only under reduced precision)
+  bool batch_walk = false;       // the grid walks ran in batches (RenderOptions::batch_walk)
 };
 
 class StreamTracer {

@@ -4,8 +4,10 @@
 Usage: check_identical.py OLD NEW [--quick]
 Renders each case with both binaries (OLD at 1 thread, NEW at 1 and 2 threads and every lane
 width the case allows), then compares the image and AOV pixels exactly (vgpu-rt compare, threshold
-0) and the --stats-json output with every wall-clock field (*_ms) and the threads/lanes fields
-removed. Prints one line per case and exits 1 if anything differs. Used for emulator speed work
+0) and the --stats-json output with every wall-clock field (*_ms), the threads/lanes/walk fields
+and the scene path (each binary resolves it in its own tree) removed; NEW also runs with --walk
+passes (its default walks in batches at 8 lanes).
+Prints one line per case and exits 1 if anything differs. Used for emulator speed work
 (docs/speed.md), where the host may do less but must compute the same.
 """
 import json
@@ -31,7 +33,7 @@ TIMING = ("_ms",)
 def strip(j):
     if isinstance(j, dict):
         return {k: strip(v) for k, v in j.items()
-                if not k.endswith(TIMING) and k not in ("threads", "lanes")}
+                if not k.endswith(TIMING) and k not in ("threads", "lanes", "walk", "scene_path")}
     if isinstance(j, list):
         return [strip(v) for v in j]
     return j
@@ -61,7 +63,9 @@ def main():
         for i, (scene, extra) in enumerate(CASES[:3] if quick else CASES):
             ref = render(old, work, f"c{i}_old", scene, extra + ["--threads", "1"])
             reduced = "--precision" in extra
-            variants = [["--threads", "1"], ["--threads", "2"]]
+            # NEW's default walks in batches (at 8 lanes); --walk passes runs pass by pass.
+            variants = [["--threads", "1"], ["--threads", "2"], ["--threads", "1", "--walk", "passes"],
+                        ["--threads", "2", "--walk", "passes"]]
             variants += [["--threads", "2", "--lanes", w] for w in
                          (["1"] if reduced else ["1", "4", "16"])]
             for v in variants:

@@ -117,6 +117,10 @@ BatchRun run_as(const Program& p, bool dynamic, const BoundTexture* units,
 void Slot::load(const Texture& t, int x0, int y, int n) {
   texture = &t;
   const int ch = t.channels();
+  if (ch == 4 && n == W) {  // the usual case: 8 whole texels, one transpose
+    texels::split8(t.texel(x0, y), v[0], v[1], v[2], v[3]);
+    return;
+  }
   for (int c = 0; c < 4; ++c)
     for (int i = 0; i < W; ++i) v[c][i] = c == 3 ? 1.0f : 0.0f;
   const float* d = t.texel(x0, y);
@@ -129,6 +133,10 @@ void Slot::load(const Texture& t, int x0, int y, int n) {
 void Slot::store(const Texture& t, float* data, int x0, int y, int n) const {
   const int ch = t.channels();
   float* d = data + t.index(x0, y);
+  if (ch == 4 && n == W) {
+    texels::join8(v[0], v[1], v[2], v[3], d);
+    return;
+  }
   for (int i = 0; i < n; ++i)
     for (int c = 0; c < ch; ++c) d[i * ch + c] = v[c][i];
 }
