@@ -404,13 +404,15 @@ struct PassKey {
 template <class T>
 class Keyed {
  public:
-  T& at(const PassKey& key) {
-    auto& by_step = v_[size_t(key.site)];
-    const size_t i = size_t(key.step + 1), j = size_t(key.k + 1);
-    if (by_step.size() <= i) by_step.resize(i + 1);
-    auto& by_k = by_step[i];
-    if (by_k.size() <= j) by_k.resize(j + 1);
-    return by_k[j];
+  [[gnu::always_inline]] T& at(const PassKey& key) {
+    // A walk asks for one step's passes in a row: each site's row of the last step is kept.
+    auto& [step, row] = rows_[size_t(key.site)];
+    if (step != key.step || !row) [[unlikely]]
+      row = &step_row(key, step);
+    const size_t j = size_t(key.k + 1);
+    if (row->size() <= j) [[unlikely]]
+      row->resize(j + 1);
+    return (*row)[j];
   }
   // f(key, value) for every pass seen.
   template <class Fn>
@@ -422,7 +424,18 @@ class Keyed {
   }
 
  private:
+  std::vector<T>& step_row(const PassKey& key, int& step) {
+    auto& by_step = v_[size_t(key.site)];
+    const size_t i = size_t(key.step + 1);
+    if (by_step.size() <= i) by_step.resize(i + 1);
+    step = key.step;
+    return by_step[i];
+  }
+
   std::array<std::vector<std::vector<T>>, kSites> v_;
+  // Per site, the step asked last and its row (by_step's vectors move when it grows, but only
+  // when a new step of the same site is asked for, and that refreshes the row).
+  std::array<std::pair<int, std::vector<T>*>, kSites> rows_{};
 };
 
 // What one pass of a walk knows about a program, worked out once per walk.
@@ -484,6 +497,7 @@ class BatchWalker {
     y_ = y;
     n_ = n;
     valid_ = uint8_t((1u << n) - 1);
+    tile8x4_ = (y % 32) / 4 * 4 + (x0 % 32) / 8;  // the 8x4 tile of its 32x32 tile it lies in
     loaded_ = 0;
     masks_loaded_ = 0;
   }
@@ -666,7 +680,7 @@ class BatchWalker {
         a.touched = true;
         touched_.push_back(key);
       }
-      const int j = (y_ % 32) / 4 * 4 + (x0_ % 32) / 8;
+      const int j = tile8x4_;
       a.ran += uint32_t(ran);
       a.ran_in[size_t(j)] = uint8_t(a.ran_in[size_t(j)] + ran);
       if (r.took) {
@@ -682,6 +696,7 @@ class BatchWalker {
   int width_, height_;
   int x0_ = 0, y_ = 0, n_ = 0;
   uint8_t valid_ = 0;
+  int tile8x4_ = 0;
   std::array<vgpu::Slot, kSlots> slots_;
   int ntextures_ = 0;
   uint32_t loaded_ = 0;
