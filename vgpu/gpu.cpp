@@ -663,6 +663,11 @@ void Gpu::parallel_rows(const Rect& r, uint64_t work,
     job();
     return;
   }
+  run_on_workers(job);
+}
+
+// job() on the calling thread and on every worker, until all have returned.
+void Gpu::run_on_workers(const std::function<void()>& job) {
   {
     std::lock_guard lk(mu_);
     job_ = &job;
@@ -1022,17 +1027,7 @@ void Gpu::parallel_for(int n, const std::function<void(int, int)>& body) {
     job();
     return;
   }
-  {
-    std::lock_guard lk(mu_);
-    job_ = &job;
-    ++job_serial_;
-    busy_ = int(workers_.size());
-  }
-  cv_work_.notify_all();
-  job();
-  std::unique_lock lk(mu_);
-  cv_done_.wait(lk, [&] { return busy_ == 0; });
-  job_ = nullptr;
+  run_on_workers(job);
 }
 
 // The statistics of a pass from what its fragments did: static per-fragment costs times the

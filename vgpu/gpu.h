@@ -127,6 +127,7 @@ class Gpu final : public Device {
                            std::chrono::steady_clock::time_point t0, double extra_ms);
   void track_pairs(const Program& p, const std::shared_ptr<const std::vector<uint32_t>>& runs,
                    bool chunk_runs);
+  void run_on_workers(const std::function<void()>& job);
   void worker_loop();
   [[noreturn]] void fail(const std::string& what) const;
 
