@@ -7,6 +7,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <exception>
+#include <mutex>
 #include <stdexcept>
 
 #include "host/devices.h"
@@ -847,19 +849,28 @@ bool StreamTracer::walk_in_batches(Cursor& c) {
     walkers.push_back(
         std::make_unique<BatchWalker>(*gpu, programs, opt_.masks, opt_.width, opt_.height));
   const int W = opt_.width, H = opt_.height, tiles_x = (W + 31) / 32, tiles_y = (H + 31) / 32;
+  // An error on a worker thread (a binding the check let through) reaches the caller.
+  std::mutex failed_mu;
+  std::exception_ptr failed;
   gpu->parallel_for(tiles_x * tiles_y, [&](int tile, int slot) {
-    BatchWalker& x = *walkers[size_t(slot)];
-    const int tx = tile % tiles_x, ty = tile / tiles_x;
-    for (int y = ty * 32; y < std::min(H, ty * 32 + 32); ++y)
-      for (int x0 = tx * 32; x0 < std::min(W, tx * 32 + 32); x0 += vgpu::kBatchWidth) {
-        x.begin(x0, y, std::min(vgpu::kBatchWidth, W - x0));
-        Cursor b = c;
-        walk_multipass(x, b);
-        const int current[3] = {b.trav, b.vs, b.isect};
-        x.finish(pairs, current, 3, masks, 2);
-      }
-    x.settle_tile(tx, ty);
+    try {
+      BatchWalker& x = *walkers[size_t(slot)];
+      const int tx = tile % tiles_x, ty = tile / tiles_x;
+      for (int y = ty * 32; y < std::min(H, ty * 32 + 32); ++y)
+        for (int x0 = tx * 32; x0 < std::min(W, tx * 32 + 32); x0 += vgpu::kBatchWidth) {
+          x.begin(x0, y, std::min(vgpu::kBatchWidth, W - x0));
+          Cursor b = c;
+          walk_multipass(x, b);
+          const int current[3] = {b.trav, b.vs, b.isect};
+          x.finish(pairs, current, 3, masks, 2);
+        }
+      x.settle_tile(tx, ty);
+    } catch (...) {
+      const std::lock_guard lk(failed_mu);
+      if (!failed) failed = std::current_exception();
+    }
   });
+  if (failed) std::rethrow_exception(failed);
   Keyed<vgpu::PassTally> tallies;
   uint64_t ran = 0;
   for (auto& w : walkers)
