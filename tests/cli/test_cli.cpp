@@ -148,8 +148,13 @@ TEST_CASE("help lists each option's allowed values and exits with 0") {
   for (const char* allowed :
        {"{diffuse,phong,phong-atten}", "[0 - 256]", "{1,4,8,16}",
         "{gf5700,r300,gf6600,rtx4090,h200}", "{stream,gl,cpu}", "1x1..16384x16384",
-        "depth=FILE.exr", "{multipass,looping}", "[1 - 4096]"})
+        "depth=FILE.exr", "{multipass,looping}", "[1 - 4096]", "{batches,passes}"})
     CHECK_MESSAGE(text.find(allowed) != std::string::npos, allowed);
+}
+
+TEST_CASE("the walk option is checked against its set and refused off the stream engine") {
+  check_refused("--walk fragments", "--walk");
+  check_refused("--engine cpu --walk passes", "--walk");
 }
 
 TEST_CASE("the looping kernels' options are checked before any work") {
