@@ -15,11 +15,11 @@
 
 #include "gl/context.h"
 #include "gl/gl_device.h"
-#include "host/camera.h"
-#include "host/cost_model.h"
-#include "host/gltf_loader.h"
-#include "host/grid.h"
-#include "host/stream_tracer.h"
+#include "host/accel/grid.h"
+#include "host/model/cost_model.h"
+#include "host/scene/camera.h"
+#include "host/scene/gltf_loader.h"
+#include "host/trace/stream_tracer.h"
 
 namespace {
 

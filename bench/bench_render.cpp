@@ -11,10 +11,10 @@
 #include <thread>
 #include <vector>
 
-#include "host/camera.h"
-#include "host/gltf_loader.h"
-#include "host/grid.h"
-#include "host/stream_tracer.h"
+#include "host/accel/grid.h"
+#include "host/scene/camera.h"
+#include "host/scene/gltf_loader.h"
+#include "host/trace/stream_tracer.h"
 
 namespace {
 

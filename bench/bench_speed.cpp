@@ -16,11 +16,11 @@
 #include <string>
 #include <vector>
 
-#include "host/camera.h"
-#include "host/cpu_tracer.h"
-#include "host/gltf_loader.h"
-#include "host/grid.h"
-#include "host/stream_tracer.h"
+#include "host/accel/grid.h"
+#include "host/scene/camera.h"
+#include "host/scene/gltf_loader.h"
+#include "host/trace/cpu_tracer.h"
+#include "host/trace/stream_tracer.h"
 
 namespace {
 
@@ -57,7 +57,7 @@ Case scene_file(const std::string& name, int bounces) {
   return c;
 }
 
-// The stability suite's fan (tests/host/stability_cases.h, case 9) with n triangles: every one
+// The stability suite's fan (tests/trace/stability_cases.h, case 9) with n triangles: every one
 // shares the centre vertex on the voxel edge x = y = 2 of a 4x4x4 grid over [0, 4]^3, so the
 // voxel column around it lists all of them.
 Case crowded_fan(int n) {

@@ -1,11 +1,11 @@
-// Runs every stability case (tests/host/stability_cases.h) through the stream tracer at fp32,
+// Runs every stability case (tests/trace/stability_cases.h) through the stream tracer at fp32,
 // fp24 and fp16 and prints a markdown table: case x precision -> "pass" or
 // "N of M pixels wrong (hit id), K unfinished rays". scripts/stability.sh writes it to
 // docs/stability.md.
 #include <cstdio>
 #include <string>
 
-#include "../tests/host/stability_cases.h"
+#include "../tests/trace/stability_cases.h"
 
 int main() {
   const auto all = stability::cases();

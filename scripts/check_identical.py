@@ -26,6 +26,8 @@ CASES = [  # (scene, extra options)
     ("teapot", ["--size", "96x128", "--precision", "fp16"]),
     ("bunny-low", ["--precision", "fp24", "--grid", "7x9x5"]),
     ("sphere-alone", ["--shading", "phong-atten", "--grid", "15"]),
+    ("bunny-refl", ["--profile", "gf6600", "--mrt", "on"]),
+    ("classic", ["--profile", "gf6600", "--kernels", "looping", "--size", "96x96"]),
 ]
 TIMING = ("_ms",)
 

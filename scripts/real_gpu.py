@@ -131,7 +131,7 @@ def main():
              "generated from the same C++ kernels the emulator runs. Frames use `docs/table1.md`'s",
              "settings (3 iterations, phong, no shadow rays, a 15³ grid); every figure is the median",
              "of the runs after one warm-up (which compiles the programs). Predictions are the cost",
-             "model's (`host/cost_model.cpp`) from the emulator's counts of the same frame, which",
+             "model's (`host/model/cost_model.cpp`) from the emulator's counts of the same frame, which",
              "equal the GL device's (`tests/gl`).",
              ""]
 

@@ -346,7 +346,7 @@ def report(rows, path, size):
     L.append("## What breaks first at fp16 and at fp24\n")
     L.append("Integers the kernels address texels with (list positions, triangle ids, voxel "
              "pointer texels) are exact in a format only while the texel centre id + 1/2 is: "
-             "below **1024 in fp16** and **65536 in fp24** (host/formats.h). *largest integer* is "
+             "below **1024 in fp16** and **65536 in fp24** (host/model/formats.h). *largest integer* is "
              "what `--precision auto` reports for the scene's voxel state at the auto grid; "
              "*wrong hit* sums over every grid and bounce count. Where the integers fit, the "
              "first to break are the floating-point quantities: t and the barycentrics at "

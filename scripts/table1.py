@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """The paper's Table 1 beside ours: renders the three scenes on every profile with vgpu-rt, reads
-the statistics and the cost model's predictions (host/cost_model.h) from --stats-json, and writes
+the statistics and the cost model's predictions (host/model/cost_model.h) from --stats-json, and writes
 docs/table1.md and docs/table1_breakdown.png (matplotlib).
 
 Usage: /usr/bin/python3 scripts/table1.py [--vgpu-rt build/host/vgpu-rt] [--reuse] [--fit]
@@ -133,8 +133,8 @@ def parse_parameters():
 
 
 def parse_cost_params():
-    """The cost model's own assumed parameters, from host/cost_model.h and .cpp."""
-    h = open(os.path.join(ROOT, "host/cost_model.h")).read()
+    """The cost model's own assumed parameters, from host/model/cost_model.h and .cpp."""
+    h = open(os.path.join(ROOT, "host/model/cost_model.h")).read()
     ops = re.search(r"double scalar_ops_per_instruction = ([\d.]+);", h).group(1)
     body = re.search(r"double branch_body_share = ([\d.]+);", h).group(1)
     return [
@@ -258,7 +258,7 @@ def write_doc(data, masks, cpu, figures, readings, mrt, mrt_masks):
     w("# Table 1: the paper's times, our measurements and the cost model's predictions\n")
     w("Written by `/usr/bin/python3 scripts/table1.py` (do not edit by hand). It renders every scene "
       "on every profile with `vgpu-rt render --stats-json`, and reads the statistics and the cost "
-      "model's predictions (`host/cost_model.h`, also printed by `vgpu-rt render --predict`).\n")
+      "model's predictions (`host/model/cost_model.h`, also printed by `vgpu-rt render --predict`).\n")
     w("Settings, the same for every cell: `" + " ".join(SETTINGS) + "`, masks off unless said. "
       "Scenes: " + ", ".join(f"{n} = `scenes/{f}.gltf`" for n, f in SCENES) + ". The paper "
       "states none of this for Table 1; *Reading the paper's settings* at the end says why these, "
@@ -436,7 +436,7 @@ def write_doc(data, masks, cpu, figures, readings, mrt, mrt_masks):
         for field, value, source, status in rows:
             w(f"| {field} | {value} | {status} | {source} |")
         w("")
-    w("The cost model's own parameters (`host/cost_model.h`), the same for every profile:\n")
+    w("The cost model's own parameters (`host/model/cost_model.h`), the same for every profile:\n")
     w("| parameter | value | status and source |")
     w("|---|---|---|")
     for name, value, src in parse_cost_params():

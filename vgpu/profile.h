@@ -39,7 +39,7 @@ struct Profile {
   double download_us = 0;
   double download_gbps = 0;
   int instruction_bytes = 16;  // bytes of one encoded instruction (program upload size)
-  // Fragment-unit throughput, for the cost model (host/cost_model.h).
+  // Fragment-unit throughput, for the cost model (host/model/cost_model.h).
   int alu_lanes = 4;            // scalar lanes one arithmetic instruction drives (4: vec4 ALU)
   double alu_per_clock = 1;     // arithmetic instructions per pipeline per clock, fp16
   double fp32_rate = 1;         // fp32 arithmetic throughput relative to fp16

@@ -3,7 +3,7 @@
 //   cd scripts/make_scenes && npm ci && node make_scenes.mjs
 //
 // Every file is a single .gltf with its buffer embedded as a base64 data URI. Conventions shared by
-// all scenes (what host/gltf_loader.cpp reads):
+// all scenes (what host/scene/gltf_loader.cpp reads):
 //   - world units, +Y up, floors at y = 0;
 //   - meshes are indexed TRIANGLES (u16 indices) with float POSITION and NORMAL; winding is
 //     counter-clockwise seen from outside; normals are smooth (area-weighted face normals) for

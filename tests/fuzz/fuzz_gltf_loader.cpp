@@ -9,7 +9,7 @@
 #include <cstdlib>
 #include <string>
 
-#include "host/gltf_loader.h"
+#include "host/scene/gltf_loader.h"
 
 namespace {
 

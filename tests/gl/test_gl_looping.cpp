@@ -4,10 +4,10 @@
 
 #include <string>
 
-#include "host/camera.h"
-#include "host/gltf_loader.h"
-#include "host/grid.h"
-#include "host/stream_tracer.h"
+#include "host/accel/grid.h"
+#include "host/scene/camera.h"
+#include "host/scene/gltf_loader.h"
+#include "host/trace/stream_tracer.h"
 #include "tests/gl/gl_compare.h"
 
 namespace {

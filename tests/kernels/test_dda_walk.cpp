@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "host/grid.h"
-#include "host/reference.h"
+#include "host/accel/grid.h"
+#include "host/trace/reference.h"
 #include "kernel_pass.h"
 
 using kernels::kFar;

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Writes the small glTF files that tests/host/test_gltf_loader.cpp loads, valid and broken.
+"""Writes the small glTF files that tests/scene/test_gltf_loader.cpp loads, valid and broken.
 
 Run from anywhere: python3 tests/data/gltf/make_cases.py. The output is committed next to this
 script; each case is a few triangles whose expected values the test states exactly.

@@ -1,0 +1,693 @@
+// vgpu-rt: the command line. `render` runs the stream ray tracer on the virtual GPU and prints
+// the pass statistics; `scenes` lists the bundled scenes; `compare` diffs two images.
+
+// GCC 12 reports false positives inside nlohmann_json's templates.
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#pragma GCC diagnostic ignored "-Wrestrict"
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <regex>
+
+#include "host/accel/grid.h"
+#include "host/image/image_io.h"
+#include "host/model/cost_model.h"
+#include "host/model/formats.h"
+#include "host/report/report.h"
+#include "host/scene/camera.h"
+#include "host/scene/gltf_loader.h"
+#include "host/trace/cpu_tracer.h"
+#include "host/trace/devices.h"
+#include "host/trace/stream_tracer.h"
+#include "kernels/registry.h"
+#include "vgpu/glsl.h"
+#include "vgpu/vgpu.h"
+#ifdef VGPU_HAVE_GL
+#include "gl/context.h"
+#endif
+
+namespace {
+
+struct RenderArgs {
+  std::string scene = "bunny";
+  std::string size = "256x256";
+  std::string out;
+  int bounces = 2;
+  std::string shading = "phong";
+  std::string shadows = "on";
+  std::string grid = "auto";
+  std::string profile = "gf5700";
+  int threads = 0;
+  int lanes = vgpu::kLanes;
+  std::string masks = "off";
+  std::string mrt = "off";
+  std::string stats = "table";
+  std::string stats_json;
+  std::string stats_csv;
+  std::string report;
+  std::vector<std::string> aovs;
+  std::string trace_pixel;
+  bool quiet = false;
+  bool predict = false;
+  std::string engine = "stream";
+  std::string gl_device = "auto";
+  std::string gl_readback = "auto";
+  std::string precision = "fp32";
+  std::string formats;
+  std::string kernels = "multipass";
+  std::string walk = "batches";
+  int steps_per_pass = 32;
+  bool steps_given = false;
+  bool walk_given = false;
+};
+
+struct UsageError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// Largest image side: the render target limit of the largest profile (vgpu/profile.cpp).
+constexpr int kMaxImageSide = 16384;
+// Host threads: 0 (one per core) or 1..kMaxThreads; more than this only queues context switches.
+constexpr int kMaxThreads = 256;
+
+// "WxH" as two positive sides, or nullopt.
+std::optional<glm::ivec2> parse_size(const std::string& text) {
+  std::smatch m;
+  if (!std::regex_match(text, m, std::regex(R"((\d{1,9})[xX](\d{1,9}))"))) return std::nullopt;
+  return glm::ivec2(std::stoi(m[1]), std::stoi(m[2]));
+}
+
+// "X,Y" pixel coordinates, or nullopt.
+std::optional<glm::ivec2> parse_pixel(const std::string& text) {
+  std::smatch m;
+  if (!std::regex_match(text, m, std::regex(R"((\d{1,9}),(\d{1,9}))"))) return std::nullopt;
+  return glm::ivec2(std::stoi(m[1]), std::stoi(m[2]));
+}
+
+// CLI11 validators: each returns an empty string for a good value, else the problem (CLI11
+// prefixes the option name; main() prints it on one line and exits with 2).
+const CLI::Validator kSizeCheck(
+    [](std::string& text) -> std::string {
+      const std::optional<glm::ivec2> s = parse_size(text);
+      if (!s) return "expected WxH (e.g. 256x256), got '" + text + "'";
+      if (s->x < 1 || s->y < 1 || s->x > kMaxImageSide || s->y > kMaxImageSide)
+        return text + " is outside the limit 1x1.." + std::to_string(kMaxImageSide) + "x" +
+               std::to_string(kMaxImageSide);
+      return {};
+    },
+    "WxH in 1x1..16384x16384", "SIZE");
+
+const CLI::Validator kPixelCheck(
+    [](std::string& text) -> std::string {
+      return parse_pixel(text) ? "" : "expected X,Y (e.g. 128,128), got '" + text + "'";
+    },
+    "X,Y", "PIXEL");
+
+const CLI::Validator kGridCheck(
+    [](std::string& text) -> std::string {
+      try {
+        host::parse_grid_spec(text);
+        return {};
+      } catch (const std::invalid_argument& e) {
+        return e.what();
+      }
+    },
+    "auto | N | AxBxC, each 1.." + std::to_string(host::kMaxGridRes), "GRID");
+
+// An output file: the extension is one of `exts` and its directory exists and is writable.
+CLI::Validator output_check(std::vector<std::string> exts) {
+  std::string desc;
+  for (const std::string& e : exts) desc += (desc.empty() ? "FILE" : " | FILE") + e;
+  return CLI::Validator(
+      [exts](std::string& path) -> std::string {
+        try {
+          host::check_output_path(path, exts);
+          return {};
+        } catch (const host::InputError& e) {
+          return e.what();
+        }
+      },
+      desc, "OUTPUT");
+}
+
+// --aov KIND=FILE.exr: the AOVs are float images, so EXR only.
+const CLI::Validator kAovCheck(
+    [](std::string& aov) -> std::string {
+      const auto eq = aov.find('=');
+      const std::string kind = aov.substr(0, eq);
+      if (eq == std::string::npos || eq + 1 == aov.size())
+        return "expected depth=FILE.exr or hit=FILE.exr, got '" + aov + "'";
+      if (kind != "depth" && kind != "hit")
+        return "unknown AOV '" + kind + "' in '" + aov + "' (known: depth, hit)";
+      try {
+        host::check_output_path(aov.substr(eq + 1), {".exr"});
+        return {};
+      } catch (const host::InputError& e) {
+        return e.what();
+      }
+    },
+    "depth=FILE.exr | hit=FILE.exr", "AOV");
+
+std::vector<std::string> profile_names() {
+  std::vector<std::string> names;
+  for (const vgpu::Profile& p : vgpu::profiles()) names.push_back(p.name);
+  return names;
+}
+
+void add_render_options(CLI::App& render, RenderArgs& a) {
+  const std::vector<std::string> on_off{"on", "off"};
+  render.add_option("scene", a.scene, "glTF file (.gltf/.glb) or a scene name from scenes/")
+      ->capture_default_str();
+  render.add_option("--size", a.size, "Image size")->check(kSizeCheck)->capture_default_str();
+  render.add_option("--out", a.out, "Write the image")->check(output_check({".png", ".exr"}));
+  render.add_option("--bounces", a.bounces, "Reflection iterations after the primary one")
+      ->check(CLI::Range(0, 64))
+      ->capture_default_str();
+  render.add_option("--shading", a.shading, "Shading model")
+      ->check(CLI::IsMember({"diffuse", "phong", "phong-atten"}))
+      ->capture_default_str();
+  render.add_option("--shadows", a.shadows, "Shadow rays")
+      ->check(CLI::IsMember(on_off))
+      ->capture_default_str();
+  render.add_option("--grid", a.grid, "Grid voxels per axis")
+      ->check(kGridCheck)
+      ->capture_default_str();
+  render
+      .add_option("--profile", a.profile,
+                  "Modeled card (the cpu engine uses only its texture limit, for --grid auto)")
+      ->check(CLI::IsMember(profile_names()))
+      ->capture_default_str();
+  render.add_option("--threads", a.threads, "Host threads (0: one per core)")
+      ->check(CLI::Range(0, kMaxThreads))
+      ->capture_default_str();
+  render
+      .add_option("--lanes", a.lanes,
+                  "SIMD lanes per batch, stream engine (1: scalar reference; fp24/fp16 run at 1 "
+                  "or 8)")
+      ->check(CLI::IsMember({1, 4, 8, 16}))
+      ->capture_default_str();
+  render
+      .add_option("--masks", a.masks,
+                  "Early-z masks for finished rays (paper's future work), stream engine")
+      ->check(CLI::IsMember(on_off))
+      ->capture_default_str();
+  render
+      .add_option("--mrt", a.mrt,
+                  "Multiple render targets (paper's future work): fused two-output passes for "
+                  "intersecciones + proximoTriangulo and traversal + actualizarVoxel; needs a "
+                  "profile with more than one output (not gf5700); off: the paper's pipeline")
+      ->check(CLI::IsMember(on_off))
+      ->capture_default_str();
+  render.add_option("--stats", a.stats, "Statistics on stdout")
+      ->check(CLI::IsMember({"table", "json", "none"}))
+      ->capture_default_str();
+  render.add_option("--stats-json", a.stats_json, "Also write the statistics as JSON")
+      ->check(output_check({".json"}));
+  render
+      .add_option("--aov", a.aovs,
+                  "Float AOV: depth (distance to the primary hit) or hit (triangle id)")
+      ->check(kAovCheck);
+  render
+      .add_option("--trace-pixel", a.trace_pixel,
+                  "Print every pass this pixel took part in and its state (stream engine)")
+      ->check(kPixelCheck);
+  render.add_flag("--quiet,-q", a.quiet, "No progress on stderr");
+  render
+      .add_option("--stats-csv", a.stats_csv,
+                  "Also write one row per pass (kernel, fragments, fetches, query) as CSV")
+      ->check(output_check({".csv"}));
+  render
+      .add_option("--report", a.report,
+                  "Write an HTML report of the frame (timeline, cost maps, pixel history), "
+                  "stream engine")
+      ->check(output_check({".html"}));
+  render
+      .add_option("--precision", a.precision,
+                  "Ray-state textures and kernel arithmetic, every group, stream engine (auto: "
+                  "per group, the fewest bits this scene needs; the stats say why)")
+      ->check(CLI::IsMember({"fp32", "fp24", "fp16", "auto"}))
+      ->capture_default_str();
+  render.add_option("--formats", a.formats,
+                    "Per group, over --precision: GROUP=FORMAT[/ARITH],... with GROUP rays, "
+                    "traversal, voxel, hits, colour, queries (e.g. colour=fp16/fp32)");
+  render
+      .add_option("--engine", a.engine,
+                  "stream (the vgpu pipeline) | gl (the same passes on an OpenGL driver) | cpu "
+                  "(double-precision reference)")
+      ->check(CLI::IsMember({"stream", "gl", "cpu"}))
+      ->capture_default_str();
+  render
+      .add_option("--gl-device", a.gl_device,
+                  "With --engine gl: auto, or an EGL device index (see vgpu-rt gl-devices)")
+      ->capture_default_str();
+  render
+      .add_option("--gl-readback", a.gl_readback,
+                  "With --engine gl: how the host waits for an occlusion query: block (the "
+                  "driver's GL_QUERY_RESULT wait), poll (spin on GL_QUERY_RESULT_AVAILABLE), "
+                  "auto (poll on a hardware driver, block on a software one)")
+      ->check(CLI::IsMember({"auto", "block", "poll"}))
+      ->capture_default_str();
+  render
+      .add_option("--kernels", a.kernels,
+                  "How rays walk the grid: multipass (the paper's kernels, one pass per step) | "
+                  "looping (one data-dependent loop, Purcell's branching variant; needs dynamic "
+                  "branching, e.g. --profile gf6600), stream engine")
+      ->check(CLI::IsMember({"multipass", "looping"}))
+      ->capture_default_str();
+  render
+      .add_option("--walk", a.walk,
+                  "How the emulator runs the multipass grid walk on the host: batches (8 pixels "
+                  "through every pass at a time, their state in registers, then the pass "
+                  "sequence replayed for the statistics) | passes (pass by pass over the "
+                  "target); same images and statistics, stream engine")
+      ->check(CLI::IsMember({"batches", "passes"}))
+      ->each([&a](const std::string&) { a.walk_given = true; })
+      ->capture_default_str();
+  render
+      .add_option("--steps-per-pass", a.steps_per_pass,
+                  "With --kernels looping: loop iterations per pass before the host's occlusion "
+                  "query (the profile's loop limit applies: gf6600 255)")
+      ->check(CLI::Range(1, 4096))
+      ->each([&a](const std::string&) { a.steps_given = true; })
+      ->capture_default_str();
+  render.add_flag("--predict", a.predict,
+                  "Print the cost model's predicted time for --profile, with its breakdown");
+}
+
+int run_render(const RenderArgs& a, bool lanes_given) {
+  // CLI11 checked each value; what is left are combinations of options.
+  host::RenderOptions opt;
+  const glm::ivec2 size = *parse_size(a.size);
+  opt.width = size.x;
+  opt.height = size.y;
+  opt.bounces = a.bounces;
+  opt.shading = host::parse_shading(a.shading);
+  opt.shadows = a.shadows == "on";
+  opt.masks = a.masks == "on";
+  opt.mrt = a.mrt == "on";
+  opt.looping = a.kernels == "looping";
+  opt.steps_per_pass = a.steps_per_pass;
+  opt.batch_walk = a.walk == "batches";
+  if (opt.mrt && opt.looping)
+    throw UsageError(
+        "--mrt on with --kernels looping: the looping program already writes the traversal, "
+        "voxel and hit targets in one pass; there are no separate passes left to fuse");
+  opt.profile = vgpu::profile(a.profile).name;
+  opt.threads = a.threads;
+  opt.lanes = a.lanes;
+  host::FormatRequest formats;
+  try {
+    formats = host::parse_format_request(a.precision, a.formats);
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(e.what());
+  }
+  const host::GridSpec grid_spec = host::parse_grid_spec(a.grid);
+  std::string aov_depth, aov_hit;
+  for (const std::string& aov : a.aovs) {
+    const auto eq = aov.find('=');
+    (aov.compare(0, eq, "depth") == 0 ? aov_depth : aov_hit) = aov.substr(eq + 1);
+  }
+  if (!a.trace_pixel.empty()) {
+    const glm::ivec2 p = *parse_pixel(a.trace_pixel);
+    if (p.x >= opt.width || p.y >= opt.height)
+      throw UsageError("--trace-pixel: " + a.trace_pixel + " is outside the " + a.size + " image");
+    opt.trace_pixel = p;
+    opt.trace_out = &std::cout;
+  }
+
+  if (a.engine != "stream" && a.engine != "cpu" && a.engine != "gl")
+    throw UsageError("--engine: expected stream, cpu or gl, got '" + a.engine + "'");
+  const bool cpu = a.engine == "cpu";
+  const bool gl = a.engine == "gl";
+  // Settings the CPU reference does not use are refused rather than recorded as if they ran.
+  if (cpu) {
+    const char* unused = a.predict                ? "--predict"
+                         : !a.trace_pixel.empty() ? "--trace-pixel"
+                         : lanes_given            ? "--lanes"
+                         : opt.masks              ? "--masks on"
+                         : opt.mrt                ? "--mrt on"
+                         : a.precision != "fp32"  ? "--precision"
+                         : !a.formats.empty()     ? "--formats"
+                         : opt.looping            ? "--kernels looping"
+                                                  : nullptr;
+    if (unused)
+      throw UsageError(std::string(unused) +
+                       " needs --engine stream (the cpu engine is a double-precision reference "
+                       "without passes, lanes or masks)");
+  }
+  if (a.steps_given && !opt.looping) throw UsageError("--steps-per-pass needs --kernels looping");
+  if (a.walk_given && a.engine != "stream")
+    throw UsageError("--walk needs --engine stream (it says how the emulator runs the walk)");
+  // Reduced precision runs at 1 or 8 lanes (vgpu/gpu.cpp): refuse another width.
+  const bool reduced = a.precision != "fp32" || !a.formats.empty();
+  if (reduced && opt.lanes != 1 && opt.lanes != 8)
+    throw UsageError("--lanes " + std::to_string(opt.lanes) + ": --precision " + a.precision +
+                     " runs at 1 or 8 lanes");
+  // The profile's output limit, before any work (the formats are checked once resolved).
+  if (opt.mrt) {
+    const std::string why =
+        host::mrt_refusal(vgpu::profile(opt.profile), host::Formats::all(vgpu::Format::fp32));
+    if (!why.empty()) throw UsageError(why);
+  }
+  if (a.engine != "stream" && (!a.report.empty() || !a.stats_csv.empty()))
+    throw UsageError(
+        "--report and --stats-csv need --engine stream (the report reads the "
+        "emulator's per-fragment state)");
+  if (gl) {
+    // The GL device runs every fragment in fp32 GLSL; the emulator-only features are refused.
+    if (!host::have_gl_device())
+      throw host::InputError(
+          "--engine gl: this build has no GL device (EGL and OpenGL were not found when it was "
+          "built; scripts/setup.sh installs them)");
+    if (a.predict || !a.trace_pixel.empty() || opt.masks || a.precision != "fp32")
+      throw UsageError(
+          "--engine gl runs the multipass pipeline as a driver does: --predict, --trace-pixel, "
+          "--masks on and --precision fp24/fp16 need --engine stream");
+    opt.device = "gl";
+    opt.gl_device = a.gl_device;
+    opt.gl_readback = a.gl_readback;
+  } else if (a.gl_device != "auto" || a.gl_readback != "auto") {
+    throw UsageError(std::string(a.gl_device != "auto" ? "--gl-device" : "--gl-readback") +
+                     " needs --engine gl");
+  }
+  if (!a.report.empty() && int64_t(opt.width) * opt.height > host::kReportMaxPixels)
+    throw UsageError("--report: at most " + std::to_string(host::kReportMaxPixels) +
+                     " pixels (512x512); got " + a.size);
+  if (!a.report.empty()) host::check_output_path(a.report, {".html"});
+  if (!a.stats_csv.empty()) host::check_output_path(a.stats_csv, {".csv"});
+  std::optional<host::FrameRecorder> recorder;
+  if (!a.report.empty() || !a.stats_csv.empty()) {
+    recorder.emplace(opt.width, opt.height, opt.masks, a.report.empty() ? 0 : host::kHistoryStride,
+                     opt.trace_pixel ? std::vector{*opt.trace_pixel} : std::vector<glm::ivec2>{},
+                     !a.report.empty());
+    opt.observer = &*recorder;
+  }
+
+  const std::string path = host::resolve_scene(a.scene);
+  const host::Scene scene = host::load_scene(path);
+  const auto t0 = std::chrono::steady_clock::now();
+  const host::Grid grid =
+      host::build_grid(scene, host::grid_spec_for(grid_spec, scene, vgpu::profile(opt.profile)));
+  opt.formats = host::resolve(formats, scene, grid, vgpu::profile(opt.profile));
+  if (opt.mrt) {
+    const std::string why = host::mrt_refusal(vgpu::profile(opt.profile), opt.formats);
+    if (!why.empty()) throw UsageError(why);
+  }
+  const float aspect = float(opt.width) / float(opt.height);
+  const host::Camera cam = host::scene_camera(scene, aspect);
+  const bool tty = ::isatty(2) && !a.quiet;
+  if (!a.quiet)
+    opt.progress = [&](int it, int n) {
+      std::fprintf(stderr, tty ? "\rvgpu-rt: iteration %d/%d" : "vgpu-rt: iteration %d/%d\n", it,
+                   n);
+      std::fflush(stderr);
+    };
+  std::optional<host::StreamTracer> tracer;
+  if (!cpu) tracer.emplace(scene, grid, opt);
+  const double init_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  host::CpuStats cpu_stats;
+  const host::RenderResult r =
+      cpu ? host::render_cpu(scene, grid, cam, opt, &cpu_stats) : tracer->render(cam);
+  if (tty) std::fprintf(stderr, "\n");
+  if (recorder) recorder->finish(r.stats);
+
+  if (!a.out.empty()) host::write_image(a.out, r.width, r.height, 3, r.rgb);
+  if (!aov_depth.empty()) host::write_image(aov_depth, r.width, r.height, 1, r.depth);
+  if (!aov_hit.empty()) host::write_image(aov_hit, r.width, r.height, 1, r.hit_id);
+
+  nlohmann::ordered_json j;
+  j["scene"] = scene.name;
+  j["scene_path"] = path;
+  j["engine"] = a.engine;
+  if (tracer) j["device"] = tracer->device().description();
+  j["triangles"] = scene.triangle_count();
+  j["input_triangles"] = scene.input_triangles;
+  j["dropped_degenerate"] = scene.dropped_degenerate;
+  j["grid"] = {grid.res.x, grid.res.y, grid.res.z};
+  j["grid_references"] = grid.references();
+  j["profile"] = opt.profile;
+  j["size"] = {r.width, r.height};
+  j["bounces"] = opt.bounces;
+  j["iterations"] = r.iterations;
+  j["shading"] = a.shading;
+  j["shadows"] = opt.shadows;
+  j["masks"] = opt.masks;
+  j["mrt"] = opt.mrt;  // fused two-output passes (kernels/fused.h)
+  j["fused_programs"] = opt.mrt ? host::mrt_programs() : std::vector<std::string>{};
+  j["kernel_variant"] = a.kernels;  // multipass | looping ("kernels" lists the programs)
+  if (opt.looping) j["steps_per_pass"] = opt.steps_per_pass;
+  j["threads"] = opt.threads;
+  j["lanes"] = opt.lanes;
+  // How the emulator ran the grid walks: in batches or pass by pass (same statistics).
+  if (!cpu && !gl) j["walk"] = r.batch_walk ? "batches" : "passes";
+  j["precision"] = a.precision;
+  if (!cpu) j["formats"] = host::to_json(opt.formats);
+  j["init_ms"] = init_ms;
+  j["grid_build_ms"] = grid.build_ms;
+  j["render_ms"] = r.render_ms;
+  if (tracer) j["texture_bytes"] = tracer->texture_bytes();
+  if (cpu)
+    j["cpu"] = {{"rays", cpu_stats.rays},
+                {"voxel_steps", cpu_stats.voxel_steps},
+                {"triangle_tests", cpu_stats.triangle_tests}};
+  j["rays_traced"] = r.rays_traced;
+  j["rays_unfinished"] = r.rays_unfinished;
+  {
+    nlohmann::ordered_json stats = r.stats.json();
+    if (gl)  // the emulator's SIMD model: a driver does not show its lanes
+      for (const char* key :
+           {"lanes_idle", "idle_in_batch32", "idle_in_batch1024", "loop_iterations",
+            "loop_lane_slots", "loop_lanes_idle", "loop_batch_iterations", "loop_idle_instructions",
+            "loop_idle_fetches"}) {
+        stats["totals"][key] = nullptr;
+        for (auto& k : stats["programs"]) k[key] = nullptr;
+      }
+    j["totals"] = std::move(stats["totals"]);
+    j["downloads"] = stats["downloads"];
+    j["download_bytes"] = stats["download_bytes"];
+    j["kernels"] = std::move(stats["programs"]);
+  }
+  // The cost model's prediction for every built-in profile (the counters do not depend on it).
+  nlohmann::ordered_json predicted_ms, predicted_breakdown;
+  for (const vgpu::Profile& p : vgpu::profiles()) {
+    if (cpu || gl) break;  // no passes, or no SIMD counters to predict from
+    if (opt.looping && p.max_loop_iterations < opt.steps_per_pass) {
+      predicted_ms[p.name] = nullptr;  // the looping program cannot run there
+      continue;
+    }
+    const host::CostBreakdown c = host::predict(r.stats, p);
+    predicted_ms[p.name] = c.total_ms;
+    for (const auto& [key, v] : c.items()) predicted_breakdown[p.name][key] = v;
+  }
+  j["predicted_ms"] = predicted_ms;
+  j["predicted_breakdown"] = predicted_breakdown;
+  auto what_if = nlohmann::ordered_json::array();  // MRT and resident programs (docs/table1.md)
+  for (const auto& [name, s] :
+       cpu || gl ? decltype(host::what_ifs(r.stats)){} : host::what_ifs(r.stats)) {
+    nlohmann::ordered_json w = {{"name", name}, {"totals", vgpu::to_json(s.totals)}};
+    for (const vgpu::Profile& p : vgpu::profiles())
+      for (const auto& [key, v] : host::predict(s, p).items())
+        w["predicted_breakdown"][p.name][key] = v;
+    what_if.push_back(w);
+  }
+  j["predicted_what_if"] = what_if;
+  if (!a.stats_json.empty()) {
+    const std::string tmp = a.stats_json + ".tmp";
+    std::ofstream f(tmp);
+    f << j.dump(2) << "\n";
+    f.close();
+    if (!f || std::rename(tmp.c_str(), a.stats_json.c_str()) != 0) {
+      std::remove(tmp.c_str());
+      throw host::InputError(a.stats_json + ": cannot write the statistics");
+    }
+  }
+  if (!a.stats_csv.empty()) host::write_stats_csv(a.stats_csv, *recorder);
+  if (!a.report.empty()) host::write_report(a.report, *recorder, r, j);
+  if (a.stats == "json") {
+    std::cout << j.dump(2) << "\n";
+  } else if (a.stats == "table") {
+    if (cpu)
+      std::printf(
+          "CPU reference (double precision, recursive Whitted): %llu rays, %llu voxel steps, %llu "
+          "triangle tests\n",
+          static_cast<unsigned long long>(cpu_stats.rays),
+          static_cast<unsigned long long>(cpu_stats.voxel_steps),
+          static_cast<unsigned long long>(cpu_stats.triangle_tests));
+    else
+      std::cout << r.stats.to_table();
+    std::printf(
+        "scene %s: %zu triangles (%u dropped as degenerate), grid %dx%dx%d (%llu references)\n",
+        scene.name.c_str(), scene.triangle_count(), scene.dropped_degenerate, grid.res.x,
+        grid.res.y, grid.res.z, static_cast<unsigned long long>(grid.references()));
+    std::printf("%s %s, %dx%d, %d iteration(s), %s shading, shadows %s, masks %s, mrt %s\n",
+                cpu ? "engine" : "profile", cpu ? "cpu" : opt.profile.c_str(), r.width, r.height,
+                r.iterations, a.shading.c_str(), a.shadows.c_str(), a.masks.c_str(), a.mrt.c_str());
+    if (!cpu)
+      std::cout << "formats (texture and arithmetic, per group):\n" << describe(opt.formats);
+    std::printf("initialization %.1f ms (grid %.1f ms), render %.1f ms (%s)\n", init_ms,
+                grid.build_ms, r.render_ms,
+                cpu            ? "host CPU"
+                : gl           ? "wall, GL device"
+                : r.batch_walk ? "host, emulated, walks in batches"
+                               : "host, emulated");
+    if (gl)
+      std::printf("device %s: passes %.2f ms of GPU time (timer queries)\n",
+                  tracer->device().description().c_str(), r.stats.totals.device_ms);
+  }
+  if (a.predict) {
+    const vgpu::Profile& p = vgpu::profile(opt.profile);
+    std::cout << host::describe(host::predict(r.stats, p), p);
+  }
+  return 0;
+}
+
+// `vgpu-rt kernels [NAME] [--glsl]`: what a fragment program is, per kernel.
+int run_kernels(const std::string& name, bool glsl) {
+  auto programs = kernels::all_programs();
+  // The looping variant's program (--kernels looping) is listed after the paper's.
+  programs.push_back(std::make_unique<vgpu::KernelProgram<kernels::LoopingTraversal>>());
+  auto spelled = [](std::string n) {
+    for (char& c : n)
+      if (c == ' ') c = '-';
+    return n;
+  };
+  if (name.empty()) {
+    if (glsl) throw UsageError("kernels --glsl: name a kernel (vgpu-rt kernels lists them)");
+    std::printf("%-22s %-22s %7s %7s %8s  %s\n", "kernel", "paper name", "outputs", "instr.",
+                "branches", "textures (unit: contents, fetches per fragment)");
+    for (const auto& p : programs) {
+      const vgpu::Program::Analysis a = p->analyze();
+      std::string units;
+      for (int u = 0; u < vgpu::kMaxTextureUnits; ++u)
+        if (a.fetches.per_unit[u])
+          units += (units.empty() ? "" : ", ") + std::to_string(u) + ": " + p->unit_name(u) +
+                   (a.fetches.per_unit[u] > 1 ? " x" + std::to_string(a.fetches.per_unit[u]) : "");
+      std::printf("%-22s %-22s %7d %7d %8d  %s\n", spelled(p->name()).c_str(), p->paper_name(),
+                  p->outputs(), a.instructions, a.branches, units.empty() ? "-" : units.c_str());
+    }
+    std::printf(
+        "instructions: one per arithmetic, compare, select and fetch, every branch taken (the "
+        "counting run); default uniforms\n");
+    return 0;
+  }
+  for (const auto& p : programs) {
+    if (name != p->name() && name != spelled(p->name()) && name != p->paper_name()) continue;
+    if (glsl) {
+      std::fputs(vgpu::to_glsl(*p, true).source.c_str(), stdout);
+    } else {
+      const vgpu::Program::Analysis a = p->analyze();
+      std::printf("%s (paper: %s): %d output(s), %d instructions, %d branch block(s)\n", p->name(),
+                  p->paper_name(), p->outputs(), a.instructions, a.branches);
+      for (int u = 0; u < vgpu::kMaxTextureUnits; ++u)
+        if (a.fetches.per_unit[u])
+          std::printf("  unit %2d  %-16s %d fetch(es) per fragment\n", u, p->unit_name(u).c_str(),
+                      a.fetches.per_unit[u]);
+    }
+    return 0;
+  }
+  throw UsageError("kernels: no kernel named '" + name + "' (vgpu-rt kernels lists them)");
+}
+
+int run_gl_devices() {
+#ifdef VGPU_HAVE_GL
+  const auto devices = gl::Context::list_devices();
+  if (devices.empty()) std::printf("EGL lists no devices (auto uses the surfaceless platform)\n");
+  for (const auto& d : devices)
+    std::printf("%d  %s%s\n", d.index, d.name.c_str(), d.software ? " (software)" : "");
+  return 0;
+#else
+  throw host::InputError("gl-devices: this build has no GL device (EGL was not found)");
+#endif
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "vgpu-rt: a virtual 2004 GPU and the stream ray tracer of Fal, Vasconcelos & "
+      "Delrieux (after Purcell et al. 2002)"};
+  app.require_subcommand(1);
+  RenderArgs a;
+  auto* render = app.add_subcommand(
+      "render", "Render a scene on the virtual GPU and print the pass statistics");
+  add_render_options(*render, a);
+  auto* scenes = app.add_subcommand("scenes", "List the scenes in scenes/");
+  std::string kernel_name;
+  bool kernel_glsl = false;
+  auto* kernels_cmd = app.add_subcommand(
+      "kernels", "List the fragment programs (kernels), or print one as its generated GLSL");
+  kernels_cmd->add_option("name", kernel_name, "A kernel's name or paper name (e.g. traversal)");
+  kernels_cmd->add_flag("--glsl", kernel_glsl,
+                        "Print the GLSL fragment shader generated from the kernel's C++ functor");
+  auto* gl_devices = app.add_subcommand("gl-devices", "List the EGL devices --gl-device can pick");
+  std::string ca, cb;
+  double threshold = 1.0 / 255.0;
+  auto* compare = app.add_subcommand(
+      "compare", "Compare two images (OpenImageIO): differing pixels, RMS, PSNR");
+  compare->add_option("a", ca, "First image")->required()->check(CLI::ExistingFile);
+  compare->add_option("b", cb, "Second image")->required()->check(CLI::ExistingFile);
+  compare->add_option("--threshold", threshold, "Per-channel difference that makes a pixel differ")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+
+  std::string da, db;
+  auto* diff = app.add_subcommand(
+      "diff", "Two runs' --stats-json side by side: per kernel and in total, B - A and B / A");
+  diff->add_option("a", da, "First --stats-json file")->required();
+  diff->add_option("b", db, "Second --stats-json file")->required();
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::fprintf(stderr, "vgpu-rt: %s (see vgpu-rt --help)\n", e.what());
+    return 2;
+  }
+  try {
+    if (*render) return run_render(a, render->count("--lanes") > 0);
+    if (*scenes) {
+      for (const auto& [name, path] : host::list_scenes()) {
+        try {
+          const host::Scene s = host::load_scene(path);
+          std::printf("%-14s %7zu triangles  %s\n", name.c_str(), s.triangle_count(), path.c_str());
+        } catch (const std::exception& e) {
+          std::printf("%-14s (unreadable: %s)\n", name.c_str(), e.what());
+        }
+      }
+      return 0;
+    }
+    if (*diff) {
+      std::cout << host::diff_stats(da, db);
+      return 0;
+    }
+    if (*kernels_cmd) return run_kernels(kernel_name, kernel_glsl);
+    if (*gl_devices) return run_gl_devices();
+    if (*compare) {
+      const host::ImageComparison c = host::compare_images(ca, cb, threshold);
+      std::printf(
+          "%dx%d, %d channels: %.4f%% of pixels differ by more than %g; RMS %.6g, PSNR %.2f dB, "
+          "max %.6g\n",
+          c.width, c.height, c.channels, 100.0 * c.differing_share, c.threshold, c.rms_error,
+          c.psnr, c.max_error);
+      return 0;
+    }
+  } catch (const UsageError& e) {
+    std::fprintf(stderr, "vgpu-rt: %s\n", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "vgpu-rt: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}

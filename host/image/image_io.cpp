@@ -1,0 +1,130 @@
+// Image files: path checks, atomic writes and comparisons. OpenImageIO itself lives in the image
+// module (host/image/image_module.h), dlopen()ed here on the first image written or compared.
+#include "host/image/image_io.h"
+
+#include <dlfcn.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <mutex>
+
+#include "host/image/image_module.h"
+#include "host/scene/scene.h"
+
+namespace host {
+
+namespace fs = std::filesystem;
+
+static std::string lower_ext(const std::string& path) {
+  std::string e = fs::path(path).extension().string();
+  for (char& c : e) c = char(std::tolower(static_cast<unsigned char>(c)));
+  return e;
+}
+
+void check_image_path(const std::string& path) {
+  check_output_path(path, {".png", ".exr"});
+}
+
+void check_output_path(const std::string& path, const std::vector<std::string>& extensions) {
+  const std::string e = lower_ext(path);
+  if (std::find(extensions.begin(), extensions.end(), e) == extensions.end()) {
+    std::string known;
+    for (const std::string& k : extensions) known += (known.empty() ? "" : " or ") + k;
+    throw InputError(path + ": unsupported extension '" + e + "' (use " + known + ")");
+  }
+  check_output_dir(path);
+}
+
+void check_output_dir(const std::string& path) {
+  const fs::path dir = fs::absolute(fs::path(path)).parent_path();
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec))
+    throw InputError(path + ": directory " + dir.string() + " does not exist");
+  if (::access(dir.c_str(), W_OK) != 0)
+    throw InputError(path + ": directory " + dir.string() + " is not writable");
+}
+
+namespace {
+
+struct ImageModule {
+  decltype(&vgpu_image_write) write = nullptr;
+  decltype(&vgpu_image_compare) compare = nullptr;
+};
+
+// The directory of the running executable (/proc/self/exe), or empty.
+fs::path exe_dir() {
+  std::error_code ec;
+  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  return ec ? fs::path() : exe.parent_path();
+}
+
+// Loads the module once: next to the executable first (an installed tree), then where the build
+// put it. Throws InputError naming `user` (the image being written or read) when it cannot.
+const ImageModule& image_module(const std::string& user) {
+  static std::once_flag once;
+  static ImageModule m;
+  static std::string error;
+  std::call_once(once, [] {
+    void* h = nullptr;
+    for (const fs::path& p : {exe_dir() / VGPU_IMAGE_MODULE_NAME, fs::path(VGPU_IMAGE_MODULE)}) {
+      if ((h = ::dlopen(p.c_str(), RTLD_NOW | RTLD_LOCAL))) break;
+      const char* e = ::dlerror();
+      if (error.empty() && e) error = e;
+    }
+    if (!h) return;
+    m.write = reinterpret_cast<decltype(m.write)>(::dlsym(h, VGPU_IMAGE_WRITE));
+    m.compare = reinterpret_cast<decltype(m.compare)>(::dlsym(h, VGPU_IMAGE_COMPARE));
+    if (!m.write || !m.compare) {
+      m = {};
+      error = std::string(VGPU_IMAGE_MODULE_NAME) + " lacks its entry points";
+    }
+  });
+  if (!m.write) throw InputError(user + ": cannot load the image module (" + error + ")");
+  return m;
+}
+
+}  // namespace
+
+void write_image(const std::string& path, int width, int height, int channels,
+                 const std::vector<float>& pixels) {
+  check_image_path(path);
+  const ImageModule& im = image_module(path);
+  // Same extension, so the module picks the right writer for the temporary file.
+  const fs::path p(path);
+  std::string name = p.stem().string();
+  name.insert(0, 1, '.');
+  name += ".tmp" + std::to_string(::getpid()) + p.extension().string();
+  const std::string tmp = (p.parent_path() / name).string();
+  char err[512] = "";
+  if (im.write(tmp.c_str(), width, height, channels, pixels.data(), err, sizeof err) != 0) {
+    std::remove(tmp.c_str());
+    throw InputError(path + ": " + err);
+  }
+  std::error_code ec;
+  fs::rename(tmp, path, ec);
+  if (ec) {
+    std::remove(tmp.c_str());
+    throw InputError(path + ": cannot write image: " + ec.message());
+  }
+}
+
+ImageComparison compare_images(const std::string& a, const std::string& b, double threshold) {
+  const ImageModule& im = image_module(a);
+  VgpuImageComparison r{};
+  char err[512] = "";
+  if (im.compare(a.c_str(), b.c_str(), threshold, &r, err, sizeof err) != 0) throw InputError(err);
+  ImageComparison c;
+  c.width = r.width;
+  c.height = r.height;
+  c.channels = r.channels;
+  c.threshold = threshold;
+  c.rms_error = r.rms_error;
+  c.psnr = r.psnr;
+  c.max_error = r.max_error;
+  c.differing_share = r.failing_pixels / (double(r.width) * r.height);
+  return c;
+}
+
+}  // namespace host

@@ -1,0 +1,60 @@
+// The image module: OpenImageIO writes and comparisons behind the C interface of
+// host/image/image_module.h. Built as libvgpu-image.so and loaded on first use by
+// host/image/image_io.cpp.
+#include "host/image/image_module.h"
+
+#include <OpenImageIO/imagebuf.h>
+#include <OpenImageIO/imagebufalgo.h>
+#include <OpenImageIO/imageio.h>
+
+#include <cstdio>
+#include <string>
+
+namespace {
+
+int fail(std::string reason, char* err, size_t err_size) {
+  for (char& c : reason)
+    if (c == '\n') c = ' ';
+  if (err_size > 0) std::snprintf(err, err_size, "%s", reason.c_str());
+  return -1;
+}
+
+}  // namespace
+
+extern "C" int vgpu_image_write(const char* path, int width, int height, int channels,
+                                const float* pixels, char* err, size_t err_size) {
+  const std::string p(path);
+  const bool png = p.size() >= 4 && (p.compare(p.size() - 4, 4, ".png") == 0 ||
+                                     p.compare(p.size() - 4, 4, ".PNG") == 0);
+  OIIO::ImageSpec spec(width, height, channels,
+                       png ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::FLOAT);
+  // Outputs must be byte-identical from run to run (hashable, cacheable): OpenImageIO stamps the
+  // write time (EXR capDate) unless DateTime is set, so it is set empty.
+  spec.attribute("DateTime", "");
+  auto out = OIIO::ImageOutput::create(p);
+  if (!out) return fail("cannot create an image writer: " + OIIO::geterror(), err, err_size);
+  bool ok = out->open(p, spec);
+  if (ok) ok = out->write_image(OIIO::TypeDesc::FLOAT, pixels);
+  if (ok) ok = out->close();
+  if (!ok) return fail("cannot write image: " + out->geterror(), err, err_size);
+  return 0;
+}
+
+extern "C" int vgpu_image_compare(const char* a, const char* b, double threshold,
+                                  VgpuImageComparison* out, char* err, size_t err_size) {
+  OIIO::ImageBuf A(a), B(b);
+  if (!A.read(0, 0, true, OIIO::TypeDesc::FLOAT))
+    return fail(std::string(a) + ": cannot read image: " + A.geterror(), err, err_size);
+  if (!B.read(0, 0, true, OIIO::TypeDesc::FLOAT))
+    return fail(std::string(b) + ": cannot read image: " + B.geterror(), err, err_size);
+  const OIIO::ImageSpec &sa = A.spec(), &sb = B.spec();
+  if (sa.width != sb.width || sa.height != sb.height || sa.nchannels != sb.nchannels)
+    return fail(std::string(b) + ": size " + std::to_string(sb.width) + "x" +
+                    std::to_string(sb.height) + "x" + std::to_string(sb.nchannels) +
+                    " differs from " + a + " (" + std::to_string(sa.width) + "x" +
+                    std::to_string(sa.height) + "x" + std::to_string(sa.nchannels) + ")",
+                err, err_size);
+  const auto r = OIIO::ImageBufAlgo::compare(A, B, float(threshold), float(threshold));
+  *out = {sa.width, sa.height, sa.nchannels, double(r.nfail), r.rms_error, r.PSNR, r.maxerror};
+  return 0;
+}

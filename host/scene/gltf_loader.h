@@ -1,0 +1,70 @@
+// The glTF 2.0 loader: reads a .gltf (external or embedded buffers) or .glb file with tinygltf,
+// validates every index, offset and length itself, and flattens the default scene into
+// host::Scene (world-space triangles, materials, camera, point lights).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "host/scene/scene.h"
+
+namespace host {
+
+struct LoadOptions {
+  // Input triangles (degenerate ones included) above this throw InputError. Values above
+  // 2^32 - 1 act as 2^32 - 1, since triangle ids are 32-bit.
+  uint64_t max_triangles = 50'000'000;
+};
+
+// Loads the default scene (or scene 0, or every root node when the file has no scenes).
+// Any problem with the file throws InputError with a one-line "PATH: problem" message.
+//
+// Geometry
+// - Nodes are walked depth-first, pre-order, children in listed order; the hierarchy must be a
+//   tree (a node reached twice is an error). A node's local transform is its matrix, or T*R*S.
+// - Primitives of mode TRIANGLES, TRIANGLE_STRIP and TRIANGLE_FAN are expanded as the glTF spec
+//   says (strip triangle i = v[i], v[i+1+i%2], v[i+2-i%2]; fan triangle i = v[i+1], v[i+2], v[0]);
+//   POINTS and LINE* primitives are skipped with a warning.
+// - Positions may be float or (KHR_mesh_quantization) byte/short, normalized or not.
+// - Triangle ids count every input triangle in that order. Triangles whose world-space cross
+//   product is zero in float or shorter than 1e-30 are dropped (Scene::dropped_degenerate) and
+//   keep their ids out of Scene::id.
+// - Under a mirroring world matrix (negative determinant) corners 1 and 2 are swapped, so every
+//   stored triangle is counter-clockwise seen from the side its normals point to.
+// Normals
+// - From the file: transformed by the inverse transpose of the world matrix, then normalised.
+// - Absent: smooth normals computed in the mesh's local space, per primitive: a vertex's normal
+//   is the sum of the (unnormalised) cross products of every triangle of the primitive that uses
+//   that vertex index, i.e. the area-weighted average of the face normals; then transformed like
+//   file normals. Vertices only shared by different indices (non-indexed primitives) get flat
+//   normals. A normal that comes out zero or not finite is replaced by the face normal.
+// Materials
+// - color = pbrMetallicRoughness.baseColorFactor.rgb, reflect = metallicFactor, both clamped to
+//   [0, 1], with the glTF defaults (white, metallicFactor 1) when absent; a number
+//   `extras.reflect` in [0, 1] on the material overrides reflect. A primitive without a material
+//   gets Material{} (0.8 grey, reflect 0), appended after the file's materials.
+// Camera
+// - The first camera node met in the walk; perspective only (orthographic is an error):
+//   position = world translation, forward = world -Z, up = world +Y made orthogonal, yfov as is.
+//   The file's aspectRatio is ignored (the image size decides).
+// Lights (KHR_lights_punctual)
+// - Point lights, at the node's world position. Spot lights are treated as point lights and
+//   directional lights skipped, each with a warning.
+// - Intensity rule: color = rgb * intensity / max(1, I_max), I_max the largest intensity among the
+//   point and spot lights of the walk. Files whose lights are at most 1 keep their values; files
+//   in physical units (Blender writes candela, often hundreds) are scaled so the brightest light is
+//   exactly its rgb, which suits a Lambert shader without falloff; ratios between lights are kept.
+// - No point light: one default white light at bounds centre + (0.3, 1.0, 0.6) * diagonal length,
+//   with Scene::default_light = true.
+Scene load_scene(const std::string& path, const LoadOptions& options = {});
+
+// A path to an existing file is returned as is; otherwise NAME is looked up as
+// VGPU_SCENES_DIR/NAME.gltf, then VGPU_SCENES_DIR/NAME.glb. Throws InputError when none exists.
+std::string resolve_scene(const std::string& name_or_path);
+
+// (name, path) of every scenes/*.gltf and scenes/*.glb, sorted by name then path.
+std::vector<std::pair<std::string, std::string>> list_scenes();
+
+}  // namespace host

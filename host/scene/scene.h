@@ -1,0 +1,94 @@
+// The scene as the renderer sees it: flattened world-space triangles, materials, camera, lights.
+// Filled by the glTF loader (host/scene/gltf_loader.cpp); read by the grid builder, the texture
+// uploader and the CPU reference tracer.
+#pragma once
+
+#include <cstdint>
+#include <glm/glm.hpp>
+#include <limits>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace host {
+
+// Any problem with an input file. what() is one line that names the file and the problem.
+struct InputError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+struct Material {
+  glm::vec3 color{0.8f};  // linear rgb, from baseColorFactor
+  float reflect = 0.0f;   // reflection coefficient a_i of the paper's blend formula
+};
+
+// glTF conventions: looks down local -Z, +Y up, yfov vertical (radians).
+struct Camera {
+  glm::vec3 position{0.0f};     // world space
+  glm::vec3 forward{0, 0, -1};  // unit, world space
+  glm::vec3 up{0, 1, 0};        // unit, orthogonal to forward
+  float yfov = 0.8f;            // radians
+};
+
+struct PointLight {
+  glm::vec3 position{0.0f};  // world space
+  glm::vec3 color{1.0f};     // linear rgb times intensity
+};
+
+struct Bounds {
+  glm::vec3 lo{std::numeric_limits<float>::max()};
+  glm::vec3 hi{-std::numeric_limits<float>::max()};
+  void extend(glm::vec3 p) {
+    lo = glm::min(lo, p);
+    hi = glm::max(hi, p);
+  }
+  bool empty() const { return lo.x > hi.x; }
+};
+
+// Triangles are stored structure-of-arrays, in the renderer's internal order. `id[i]` is the
+// input triangle id of internal triangle i: its index in the flattened input order (nodes
+// depth-first pre-order, a mesh's primitives in order, triangles in index order, strips and fans
+// expanded), kept even when degenerate triangles are dropped.
+struct Scene {
+  std::string source;                 // file path, for messages
+  std::string name;                   // short name (file stem)
+  std::vector<glm::vec3> p0, p1, p2;  // corners, world space
+  std::vector<glm::vec3> n0, n1, n2;  // corner normals, world space, unit length
+  std::vector<uint32_t> material;     // index into materials, per triangle
+  std::vector<uint32_t> id;           // input triangle id, per triangle
+  std::vector<Material> materials;
+  std::optional<Camera> camera;       // first camera node met depth-first, if any
+  std::vector<PointLight> lights;     // KHR_lights_punctual point lights, or the default light
+  bool default_light = false;         // true when lights holds the documented default
+  uint32_t input_triangles = 0;       // triangles in the flattened input, degenerate included
+  uint32_t dropped_degenerate = 0;    // zero-area triangles dropped
+  std::vector<std::string> warnings;  // e.g. "skipped 2 LINES primitives"
+
+  size_t triangle_count() const { return p0.size(); }
+  // Appends a triangle: corners, corner normals (unit), material index and input id.
+  void add_triangle(glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 na, glm::vec3 nb, glm::vec3 nc,
+                    uint32_t mat, uint32_t input_id) {
+    p0.push_back(a), p1.push_back(b), p2.push_back(c);
+    n0.push_back(na), n1.push_back(nb), n2.push_back(nc);
+    material.push_back(mat);
+    id.push_back(input_id);
+  }
+  // The same with the face normal at every corner (+z for a zero-area triangle).
+  void add_flat_triangle(glm::vec3 a, glm::vec3 b, glm::vec3 c, uint32_t mat, uint32_t input_id) {
+    const glm::vec3 n = glm::cross(b - a, c - a);
+    const glm::vec3 u = glm::length(n) > 0 ? glm::normalize(n) : glm::vec3(0, 0, 1);
+    add_triangle(a, b, c, u, u, u, mat, input_id);
+  }
+  Bounds bounds() const {
+    Bounds b;
+    for (size_t i = 0; i < p0.size(); ++i) {
+      b.extend(p0[i]);
+      b.extend(p1[i]);
+      b.extend(p2[i]);
+    }
+    return b;
+  }
+};
+
+}  // namespace host

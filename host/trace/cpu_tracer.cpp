@@ -1,0 +1,305 @@
+// The CPU reference tracer (see cpu_tracer.h): Whitted's recursion per pixel, in double
+// precision, over the same uniform grid as the stream tracer.
+#include "host/trace/cpu_tracer.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <thread>
+#include <vector>
+
+#include "host/common/parallel.h"
+#include "kernels/kernels.h"
+
+namespace host {
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// A triangle as the intersection test wants it, world space.
+struct Tri {
+  glm::dvec3 p0, e1, e2;  // corner 0 and the edges to corners 1 and 2
+};
+
+struct Hit {
+  int64_t tri = -1;               // internal triangle index, -1 = none
+  double t = kInf, u = 0, v = 0;  // ray parameter (unit direction: world distance), barycentrics
+};
+
+// Per-thread counters, summed at the end; each on its own cache line, so the workers do not
+// share one.
+struct alignas(64) Counters {
+  uint64_t rays = 0, entered = 0, voxel_steps = 0, triangle_tests = 0;
+  int iterations = 0;
+};
+
+// Moller-Trumbore, two-sided, closed triangle, t > 0: the kernels' intersect_triangle in double.
+bool intersect(const glm::dvec3& o, const glm::dvec3& d, const Tri& tri, double& t, double& u,
+               double& v) {
+  const glm::dvec3 p = glm::cross(d, tri.e2);
+  const double det = glm::dot(tri.e1, p);
+  if (det == 0.0) return false;
+  const double inv = 1.0 / det;
+  const glm::dvec3 s = o - tri.p0;
+  u = glm::dot(s, p) * inv;
+  if (u < 0.0 || u > 1.0) return false;
+  const glm::dvec3 q = glm::cross(s, tri.e1);
+  v = glm::dot(d, q) * inv;
+  if (v < 0.0 || u + v > 1.0) return false;
+  t = glm::dot(tri.e2, q) * inv;
+  return t > 0.0;
+}
+
+// cpu_primary_dir, with the part that is the same for every pixel (camera basis, tan(yfov / 2),
+// aspect) evaluated once per image.
+struct PrimaryRays {
+  PrimaryRays(const Camera& camera, int width, int height)
+      : forward(camera.forward),
+        up(camera.up),
+        right(glm::normalize(glm::cross(forward, up))),
+        t(std::tan(double(camera.yfov) / 2.0)),
+        a(double(width) / double(height)),
+        W(width),
+        H(height) {}
+
+  glm::dvec3 dir(int x, int y) const {
+    const double sx = (2.0 * (x + 0.5) / double(W) - 1.0) * t * a;
+    const double sy = (1.0 - 2.0 * (y + 0.5) / double(H)) * t;
+    return glm::normalize(forward + sx * right + sy * up);
+  }
+
+  glm::dvec3 forward, up, right;
+  double t, a;  // tan(yfov / 2), W / H
+  int W, H;
+};
+
+class Tracer {
+ public:
+  Tracer(const Scene& scene, const Grid& grid, const Camera& camera, const RenderOptions& opt)
+      : scene_(scene),
+        grid_(grid),
+        cam_(camera),
+        opt_(opt),
+        primary_(camera, opt.width, opt.height) {
+    tris_.reserve(scene.triangle_count());
+    geo_normals_.reserve(scene.triangle_count());
+    for (size_t i = 0; i < scene.triangle_count(); ++i) {
+      const glm::dvec3 p0(scene.p0[i]);
+      const Tri& tri =
+          tris_.emplace_back(Tri{p0, glm::dvec3(scene.p1[i]) - p0, glm::dvec3(scene.p2[i]) - p0});
+      geo_normals_.push_back(glm::normalize(glm::cross(tri.e1, tri.e2)));
+    }
+    const double diag = glm::length(glm::dvec3(grid.hi) - glm::dvec3(grid.lo));
+    slack_ = kSlackOfDiagonal * diag;
+    offset_ = kOffsetOfDiagonal * diag;
+    atten_dist_ = kAttenOfDiagonal * diag;
+    for (int a = 0; a < 3; ++a) {
+      box_lo_[a] = grid.boundary(a, 0);
+      box_hi_[a] = grid.boundary(a, grid.res[a]);
+    }
+    iterations_ = 1 + std::max(0, opt.bounces);
+    const kernels::Shader shader;
+    ambient_ = glm::dvec3(shader.ambient);
+    background_ = glm::dvec3(shader.background);
+    specular_ = shader.specular;
+    min_weight_ = kernels::ReflectedRays{}.min_weight;
+  }
+
+  // The nearest valid hit along o + t d, 0 < t < tmax (d unit, world space). any_hit: stop at
+  // the first valid hit (shadow rays only need to know whether one exists).
+  Hit trace(const glm::dvec3& o, const glm::dvec3& d, double tmax, bool any_hit,
+            Counters& c) const {
+    ++c.rays;
+    Hit best;
+    // Slab test against the grid box.
+    double tnear = 0.0, tfar = tmax;
+    for (int a = 0; a < 3; ++a) {
+      if (d[a] == 0.0) {
+        if (o[a] < box_lo_[a] || o[a] > box_hi_[a]) return best;
+        continue;
+      }
+      double t0 = (box_lo_[a] - o[a]) / d[a], t1 = (box_hi_[a] - o[a]) / d[a];
+      if (t0 > t1) std::swap(t0, t1);
+      tnear = std::max(tnear, t0);
+      tfar = std::min(tfar, t1);
+    }
+    if (!(tnear <= tfar)) return best;
+    ++c.entered;
+
+    // Amanatides & Woo set-up: the entry voxel, the t of the next boundary per axis, and the t
+    // between two boundaries per axis.
+    glm::ivec3 vox = grid_.voxel_of(o + d * tnear);
+    glm::ivec3 step(0);
+    glm::dvec3 t_next(kInf), t_delta(kInf);
+    for (int a = 0; a < 3; ++a) {
+      if (d[a] > 0.0) {
+        step[a] = 1;
+        t_next[a] = (grid_.boundary(a, vox[a] + 1) - o[a]) / d[a];
+        t_delta[a] = double(grid_.cell[a]) / d[a];
+      } else if (d[a] < 0.0) {
+        step[a] = -1;
+        t_next[a] = (grid_.boundary(a, vox[a]) - o[a]) / d[a];
+        t_delta[a] = -double(grid_.cell[a]) / d[a];
+      }
+    }
+
+    double t_enter = tnear;
+    for (;;) {
+      ++c.voxel_steps;
+      const double t_exit = std::min({t_next.x, t_next.y, t_next.z});
+      // Every triangle of the voxel; a hit counts only inside the voxel (with the slack).
+      for (const uint32_t k : grid_.triangles_in(grid_.index(vox))) {
+        ++c.triangle_tests;
+        double t, u, v;
+        if (!intersect(o, d, tris_[k], t, u, v)) continue;
+        if (t < t_enter - slack_ || t > t_exit + slack_ || !(t < tmax) || !(t < best.t)) continue;
+        best = Hit{int64_t(k), t, u, v};
+        if (any_hit) return best;
+      }
+      if (best.tri >= 0) return best;
+      // Next voxel: every axis tied at the exit steps at once (an edge or corner crossing).
+      bool outside = false;
+      for (int a = 0; a < 3; ++a) {
+        if (t_next[a] != t_exit) continue;
+        vox[a] += step[a];
+        t_next[a] += t_delta[a];
+        outside = outside || vox[a] < 0 || vox[a] >= grid_.res[a];
+      }
+      if (outside) return best;
+      t_enter = t_exit;
+      if (t_enter - slack_ >= tmax) return best;  // nothing left can pass t < tmax
+    }
+  }
+
+  // One pixel: the primary ray and, recursively, its reflections.
+  void pixel(int x, int y, RenderResult& out, Counters& c) const {
+    const size_t idx = size_t(y) * size_t(opt_.width) + size_t(x);
+    Hit primary;
+    const glm::dvec3 colour =
+        radiance(glm::dvec3(cam_.position), primary_.dir(x, y), 0, 1.0, &primary, c);
+    if (primary.tri >= 0) {
+      out.depth[idx] = float(primary.t);
+      out.hit_id[idx] = float(scene_.id[size_t(primary.tri)]);
+    }
+    for (int ch = 0; ch < 3; ++ch) out.rgb[idx * 3 + size_t(ch)] = float(colour[ch]);
+  }
+
+  // Whitted's recursion: the colour seen along o + t d (d unit) by the surface `depth` (0-based)
+  // of the chain, whose weight in the final colour is w. Returns (1 - a) C + a L_reflected, so
+  // the primary call returns the paper's sum_i w_i (1 - a_i) C_i. The chain stops where the
+  // next weight w a falls under 1/512 or after 1 + bounces surfaces, as rayosReflejados does.
+  glm::dvec3 radiance(const glm::dvec3& o, const glm::dvec3& d, int depth, double w, Hit* hit_out,
+                      Counters& c) const {
+    c.iterations = std::max(c.iterations, depth + 1);
+    const Hit h = trace(o, d, kInf, false, c);
+    if (hit_out) *hit_out = h;
+    if (h.tri < 0) return background_;
+    const size_t k = size_t(h.tri);
+    const glm::dvec3 p = o + d * h.t;  // world space, on the surface
+    glm::dvec3 ng = geo_normals_[k];
+    if (glm::dot(ng, d) > 0.0) ng = -ng;
+    const glm::dvec3 lifted = p + ng * offset_;  // origin of the shadow and reflected rays
+    glm::dvec3 n = glm::dvec3(scene_.n0[k]) * (1.0 - h.u - h.v) + glm::dvec3(scene_.n1[k]) * h.u +
+                   glm::dvec3(scene_.n2[k]) * h.v;
+    const double len = glm::length(n);
+    n = len > 0.0 ? n / len : ng;
+    if (glm::dot(n, d) > 0.0) n = -n;
+
+    const Material& mat = scene_.materials[scene_.material[k]];
+    const glm::dvec3 kd(mat.color);
+    glm::dvec3 local = kd * ambient_;
+    for (const PointLight& light : scene_.lights) {
+      const glm::dvec3 lp(light.position);
+      if (opt_.shadows) {
+        const glm::dvec3 to_light = lp - lifted;
+        const double shadow_dist = glm::length(to_light);
+        if (trace(lifted, to_light / shadow_dist, shadow_dist, true, c).tri >= 0) continue;
+      }
+      const glm::dvec3 to = lp - p;
+      const double dist = glm::length(to);
+      const glm::dvec3 l = to / dist;
+      glm::dvec3 lit = kd * std::max(glm::dot(n, l), 0.0);
+      if (opt_.shading != kernels::ShadingModel::diffuse) {
+        const glm::dvec3 r = glm::reflect(l, n);          // mirror of l, pointing away
+        const double rv = std::max(glm::dot(r, d), 0.0);  // = max(r'.v, 0), v = -d
+        lit += glm::dvec3(specular_ * std::pow(rv, 32.0));
+      }
+      if (opt_.shading == kernels::ShadingModel::phong_atten) {
+        const double q = dist / atten_dist_;
+        lit /= 1.0 + q * q;
+      }
+      local += lit * glm::dvec3(light.color);
+    }
+
+    const double a = mat.reflect;
+    glm::dvec3 colour = local * (1.0 - a);
+    if (w * a >= min_weight_ && depth + 1 < iterations_) {
+      const glm::dvec3 r = glm::normalize(glm::reflect(d, n));
+      colour += a * radiance(lifted, r, depth + 1, w * a, nullptr, c);
+    }
+    return colour;
+  }
+
+ private:
+  const Scene& scene_;
+  const Grid& grid_;
+  const Camera& cam_;
+  const RenderOptions& opt_;
+  const PrimaryRays primary_;
+  std::vector<Tri> tris_;
+  std::vector<glm::dvec3> geo_normals_;  // unit geometric normal per triangle: e1 x e2 normalized
+  double slack_ = 0, offset_ = 0, atten_dist_ = 0;
+  glm::dvec3 box_lo_{0.0}, box_hi_{0.0};
+  int iterations_ = 1;  // surfaces per chain at most: 1 + bounces
+  // kernels::Shader's and rayosReflejados' constants, so both tracers read them from one place.
+  glm::dvec3 ambient_, background_;
+  double specular_ = 0, min_weight_ = 0;
+};
+
+}  // namespace
+
+glm::dvec3 cpu_primary_dir(const Camera& camera, int W, int H, int x, int y) {
+  return PrimaryRays(camera, W, H).dir(x, y);
+}
+
+RenderResult render_cpu(const Scene& scene, const Grid& grid, const Camera& camera,
+                        const RenderOptions& options, CpuStats* stats) {
+  const auto t0 = std::chrono::steady_clock::now();
+  if (grid.start.size() != grid.voxels() + 1)
+    throw std::invalid_argument("render_cpu: the grid has no voxel lists (not built)");
+  RenderResult res;
+  const int W = std::max(options.width, 0), H = std::max(options.height, 0);
+  res.width = W;
+  res.height = H;
+  const size_t pixels = size_t(W) * size_t(H);
+  res.rgb.assign(pixels * 3, 0.0f);
+  res.depth.assign(pixels, 0.0f);
+  res.hit_id.assign(pixels, -1.0f);
+
+  const Tracer tracer(scene, grid, camera, options);
+  const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
+  const unsigned workers = std::clamp<unsigned>(
+      options.threads > 0 ? unsigned(options.threads) : cores, 1u, unsigned(std::max(H, 1)));
+  std::vector<Counters> counters(workers);
+  // Every pixel is independent, so the order in which rows are handed out does not matter.
+  for_each_row(H, workers, [&](unsigned worker, int y) {
+    for (int x = 0; x < W; ++x) tracer.pixel(x, y, res, counters[worker]);
+  });
+
+  CpuStats total;
+  for (const Counters& c : counters) {
+    total.rays += c.rays;
+    total.voxel_steps += c.voxel_steps;
+    total.triangle_tests += c.triangle_tests;
+    res.rays_traced += c.entered;
+    res.iterations = std::max(res.iterations, c.iterations);
+  }
+  if (stats) *stats = total;
+  res.render_ms = ms_since(t0);
+  return res;
+}
+
+}  // namespace host

@@ -1,0 +1,54 @@
+// The paper's "CPU" column and the accuracy ground truth: a direct, recursive Whitted tracer on
+// the host in double precision. Same camera, grid, traversal rule, shading models, shadows,
+// offsets and blend formula as the stream tracer (host/trace/stream_tracer.h), so the two images
+// can be compared pixel by pixel; only the precision (double against the card's fp32/fp24/fp16) and
+// the execution model (recursion and a per-ray loop against query-steered passes) differ.
+#pragma once
+
+#include <cstdint>
+#include <glm/glm.hpp>
+
+#include "host/accel/grid.h"
+#include "host/scene/scene.h"
+#include "host/trace/stream_tracer.h"
+
+namespace host {
+
+// Work counters of one CPU render, summed over every thread as integers.
+struct CpuStats {
+  uint64_t rays = 0;         // rays cast: primary, reflected, shadow (also those missing the grid)
+  uint64_t voxel_steps = 0;  // voxels examined by the 3D-DDA, summed over every ray
+  uint64_t triangle_tests = 0;  // ray-triangle tests (no mailbox: a triangle listed in several
+                                // voxels may be tested once per voxel)
+};
+
+// Renders with the options the stream tracer takes; the GPU-only ones (profile, lanes, masks,
+// host_shortcut, trace_pixel, keep_pass_records) are ignored, `progress` is not called.
+//   - primary rays: cpu_primary_dir, from the camera position;
+//   - traversal: incremental 3D-DDA (Amanatides & Woo) over the Grid's voxels, tied axes stepped
+//     together; in each voxel every listed triangle is tested (Moller-Trumbore, two-sided) and
+//     the nearest hit is kept only if its t lies in the voxel's [t_enter, t_exit] widened by
+//     t_slack = 1e-5 * grid diagonal (the stream tracer's rule); the walk ends at the first voxel
+//     with such a hit, or when it leaves the grid;
+//   - shading: kernels::Shader's models and constants (ambient 0.1 x kd, specular 0.5, exponent
+//     32, atten_dist = 0.5 * grid diagonal), evaluated at the exact hit point with the shading
+//     normal interpolated by the hit's barycentrics; background black; with no lights, only the
+//     ambient term;
+//   - shadows: a ray from the offset hit point to each light, blocked by any hit with t below the
+//     light's distance;
+//   - offsets: reflection and shadow origin = hit point + geometric normal (towards the incoming
+//     side) * 1e-4 * grid diagonal;
+//   - blend: final = sum_i w_i (1 - a_i) C_i, w_{i+1} = w_i a_i; reflection stops when
+//     w < 1/512 or after 1 + bounces iterations.
+// Multi-threaded over rows (options.threads, 0 = every core); each pixel is computed alone, so
+// the output is bit-identical for any thread count. RenderResult::stats (vgpu::FrameStats) stays
+// empty; rays_traced counts the rays that enter the grid, as the stream tracer's queries do;
+// render_ms is the wall time of the whole call. Counters go to *stats when given.
+RenderResult render_cpu(const Scene& scene, const Grid& grid, const Camera& camera,
+                        const RenderOptions& options, CpuStats* stats = nullptr);
+
+// host::primary_dir's contract (camera.h) evaluated in double from the camera's float fields:
+// the unit world-space direction through the centre of pixel (x, y), y = 0 the top row.
+glm::dvec3 cpu_primary_dir(const Camera& camera, int W, int H, int x, int y);
+
+}  // namespace host

@@ -1,0 +1,337 @@
+// The paper's walk through the uniform grid (host/trace/grid_walk.h): its textures, its pass
+// sequence (multipass and looping) and the walkers instantiated for it.
+#include "host/trace/grid_walk.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+#include "host/trace/walk.h"
+
+namespace host {
+
+using namespace kernels;
+using vgpu::Format;
+using vgpu::Stencil;
+using vgpu::Texture;
+
+GridSpec grid_spec_for(const GridSpec& spec, const Scene& scene, const vgpu::Profile& profile) {
+  if (!spec.automatic()) return spec;
+  glm::ivec3 r = auto_resolution(scene.bounds(), scene.triangle_count());
+  const double maxs = profile.max_texture_size;
+  while (double(r.x) * r.y > maxs) {
+    const double f = std::sqrt(maxs / (double(r.x) * r.y));
+    r.x = std::max(1, int(r.x * f));
+    r.y = std::max(1, int(r.y * f));
+  }
+  r.z = std::min(r.z, profile.max_texture_size);
+  return GridSpec{r};
+}
+
+namespace {
+
+// The fused programs, each with its two kernels' groups (their arithmetic must agree).
+struct FusedInfo {
+  const char* name;
+  int outputs;
+  Group first, second;
+};
+const std::array<FusedInfo, 2>& fused_programs() {
+  static const std::array<FusedInfo, 2> f{
+      FusedInfo{IntersectNext::name, IntersectNext::outputs, Group::hits, Group::voxel},
+      FusedInfo{TraverseUpdate::name, TraverseUpdate::outputs, Group::traversal, Group::voxel}};
+  return f;
+}
+
+}  // namespace
+
+std::string mrt_refusal(const vgpu::Profile& profile, const Formats& formats) {
+  for (const FusedInfo& f : fused_programs()) {
+    if (f.outputs > profile.max_outputs)
+      return "--mrt on: program '" + std::string(f.name) + "' writes " + std::to_string(f.outputs) +
+             " outputs; profile " + profile.name + " allows " +
+             std::to_string(profile.max_outputs) + " (no multiple render targets)";
+    if (formats.arithmetic(f.first) != formats.arithmetic(f.second))
+      return "--mrt on: program '" + std::string(f.name) + "' computes in one format, but groups " +
+             std::string(group_name(f.first)) + " (" +
+             std::string(vgpu::format_name(formats.arithmetic(f.first))) + ") and " +
+             std::string(group_name(f.second)) + " (" +
+             std::string(vgpu::format_name(formats.arithmetic(f.second))) +
+             ") differ; give them one arithmetic format (--formats)";
+  }
+  return {};
+}
+
+std::vector<std::string> mrt_programs() {
+  std::vector<std::string> v;
+  for (const FusedInfo& f : fused_programs()) v.push_back(f.name);
+  return v;
+}
+
+GridWalk::GridWalk(vgpu::Device& gpu, const Grid& grid, const RenderOptions& options,
+                   float scene_width)
+    : opt_(options), res_(grid.res) {
+  // Each program computes in its group's arithmetic format (formats.h: which kernel is where).
+  const Formats& fm = opt_.formats;
+  for (auto [prog, g] :
+       std::initializer_list<std::pair<vgpu::Program*, Group>>{{&init_, Group::traversal},
+                                                               {&reset_, Group::traversal},
+                                                               {&traversal_, Group::traversal},
+                                                               {&in_grid_, Group::queries},
+                                                               {&update_, Group::voxel},
+                                                               {&next_, Group::voxel},
+                                                               {&intersecting_, Group::queries},
+                                                               {&intersect_, Group::hits}})
+    prog->set_precision(fm.arithmetic(g));
+  if (opt_.mrt) {
+    // The tracer checked mrt_refusal: both kernels' groups compute alike.
+    intersect_next_.set_precision(fm.arithmetic(Group::hits));
+    traverse_update_.set_precision(fm.arithmetic(Group::traversal));
+  }
+  // The looping program does the traversal, voxel and hits groups' work: it computes in the
+  // finest of their arithmetic formats (their textures keep their own formats).
+  Format loop_arith = fm.arithmetic(Group::traversal);
+  for (Group g : {Group::voxel, Group::hits})
+    if (vgpu::significand_bits(fm.arithmetic(g)) > vgpu::significand_bits(loop_arith))
+      loop_arith = fm.arithmetic(g);
+  looping_.set_precision(loop_arith);
+
+  // The lists, each closed by -1 (entry 0 is the -1 every empty voxel shares), and the voxel
+  // pointers at (X*sizeY + Y, Z).
+  const int maxs = gpu.profile().max_texture_size;
+  const glm::ivec3 r = grid.res;
+  if (size_t(r.x) * r.y > size_t(maxs) || r.z > maxs)
+    throw vgpu::Error("grid " + std::to_string(r.x) + "x" + std::to_string(r.y) + "x" +
+                      std::to_string(r.z) + " needs a " + std::to_string(r.x * r.y) + "x" +
+                      std::to_string(r.z) + " voxel pointer texture; profile " +
+                      gpu.profile().name + " allows " + std::to_string(maxs) + "x" +
+                      std::to_string(maxs));
+  size_t nonempty = 0;
+  for (size_t vox = 0; vox < grid.voxels(); ++vox) {
+    const uint32_t n = grid.start[vox + 1] - grid.start[vox];
+    nonempty += n > 0;
+    max_list_ = std::max(max_list_, int(n));
+  }
+  const size_t list_len = 1 + grid.tris.size() + nonempty;
+  if (list_len >= (size_t(1) << 24))
+    throw vgpu::Error("grid lists hold " + std::to_string(list_len) +
+                      " entries; list positions are exact floats only below 2^24");
+  const int lw = int(std::min<size_t>(list_len, size_t(maxs)));
+  const size_t lh = (list_len + lw - 1) / lw;
+  if (lh > size_t(maxs))
+    throw vgpu::Error("grid lists hold " + std::to_string(list_len) + " entries; profile " +
+                      gpu.profile().name + " holds at most " + std::to_string(size_t(maxs) * maxs) +
+                      " (use a coarser grid)");
+  lists_ = gpu.make_texture("triangle lists", lw, int(lh), 1);
+  pointers_ = gpu.make_texture("voxel pointers", r.x * r.y, r.z, 1);
+  size_t k = 0;
+  auto put = [&](float value) {
+    lists_.texel_mut(int(k % lw), int(k / lw))[0] = value;
+    ++k;
+  };
+  put(kNone);
+  for (int z = 0; z < r.z; ++z)
+    for (int y = 0; y < r.y; ++y)
+      for (int x = 0; x < r.x; ++x) {
+        const auto tris = grid.triangles_in(grid.index(x, y, z));
+        float start = 0;
+        if (!tris.empty()) {
+          start = float(k);
+          for (uint32_t t : tris) put(float(t));
+          put(kNone);
+        }
+        pointers_.texel_mut(x * r.y + y, z)[0] = start;
+      }
+
+  // Uniforms that do not change during a frame.
+  GridUniforms g;
+  g.lo = grid.lo;
+  g.cell = grid.cell;
+  g.res = glm::vec3(r);
+  g.list_width = float(lw);
+  const float diag = glm::length(grid.hi - grid.lo);
+  g.t_slack = float(kSlackOfDiagonal) * diag;
+  const SceneUniforms su{scene_width};
+  init_.kernel.grid = g;
+  reset_.kernel.grid = g;
+  traversal_.kernel.grid = g;
+  update_.kernel.grid = g;
+  intersect_.kernel.grid = g;
+  intersect_.kernel.scene = su;
+  next_.kernel.grid = g;
+  intersect_next_.kernel.grid = g;
+  intersect_next_.kernel.scene = su;
+  traverse_update_.kernel.grid = g;
+  looping_.kernel.grid = g;
+  looping_.kernel.scene = su;
+  looping_.kernel.steps = opt_.steps_per_pass;
+}
+
+void GridWalk::make_state(vgpu::Device& gpu, const Shared& shared) {
+  sh_ = shared;
+  const Formats& fm = opt_.formats;
+  for (int i = 0; i < 2; ++i) {
+    const std::string sfx = i ? " B" : " A";
+    trav_[i] =
+        gpu.make_texture("traversal" + sfx, opt_.width, opt_.height, 4, fm[Group::traversal]);
+    vs_[i] = gpu.make_texture("voxel state" + sfx, opt_.width, opt_.height, 4, fm[Group::voxel]);
+  }
+}
+
+void GridWalk::upload(vgpu::Device& gpu) const {
+  gpu.upload(lists_);
+  gpu.upload(pointers_);
+}
+
+uint64_t GridWalk::texture_bytes() const {
+  return lists_.bytes() + pointers_.bytes() + trav_[0].bytes() + trav_[1].bytes() + vs_[0].bytes() +
+         vs_[1].bytes();
+}
+
+WriteBack GridWalk::write_back(const Cursor& c) const {
+  WriteBack wb;
+  wb.npairs = 3;
+  wb.pairs[0] = {const_cast<Texture*>(&trav_[0]), const_cast<Texture*>(&trav_[1])};
+  wb.pairs[1] = {const_cast<Texture*>(&vs_[0]), const_cast<Texture*>(&vs_[1])};
+  wb.pairs[2] = {sh_.isect[0], sh_.isect[1]};
+  wb.current = {c.trav, c.vs, c.isect, 0};
+  wb.nmasks = 2;
+  wb.masks = {sh_.grid_mask, sh_.isect_mask, nullptr, nullptr};
+  return wb;
+}
+
+void GridWalk::trace(PassRunner& r, Texture& origins, Texture& rays, bool primary, glm::vec3 eye) {
+  vgpu::Device& gpu = r.device();
+  int& cur_isect = *sh_.cur_isect;
+  gpu.clear(*sh_.isect[cur_isect], {kFar, 0, 0, kNone});
+  gpu.clear(vs_[cur_vs_], {0, 0, 0, kNone});
+  // Enter the grid.
+  if (primary) {
+    init_.kernel.eye = eye;
+    r.pass(init_, {&rays}, trav_[cur_trav_ ^ 1]);
+  } else {
+    r.pass(reset_, {&origins, &rays}, trav_[cur_trav_ ^ 1]);
+  }
+  cur_trav_ ^= 1;
+  if (opt_.looping) {
+    sh_.grid_mask->fill(1);
+    const uint64_t walking = r.count(in_grid_, trav_[cur_trav_], nullptr, sh_.grid_mask);
+    r.counts.rays_traced += walking;
+    walk_looping(r, origins, rays, walking);
+    return;
+  }
+  Cursor c{&origins, &rays, cur_trav_, cur_vs_, cur_isect};
+  walk::run_walk(r, *this, c);
+  cur_trav_ = c.trav;
+  cur_vs_ = c.vs;
+  cur_isect = c.isect;
+}
+
+template <class X>
+void GridWalk::walk(X& x, Cursor& c) {
+  Texture &origins = *c.origins, &rays = *c.rays;
+  Texture* const* isect = sh_.isect;
+  const Texture* const* v = sh_.vertices;
+  Stencil &grid_mask = *sh_.grid_mask, &isect_mask = *sh_.isect_mask;
+  auto key = [&c](int step, int k, Site site) {
+    return walk::PassKey{step, k, site, uint8_t(c.trav | c.vs << 1 | c.isect << 2)};
+  };
+  x.fill(grid_mask, 1);
+  auto walking = x.count(key(-1, -1, kEnter), in_grid_, trav_[c.trav], nullptr, &grid_mask);
+  x.traced(walking);
+  // In exact arithmetic a ray crosses at most nx+ny+nz voxels and tests each voxel's list once.
+  // Reduced precision can break both (fp16 cannot count past 2048): the host stops there and
+  // reports the rays left unfinished instead of looping forever.
+  const int max_steps = res_.x + res_.y + res_.z + 2;
+  for (int step = 0; X::any(walking); ++step) {
+    if (step == max_steps) {
+      x.unfinished(walking);
+      break;
+    }
+    // The first triangle of each ray's new voxel (under --mrt on, only at the first step: later
+    // ones come from the fused traversal + update voxel pass).
+    if (!opt_.mrt || step == 0) {
+      x.pass(key(step, -1, kUpdate), update_, {&trav_[c.trav], &vs_[c.vs], &pointers_, &lists_},
+             {&vs_[c.vs ^ 1]}, &grid_mask);
+      c.vs ^= 1;
+    }
+    x.copy(isect_mask, grid_mask);
+    auto testing =
+        x.count(key(step, -1, kTesting), intersecting_, vs_[c.vs], &grid_mask, &isect_mask);
+    // One triangle per pass, until no ray has a triangle left in its voxel.
+    for (int k = 0; X::any(testing); ++k) {
+      if (k == max_list_ + 1) break;  // lists cannot be longer: stuck positions (fp16)
+      if (opt_.mrt) {
+        // intersecciones + proximoTriangulo in one pass, two targets.
+        x.pass(key(step, k, kIntersectNext), intersect_next_,
+               {&origins, &rays, &trav_[c.trav], &vs_[c.vs], isect[c.isect], v[0], v[1], v[2],
+                &lists_},
+               {isect[c.isect ^ 1], &vs_[c.vs ^ 1]}, &isect_mask);
+        c.isect ^= 1;
+        c.vs ^= 1;
+      } else {
+        x.pass(key(step, k, kIntersect), intersect_,
+               {&origins, &rays, &trav_[c.trav], &vs_[c.vs], isect[c.isect], v[0], v[1], v[2]},
+               {isect[c.isect ^ 1]}, &isect_mask);
+        c.isect ^= 1;
+        x.pass(key(step, k, kNext), next_, {&vs_[c.vs], &lists_}, {&vs_[c.vs ^ 1]}, &isect_mask);
+        c.vs ^= 1;
+      }
+      testing =
+          x.count(key(step, k, kTestingOn), intersecting_, vs_[c.vs], &isect_mask, &isect_mask);
+    }
+    // One voxel step for every ray still walking (under --mrt on, with the next voxel's first
+    // triangle in the same pass).
+    if (opt_.mrt) {
+      x.pass(key(step, -1, kTraverseUpdate), traverse_update_,
+             {&origins, &rays, &trav_[c.trav], isect[c.isect], &vs_[c.vs], &pointers_, &lists_},
+             {&trav_[c.trav ^ 1], &vs_[c.vs ^ 1]}, &grid_mask);
+      c.trav ^= 1;
+      c.vs ^= 1;
+    } else {
+      x.pass(key(step, -1, kTraversal), traversal_,
+             {&origins, &rays, &trav_[c.trav], isect[c.isect]}, {&trav_[c.trav ^ 1]}, &grid_mask);
+      c.trav ^= 1;
+    }
+    walking = x.count(key(step, -1, kInGrid), in_grid_, trav_[c.trav], &grid_mask, &grid_mask);
+  }
+}
+
+void GridWalk::walk_looping(PassRunner& r, Texture& origins, Texture& rays, uint64_t walking) {
+  vgpu::Device& gpu = r.device();
+  const vgpu::Program& p = looping_;
+  int& cur_isect = *sh_.cur_isect;
+  // A ray iterates once per triangle it tests and once per voxel it steps through: at most
+  // (nx + ny + nz + 2) voxels of (longest list + 1) iterations each. Past that many passes the
+  // host stops, as the multipass loop does, and reports the rays left unfinished.
+  const int64_t max_iterations = int64_t(res_.x + res_.y + res_.z + 2) * int64_t(max_list_ + 1);
+  const int64_t max_passes = (max_iterations + opt_.steps_per_pass - 1) / opt_.steps_per_pass;
+  for (int64_t k = 0; walking > 0; ++k) {
+    if (k == max_passes) {
+      r.counts.rays_unfinished += walking;
+      break;
+    }
+    Texture& trav = trav_[cur_trav_ ^ 1];
+    gpu.use_program(p);
+    gpu.unbind_textures();
+    int unit = 0;
+    for (const Texture* t : std::initializer_list<const Texture*>{
+             &origins, &rays, &trav_[cur_trav_], &vs_[cur_vs_], sh_.isect[cur_isect],
+             sh_.vertices[0], sh_.vertices[1], sh_.vertices[2], &pointers_, &lists_})
+      gpu.bind_texture(unit++, *t);
+    gpu.set_targets({&trav, &vs_[cur_vs_ ^ 1], sh_.isect[cur_isect ^ 1]});
+    // The walking rays' mask, as for the multipass kernels (finished rays keep their state).
+    r.set_work(sh_.grid_mask);
+    const bool traced = r.traces_pixel(sh_.grid_mask);
+    if (opt_.observer) opt_.observer->pass_begin(sh_.grid_mask);
+    const vgpu::PassRecord& rec = gpu.draw();
+    if (opt_.observer) opt_.observer->pass({p, rec, trav, gpu.branch_flags(), gpu.stats()});
+    cur_trav_ ^= 1;
+    cur_vs_ ^= 1;
+    cur_isect ^= 1;
+    if (traced) r.trace_targets(p, {&trav_[cur_trav_], &vs_[cur_vs_], sh_.isect[cur_isect]});
+    walking = r.count(in_grid_, trav_[cur_trav_], sh_.grid_mask, sh_.grid_mask);
+  }
+}
+
+}  // namespace host

@@ -1,0 +1,122 @@
+// The paper's walk through the uniform grid (Sec. 2.2-2.3): the grid's textures, and which pass
+// runs next, steered by which query. How the passes run is host/trace/walk.h's business.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "host/accel/grid.h"
+#include "host/model/formats.h"
+#include "host/scene/scene.h"
+#include "host/trace/passes.h"
+#include "host/trace/render_options.h"
+#include "kernels/kernels.h"
+#include "vgpu/vgpu.h"
+
+namespace host {
+
+// Lengths both tracers derive from the grid diagonal, as fractions of it (the stream tracer's
+// uniforms take float(k) * diagonal in float, the CPU tracer k * diagonal in double).
+inline constexpr double kSlackOfDiagonal = 1e-5;   // GridUniforms::t_slack (in-voxel rule)
+inline constexpr double kOffsetOfDiagonal = 1e-4;  // ReflectionOrigin::offset (origin lift)
+inline constexpr double kAttenOfDiagonal = 0.5;    // Shader::atten_dist
+
+class GridWalk {
+ public:
+  // The passes of the walk, by where the walk issues them. With the step (-1 before the first)
+  // and the triangle index k within a step (-1 outside the triangle loop), a site names one
+  // pass of the sequence (walk::PassKey).
+  enum Site : int {
+    kEnter,           // rayosEnGrilla before the first step
+    kUpdate,          // actualizarVoxel
+    kTesting,         // rayosIntersectando after actualizarVoxel
+    kIntersect,       // intersecciones
+    kNext,            // proximoTriangulo
+    kIntersectNext,   // intersecciones + proximoTriangulo (--mrt on)
+    kTestingOn,       // rayosIntersectando in the triangle loop
+    kTraversal,       // traversal
+    kTraverseUpdate,  // traversal + actualizarVoxel (--mrt on)
+    kInGrid,          // rayosEnGrilla after the step
+    kSites
+  };
+
+  // The tracer's textures and masks the walk reads and writes: the scene's vertices, the
+  // intersection state (nearest hit so far) and the two masks of walking and testing rays.
+  struct Shared {
+    const vgpu::Texture* vertices[3];
+    vgpu::Texture* isect[2];
+    int* cur_isect;  // which of isect is current
+    vgpu::Stencil* grid_mask;
+    vgpu::Stencil* isect_mask;
+  };
+
+  // The grid's static textures, built and checked against the profile's limits (throws
+  // vgpu::Error naming the limit); the walk's programs, each computing in its group's format.
+  GridWalk(vgpu::Device& gpu, const Grid& grid, const RenderOptions& options, float scene_width);
+  // The per-pixel state textures (traversal, voxel state), made after the tracer's own.
+  void make_state(vgpu::Device& gpu, const Shared& shared);
+  // Video memory gets the static textures once, at initialization.
+  void upload(vgpu::Device& gpu) const;
+  uint64_t texture_bytes() const;
+
+  // One stream of rays through the grid: enter it (initTraversal for primary rays, from the eye;
+  // reinicializarTraversal otherwise), then walk it until no ray is walking. Leaves the nearest
+  // hits in the current intersection texture.
+  void trace(PassRunner& r, vgpu::Texture& origins, vgpu::Texture& rays, bool primary,
+             glm::vec3 eye);
+
+  // Where the walk is: the rays it traces and the current texture of each ping-pong pair.
+  struct Cursor {
+    vgpu::Texture *origins, *rays;
+    int trav, vs, isect;
+  };
+  // The multipass walk (one voxel step and one triangle per pass), written once for every way
+  // it runs (host/trace/walk.h).
+  template <class X>
+  void walk(X& x, Cursor& c);
+  // The state a batch walk hands back: the three ping-pong pairs and both masks.
+  WriteBack write_back(const Cursor& c) const;
+
+ private:
+  // The looping variant (RenderOptions::looping): one looping program drawn again while rays
+  // walk, steps_per_pass iterations per pass.
+  void walk_looping(PassRunner& r, vgpu::Texture& origins, vgpu::Texture& rays, uint64_t walking);
+
+  const RenderOptions& opt_;
+  glm::ivec3 res_;
+  int max_list_ = 0;  // longest voxel list: a ray tests at most this many triangles per voxel
+  Shared sh_{};
+  // Static textures: the triangle lists, each closed by -1, and the voxel pointers.
+  vgpu::Texture lists_, pointers_;
+  // Per-pixel state (ping-pong pairs): traversal (voxel, entry t) and voxel state (list position).
+  vgpu::Texture trav_[2], vs_[2];
+  int cur_trav_ = 0, cur_vs_ = 0;
+  vgpu::KernelProgram<kernels::InitTraversal> init_;
+  vgpu::KernelProgram<kernels::ResetTraversal> reset_;
+  vgpu::KernelProgram<kernels::Traversal> traversal_;
+  vgpu::KernelProgram<kernels::RaysInGrid> in_grid_;
+  vgpu::KernelProgram<kernels::UpdateVoxel> update_;
+  vgpu::KernelProgram<kernels::Intersections> intersect_;
+  vgpu::KernelProgram<kernels::NextTriangle> next_;
+  vgpu::KernelProgram<kernels::RaysIntersecting> intersecting_;
+  // Fused programs for --mrt on (kernels/fused.h).
+  vgpu::KernelProgram<kernels::IntersectNext> intersect_next_;
+  vgpu::KernelProgram<kernels::TraverseUpdate> traverse_update_;
+  vgpu::KernelProgram<kernels::LoopingTraversal> looping_;
+};
+
+// The grid spec to build for a profile: an automatic resolution is shrunk in x and y until the
+// voxel pointer texture (sizeX*sizeY by sizeZ texels) fits the profile's largest texture; an
+// explicit one is kept (and refused at initialization if it does not fit).
+GridSpec grid_spec_for(const GridSpec& spec, const Scene& scene, const vgpu::Profile& profile);
+
+// Why RenderOptions::mrt cannot run with this profile and these formats (empty: it can): a
+// fused program writes more outputs than the profile allows, or computes in one arithmetic
+// format where its two kernels' groups differ (host/model/formats.h). Names the fused program.
+std::string mrt_refusal(const vgpu::Profile& profile, const Formats& formats);
+
+// The fused programs --mrt on runs (kernels/fused.h), by statistics name.
+std::vector<std::string> mrt_programs();
+
+}  // namespace host

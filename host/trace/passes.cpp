@@ -1,0 +1,111 @@
+// How the host issues one pass on a device (host/trace/passes.h): bindings, masks, the draw,
+// the occlusion query of a counting pass, and what the observer and --trace-pixel see.
+#include "host/trace/passes.h"
+
+#include <algorithm>
+#include <cstdio>
+
+#include "vgpu/record.h"
+
+namespace host {
+
+using vgpu::Stencil;
+using vgpu::Texture;
+
+void PassRunner::set_work(const Stencil* work) {
+  if (!gpu_.has_stencil()) return;
+  gpu_.set_stencil_test(nullptr);
+  gpu_.set_work_mask(opt_.masks || opt_.host_shortcut ? work : nullptr);
+  gpu_.set_work_mask_counts_as_masked(opt_.masks);
+}
+
+const vgpu::PassRecord& PassRunner::pass(const vgpu::Program& p,
+                                         std::initializer_list<const Texture*> in, Texture& out,
+                                         const Stencil* work) {
+  return pass(p, in, {&out}, work);
+}
+
+const vgpu::PassRecord& PassRunner::pass(const vgpu::Program& p,
+                                         std::initializer_list<const Texture*> in,
+                                         std::initializer_list<Texture*> outs,
+                                         const Stencil* work) {
+  gpu_.use_program(p);
+  gpu_.unbind_textures();
+  int unit = 0;
+  for (const Texture* t : in) gpu_.bind_texture(unit++, *t);
+  gpu_.set_targets(outs);
+  set_work(work);
+  const bool traced = traces_pixel(work);
+  if (opt_.observer) opt_.observer->pass_begin(work);
+  const vgpu::PassRecord& rec = gpu_.draw();
+  // The observer sees the first target (a fused pass's other targets are the same pass).
+  if (opt_.observer)
+    opt_.observer->pass({p, rec, **outs.begin(), gpu_.branch_flags(), gpu_.stats()});
+  if (traced && !p.idle_discards()) {
+    const int x = opt_.trace_pixel->x, y = opt_.trace_pixel->y;
+    for (const Texture* out : outs) {
+      const float* t = out->texel(x, y);
+      char line[256];
+      int n = std::snprintf(line, sizeof line, "  %-22s %-24s -> %-14s (", p.paper_name(), p.name(),
+                            out->name().c_str());
+      for (int c = 0; c < out->channels(); ++c)
+        n += std::snprintf(line + n, sizeof line - size_t(n), "%s%g", c ? ", " : "", t[c]);
+      *opt_.trace_out << line << ")\n";
+    }
+  }
+  return rec;
+}
+
+void PassRunner::trace_targets(const vgpu::Program& p, std::initializer_list<const Texture*> outs) {
+  const int x = opt_.trace_pixel->x, y = opt_.trace_pixel->y;
+  for (const Texture* t : outs) {
+    const float* v = t->texel(x, y);
+    char line[256];
+    std::snprintf(line, sizeof line, "  %-22s %-24s -> %-14s (%g, %g, %g, %g)\n", p.paper_name(),
+                  p.name(), t->name().c_str(), v[0], v[1], v[2], v[3]);
+    *opt_.trace_out << line;
+  }
+}
+
+bool PassRunner::traces_pixel(const Stencil* work) const {
+  return opt_.trace_pixel && opt_.trace_out &&
+         (!work || work->get(opt_.trace_pixel->x, opt_.trace_pixel->y) != 0);
+}
+
+uint64_t PassRunner::count(const vgpu::Program& p, const Texture& in, const Stencil* work,
+                           Stencil* write) {
+  const bool traced = traces_pixel(work);
+  // The masks are the emulator's (its work mask, or stencils under --masks on).
+  if (gpu_.has_stencil()) gpu_.set_stencil_write(write);
+  gpu_.begin_query();
+  pass(p, {&in}, counter_, work);
+  const uint64_t n = gpu_.end_query();
+  if (gpu_.has_stencil()) gpu_.set_stencil_write(nullptr);
+  if (opt_.observer) opt_.observer->query(n, write, gpu_.stats());
+  if (traced) {
+    char line[160];
+    const char* mine = !write                                                 ? ""
+                       : write->get(opt_.trace_pixel->x, opt_.trace_pixel->y) ? "counted"
+                                                                              : "discarded";
+    std::snprintf(line, sizeof line, "  %-22s %-24s    query: %llu rays; this one %s\n",
+                  p.paper_name(), p.name(), static_cast<unsigned long long>(n), mine);
+    *opt_.trace_out << line;
+  }
+  return n;
+}
+
+uint32_t PassRunner::own_only_units(const vgpu::Program& p) {
+  auto cached = std::find_if(own_only_.begin(), own_only_.end(),
+                             [&](const auto& e) { return e.first == &p; });
+  if (cached != own_only_.end()) return cached->second;
+  const vgpu::Recording rec = p.record();
+  uint32_t own = 0, other = 0;
+  for (const vgpu::RecNode& n : rec.nodes) {
+    if (n.op == vgpu::Op::fetch_own) own |= 1u << n.unit;
+    if (n.op == vgpu::Op::fetch) other |= 1u << n.unit;
+  }
+  own_only_.emplace_back(&p, own & ~other);
+  return own & ~other;
+}
+
+}  // namespace host

@@ -1,0 +1,79 @@
+// How the host issues one pass: program, textures, targets and masks set on the device, the
+// draw, and what the observer and --trace-pixel are told. The host loop and every walk use it.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <initializer_list>
+#include <utility>
+#include <vector>
+
+#include "host/trace/render_options.h"
+#include "vgpu/device.h"
+
+namespace host {
+
+// What the walks of one frame counted.
+struct WalkCounts {
+  uint64_t rays_traced = 0;      // rays entering a trace
+  uint64_t rays_unfinished = 0;  // rays stopped by a walk's pass cap (reduced precision)
+  bool batch_walk = false;       // a walk of this frame ran in batches (host/trace/walk.h)
+};
+
+// The state a batch walk hands back to the textures and masks: each ping-pong pair of state
+// textures with its current member, and the masks the walk leaves.
+struct WriteBack {
+  static constexpr int kMax = 4;
+  std::array<std::array<vgpu::Texture*, 2>, kMax> pairs{};
+  std::array<int, kMax> current{};
+  int npairs = 0;
+  std::array<vgpu::Stencil*, kMax> masks{};
+  int nmasks = 0;
+};
+
+class PassRunner {
+ public:
+  // `counter` is the colour target of counting passes (only their query result matters).
+  PassRunner(vgpu::Device& gpu, const RenderOptions& options, vgpu::Texture& counter)
+      : gpu_(gpu), opt_(options), counter_(counter) {}
+
+  vgpu::Device& device() const { return gpu_; }
+  const RenderOptions& options() const { return opt_; }
+
+  // One pass of p over the whole target (outs[i] is the program's output i), on the fragments
+  // `work` leaves (nullptr: all). The same finished-ray mask either skips fragments on the
+  // modeled hardware (--masks on) or only saves the emulator's host work (every fragment is
+  // charged).
+  const vgpu::PassRecord& pass(const vgpu::Program& p,
+                               std::initializer_list<const vgpu::Texture*> in, vgpu::Texture& out,
+                               const vgpu::Stencil* work = nullptr);
+  const vgpu::PassRecord& pass(const vgpu::Program& p,
+                               std::initializer_list<const vgpu::Texture*> in,
+                               std::initializer_list<vgpu::Texture*> outs,
+                               const vgpu::Stencil* work = nullptr);
+  // A counting pass inside an occlusion query: the fragments p does not discard; those are
+  // marked in `write` (nullptr: none).
+  uint64_t count(const vgpu::Program& p, const vgpu::Texture& in, const vgpu::Stencil* work,
+                 vgpu::Stencil* write);
+  // The work mask of the next draw, as pass() sets it (for a walk that draws by itself).
+  void set_work(const vgpu::Stencil* work);
+  // Whether --trace-pixel output is on and the traced pixel takes part in a pass under `work`
+  // (no mask, or the finished-ray mask says its ray is not done).
+  bool traces_pixel(const vgpu::Stencil* work) const;
+  // Prints the traced pixel's texel of each target after a pass of p.
+  void trace_targets(const vgpu::Program& p, std::initializer_list<const vgpu::Texture*> outs);
+
+  // The units p reads only at the fragment's own texel (Op::fetch_own in its recording, never
+  // Op::fetch): those may come from a batch's registers. Worked out once per program.
+  uint32_t own_only_units(const vgpu::Program& p);
+
+  WalkCounts counts;  // this frame's; the host loop resets it
+
+ private:
+  vgpu::Device& gpu_;
+  const RenderOptions& opt_;
+  vgpu::Texture& counter_;
+  std::vector<std::pair<const vgpu::Program*, uint32_t>> own_only_;
+};
+
+}  // namespace host

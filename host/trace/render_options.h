@@ -1,0 +1,111 @@
+// What a stream-tracer frame is asked for (RenderOptions), what it gives back (RenderResult) and
+// what it shows an observer while it runs (PassObserver). No tracer code: the devices and the
+// walkers include this without the tracer.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <glm/glm.hpp>
+#include <optional>
+#include <ostream>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "host/model/formats.h"
+#include "kernels/shader.h"
+#include "vgpu/vgpu.h"
+
+namespace host {
+
+// What the host loop shows an observer (the HTML frame report, host/report/report.h): every pass
+// with what it ran on, every occlusion-query result, and where iterations and traces begin.
+class PassObserver {
+ public:
+  enum class TraceKind { primary, shadow, reflected };
+  struct Pass {
+    const vgpu::Program& program;
+    const vgpu::PassRecord& record;
+    const vgpu::Texture& target;
+    // Per fragment of the drawn rectangle, row by row: vgpu::kBranchTook, kBranchIdle or 0 (not
+    // shaded); empty when the program does not branch.
+    std::span<const uint8_t> branch_flags;
+    const vgpu::FrameStats& stats;  // the frame so far, this pass included
+  };
+  virtual ~PassObserver() = default;
+  virtual void iteration(int iteration) = 0;  // 1-based
+  virtual void trace_begin(TraceKind kind) = 0;
+  virtual void trace_end() = 0;
+  // Before a pass: the fragments with work to do (nullptr: every fragment). A counting pass may
+  // write the same stencil, so this is the one moment it can be seen.
+  virtual void pass_begin(const vgpu::Stencil* work) = 0;
+  virtual void pass(const Pass& p) = 0;
+  // After a counting pass: its query result and the stencil it wrote (nullptr: none).
+  virtual void query(uint64_t result, const vgpu::Stencil* written,
+                     const vgpu::FrameStats& stats) = 0;
+};
+
+struct RenderOptions {
+  int width = 256, height = 256;  // the paper's image size
+  int bounces = 2;                // reflection iterations after the primary one (Fig. 1: 3 in all)
+  kernels::ShadingModel shading = kernels::ShadingModel::phong;
+  bool shadows = true;
+  std::string profile = "gf5700";
+  // The device the passes run on: "vgpu" (the emulator) or "gl" (a real OpenGL driver, EGL
+  // device gl_device: "auto" or an index).
+  std::string device = "vgpu";
+  std::string gl_device = "auto";
+  // How the GL device waits for a query result: "block" (GL_QUERY_RESULT, the driver's wait),
+  // "poll" (spin on GL_QUERY_RESULT_AVAILABLE) or "auto" (poll on a hardware driver, block on
+  // a software one; see gl::GlDevice::ReadbackWait).
+  std::string gl_readback = "auto";
+  int threads = 0;  // 0: every host core
+  int lanes = vgpu::kLanes;
+  // Formats of the ray-state textures and of the arithmetic of the kernels writing them, per
+  // group (host/model/formats.h; --precision sets them all, --formats one by one). The scene
+  // textures stay fp32. fp16 cannot address texels past 1024 exactly, as on NV3x.
+  Formats formats;
+  // Early-z/stencil masks for finished rays (the paper's future work): masked fragments cost
+  // nothing. Off: every fragment runs every pass, as on the paper's GeForce FX.
+  bool masks = false;
+  // Multiple render targets (the paper's future work, kernels/fused.h): the host loop runs
+  // intersecciones + proximoTriangulo and traversal + actualizarVoxel as one pass each, writing
+  // two targets. Needs a profile with max_outputs >= 2 (the constructor throws naming the fused
+  // program and the limit, see mrt_refusal). Off: the paper's one-output multipass pipeline.
+  bool mrt = false;
+  // The kernels that walk the grid: false, the paper's multipass pipeline (one pass per voxel
+  // step and per triangle); true, one looping program (kernels/looping_traversal.h, fp40 and
+  // later) drawn again while rays walk, `steps_per_pass` loop iterations per pass.
+  bool looping = false;
+  int steps_per_pass = 32;
+  // Emulator shortcut: skip host work for fragments whose result cannot change (finished rays);
+  // their statistics are charged as if run. Off only to check that it changes nothing.
+  bool host_shortcut = true;
+  // Emulator shortcut: run the multipass grid walk batch by batch (8 neighbouring pixels through
+  // every pass of the walk, their ray state in registers, vgpu/batch.h), then replay the pass
+  // sequence for the statistics. Same images, AOVs and statistics as pass by pass (false). Used
+  // where it applies: the vgpu at 8 lanes, with host_shortcut or masks, the multipass kernels,
+  // no observer and no trace_pixel; elsewhere the walk runs pass by pass.
+  bool batch_walk = true;
+  std::optional<glm::ivec2> trace_pixel;  // print every pass this pixel took part in
+  std::ostream* trace_out = nullptr;
+  bool keep_pass_records = false;
+  // Called at the start of each ray-tracing iteration (1-based) with the iteration count.
+  std::function<void(int iteration, int iterations)> progress;
+  PassObserver* observer = nullptr;  // not owned
+};
+
+struct RenderResult {
+  int width = 0, height = 0;
+  std::vector<float> rgb;     // width*height*3, linear, row 0 = top
+  std::vector<float> depth;   // distance to the primary hit, 0 where the ray misses
+  std::vector<float> hit_id;  // input triangle id of the primary hit, -1 where it misses
+  vgpu::FrameStats stats;
+  double render_ms = 0;
+  int iterations = 0;            // ray-tracing iterations run (primary included)
+  uint64_t rays_traced = 0;      // rays entering a trace (primary, reflected, shadow)
+  uint64_t rays_unfinished = 0;  // rays stopped by the pass cap (only under reduced precision)
+  bool batch_walk = false;       // the grid walks ran in batches (RenderOptions::batch_walk)
+};
+
+}  // namespace host

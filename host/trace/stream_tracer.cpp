@@ -1,0 +1,276 @@
+// The stream ray tracer's host loop, the paper's pipeline: rays, the walk through the grid,
+// shading with shadow rays, reflections; the walk itself is host/trace/grid_walk.cpp.
+#include "host/trace/stream_tracer.h"
+
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <exception>
+#include <mutex>
+#include <stdexcept>
+
+#include "host/common/parallel.h"
+#include "host/trace/devices.h"
+#include "host/trace/passes.h"
+
+namespace host {
+
+using namespace kernels;
+using vgpu::Format;
+using vgpu::KernelProgram;
+using vgpu::Stencil;
+using vgpu::Texture;
+
+struct StreamTracer::State {
+  // Static textures: the scene, triangle i at texel (i mod width, i div width).
+  Texture v[3], n[3], colors;
+  // Dynamic textures (ping-pong pairs where a pass reads what it replaces).
+  Texture rays[2], origins[2], shadow_rays, isect[2], result[2], counter;
+  int cur_rays = 0, cur_isect = 0, cur_result = 0;
+  // The rays still walking, and those with a triangle left to test (the walk's masks).
+  Stencil grid_mask, isect_mask;
+  // The programs of the pipeline around the walk, with their uniforms.
+  KernelProgram<GenerateRays> generate;
+  KernelProgram<Shader> shader;
+  KernelProgram<ReflectedRays> reflected;
+  KernelProgram<ReflectionOrigin> origin;
+  KernelProgram<ReflectionDirection> direction;
+  KernelProgram<ShadowRays> shadow;
+  // The walk through the acceleration structure, and how passes are issued.
+  std::unique_ptr<GridWalk> walk;
+  std::unique_ptr<PassRunner> runner;
+};
+
+kernels::ShadingModel parse_shading(const std::string& name) {
+  if (name == "diffuse") return ShadingModel::diffuse;
+  if (name == "phong") return ShadingModel::phong;
+  if (name == "phong-atten") return ShadingModel::phong_atten;
+  throw std::invalid_argument("unknown shading model '" + name +
+                              "' (known: diffuse, phong, phong-atten)");
+}
+
+StreamTracer::StreamTracer(const Scene& scene, const Grid& grid, const RenderOptions& options)
+    : scene_(scene), grid_(grid), opt_(options) {
+  const auto t0 = std::chrono::steady_clock::now();
+  gpu_ = make_device(opt_);
+  s_ = std::make_unique<State>();
+  State& s = *s_;
+  vgpu::Device& gpu = *gpu_;
+  if (opt_.masks && !gpu.has_stencil())
+    throw vgpu::Error("--masks on needs stencil masks, which the " + opt_.device +
+                      " device does not have");
+  if (opt_.trace_pixel && !gpu.has_stencil())
+    throw vgpu::Error("--trace-pixel follows the emulator's finished-ray masks, which the " +
+                      opt_.device + " device does not have");
+  // Each program computes in its group's arithmetic format (formats.h: which kernel is where);
+  // the walk's programs are set by the walk.
+  const Formats& fm = opt_.formats;
+  for (auto [prog, g] :
+       std::initializer_list<std::pair<vgpu::Program*, Group>>{{&s.generate, Group::rays},
+                                                               {&s.origin, Group::rays},
+                                                               {&s.direction, Group::rays},
+                                                               {&s.shadow, Group::rays},
+                                                               {&s.shader, Group::colour},
+                                                               {&s.reflected, Group::colour}})
+    prog->set_precision(fm.arithmetic(g));
+  if (opt_.mrt) {
+    const std::string why = mrt_refusal(gpu.profile(), fm);
+    if (!why.empty()) throw vgpu::Error(why);
+  }
+  const int maxs = gpu.profile().max_texture_size;
+
+  // Scene textures: triangle i at texel (i mod width, i div width).
+  const size_t ntri = scene.triangle_count();
+  const int sw = int(std::min<size_t>(std::max<size_t>(ntri, 1), size_t(maxs)));
+  const size_t sh = (ntri + sw - 1) / sw;
+  if (sh > size_t(maxs))
+    throw vgpu::Error("scene has " + std::to_string(ntri) + " triangles; profile " +
+                      gpu.profile().name + " holds at most " + std::to_string(size_t(maxs) * maxs) +
+                      " in one " + std::to_string(maxs) + "x" + std::to_string(maxs) + " texture");
+  const std::vector<glm::vec3>* P[3] = {&scene.p0, &scene.p1, &scene.p2};
+  const std::vector<glm::vec3>* N[3] = {&scene.n0, &scene.n1, &scene.n2};
+  for (int c = 0; c < 3; ++c) {
+    s.v[c] = gpu.make_texture("vertices" + std::to_string(c), sw, int(sh), 3);
+    s.n[c] = gpu.make_texture("normals" + std::to_string(c), sw, int(sh), 3);
+    for (size_t i = 0; i < ntri; ++i) {
+      float* tv = s.v[c].texel_mut(int(i % sw), int(i / sw));
+      float* tn = s.n[c].texel_mut(int(i % sw), int(i / sw));
+      for (int k = 0; k < 3; ++k) tv[k] = (*P[c])[i][k], tn[k] = (*N[c])[i][k];
+    }
+  }
+  s.colors = gpu.make_texture("colors", sw, int(sh), 4);
+  for (size_t i = 0; i < ntri; ++i) {
+    const Material& m = scene.materials[scene.material[i]];
+    float* t = s.colors.texel_mut(int(i % sw), int(i / sw));
+    t[0] = m.color.r, t[1] = m.color.g, t[2] = m.color.b, t[3] = m.reflect;
+  }
+
+  // The acceleration structure's textures and walk (host/trace/grid_walk.h).
+  s.walk = std::make_unique<GridWalk>(gpu, grid, opt_, float(sw));
+
+  // Video memory gets the static textures once, at initialization.
+  for (const Texture* t : {&s.v[0], &s.v[1], &s.v[2], &s.n[0], &s.n[1], &s.n[2], &s.colors})
+    gpu.upload(*t);
+  s.walk->upload(gpu);
+
+  // Dynamic textures: one texel per pixel.
+  const int W = opt_.width, H = opt_.height;
+  for (int i = 0; i < 2; ++i) {
+    const std::string sfx = i ? " B" : " A";
+    s.rays[i] = gpu.make_texture("rays" + sfx, W, H, 4, fm[Group::rays]);
+    s.origins[i] = gpu.make_texture("origins" + sfx, W, H, 4, fm[Group::rays]);
+    s.isect[i] = gpu.make_texture("intersection" + sfx, W, H, 4, fm[Group::hits]);
+    s.result[i] = gpu.make_texture("result" + sfx, W, H, 4, fm[Group::colour]);
+  }
+  s.shadow_rays = gpu.make_texture("shadow rays", W, H, 4, fm[Group::rays]);
+  // Counting passes need a colour target; only their query result matters.
+  s.counter = gpu.make_texture("counter", W, H, 1, Format::fp16);
+  s.grid_mask = Stencil(W, H, 1);
+  s.isect_mask = Stencil(W, H, 1);
+  s.walk->make_state(gpu, {{&s.v[0], &s.v[1], &s.v[2]},
+                           {&s.isect[0], &s.isect[1]},
+                           &s.cur_isect,
+                           &s.grid_mask,
+                           &s.isect_mask});
+  s.runner = std::make_unique<PassRunner>(gpu, opt_, s.counter);
+
+  // Uniforms that do not change during a frame.
+  const float diag = glm::length(grid.hi - grid.lo);
+  const SceneUniforms su{float(sw)};
+  s.shader.kernel.scene = su;
+  s.shader.kernel.model = opt_.shading;
+  s.shader.kernel.shadows = opt_.shadows;
+  s.shader.kernel.atten_dist = float(kAttenOfDiagonal) * diag;
+  s.origin.kernel.scene = su;
+  s.origin.kernel.offset = float(kOffsetOfDiagonal) * diag;
+  s.direction.kernel.scene = su;
+  gpu.stats().keep_pass_records = opt_.keep_pass_records;
+  init_ms_ = ms_since(t0);
+}
+
+StreamTracer::~StreamTracer() = default;
+
+uint64_t StreamTracer::texture_bytes() const {
+  uint64_t b = s_->walk->texture_bytes();
+  for (const Texture* t : {&s_->v[0], &s_->v[1], &s_->v[2], &s_->n[0], &s_->n[1], &s_->n[2],
+                           &s_->colors, &s_->shadow_rays, &s_->counter})
+    b += t->bytes();
+  for (int i = 0; i < 2; ++i)
+    for (const Texture* t : {&s_->rays[i], &s_->origins[i], &s_->isect[i], &s_->result[i]})
+      b += t->bytes();
+  return b;
+}
+
+void StreamTracer::trace(Texture& origins, Texture& rays, bool primary, const Camera& cam) {
+  s_->walk->trace(*s_->runner, origins, rays, primary, cam.position);
+}
+
+RenderResult StreamTracer::render(const Camera& cam) {
+  const auto t0 = std::chrono::steady_clock::now();
+  vgpu::Device& gpu = *gpu_;
+  State& s = *s_;
+  gpu.stats().clear();
+  PassRunner& r = *s.runner;
+  r.counts = {};
+  const int W = opt_.width, H = opt_.height;
+  RenderResult res;
+  res.width = W;
+  res.height = H;
+
+  // generadorRayos: one primary ray per pixel; every primary ray starts at the eye.
+  GenerateRays& g = s.generate.kernel;
+  g.forward = cam.forward;
+  g.right = glm::normalize(glm::cross(cam.forward, cam.up));
+  g.up = glm::cross(g.right, cam.forward);
+  g.tan_half_fov = std::tan(0.5f * cam.yfov);
+  g.aspect = float(W) / float(H);
+  g.width = float(W);
+  g.height = float(H);
+  if (opt_.trace_pixel && opt_.trace_out)
+    *opt_.trace_out << "pixel " << opt_.trace_pixel->x << "," << opt_.trace_pixel->y << ":\n";
+  int ro = 0;  // origins[ro]: this iteration's ray origins; origins[ro ^ 1]: its hit points
+  gpu.clear(s.origins[ro], {cam.position.x, cam.position.y, cam.position.z, 0});
+  r.pass(s.generate, {}, s.rays[s.cur_rays]);
+  gpu.clear(s.result[s.cur_result], {0, 0, 0, 1});
+
+  const int iterations = 1 + std::max(0, opt_.bounces);
+  for (int it = 0; it < iterations; ++it) {
+    if (opt_.trace_pixel && opt_.trace_out) *opt_.trace_out << "iteration " << it + 1 << ":\n";
+    res.iterations = it + 1;
+    if (opt_.progress) opt_.progress(it + 1, iterations);
+    if (opt_.observer) opt_.observer->iteration(it + 1);
+    Texture& rays = s.rays[s.cur_rays];
+    if (opt_.observer)
+      opt_.observer->trace_begin(it ? PassObserver::TraceKind::reflected
+                                    : PassObserver::TraceKind::primary);
+    trace(s.origins[ro], rays, it == 0, cam);
+    if (opt_.observer) opt_.observer->trace_end();
+    Texture& hits = s.isect[s.cur_isect];
+    if (it == 0) {
+      gpu.download(hits);
+      res.depth.assign(size_t(W) * H, 0.0f);
+      res.hit_id.assign(size_t(W) * H, -1.0f);
+      for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+          const float* t = hits.texel(x, y);
+          if (t[3] >= 0) {
+            res.depth[size_t(y) * W + x] = t[0];
+            res.hit_id[size_t(y) * W + x] = float(scene_.id[size_t(t[3])]);
+          }
+        }
+    }
+    // inicioReflejo: hit points, the shader's record and the next rays' origins.
+    Texture& surface = s.origins[ro ^ 1];
+    r.pass(s.origin, {&s.origins[ro], &rays, &hits, &s.v[0], &s.v[1], &s.v[2]}, surface);
+    // shader: one pass per light, after that light's shadow rays are traced.
+    const auto& lights = scene_.lights;
+    for (size_t li = 0; li < lights.size(); ++li) {
+      Shader& sh = s.shader.kernel;
+      sh.light = lights[li].position;
+      sh.light_color = lights[li].color;
+      sh.first_light = li == 0;
+      sh.last_light = li + 1 == lights.size();
+      if (opt_.shadows) {
+        s.shadow.kernel.light = lights[li].position;
+        r.pass(s.shadow, {&surface, &s.result[s.cur_result]}, s.shadow_rays);
+        if (opt_.observer) opt_.observer->trace_begin(PassObserver::TraceKind::shadow);
+        trace(surface, s.shadow_rays, false, cam);
+        if (opt_.observer) opt_.observer->trace_end();
+      }
+      r.pass(s.shader,
+             {&surface, &rays, &s.result[s.cur_result], &s.isect[s.cur_isect], &s.colors, &s.v[0],
+              &s.v[1], &s.v[2], &s.n[0], &s.n[1], &s.n[2]},
+             s.result[s.cur_result ^ 1]);
+      s.cur_result ^= 1;
+    }
+    if (it + 1 == iterations) break;
+    // rayosReflejados: stop when no ray was reflected.
+    if (r.count(s.reflected, s.result[s.cur_result], nullptr, &s.grid_mask) == 0) break;
+    r.pass(s.direction,
+           {&rays, &surface, &s.result[s.cur_result], &s.v[0], &s.v[1], &s.v[2], &s.n[0], &s.n[1],
+            &s.n[2]},
+           s.rays[s.cur_rays ^ 1]);
+    s.cur_rays ^= 1;
+    ro ^= 1;
+  }
+
+  Texture& out = s.result[s.cur_result];
+  gpu.download(out);
+  res.rgb.resize(size_t(W) * H * 3);
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      const float* t = out.texel(x, y);
+      for (int c = 0; c < 3; ++c) res.rgb[(size_t(y) * W + x) * 3 + c] = t[c];
+    }
+  res.stats = gpu.stats();
+  res.rays_traced = r.counts.rays_traced;
+  res.rays_unfinished = r.counts.rays_unfinished;
+  res.batch_walk = r.counts.batch_walk;
+  res.render_ms = ms_since(t0);
+  return res;
+}
+
+}  // namespace host

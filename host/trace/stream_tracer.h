@@ -1,0 +1,49 @@
+// The paper's pipeline on the virtual GPU: static textures uploaded once (initialization), then
+// per frame: generate rays -> enter the grid -> alternate traversal and intersection passes
+// steered by occlusion-query counts -> shade (one pass per light, shadow rays through the same
+// kernels) -> reflected rays through the same pipeline, up to a maximum number of iterations.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "host/accel/grid.h"
+#include "host/model/formats.h"
+#include "host/scene/scene.h"
+#include "host/trace/grid_walk.h"
+#include "host/trace/render_options.h"
+#include "kernels/kernels.h"
+#include "vgpu/vgpu.h"
+
+namespace host {
+
+class StreamTracer {
+ public:
+  // Initialization, timed apart from rendering: the static textures (scene and grid) are built
+  // and checked against the profile's limits. Throws vgpu::Error naming the limit.
+  StreamTracer(const Scene& scene, const Grid& grid, const RenderOptions& options);
+  ~StreamTracer();
+  RenderResult render(const Camera& camera);
+  double init_ms() const { return init_ms_; }
+  vgpu::Device& device() { return *gpu_; }
+  uint64_t texture_bytes() const;  // static + dynamic textures, as the modeled card holds them
+
+ private:
+  struct State;
+  // One ray stream (primary, shadow or reflected) through the grid: the walk of
+  // host/trace/grid_walk.h.
+  void trace(vgpu::Texture& origins, vgpu::Texture& rays, bool primary, const Camera& cam);
+
+  const Scene& scene_;
+  const Grid& grid_;
+  RenderOptions opt_;
+  std::unique_ptr<vgpu::Device> gpu_;
+  std::unique_ptr<State> s_;
+  double init_ms_ = 0;
+};
+
+// Names of the shading models as the CLI spells them.
+kernels::ShadingModel parse_shading(const std::string& name);
+
+}  // namespace host

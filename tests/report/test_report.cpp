@@ -1,0 +1,250 @@
+// Tests of the frame recorder and its outputs (host/report): its per-pass counts add up to the
+// frame's statistics, a kept pixel's history is what --trace-pixel prints, the per-pixel maps
+// agree with the passes, and the CSV, the HTML report and the stats diff are written as stated.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "host/accel/grid.h"
+#include "host/image/image_io.h"
+#include "host/report/report.h"
+#include "host/scene/camera.h"
+#include "host/scene/gltf_loader.h"
+#include "host/scene/scene.h"
+#include "host/trace/stream_tracer.h"
+
+namespace {
+
+struct Frame {
+  host::RenderResult result;
+  std::string trace;  // --trace-pixel output, when asked for
+};
+
+// sphere.gltf at 48x40 (not a multiple of the 8x4 and 32x32 tiles) with the recorder attached.
+Frame render(host::FrameRecorder& rec, bool masks, std::optional<glm::ivec2> trace_pixel = {},
+             int threads = 2, int lanes = vgpu::kLanes) {
+  static const host::Scene scene = host::load_scene(host::resolve_scene("sphere"));
+  host::RenderOptions opt;
+  opt.width = 48;
+  opt.height = 40;
+  opt.masks = masks;
+  opt.threads = threads;
+  opt.lanes = lanes;
+  opt.observer = &rec;
+  std::ostringstream trace;
+  if (trace_pixel) {
+    opt.trace_pixel = trace_pixel;
+    opt.trace_out = &trace;
+  }
+  const host::Grid grid = host::build_grid(
+      scene, host::grid_spec_for(host::GridSpec{}, scene, vgpu::profile(opt.profile)));
+  host::StreamTracer tracer(scene, grid, opt);
+  const host::Camera cam = host::scene_camera(scene, 1.2f);
+  Frame f{tracer.render(cam), ""};
+  rec.finish(f.result.stats);
+  f.trace = trace.str();
+  return f;
+}
+
+std::string temp_path(const std::string& name) {
+  return (std::filesystem::temp_directory_path() / ("vgpu_test_report_" + name)).string();
+}
+
+std::string slurp(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  std::ostringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+}  // namespace
+
+TEST_CASE("the recorder's passes plus what lies between them sum to the frame's statistics") {
+  for (bool masks : {false, true}) {
+    CAPTURE(masks);
+    host::FrameRecorder rec(48, 40, masks, 0);
+    const Frame f = render(rec, masks);
+    const vgpu::FrameStats& s = f.result.stats;
+    vgpu::Counters sum = rec.tail();
+    uint64_t useful = 0, idle = 0;
+    for (const auto& p : rec.passes()) {
+      sum += p.counters;
+      sum += p.before;
+      sum += p.after;
+      useful += p.useful;
+      idle += p.idle;
+      CHECK(p.useful + p.idle + p.counters.fragments_masked == p.counters.fragments_launched);
+    }
+    CHECK(sum.same_counts(s.totals));
+    CHECK(rec.passes().size() == s.totals.passes);
+    if (masks) {
+      CHECK(idle == 0);  // with masks on, fragments with nothing to do are masked instead
+      CHECK(useful == s.totals.fragments_shaded);
+    } else {
+      CHECK(idle > 0);
+      CHECK(s.totals.fragments_masked == 0);
+    }
+  }
+}
+
+TEST_CASE("the per-pixel cost maps add up to the useful fragments of their kernels") {
+  host::FrameRecorder rec(48, 40, false, 0);
+  render(rec, false);
+  uint64_t trav = 0, isect = 0, idle = 0;
+  for (const auto& p : rec.passes()) {
+    if (p.program == kernels::Traversal::name) trav += p.useful;
+    if (p.program == kernels::Intersections::name) isect += p.useful;
+    if (p.work_mask >= 0) idle += p.idle;
+  }
+  uint64_t v = 0, t = 0, i = 0;
+  for (size_t k = 0; k < rec.voxel_steps().size(); ++k) {
+    v += rec.voxel_steps()[k];
+    t += rec.triangle_tests()[k];
+    i += rec.idle_passes()[k];
+  }
+  CHECK(v == trav);
+  CHECK(t == isect);
+  CHECK(i == idle);
+  CHECK(v > 0);
+  // The wavefront: walking after step k is steps > k, so its counts are the queries' results.
+  for (size_t tr = 0; tr < rec.traces().size(); ++tr) {
+    std::vector<int64_t> queries;
+    for (const auto& p : rec.passes())
+      if (p.trace == int(tr) && p.program == kernels::RaysInGrid::name) queries.push_back(p.query);
+    for (size_t k = 0; k < queries.size(); ++k) {
+      int64_t walking = 0;
+      for (uint16_t s : rec.wavefront()[tr]) walking += s > k;
+      CHECK(walking == queries[k]);
+    }
+  }
+}
+
+TEST_CASE("a kept pixel's history holds the states --trace-pixel prints, in order") {
+  const glm::ivec2 px{21, 17};  // off the sample grid: kept because it is traced
+  host::FrameRecorder rec(48, 40, false, 16, {px});
+  const Frame f = render(rec, false, px);
+  const auto& pixels = rec.history_pixels();
+  const size_t k = size_t(std::find(pixels.begin(), pixels.end(), px) - pixels.begin());
+  REQUIRE(k < pixels.size());
+  CHECK(pixels.size() == 3 * 3 + 1);  // x in {0, 16, 32}, y in {0, 16, 32}, and px
+  // Every "-> target (a, b, c, d)" line, as floats.
+  std::vector<float> printed;
+  std::istringstream lines(f.trace);
+  for (std::string line; std::getline(lines, line);) {
+    const size_t open = line.find(" (", line.find("->"));
+    if (line.find("->") == std::string::npos || open == std::string::npos) continue;
+    std::istringstream nums(line.substr(open + 2));
+    for (std::string n; std::getline(nums, n, ',');) printed.push_back(std::stof(n));
+  }
+  const std::vector<float>& kept = rec.history_states()[k];
+  REQUIRE(printed.size() == kept.size());
+  REQUIRE(printed.size() > 40);
+  for (size_t i = 0; i < kept.size(); ++i) {
+    CAPTURE(i);
+    CHECK(printed[i] == doctest::Approx(kept[i]).epsilon(1e-5));
+  }
+}
+
+TEST_CASE("the stats CSV has a header and one row per pass, and the report carries the data") {
+  host::FrameRecorder rec(48, 40, false);
+  const Frame f = render(rec, false);
+  const std::string csv = temp_path("passes.csv"), html = temp_path("frame.html");
+  host::write_stats_csv(csv, rec);
+  std::istringstream rows(slurp(csv));
+  std::string header, line;
+  std::getline(rows, header);
+  CHECK(header.rfind("index,kernel,paper_name,iteration", 0) == 0);
+  size_t n = 0;
+  while (std::getline(rows, line)) {
+    CHECK(line.rfind(std::to_string(n) + ",", 0) == 0);
+    ++n;
+  }
+  CHECK(n == f.result.stats.totals.passes);
+
+  nlohmann::ordered_json run = f.result.stats.json();
+  host::write_report(html, rec, f.result, run);
+  const std::string page = slurp(html);
+  CHECK(page.find("@REPORT_DATA@") == std::string::npos);
+  CHECK(page.find("/*@CHART_JS@*/") == std::string::npos);
+  CHECK(page.find("\"mask_count\":") != std::string::npos);
+  std::remove(csv.c_str());
+  std::remove(html.c_str());
+}
+
+TEST_CASE("an output in a missing directory or with the wrong extension is refused up front") {
+  CHECK_THROWS_WITH_AS(host::check_output_path("/no/such/dir/r.html", {".html"}),
+                       doctest::Contains("does not exist"), host::InputError);
+  CHECK_THROWS_WITH_AS(host::check_output_path(temp_path("r.htm"), {".html"}),
+                       doctest::Contains("unsupported extension '.htm'"), host::InputError);
+  CHECK_NOTHROW(host::check_output_path(temp_path("r.HTML"), {".html"}));
+}
+
+TEST_CASE("diff shows each counter of two stats files, B - A and B / A, and refuses other JSON") {
+  const std::string a = temp_path("a.json"), b = temp_path("b.json"), bad = temp_path("bad.json");
+  std::ofstream(a) << R"({"masks": false, "totals": {"passes": 10, "fragments_shaded": 400},
+    "kernels": [{"name": "traversal", "paper_name": "traversal", "passes": 4}]})";
+  std::ofstream(b) << R"({"masks": true, "totals": {"passes": 10, "fragments_shaded": 100},
+    "kernels": [{"name": "traversal", "paper_name": "traversal", "passes": 4},
+                {"name": "shader", "paper_name": "shader", "passes": 1}]})";
+  std::ofstream(bad) << R"({"scene": "x"})";
+  const std::string d = host::diff_stats(a, b);
+  CHECK(d.find("differs: masks false -> true") != std::string::npos);
+  CHECK(d.find("-300") != std::string::npos);                    // fragments_shaded, B - A
+  CHECK(d.find("0.250") != std::string::npos);                   // fragments_shaded, B / A
+  CHECK(d.find("kernel shader (shader)") != std::string::npos);  // only B ran it
+  CHECK_THROWS_WITH_AS(host::diff_stats(a, bad), doctest::Contains("not a vgpu-rt --stats-json"),
+                       host::InputError);
+  CHECK_THROWS_WITH_AS(host::diff_stats(temp_path("none.json"), a),
+                       doctest::Contains("cannot open"), host::InputError);
+  for (const std::string& p : {a, b, bad}) std::remove(p.c_str());
+}
+
+TEST_CASE("a counts-only recorder (the CSV's) records the same passes and keeps no pixels") {
+  host::FrameRecorder full(48, 40, false), counts(48, 40, false, 8, {}, false);
+  render(full, false);
+  render(counts, false);
+  REQUIRE(counts.passes().size() == full.passes().size());
+  for (size_t i = 0; i < full.passes().size(); ++i) {
+    CAPTURE(i);
+    CHECK(counts.passes()[i].useful == full.passes()[i].useful);
+    CHECK(counts.passes()[i].idle == full.passes()[i].idle);
+    CHECK(counts.passes()[i].query == full.passes()[i].query);
+    CHECK(counts.passes()[i].work_mask == -1);
+  }
+  CHECK(counts.masks().empty());
+  CHECK(counts.voxel_steps().empty());
+  CHECK(counts.history_pixels().empty());
+  CHECK(!full.masks().empty());
+}
+
+TEST_CASE("what the recorder sees is the same for any thread count and lane width") {
+  host::FrameRecorder a(48, 40, false), b(48, 40, false);
+  render(a, false, {}, 1, 1);
+  render(b, false, {}, 3, 16);
+  REQUIRE(a.passes().size() == b.passes().size());
+  for (size_t i = 0; i < a.passes().size(); ++i) {
+    CAPTURE(i);
+    CHECK(a.passes()[i].counters.same_counts(b.passes()[i].counters));
+    CHECK(a.passes()[i].useful == b.passes()[i].useful);
+    CHECK(a.passes()[i].work_mask == b.passes()[i].work_mask);
+  }
+  CHECK(a.masks() == b.masks());
+  CHECK(a.voxel_steps() == b.voxel_steps());
+  CHECK(a.triangle_tests() == b.triangle_tests());
+  CHECK(a.wavefront() == b.wavefront());
+  CHECK(a.history_states() == b.history_states());
+  REQUIRE(a.occupancy().size() == b.occupancy().size());
+  for (size_t k = 0; k < a.occupancy().size(); ++k) {
+    CAPTURE(a.occupancy()[k].first);
+    CHECK(a.occupancy()[k].second.tile8x4 == b.occupancy()[k].second.tile8x4);
+    CHECK(a.occupancy()[k].second.tile32x32 == b.occupancy()[k].second.tile32x32);
+  }
+}
