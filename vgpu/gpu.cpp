@@ -1,4 +1,5 @@
-// The fragment processor and pipeline state: passes, limits, queries, masks, statistics.
+// The fragment processor and pipeline state: programs, units, targets, queries, and the pass
+// itself (draw() plans it, run_rows() shades the fragments of a band of rows).
 #include "vgpu/gpu.h"
 
 #include <algorithm>
@@ -9,117 +10,13 @@
 #include <cstring>
 #include <vector>
 
+#include "vgpu/gpu_internal.h"
+
 namespace vgpu {
 
+using namespace gpu_detail;
+
 namespace {
-
-// Batch flags per fragment: kTook took the branch, kIdle sat idle in it, 0 not shaded.
-constexpr uint8_t kTook = kBranchTook, kIdle = kBranchIdle;
-
-constexpr uint64_t kOnes = 0x0101010101010101ull, kHighs = 0x8080808080808080ull;
-
-// The high bit of every non-zero byte of v.
-constexpr uint64_t nonzero_bytes(uint64_t v) {
-  return (((v & ~kHighs) + ~kHighs) | v) & kHighs;
-}
-
-// Up to eight bytes from p (n of them; the rest read as 0).
-inline uint64_t load_bytes(const uint8_t* p, int n) {
-  uint64_t v = 0;
-  if (n >= 8) {
-    std::memcpy(&v, p, 8);  // a fixed size: one load, no call
-    return v;
-  }
-  for (int i = 0; i < n; ++i) v |= uint64_t(p[i]) << (8 * i);
-  return v;
-}
-
-// Idle fragments in the 8x4 and the 32x32 tiles of the drawn rectangle where no fragment took
-// the branch: {in 8x4 tiles, in 32x32 tiles}. That is every idle fragment (`idle_flags` of them)
-// less those in tiles with work, so only the 32x32 tiles `took32` marks are scanned, eight
-// fragments at a time. A fragment is idle when it passed the stencil test and the work mask
-// left it idle (unless that counts as masked), or when it ran and its flag says so (the masks,
-// not the flags, decide for fragments that did not run).
-std::array<uint64_t, 2> idle_in_batches(const Rect& r, const uint8_t* flags, const Stencil* work,
-                                        const Stencil* test, bool work_masked, uint64_t idle_flags,
-                                        const uint8_t* took8, const uint8_t* took32) {
-  const int w = r.width(), h = r.height();
-  const int cols8 = (w + 7) / 8, cols32 = (w + 31) / 32, rows32 = (h + 31) / 32;
-  std::array<uint64_t, 2> total{idle_flags, idle_flags};
-  std::vector<uint64_t> idle8(
-      static_cast<size_t>(cols8));  // per 8x4 tile of the current band of 4 rows
-  for (int ty = 0; ty < rows32; ++ty)
-    for (int tx = 0; tx < cols32; ++tx) {
-      if (!took32[size_t(ty) * size_t(cols32) + size_t(tx)]) continue;
-      const int c0 = tx * 4, c1 = std::min(cols8, c0 + 4);
-      for (int band = ty * 8; band < std::min((h + 3) / 4, ty * 8 + 8); ++band) {
-        for (int c = c0; c < c1; ++c) idle8[size_t(c)] = 0;
-        for (int y = band * 4; y < std::min(h, band * 4 + 4); ++y) {
-          const uint8_t* fl = flags + size_t(y) * size_t(w);
-          const uint8_t* st = test ? test->row(r.y0 + y) + r.x0 : nullptr;
-          const uint8_t* wk = work ? work->row(r.y0 + y) + r.x0 : nullptr;
-          for (int c = c0; c < c1; ++c) {
-            const int x = 8 * c, n = std::min(8, w - x);
-            // Fragments of the rectangle that passed the stencil test.
-            uint64_t live = st ? nonzero_bytes(load_bytes(st + x, n)) : kHighs;
-            if (n < 8) live &= kHighs >> (8 * (8 - n));
-            const uint64_t ran = wk ? nonzero_bytes(load_bytes(wk + x, n)) : kHighs;
-            const uint64_t flagged_idle = ~nonzero_bytes(load_bytes(fl + x, n) ^ (kOnes * kIdle));
-            const uint64_t idle = live & ((ran & flagged_idle) | (work_masked ? 0 : ~ran & kHighs));
-            idle8[size_t(c)] += uint64_t(std::popcount(idle));
-          }
-        }
-        for (int c = c0; c < c1; ++c) {
-          const uint64_t n = idle8[size_t(c)];
-          if (took8[size_t(band) * size_t(cols8) + size_t(c)]) total[0] -= n;
-          total[1] -= n;
-        }
-      }
-    }
-  return total;
-}
-
-// The same counters for a pass under a listed mask (a whole-target draw, no stencil test), from
-// the list instead of a scan of the tiles: there a tile's idle fragments are its fragments (or,
-// when idle ones count as masked, its listed ones) less those that took the branch, so per-tile
-// counts of listed and kTook fragments give them. `w` x `h`: the target, texel index y * w + x.
-std::array<uint64_t, 2> idle_in_batches_listed(int w, int h, const uint8_t* flags,
-                                               const std::vector<uint32_t>& listed,
-                                               bool work_masked, uint64_t idle_flags) {
-  const int cols8 = (w + 7) / 8, rows4 = (h + 3) / 4, cols32 = (w + 31) / 32;
-  const int rows32 = (h + 31) / 32;
-  // Per 8x4 and 32x32 tile: {listed, took}.
-  thread_local std::vector<std::array<uint32_t, 2>> t8, t32;
-  t8.assign(size_t(cols8) * size_t(rows4), {0, 0});
-  t32.assign(size_t(cols32) * size_t(rows32), {0, 0});
-  int y = 0;
-  uint32_t row0 = 0;
-  for (const uint32_t i : listed) {
-    if (i - row0 >= uint32_t(w)) {
-      y = int(i / uint32_t(w));
-      row0 = uint32_t(y) * uint32_t(w);
-    }
-    const int x = int(i - row0);
-    const uint32_t took = flags[i] == kTook ? 1 : 0;
-    auto& a = t8[size_t(y / 4) * size_t(cols8) + size_t(x / 8)];
-    auto& b = t32[size_t(y / 32) * size_t(cols32) + size_t(x / 32)];
-    ++a[0], ++b[0];
-    a[1] += took, b[1] += took;
-  }
-  std::array<uint64_t, 2> total{idle_flags, idle_flags};
-  auto settle = [&](const std::vector<std::array<uint32_t, 2>>& t, int cols, int tw, int th,
-                    uint64_t& sum) {
-    for (size_t k = 0; k < t.size(); ++k) {
-      if (t[k][1] == 0) continue;  // no fragment took the branch: its idle ones stay counted
-      const int c = int(k % size_t(cols)), r = int(k / size_t(cols));
-      const uint64_t area = uint64_t(std::min(tw, w - c * tw)) * uint64_t(std::min(th, h - r * th));
-      sum -= (work_masked ? t[k][0] : area) - t[k][1];
-    }
-  };
-  settle(t8, cols8, 8, 4, total[0]);
-  settle(t32, cols32, 32, 32, total[1]);
-  return total;
-}
 
 // End of a stretch of live idle fragments from `from`: the first i < to with wk[i] != 0 or, when
 // there is a stencil test, st[i] == 0. Eight bytes at a time, the row's hottest loop.
@@ -134,66 +31,7 @@ int stretch_end(const uint8_t* wk, const uint8_t* st, int from, int to) {
   return to;
 }
 
-// A looping pass's batches: the profile's branch granularity as a tile of the drawn rectangle
-// (2^k pixels: 2^ceil(k/2) wide, 2^floor(k/2) high, so 32 is 8x4 and 1024 is 32x32), aligned to
-// its corner. A batch iterates as long as its busiest shaded fragment: every shaded fragment of
-// it holds a lane slot for each of those iterations, active while it still loops. `iters`: per
-// texel of the target (tw wide), the iterations each fragment ran. Per iteration k of the
-// budget, the active and idle lanes of the batches still iterating go to active[k-1], idle[k-1].
-LoopCounts loop_batches(const Rect& r, const uint32_t* iters, uint32_t tw, const Stencil* work,
-                        const Stencil* test, bool work_masked, int granularity, int budget,
-                        std::vector<uint64_t>& active, std::vector<uint64_t>& idle) {
-  const int k = std::bit_width(unsigned(std::max(granularity, 1))) - 1;
-  const int bw = 1 << ((k + 1) / 2), bh = 1 << (k / 2);
-  active.assign(size_t(budget), 0);
-  idle.assign(size_t(budget), 0);
-  std::vector<uint64_t> exactly(size_t(budget) + 1);  // fragments of the batch with c iterations
-  LoopCounts n;
-  for (int ty = r.y0; ty < r.y1; ty += bh)
-    for (int tx = r.x0; tx < r.x1; tx += bw) {
-      std::fill(exactly.begin(), exactly.end(), 0);
-      uint64_t lanes = 0;
-      uint32_t most = 0;
-      for (int y = ty; y < std::min(r.y1, ty + bh); ++y)
-        for (int x = tx; x < std::min(r.x1, tx + bw); ++x) {
-          if (test && test->get(x, y) == 0) continue;                 // masked before shading
-          if (work_masked && work && work->get(x, y) == 0) continue;  // early-z: not shaded
-          const uint32_t c = std::min(iters[size_t(y) * tw + size_t(x)], uint32_t(budget));
-          ++lanes;
-          ++exactly[c];
-          n.iterations += c;
-          most = std::max(most, c);
-        }
-      n.shaded += lanes;
-      n.slots += lanes * most;
-      n.batch_iterations += most;
-      uint64_t out = exactly[0];  // fragments out of the loop before iteration j + 1
-      for (uint32_t j = 0; j < most; ++j) {
-        active[j] += lanes - out;
-        idle[j] += out;
-        out += exactly[j + 1];
-      }
-    }
-  return n;
-}
-
 }  // namespace
-
-struct Gpu::Chunk {
-  uint64_t launched = 0, shaded = 0, masked = 0, discarded = 0, idle = 0;
-  uint64_t idle_flags = 0;  // fragments flagged kIdle (for the batch counters)
-  // Texel indices, ascending: the fragments that ran (DrawPlan::list_runs) and those whose
-  // stencil write is 1 (DrawPlan::list_survivors).
-  std::vector<uint32_t> runs, survivors;
-  void reset() {
-    std::vector<uint32_t> keep_runs = std::move(runs), keep_survivors = std::move(survivors);
-    *this = Chunk{};
-    runs = std::move(keep_runs);
-    survivors = std::move(keep_survivors);
-    runs.clear();
-    survivors.clear();
-  }
-};
 
 // What one draw's row workers share: where outputs go, where idle fragments' outputs come from,
 // and the batch-flag maps. Built once per draw on the calling thread.
@@ -221,22 +59,6 @@ struct Gpu::DrawPlan {
   // A looping program: per texel of the target, the iterations its fragment ran (0 if none).
   uint32_t* loop_map = nullptr;
 };
-
-Gpu::Gpu(const Profile& profile, int threads, int lanes) : profile_(profile), lanes_(lanes) {
-  if (lanes != 1 && lanes != 4 && lanes != 8 && lanes != 16)
-    throw Error("lane width must be 1, 4, 8 or 16 (got " + std::to_string(lanes) + ")");
-  if (threads <= 0) threads = int(std::max(1u, std::thread::hardware_concurrency()));
-  for (int i = 1; i < threads; ++i) workers_.emplace_back([this] { worker_loop(); });
-}
-
-Gpu::~Gpu() {
-  {
-    std::lock_guard lk(mu_);
-    stop_ = true;
-  }
-  cv_work_.notify_all();
-  for (auto& w : workers_) w.join();
-}
 
 void Gpu::fail(const std::string& what) const {
   throw Error(what);
@@ -639,63 +461,6 @@ void Gpu::run_rows(const Program& p, const Rect& r, int y0, int y1, const DrawPl
   result = std::move(out);
 }
 
-void Gpu::parallel_rows(const Rect& r, uint64_t work,
-                        const std::function<void(int, int, Chunk&)>& body,
-                        std::vector<Chunk>& chunks) {
-  const int rows = r.height();
-  // Enough chunks to balance uneven rows, few enough to keep scheduling cheap; a pass that
-  // visits few fragments runs on the calling thread (waking workers would cost more).
-  const bool small = work < 4096;
-  const int nchunks = small ? 1 : std::max(1, std::min(rows, threads() * 8));
-  chunks.resize(size_t(nchunks));
-  for (Chunk& c : chunks) c.reset();
-  std::atomic<int> next{0};
-  const std::function<void()> job = [&] {
-    for (;;) {
-      const int k = next.fetch_add(1);
-      if (k >= nchunks) return;
-      const int ya = r.y0 + int(int64_t(rows) * k / nchunks);
-      const int yb = r.y0 + int(int64_t(rows) * (k + 1) / nchunks);
-      body(ya, yb, chunks[size_t(k)]);
-    }
-  };
-  if (workers_.empty() || nchunks == 1) {
-    job();
-    return;
-  }
-  run_on_workers(job);
-}
-
-// job() on the calling thread and on every worker, until all have returned.
-void Gpu::run_on_workers(const std::function<void()>& job) {
-  {
-    std::lock_guard lk(mu_);
-    job_ = &job;
-    ++job_serial_;
-    busy_ = int(workers_.size());
-  }
-  cv_work_.notify_all();
-  job();
-  std::unique_lock lk(mu_);
-  cv_done_.wait(lk, [&] { return busy_ == 0; });
-  job_ = nullptr;
-}
-
-void Gpu::worker_loop() {
-  uint64_t seen = 0;
-  std::unique_lock lk(mu_);
-  for (;;) {
-    cv_work_.wait(lk, [&] { return stop_ || job_serial_ != seen; });
-    if (stop_) return;
-    seen = job_serial_;
-    const std::function<void()>* job = job_;
-    lk.unlock();
-    (*job)();
-    lk.lock();
-    if (--busy_ == 0) cv_done_.notify_one();
-  }
-}
-
 // After a pass that carried idle fragments over from passthrough units: each source and target
 // now agree except at the fragments that ran: `runs`, or those the row chunks listed when
 // `chunk_runs`; neither: no record.
@@ -972,114 +737,6 @@ const PassRecord& Gpu::draw(const Rect& rect) {
                               work_masked_, sum.idle_flags, plan.took8, plan.took32);
   return settle(p, a, rect, sum, plan.flags ? &batch : nullptr, looping ? &loop_n : nullptr,
                 std::move(loop_active), std::move(loop_idle), t0, 0.0);
-}
-
-// A pass that a batch walk ran already (Gpu::replay_next): nothing runs, and the statistics
-// come out as the fragment processor's would. The walk ran the fragments of the work mask
-// (every fragment without one); the others are idle, settled as run_rows's listed path settles
-// them; the tally's tile sums give the batch counters as idle_in_batches_listed does.
-const PassRecord& Gpu::replay(const Program& p, const Program::Analysis& a, const Rect& rect,
-                              const PassTally& t, std::chrono::steady_clock::time_point t0) {
-  const Texture& target = *targets_[0];
-  if (stencil_test_ || rect.x0 != 0 || rect.y0 != 0 || rect.x1 != target.width() ||
-      rect.y1 != target.height() || a.loop.loops > 0)
-    fail("program '" + std::string(p.name()) +
-         "': a replayed pass must cover the whole target, without stencil test or loop");
-  const uint64_t area = rect.area();
-  if (t.ran > area || (!work_mask_ && t.ran != area))
-    fail("program '" + std::string(p.name()) + "': replayed tally does not fit the pass");
-  const uint64_t idle = area - t.ran;
-  Chunk sum;
-  sum.launched = area;
-  sum.shaded = area;
-  sum.discarded = t.killed;
-  sum.idle = t.lanes_idle;
-  sum.idle_flags = t.flagged_idle;
-  if (work_masked_) {  // idle fragments: rejected by the early-z test, never shaded
-    sum.shaded -= idle;
-    sum.masked += idle;
-  } else {
-    sum.idle += uint64_t(a.branches) * idle;
-    if (p.idle_discards()) sum.discarded += idle;
-    if (a.branches > 0) sum.idle_flags += idle;
-  }
-  flags_size_ = 0;  // no per-fragment map: nothing ran here
-  flags_ran_.reset();
-  // The walk left the targets and the stencil written: whatever the emulator knew of them is old.
-  for (Texture* target_tex : targets_) ++target_tex->version_;
-  if (stencil_write_) ++stencil_write_->version_;
-  const std::array<uint64_t, 2> batch{sum.idle_flags - t.idle_near_took8x4,
-                                      sum.idle_flags - t.idle_near_took32x32};
-  return settle(p, a, rect, sum, a.branches > 0 ? &batch : nullptr, nullptr, {}, {}, t0, t.host_ms);
-}
-
-void Gpu::parallel_for(int n, const std::function<void(int, int)>& body) {
-  std::atomic<int> next{0}, slot{0};
-  const std::function<void()> job = [&] {
-    const int mine = slot.fetch_add(1);
-    for (;;) {
-      const int k = next.fetch_add(1);
-      if (k >= n) return;
-      body(k, mine);
-    }
-  };
-  if (workers_.empty() || n <= 1) {
-    job();
-    return;
-  }
-  run_on_workers(job);
-}
-
-// The statistics of a pass from what its fragments did: static per-fragment costs times the
-// fragments shaded (identical at any width and thread count), the batch and loop counters.
-const PassRecord& Gpu::settle(const Program& p, const Program::Analysis& a, const Rect& rect,
-                              const Chunk& sum, const std::array<uint64_t, 2>* batch,
-                              const LoopCounts* loop, std::vector<uint64_t> loop_active,
-                              std::vector<uint64_t> loop_idle,
-                              std::chrono::steady_clock::time_point t0, double extra_ms) {
-  const std::string pname = p.name();
-  const bool looping = loop != nullptr;
-  const Format precision = precision_of(p);
-  Counters c = pass_counters(a, units_.data(), targets_, sum.launched, sum.shaded, sum.discarded);
-  c.fragments_masked = sum.masked;
-  c.lanes_idle = sum.idle;
-  if (looping) add_loop_counters(c, a, units_.data(), *loop);
-  if (batch) {
-    c.idle_in_batch32 = (*batch)[0];
-    c.idle_in_batch1024 = (*batch)[1];
-  }
-  // Arithmetic (every counted operation but the fetches) by the precision it ran at.
-  const uint64_t alu = c.instructions - c.texture_fetches;
-  if (precision == Format::fp24) c.alu_fp24 = alu;
-  if (precision == Format::fp16) c.alu_fp16 = alu;
-  if (query_active_) query_count_ += sum.shaded - sum.discarded;
-  c.host_ms =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count() +
-      extra_ms;
-
-  FrameStats::ProgramTotals& totals = stats_.program(pname, p.paper_name(), a.instructions);
-  totals.counters += c;
-  totals.instructions = a.instructions;
-  if (looping) {
-    totals.loop_budget = std::max(totals.loop_budget, a.loop.max_iterations);
-    totals.loop_body_instructions = a.loop.body_instructions;
-    auto add = [](std::vector<uint64_t>& to, const std::vector<uint64_t>& v) {
-      if (to.size() < v.size()) to.resize(v.size(), 0);
-      for (size_t i = 0; i < v.size(); ++i) to[i] += v[i];
-    };
-    add(totals.loop_active, loop_active);
-    add(totals.loop_idle, loop_idle);
-  }
-  stats_.totals += c;
-  PassRecord rec{pname, rect.width(), rect.height(), c, -1};
-  rec.loop_active = std::move(loop_active);
-  rec.loop_idle = std::move(loop_idle);
-  if (stats_.keep_pass_records) {
-    stats_.passes.push_back(std::move(rec));
-    return stats_.passes.back();
-  }
-  last_pass_ = std::move(rec);
-  return last_pass_;
 }
 
 }  // namespace vgpu

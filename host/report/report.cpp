@@ -26,7 +26,7 @@
 #include "kernels/registry.h"
 #include "vgpu/glsl.h"
 
-// tinygltf's base64 encoder (tiny_gltf.h, compiled once in gltf_loader.cpp): no second copy here
+// tinygltf's base64 encoder (tiny_gltf.h, compiled once in host/scene/gltf_file.cpp): no second copy here
 // and no OpenImageIO in the report.
 namespace tinygltf {
 std::string base64_encode(unsigned char const* bytes, unsigned int len);
