@@ -1,14 +1,17 @@
 // The GL device checked against the vgpu on the same hand-made texels: every kernel pass that a
-// kernel test runs (tests/kernels/kernel_pass.h) is run again as a GL pass, and each output
-// channel must match the vgpu's within the kernel's stated ulps, the query count exactly.
+// kernel test runs (tests/kernels/kernel_pass.h, tests/kernels/test_looping_traversal.cpp) is
+// run again as a GL pass, and each output channel must match the vgpu's within the kernel's
+// stated ulps, the query count exactly. And whole frames: check_same_frame.
 #pragma once
 
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstdint>
 #include <map>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -50,6 +53,7 @@ inline int ulps_allowed(const std::string& kernel) {
       {"shadow rays", 4},
       {"intersections + next triangle", 16},  // as intersections
       {"traversal + update voxel", 4},        // as traversal
+      {"looping traversal", 16},              // intersections and traversal in one loop
   };
   const auto it = allowed.find(kernel);
   return it == allowed.end() ? 0 : it->second;
@@ -87,10 +91,19 @@ inline void check_same_targets(const vgpu::Program& p,
   d.use_program(p);
   d.unbind_textures();
   for (size_t i = 0; i < units.size(); ++i) d.bind_texture(int(i), *units[i]);
-  if (outs.size() == 1)
-    d.set_targets({&outs[0]});
-  else
-    d.set_targets({&outs[0], &outs[1]});
+  switch (outs.size()) {
+    case 1:
+      d.set_targets({&outs[0]});
+      break;
+    case 2:
+      d.set_targets({&outs[0], &outs[1]});
+      break;
+    case 3:  // the looping program: traversal, voxel state and intersection
+      d.set_targets({&outs[0], &outs[1], &outs[2]});
+      break;
+    default:
+      FAIL("check_same_targets binds 1 to 3 targets, not " << outs.size());
+  }
   if (vgpu_query) d.begin_query();
   d.draw();
   const uint64_t n = vgpu_query ? d.end_query() : 0;
@@ -118,6 +131,76 @@ inline void check_same_targets(const vgpu::Program& p,
   if (vgpu_query) {
     INFO("GL device against vgpu: program '" << name << "' occlusion query");
     CHECK(n == *vgpu_query);
+  }
+}
+
+// A whole frame of one scene from the vgpu and from the GL device (`device`, its description):
+// the primary hits' triangle ids and depths (RenderResult::hit_id, ::depth) and the image.
+// llvmpipe computes every kernel correctly rounded, as the vgpu does (0 ulps measured on every
+// kernel, see ulps_allowed), so there all three must be equal bit for bit: one differing texel
+// in any pass of the frame shows up as a differing hit id, depth or colour. Another driver may
+// use the approximations GLSL allows within each kernel's stated ulps, and those bounds forbid
+// requiring equality there: `depth_kernel` (intersections: 16 ulps) may move a hit parameter t,
+// which changes the depth and, for a ray through a shared edge or two hits a few ulps apart,
+// the triangle hit; the shader (64 ulps) changes colours. There hit ids may differ on 0.1% of
+// the pixels, depths where the hit ids agree by depth_kernel's ulps, and colours to a PSNR of
+// 60 dB.
+inline void check_same_frame(const std::string& device, const std::string& depth_kernel,
+                             const std::vector<float>& vgpu_hit, const std::vector<float>& gl_hit,
+                             const std::vector<float>& vgpu_depth,
+                             const std::vector<float>& gl_depth, const std::vector<float>& vgpu_rgb,
+                             const std::vector<float>& gl_rgb) {
+  const size_t n = vgpu_hit.size();
+  REQUIRE(n > 0);
+  REQUIRE(gl_hit.size() == n);
+  REQUIRE(vgpu_depth.size() == n);
+  REQUIRE(gl_depth.size() == n);
+  REQUIRE(vgpu_rgb.size() == 3 * n);
+  REQUIRE(gl_rgb.size() == 3 * n);
+  const bool exact = device.find("llvmpipe") != std::string::npos;
+  size_t hits = 0, depths = 0, colours = 0, first = n;
+  uint64_t depth_ulps = 0, colour_ulps = 0;
+  double sq = 0;
+  for (size_t i = 0; i < n; ++i) {
+    if (vgpu_hit[i] != gl_hit[i]) {
+      ++hits;
+      first = std::min(first, i);
+      continue;
+    }
+    const uint64_t u = ulp_distance(vgpu_depth[i], gl_depth[i]);
+    depth_ulps = std::max(depth_ulps, u);
+    depths += u > 0;
+    if (u > 0) first = std::min(first, i);
+  }
+  for (size_t i = 0; i < 3 * n; ++i) {
+    const uint64_t u = ulp_distance(vgpu_rgb[i], gl_rgb[i]);
+    colour_ulps = std::max(colour_ulps, u);
+    colours += u > 0;
+    if (u > 0) first = std::min(first, i / 3);
+    const double d = double(vgpu_rgb[i]) - double(gl_rgb[i]);
+    sq += d * d;
+  }
+  const double mse = sq / double(3 * n);
+  const double psnr = mse == 0 ? INFINITY : 10 * std::log10(1.0 / mse);
+  MESSAGE("GL device (" << device << ") against vgpu, " << n << " pixels: " << hits << " hit ids, "
+                        << depths << " depths (worst " << depth_ulps << " ulps) and " << colours
+                        << " colour channels (worst " << colour_ulps << " ulps, PSNR " << psnr
+                        << " dB) differ");
+  std::ostringstream where;
+  if (first < n)
+    where << "first differing pixel " << first << ": hit id vgpu " << vgpu_hit[first] << ", GL "
+          << gl_hit[first] << "; depth vgpu " << vgpu_depth[first] << ", GL " << gl_depth[first]
+          << "; red vgpu " << vgpu_rgb[3 * first] << ", GL " << gl_rgb[3 * first];
+  const std::string where_text = where.str();
+  INFO(where_text);
+  if (exact) {
+    CHECK(hits == 0);
+    CHECK(depths == 0);
+    CHECK(colours == 0);
+  } else {
+    CHECK(hits * 1000 <= n);
+    CHECK(depth_ulps <= uint64_t(ulps_allowed(depth_kernel)));
+    CHECK(psnr >= 60.0);
   }
 }
 

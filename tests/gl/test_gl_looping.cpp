@@ -12,7 +12,12 @@
 
 namespace {
 
-host::RenderResult render(const std::string& scene_name, const std::string& device, int size) {
+struct Frame {
+  host::RenderResult result;
+  std::string device;  // the device's description
+};
+
+Frame render(const std::string& scene_name, const std::string& device, int size) {
   const host::Scene scene = host::load_scene(host::resolve_scene(scene_name));
   host::RenderOptions opt;
   opt.width = opt.height = size;
@@ -26,7 +31,7 @@ host::RenderResult render(const std::string& scene_name, const std::string& devi
       host::build_grid(scene, host::grid_spec_for({}, scene, vgpu::profile(opt.profile)));
   const host::Camera cam = host::scene_camera(scene);
   host::StreamTracer tracer(scene, grid, opt);
-  return tracer.render(cam);
+  return {tracer.render(cam), tracer.device().description()};
 }
 
 }  // namespace
@@ -50,10 +55,11 @@ TEST_CASE("the looping program prints as one GLSL loop with its budget and a bre
   CHECK(fetches == size_t(p.analyze().fetches.total()));
 }
 
-TEST_CASE("looping frames on the GL device give the vgpu's queries and hit ids") {
+TEST_CASE("looping frames on the GL device give the vgpu's queries, hit ids, depths and image") {
   for (const std::string name : {"sphere", "bunny-refl"}) {
     CAPTURE(name);
-    const host::RenderResult v = render(name, "vgpu", 64), g = render(name, "gl", 64);
+    const Frame vf = render(name, "vgpu", 64), gf = render(name, "gl", 64);
+    const host::RenderResult &v = vf.result, &g = gf.result;
     REQUIRE(v.stats.passes.size() == g.stats.passes.size());
     size_t loops = 0;
     for (size_t i = 0; i < v.stats.passes.size(); ++i) {
@@ -63,9 +69,7 @@ TEST_CASE("looping frames on the GL device give the vgpu's queries and hit ids")
       loops += v.stats.passes[i].program == "looping traversal";
     }
     CHECK(loops > 1);
-    size_t same = 0;
-    for (size_t i = 0; i < v.hit_id.size(); ++i) same += v.hit_id[i] == g.hit_id[i];
-    MESSAGE(name << ": hit ids equal on " << same << " of " << v.hit_id.size() << " pixels");
-    CHECK(double(same) >= 0.999 * double(v.hit_id.size()));
+    gltest::check_same_frame(gf.device, "looping traversal", v.hit_id, g.hit_id, v.depth, g.depth,
+                             v.rgb, g.rgb);
   }
 }

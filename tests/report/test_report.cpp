@@ -39,6 +39,7 @@ Frame render(host::FrameRecorder& rec, bool masks, std::optional<glm::ivec2> tra
   opt.threads = threads;
   opt.lanes = lanes;
   opt.observer = &rec;
+  opt.keep_pass_records = true;  // the device's own record of every pass, to check against
   std::ostringstream trace;
   if (trace_pixel) {
     opt.trace_pixel = trace_pixel;
@@ -74,30 +75,179 @@ TEST_CASE("the recorder's passes plus what lies between them sum to the frame's 
     const Frame f = render(rec, masks);
     const vgpu::FrameStats& s = f.result.stats;
     vgpu::Counters sum = rec.tail();
-    uint64_t useful = 0, idle = 0;
     for (const auto& p : rec.passes()) {
       sum += p.counters;
       sum += p.before;
       sum += p.after;
-      useful += p.useful;
-      idle += p.idle;
-      CHECK(p.useful + p.idle + p.counters.fragments_masked == p.counters.fragments_launched);
     }
     CHECK(sum.same_counts(s.totals));
     CHECK(rec.passes().size() == s.totals.passes);
-    if (masks) {
-      CHECK(idle == 0);  // with masks on, fragments with nothing to do are masked instead
-      CHECK(useful == s.totals.fragments_shaded);
-    } else {
-      CHECK(idle > 0);
-      CHECK(s.totals.fragments_masked == 0);
-    }
   }
+}
+
+// The sum above holds whatever the recorder attributes to which pass (before and after are
+// differences of the running totals). Here each pass's program load, clears, query and
+// read-back, and its useful and idle fragments, come from the pass sequence itself: a load
+// wherever the program changes, the frame's clears before generate rays (origins) and before
+// each trace's entry pass (intersection and voxel state, the primary trace also the result),
+// a query and a read-back after each counting pass; and the fragments with work to do from the
+// device's own query results (rays walking after the last rayosEnGrilla, rays testing after the
+// last rayosIntersectando).
+TEST_CASE("each pass's program load, clears, read-back and useful fragments are its own") {
+  namespace k = kernels;
+  const uint64_t n = 48 * 40;
+  const uint64_t clear_bytes = n * 4 * sizeof(float);  // every cleared texture: 4 x fp32 texels
+  const uint64_t instruction_bytes = vgpu::profile("gf5700").instruction_bytes;
+  for (bool masks : {false, true}) {
+    CAPTURE(masks);
+    host::FrameRecorder rec(48, 40, masks, 0);
+    const Frame f = render(rec, masks);
+    const vgpu::FrameStats& s = f.result.stats;
+    const auto& passes = rec.passes();
+    REQUIRE(passes.size() == s.passes.size());  // the device's own record of every pass
+    REQUIRE(passes.size() > 20);
+    uint64_t walking = 0, testing = 0;  // the last rayosEnGrilla / rayosIntersectando results
+    size_t loads = 0, clears = 0, readbacks = 0, masked_passes = 0, entries = 0;
+    for (size_t i = 0; i < passes.size(); ++i) {
+      const auto& p = passes[i];
+      const std::string& prev = i ? passes[i - 1].program : std::string();
+      CAPTURE(i);
+      CAPTURE(p.program);
+      REQUIRE(p.program == s.passes[i].program);
+      const bool counting = p.program == k::RaysInGrid::name ||
+                            p.program == k::RaysIntersecting::name ||
+                            p.program == k::ReflectedRays::name;
+      const bool entry =
+          p.program == k::InitTraversal::name || p.program == k::ResetTraversal::name;
+      if (entry) {  // a trace begins with its entry pass
+        REQUIRE(entries < rec.traces().size());
+        CHECK(rec.traces()[entries].first_pass == int(i));
+        ++entries;
+      }
+      // Before the pass: a program load where the program changes, and the frame's clears.
+      vgpu::Counters before;
+      if (p.program != prev) {
+        const vgpu::FrameStats::ProgramTotals* prog = s.find(p.program);
+        REQUIRE(prog != nullptr);
+        before.program_loads = 1;
+        before.program_bytes = uint64_t(prog->instructions) * instruction_bytes;
+      }
+      before.clears = p.program == k::GenerateRays::name    ? 1
+                      : p.program == k::InitTraversal::name ? 3
+                      : entry                               ? 2
+                                                            : 0;
+      before.bytes_written = before.clears * clear_bytes;
+      // After it: a counting pass's query and its read-back, nothing else.
+      vgpu::Counters after;
+      after.queries = after.query_readbacks = counting;
+      CHECK(p.before.same_counts(before));
+      CHECK(p.after.same_counts(after));
+      CHECK(p.counters.passes == 1);
+      CHECK(p.counters.program_loads + p.counters.clears + p.counters.query_readbacks == 0);
+      CHECK(p.query == (counting ? s.passes[i].query_result : -1));
+      loads += p.before.program_loads;
+      clears += p.before.clears;
+      readbacks += p.after.query_readbacks;
+      // The fragments with work: rays walking for the walk's passes over the grid mask, rays
+      // testing for the triangle loop's; every fragment for the others (a trace's first
+      // rayosEnGrilla, right after its entry pass, counts every ray).
+      const bool after_entry = prev == k::InitTraversal::name || prev == k::ResetTraversal::name;
+      const bool grid_mask =
+          (p.program == k::RaysInGrid::name && !after_entry) || p.program == k::UpdateVoxel::name ||
+          p.program == k::Traversal::name ||
+          (p.program == k::RaysIntersecting::name && prev == k::UpdateVoxel::name);
+      const bool isect_mask =
+          p.program == k::Intersections::name || p.program == k::NextTriangle::name ||
+          (p.program == k::RaysIntersecting::name && prev == k::NextTriangle::name);
+      const uint64_t useful = grid_mask ? walking : isect_mask ? testing : n;
+      masked_passes += grid_mask || isect_mask;
+      CHECK((p.work_mask >= 0) == (grid_mask || isect_mask));
+      CHECK(p.counters.fragments_launched == n);
+      CHECK(p.useful == useful);
+      if (masks) {  // fragments without work are masked (early z), not shaded
+        CHECK(p.counters.fragments_shaded == useful);
+        CHECK(p.counters.fragments_masked == n - useful);
+        CHECK(p.idle == 0);
+      } else {  // every fragment runs; those without work idle
+        CHECK(p.counters.fragments_shaded == n);
+        CHECK(p.counters.fragments_masked == 0);
+        CHECK(p.idle == n - useful);
+      }
+      if (p.program == k::RaysInGrid::name) walking = uint64_t(s.passes[i].query_result);
+      if (p.program == k::RaysIntersecting::name) testing = uint64_t(s.passes[i].query_result);
+    }
+    // Nothing after the last pass, and the counts above are the frame's.
+    CHECK(rec.tail().same_counts(vgpu::Counters{}));
+    CHECK(loads == s.totals.program_loads);
+    CHECK(clears == s.totals.clears);
+    CHECK(readbacks == s.totals.query_readbacks);
+    CHECK(entries == rec.traces().size());
+    CHECK(entries >= 3);  // primary, its shadow rays and a reflected trace at least
+    CHECK(masked_passes > 10);
+    CHECK(loads > entries);
+  }
+}
+
+TEST_CASE(
+    "the per-pixel cost maps and the wavefront hold each pixel's passes as --trace-pixel prints "
+    "them") {
+  // Off the 8x4 and 32x32 tile grids and off the diagonal (a transposed index reads another
+  // pixel): on the sphere, at its rim and off it.
+  const glm::ivec2 pixels[] = {{21, 17}, {30, 12}, {9, 33}, {44, 3}};
+  uint64_t stepped = 0, tested = 0, idled = 0;
+  for (const glm::ivec2 px : pixels) {
+    CAPTURE(px.x);
+    CAPTURE(px.y);
+    host::FrameRecorder rec(48, 40, false, 0);
+    const Frame f = render(rec, false, px);
+    // The passes the pixel took part in, by paper name, one line each; a trace begins with its
+    // entry pass (initTraversal, reinicializarTraversal), which runs on every pixel.
+    std::vector<std::string> kernels_run;
+    std::vector<size_t> trace_steps;  // traversal passes per trace
+    std::istringstream lines(f.trace);
+    for (std::string line; std::getline(lines, line);) {
+      if (line.rfind("  ", 0) != 0) continue;  // "pixel X,Y:", "iteration N:"
+      std::istringstream words(line);
+      std::string paper;
+      words >> paper;
+      kernels_run.push_back(paper);
+      if (paper == kernels::InitTraversal::paper_name ||
+          paper == kernels::ResetTraversal::paper_name)
+        trace_steps.push_back(0);
+      if (paper == kernels::Traversal::paper_name) {
+        REQUIRE(!trace_steps.empty());
+        ++trace_steps.back();
+      }
+    }
+    const auto ran = [&](const char* paper) {
+      return uint64_t(std::count(kernels_run.begin(), kernels_run.end(), paper));
+    };
+    const size_t i = size_t(px.y) * 48 + size_t(px.x);
+    REQUIRE(rec.voxel_steps().size() == 48 * 40);
+    CHECK(rec.voxel_steps()[i] == ran(kernels::Traversal::paper_name));
+    CHECK(rec.triangle_tests()[i] == ran(kernels::Intersections::paper_name));
+    // Every pass without a work mask runs on every pixel: the passes it sat out are the idle ones.
+    CHECK(rec.idle_passes()[i] == f.result.stats.totals.passes - kernels_run.size());
+    REQUIRE(trace_steps.size() == rec.traces().size());
+    REQUIRE(rec.wavefront().size() == rec.traces().size());
+    for (size_t tr = 0; tr < trace_steps.size(); ++tr) {
+      CAPTURE(tr);
+      CHECK(rec.wavefront()[tr][i] == trace_steps[tr]);
+    }
+    stepped += rec.voxel_steps()[i];
+    tested += rec.triangle_tests()[i];
+    idled += rec.idle_passes()[i];
+  }
+  CHECK(stepped > 0);
+  CHECK(tested > 0);
+  CHECK(idled > 0);
 }
 
 TEST_CASE("the per-pixel cost maps add up to the useful fragments of their kernels") {
   host::FrameRecorder rec(48, 40, false, 0);
-  render(rec, false);
+  const Frame f = render(rec, false);
+  const vgpu::FrameStats& s = f.result.stats;
+  REQUIRE(rec.passes().size() == s.passes.size());
   uint64_t trav = 0, isect = 0, idle = 0;
   for (const auto& p : rec.passes()) {
     if (p.program == kernels::Traversal::name) trav += p.useful;
@@ -114,17 +264,31 @@ TEST_CASE("the per-pixel cost maps add up to the useful fragments of their kerne
   CHECK(t == isect);
   CHECK(i == idle);
   CHECK(v > 0);
-  // The wavefront: walking after step k is steps > k, so its counts are the queries' results.
+  CHECK(t > 0);
+  // The wavefront: the rays walking after step k of a trace are those with more than k steps,
+  // so its counts are the device's query results (its own pass records, not the recorder's),
+  // one rayosEnGrilla before the first step and one after each, the last 0.
+  REQUIRE(rec.traces().size() >= 3);
+  REQUIRE(rec.wavefront().size() == rec.traces().size());
+  size_t checked = 0;
   for (size_t tr = 0; tr < rec.traces().size(); ++tr) {
+    CAPTURE(tr);
     std::vector<int64_t> queries;
-    for (const auto& p : rec.passes())
-      if (p.trace == int(tr) && p.program == kernels::RaysInGrid::name) queries.push_back(p.query);
+    for (size_t k = 0; k < rec.passes().size(); ++k)
+      if (rec.passes()[k].trace == int(tr) && s.passes[k].program == kernels::RaysInGrid::name)
+        queries.push_back(s.passes[k].query_result);
+    REQUIRE(queries.size() == size_t(rec.traces()[tr].steps) + 1);
+    CHECK(queries.back() == 0);
     for (size_t k = 0; k < queries.size(); ++k) {
+      CAPTURE(k);
       int64_t walking = 0;
-      for (uint16_t s : rec.wavefront()[tr]) walking += s > k;
+      for (uint16_t st : rec.wavefront()[tr]) walking += st > k;
       CHECK(walking == queries[k]);
+      ++checked;
     }
   }
+  CHECK(rec.traces()[0].steps > 10);  // the primary rays cross the grid
+  CHECK(checked > rec.traces().size() + 10);
 }
 
 TEST_CASE("a kept pixel's history holds the states --trace-pixel prints, in order") {
