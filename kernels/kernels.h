@@ -18,3 +18,25 @@
 #include "kernels/shadow_rays.h"
 #include "kernels/traversal.h"
 #include "kernels/update_voxel.h"
+#include "vgpu/program.h"
+
+// Each kernel's program (its run at every lane family: widths 1, 4, 8, 16, fp24/fp16 rounding,
+// counting, recording) is compiled once, in kernels/programs_*.cpp: a file that includes this
+// header and makes a vgpu::KernelProgram<K> links to that copy instead of compiling its own.
+extern template class vgpu::KernelProgram<kernels::GenerateRays>;
+extern template class vgpu::KernelProgram<kernels::InitTraversal>;
+extern template class vgpu::KernelProgram<kernels::ResetTraversal>;
+extern template class vgpu::KernelProgram<kernels::Traversal>;
+extern template class vgpu::KernelProgram<kernels::RaysInGrid>;
+extern template class vgpu::KernelProgram<kernels::UpdateVoxel>;
+extern template class vgpu::KernelProgram<kernels::Intersections>;
+extern template class vgpu::KernelProgram<kernels::NextTriangle>;
+extern template class vgpu::KernelProgram<kernels::RaysIntersecting>;
+extern template class vgpu::KernelProgram<kernels::Shader>;
+extern template class vgpu::KernelProgram<kernels::ShadowRays>;
+extern template class vgpu::KernelProgram<kernels::ReflectedRays>;
+extern template class vgpu::KernelProgram<kernels::ReflectionOrigin>;
+extern template class vgpu::KernelProgram<kernels::ReflectionDirection>;
+extern template class vgpu::KernelProgram<kernels::IntersectNext>;
+extern template class vgpu::KernelProgram<kernels::TraverseUpdate>;
+extern template class vgpu::KernelProgram<kernels::LoopingTraversal>;

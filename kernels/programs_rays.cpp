@@ -1,0 +1,11 @@
+// The compiled programs of the ray kernels: generadorRayos, rayosSombra, inicioReflejo,
+// direccionReflejo, shader, rayosReflejados (kernels/kernels.h declares them; every lane family of
+// each is compiled here, once).
+#include "kernels/kernels.h"
+
+template class vgpu::KernelProgram<kernels::GenerateRays>;
+template class vgpu::KernelProgram<kernels::ShadowRays>;
+template class vgpu::KernelProgram<kernels::ReflectionOrigin>;
+template class vgpu::KernelProgram<kernels::ReflectionDirection>;
+template class vgpu::KernelProgram<kernels::Shader>;
+template class vgpu::KernelProgram<kernels::ReflectedRays>;
