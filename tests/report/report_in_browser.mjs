@@ -42,7 +42,7 @@ try {
   check(await page.evaluate(() => document.body.dataset.historyPixel) === `${px},${py}`, "the click picks the pixel");
   const rows = await page.$$eval("#history tr", trs => trs.slice(1).map(tr => Array.from(tr.children, td => td.textContent)));
   // Columns: #, pass, iteration, trace, paper name, kernel, writes, state/query. Printed as
-  // StreamTracer::pass and ::count print them.
+  // PassRunner::pass and ::count (host/trace/passes.cpp) print them.
   const shown = rows.map(r => r[7].startsWith("query:")
     ? `  ${r[4].padEnd(22)} ${r[5].padEnd(24)}    ${r[7]}`
     : `  ${r[4].padEnd(22)} ${r[5].padEnd(24)} -> ${r[6].padEnd(14)} ${r[7]}`);
