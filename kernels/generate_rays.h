@@ -1,4 +1,5 @@
-// generadorRayos: once per frame, one primary ray per pixel from the camera (paper Sec. 2.1).
+// generadorRayos: once per frame, one primary ray per pixel from the camera (paper Sec. 2.1);
+// and its jittered variant for supersampling.
 // Generalises the paper's fixed camera (rays from z = 0 towards (0, 0, -1)) to a real camera:
 // pixel (x, y), y = 0 the top row, ray through the pixel centre (the CLI's camera contract).
 #pragma once
@@ -18,12 +19,35 @@ struct GenerateRays {
 
   template <class L>
   void operator()(Fragments<L>& f) const {
-    using F = typename L::F;
     // f.x, f.y are already pixel centres (x + 0.5, y + 0.5).
-    const F sx = (F(2.0f) * f.x / F(width) - F(1.0f)) * F(tan_half_fov * aspect);
-    const F sy = (F(1.0f) - F(2.0f) * f.y / F(height)) * F(tan_half_fov);
+    f.out(0) = ray_through<L>(f.x, f.y);
+  }
+
+  // The ray through image point (px, py), in pixels from the top-left corner of the image.
+  template <class L>
+  Vec4<typename L::F> ray_through(const typename L::F& px, const typename L::F& py) const {
+    using F = typename L::F;
+    const F sx = (F(2.0f) * px / F(width) - F(1.0f)) * F(tan_half_fov * aspect);
+    const F sy = (F(1.0f) - F(2.0f) * py / F(height)) * F(tan_half_fov);
     const Vec3<F> d = normalize(splat<F>(forward) + splat<F>(right) * sx + splat<F>(up) * sy);
-    f.out(0) = {d.x, d.y, d.z, F(kFar)};
+    return {d.x, d.y, d.z, F(kFar)};
+  }
+};
+
+// generadorRayosMuestra (an extension, --spp N): one ray per pixel through the sample position
+// (jitter_x, jitter_y) within the pixel instead of its centre, the same for every pixel of a
+// sample frame (the accumulation-buffer way: each frame moves the whole image by a sub-pixel
+// offset, host/trace/sampling.h picks them).
+struct GenerateSampleRays : GenerateRays {
+  static constexpr const char* name = "generate sample rays";
+  static constexpr const char* paper_name = "generadorRayosMuestra (extension)";
+
+  float jitter_x = 0.5f, jitter_y = 0.5f;  // in [0, 1): 0 the pixel's left / top edge
+
+  template <class L>
+  void operator()(Fragments<L>& f) const {
+    using F = typename L::F;
+    f.out(0) = ray_through<L>(f.x + F(jitter_x - 0.5f), f.y + F(jitter_y - 0.5f));
   }
 };
 

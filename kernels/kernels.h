@@ -2,6 +2,7 @@
 // fused two-output programs --mrt on runs (kernels/fused.h).
 #pragma once
 
+#include "kernels/accumulate_samples.h"
 #include "kernels/fused.h"
 #include "kernels/generate_rays.h"
 #include "kernels/init_traversal.h"
@@ -14,6 +15,7 @@
 #include "kernels/reflection_direction.h"
 #include "kernels/reflection_origin.h"
 #include "kernels/reset_traversal.h"
+#include "kernels/resolve_samples.h"
 #include "kernels/shader.h"
 #include "kernels/shadow_rays.h"
 #include "kernels/traversal.h"
@@ -40,3 +42,6 @@ extern template class vgpu::KernelProgram<kernels::ReflectionDirection>;
 extern template class vgpu::KernelProgram<kernels::IntersectNext>;
 extern template class vgpu::KernelProgram<kernels::TraverseUpdate>;
 extern template class vgpu::KernelProgram<kernels::LoopingTraversal>;
+extern template class vgpu::KernelProgram<kernels::GenerateSampleRays>;
+extern template class vgpu::KernelProgram<kernels::AccumulateSamples>;
+extern template class vgpu::KernelProgram<kernels::ResolveSamples>;

@@ -15,8 +15,9 @@
 //
 // Dynamic (per pixel):
 //   origins         xyz = ray origin, world space; w unused    (paper: texturaInicioRayos)
-//   rays            xyz = ray direction (unit), w = tmax; tmax < 0 marks no ray (paper:
-//   texturaRayos) traversal       xyz = current voxel, w = ray parameter t where the ray enters it;
+//   rays            xyz = ray direction (unit), w = tmax; tmax < 0 marks no ray
+//                   (paper: texturaRayos)
+//   traversal       xyz = current voxel, w = ray parameter t where the ray enters it;
 //                   x = -1 once the ray is done: left the grid, or found its hit
 //                   (paper: texturaEstadoTraversal)
 //   voxel state     x = position in the triangle lists, w = triangle to test next;
@@ -28,6 +29,8 @@
 //   result          rgb = colour accumulated so far, a = weight of the current ray in the final
 //                   colour (product of the reflection coefficients met so far) (paper:
 //                   texturaResultado)
+//   sample sum      rgb = sum of the sample frames' colours, a = samples added (--spp N > 1;
+//                   an extension, kernels/accumulate_samples.h)
 #pragma once
 
 #include <glm/glm.hpp>

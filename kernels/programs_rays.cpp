@@ -1,6 +1,7 @@
 // The compiled programs of the ray kernels: generadorRayos, rayosSombra, inicioReflejo,
-// direccionReflejo, shader, rayosReflejados (kernels/kernels.h declares them; every lane family of
-// each is compiled here, once).
+// direccionReflejo, shader, rayosReflejados, and supersampling's generadorRayosMuestra,
+// acumularMuestras, resolverMuestras (kernels/kernels.h declares them; every lane family of each is
+// compiled here, once).
 #include "kernels/kernels.h"
 
 template class vgpu::KernelProgram<kernels::GenerateRays>;
@@ -9,3 +10,6 @@ template class vgpu::KernelProgram<kernels::ReflectionOrigin>;
 template class vgpu::KernelProgram<kernels::ReflectionDirection>;
 template class vgpu::KernelProgram<kernels::Shader>;
 template class vgpu::KernelProgram<kernels::ReflectedRays>;
+template class vgpu::KernelProgram<kernels::GenerateSampleRays>;
+template class vgpu::KernelProgram<kernels::AccumulateSamples>;
+template class vgpu::KernelProgram<kernels::ResolveSamples>;

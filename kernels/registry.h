@@ -1,5 +1,6 @@
 // Every kernel as a program with its default uniforms, in the order a frame first runs them:
-// what `vgpu-rt kernels` lists and prints as GLSL; then the fused programs of --mrt on.
+// what `vgpu-rt kernels` lists and prints as GLSL; then supersampling's and the fused programs
+// of --mrt on.
 #pragma once
 
 #include <memory>
@@ -26,6 +27,10 @@ inline std::vector<std::unique_ptr<vgpu::Program>> all_programs() {
   v.push_back(std::make_unique<vgpu::KernelProgram<ReflectedRays>>());
   v.push_back(std::make_unique<vgpu::KernelProgram<ReflectionDirection>>());
   v.push_back(std::make_unique<vgpu::KernelProgram<ResetTraversal>>());
+  // Supersampling (--spp N): the jittered ray generator, the accumulation and the resolve.
+  v.push_back(std::make_unique<vgpu::KernelProgram<GenerateSampleRays>>());
+  v.push_back(std::make_unique<vgpu::KernelProgram<AccumulateSamples>>());
+  v.push_back(std::make_unique<vgpu::KernelProgram<ResolveSamples>>());
   // The fused programs of --mrt on (kernels/fused.h), two outputs each.
   v.push_back(std::make_unique<vgpu::KernelProgram<IntersectNext>>());
   v.push_back(std::make_unique<vgpu::KernelProgram<TraverseUpdate>>());

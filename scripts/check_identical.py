@@ -35,7 +35,7 @@ TIMING = ("_ms",)
 def strip(j):
     if isinstance(j, dict):
         return {k: strip(v) for k, v in j.items()
-                if not k.endswith(TIMING) and k not in ("threads", "lanes", "walk", "scene_path")}
+                if not k.endswith(TIMING) and k not in ("threads", "lanes", "walk", "scene_path", "sampling")}
     if isinstance(j, list):
         return [strip(v) for v in j]
     return j

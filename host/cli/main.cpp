@@ -25,6 +25,7 @@
 #include "host/scene/gltf_loader.h"
 #include "host/trace/cpu_tracer.h"
 #include "host/trace/devices.h"
+#include "host/trace/sampling.h"
 #include "host/trace/stream_tracer.h"
 #include "kernels/registry.h"
 #include "vgpu/glsl.h"
@@ -64,6 +65,7 @@ struct RenderArgs {
   std::string kernels = "multipass";
   std::string walk = "batches";
   int steps_per_pass = 32;
+  int spp = 1;
   bool steps_given = false;
   bool walk_given = false;
 };
@@ -120,6 +122,19 @@ const CLI::Validator kGridCheck(
       }
     },
     "auto | N | AxBxC, each 1.." + std::to_string(host::kMaxGridRes), "GRID");
+
+const CLI::Validator kSppCheck(
+    [](std::string& text) -> std::string {
+      try {
+        size_t used = 0;
+        const int n = std::stoi(text, &used);
+        if (used == text.size()) return host::spp_refusal(n);
+      } catch (const std::exception&) {
+      }
+      return "expected a square from 1 to " + std::to_string(host::kMaxSpp) + ", got '" + text +
+             "'";
+    },
+    "1, 4, 9, ..., 256", "N");
 
 // An output file: the extension is one of `exts` and its directory exists and is writable.
 CLI::Validator output_check(std::vector<std::string> exts) {
@@ -271,6 +286,13 @@ void add_render_options(CLI::App& render, RenderArgs& a) {
       ->each([&a](const std::string&) { a.walk_given = true; })
       ->capture_default_str();
   render
+      .add_option("--spp", a.spp,
+                  "Rays per pixel, a square: a stratified, jittered n x n grid in each pixel "
+                  "(seeded: the same image every run), one sample frame each, resolved by a box "
+                  "filter; 1 is one ray through each pixel's centre")
+      ->check(kSppCheck)
+      ->capture_default_str();
+  render
       .add_option("--steps-per-pass", a.steps_per_pass,
                   "With --kernels looping: loop iterations per pass before the host's occlusion "
                   "query (the profile's loop limit applies: gf6600 255)")
@@ -295,6 +317,7 @@ int run_render(const RenderArgs& a, bool lanes_given) {
   opt.looping = a.kernels == "looping";
   opt.steps_per_pass = a.steps_per_pass;
   opt.batch_walk = a.walk == "batches";
+  opt.spp = a.spp;
   if (opt.mrt && opt.looping)
     throw UsageError(
         "--mrt on with --kernels looping: the looping program already writes the traversal, "
@@ -460,6 +483,11 @@ int run_render(const RenderArgs& a, bool lanes_given) {
                 {"triangle_tests", cpu_stats.triangle_tests}};
   j["rays_traced"] = r.rays_traced;
   j["rays_unfinished"] = r.rays_unfinished;
+  // Supersampling (--spp): samples per pixel and the passes it added to the first sample frame.
+  j["sampling"] = {{"spp", opt.spp},
+                   {"samples_per_pixel_mean", double(r.samples)},
+                   {"samples_per_pixel_max", r.samples},
+                   {"passes_added", cpu ? 0 : r.stats.totals.passes - r.first_frame_passes}};
   {
     nlohmann::ordered_json stats = r.stats.json();
     if (gl)  // the emulator's SIMD model: a driver does not show its lanes

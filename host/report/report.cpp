@@ -371,9 +371,12 @@ void write_report(const std::string& path, const FrameRecorder& rec, const Rende
       chain[m * bytes + i] = rec.masks()[m][i] ^ (m ? rec.masks()[m - 1][i] : 0);
   d["mask_count"] = rec.masks().size();
   d["masks"] = pack(chain);
+  // Primary rays per pixel (--spp: the same in every pixel).
+  const std::vector<uint32_t> rays(n, uint32_t(std::max(res.samples, 1)));
   d["maps"] = {{"voxels", pack(rec.voxel_steps())},
                {"tests", pack(rec.triangle_tests())},
-               {"idle", pack(rec.idle_passes())}};
+               {"idle", pack(rec.idle_passes())},
+               {"rays", pack(rays)}};
   auto wave = json::array();
   for (const auto& w : rec.wavefront()) wave.push_back(pack(w));
   d["wavefront"] = std::move(wave);

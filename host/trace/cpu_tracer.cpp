@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "host/common/parallel.h"
+#include "host/trace/sampling.h"
 #include "kernels/kernels.h"
 
 namespace host {
@@ -65,9 +66,11 @@ struct PrimaryRays {
         W(width),
         H(height) {}
 
-  glm::dvec3 dir(int x, int y) const {
-    const double sx = (2.0 * (x + 0.5) / double(W) - 1.0) * t * a;
-    const double sy = (1.0 - 2.0 * (y + 0.5) / double(H)) * t;
+  glm::dvec3 dir(int x, int y) const { return dir(x, y, 0.5, 0.5); }
+  // Through the point (jx, jy) of the pixel, in [0, 1)^2 from its top-left corner.
+  glm::dvec3 dir(int x, int y, double jx, double jy) const {
+    const double sx = (2.0 * (x + jx) / double(W) - 1.0) * t * a;
+    const double sy = (1.0 - 2.0 * (y + jy) / double(H)) * t;
     return glm::normalize(forward + sx * right + sy * up);
   }
 
@@ -178,8 +181,18 @@ class Tracer {
   void pixel(int x, int y, RenderResult& out, Counters& c) const {
     const size_t idx = size_t(y) * size_t(opt_.width) + size_t(x);
     Hit primary;
-    const glm::dvec3 colour =
-        radiance(glm::dvec3(cam_.position), primary_.dir(x, y), 0, 1.0, &primary, c);
+    glm::dvec3 colour(0.0);
+    if (opt_.spp <= 1) {
+      colour = radiance(glm::dvec3(cam_.position), primary_.dir(x, y), 0, 1.0, &primary, c);
+    } else {
+      // The stream tracer's sample positions; the AOVs are the first sample's, as there.
+      for (int s = 0; s < opt_.spp; ++s) {
+        const glm::vec2 j = sample_offset(opt_.spp, s, opt_.sample_seed);
+        colour += radiance(glm::dvec3(cam_.position), primary_.dir(x, y, j.x, j.y), 0, 1.0,
+                           s == 0 ? &primary : nullptr, c);
+      }
+      colour /= double(opt_.spp);
+    }
     if (primary.tri >= 0) {
       out.depth[idx] = float(primary.t);
       out.hit_id[idx] = float(scene_.id[size_t(primary.tri)]);
@@ -298,6 +311,7 @@ RenderResult render_cpu(const Scene& scene, const Grid& grid, const Camera& came
     res.iterations = std::max(res.iterations, c.iterations);
   }
   if (stats) *stats = total;
+  res.samples = std::max(options.spp, 1);
   res.render_ms = ms_since(t0);
   return res;
 }

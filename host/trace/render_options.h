@@ -87,6 +87,11 @@ struct RenderOptions {
   // where it applies: the vgpu at 8 lanes, with host_shortcut or masks, the multipass kernels,
   // no observer and no trace_pixel; elsewhere the walk runs pass by pass.
   bool batch_walk = true;
+  // Supersampling (host/trace/sampling.h): rays per pixel, a square from 1 to 256, on a
+  // stratified, jittered grid drawn from sample_seed; the box filter resolves them. 1: one ray
+  // through each pixel's centre, the paper's image.
+  int spp = 1;
+  uint64_t sample_seed = 1;
   std::optional<glm::ivec2> trace_pixel;  // print every pass this pixel took part in
   std::ostream* trace_out = nullptr;
   bool keep_pass_records = false;
@@ -102,10 +107,12 @@ struct RenderResult {
   std::vector<float> hit_id;  // input triangle id of the primary hit, -1 where it misses
   vgpu::FrameStats stats;
   double render_ms = 0;
-  int iterations = 0;            // ray-tracing iterations run (primary included)
-  uint64_t rays_traced = 0;      // rays entering a trace (primary, reflected, shadow)
-  uint64_t rays_unfinished = 0;  // rays stopped by the pass cap (only under reduced precision)
-  bool batch_walk = false;       // the grid walks ran in batches (RenderOptions::batch_walk)
+  int iterations = 0;               // ray-tracing iterations run (primary included)
+  uint64_t rays_traced = 0;         // rays entering a trace (primary, reflected, shadow)
+  uint64_t rays_unfinished = 0;     // rays stopped by the pass cap (only under reduced precision)
+  bool batch_walk = false;          // the grid walks ran in batches (RenderOptions::batch_walk)
+  int samples = 1;                  // sample frames rendered (RenderOptions::spp)
+  uint64_t first_frame_passes = 0;  // passes of the first sample frame (the rest is sampling's)
 };
 
 }  // namespace host

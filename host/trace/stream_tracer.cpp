@@ -15,6 +15,7 @@
 #include "host/common/parallel.h"
 #include "host/trace/devices.h"
 #include "host/trace/passes.h"
+#include "host/trace/sampling.h"
 
 namespace host {
 
@@ -39,6 +40,12 @@ struct StreamTracer::State {
   KernelProgram<ReflectionOrigin> origin;
   KernelProgram<ReflectionDirection> direction;
   KernelProgram<ShadowRays> shadow;
+  // Supersampling (--spp N > 1): sample frames' rays, their sum and the box filter.
+  KernelProgram<GenerateSampleRays> sample_generate;
+  KernelProgram<AccumulateSamples> accumulate;
+  KernelProgram<ResolveSamples> resolve;
+  Texture sum[2];
+  int cur_sum = 0;
   // The walk through the acceleration structure, and how passes are issued.
   std::unique_ptr<GridWalk> walk;
   std::unique_ptr<PassRunner> runner;
@@ -80,6 +87,8 @@ StreamTracer::StreamTracer(const Scene& scene, const Grid& grid, const RenderOpt
     const std::string why = mrt_refusal(gpu.profile(), fm);
     if (!why.empty()) throw vgpu::Error(why);
   }
+  if (const std::string why = spp_refusal(opt_.spp); !why.empty())
+    throw std::invalid_argument("spp: " + why);
   const int maxs = gpu.profile().max_texture_size;
 
   // Scene textures: triangle i at texel (i mod width, i div width).
@@ -128,6 +137,10 @@ StreamTracer::StreamTracer(const Scene& scene, const Grid& grid, const RenderOpt
   s.shadow_rays = gpu.make_texture("shadow rays", W, H, 4, fm[Group::rays]);
   // Counting passes need a colour target; only their query result matters.
   s.counter = gpu.make_texture("counter", W, H, 1, Format::fp16);
+  if (opt_.spp > 1)
+    for (int i = 0; i < 2; ++i)
+      s.sum[i] = gpu.make_texture(std::string("sample sum ") + (i ? "B" : "A"), W, H, 4,
+                                  fm[Group::colour]);
   s.grid_mask = Stencil(W, H, 1);
   s.isect_mask = Stencil(W, H, 1);
   s.walk->make_state(gpu, {{&s.v[0], &s.v[1], &s.v[2]},
@@ -161,6 +174,7 @@ uint64_t StreamTracer::texture_bytes() const {
   for (int i = 0; i < 2; ++i)
     for (const Texture* t : {&s_->rays[i], &s_->origins[i], &s_->isect[i], &s_->result[i]})
       b += t->bytes();
+  if (opt_.spp > 1) b += s_->sum[0].bytes() + s_->sum[1].bytes();
   return b;
 }
 
@@ -191,17 +205,64 @@ RenderResult StreamTracer::render(const Camera& cam) {
   g.height = float(H);
   if (opt_.trace_pixel && opt_.trace_out)
     *opt_.trace_out << "pixel " << opt_.trace_pixel->x << "," << opt_.trace_pixel->y << ":\n";
+  int iteration_number = 0;
+  if (opt_.spp <= 1) {
+    frame(cam, s.generate, res, true, iteration_number);
+  } else {
+    // Supersampling as a 2004 card would: one whole frame per sample, each through its own
+    // sub-pixel offset (generadorRayosMuestra), added into a sum texture (acumularMuestras),
+    // then one box-filter pass (resolverMuestras). No texture grows with the sample count.
+    static_cast<GenerateRays&>(s.sample_generate.kernel) = g;
+    gpu.clear(s.sum[s.cur_sum], {0, 0, 0, 0});
+    for (int k = 0; k < opt_.spp; ++k) {
+      const glm::vec2 j = sample_offset(opt_.spp, k, opt_.sample_seed);
+      s.sample_generate.kernel.jitter_x = j.x;
+      s.sample_generate.kernel.jitter_y = j.y;
+      frame(cam, s.sample_generate, res, k == 0, iteration_number);
+      if (k == 0) res.first_frame_passes = gpu.stats().totals.passes;
+      r.pass(s.accumulate, {&s.sum[s.cur_sum], &s.result[s.cur_result]}, s.sum[s.cur_sum ^ 1]);
+      s.cur_sum ^= 1;
+    }
+    r.pass(s.resolve, {&s.sum[s.cur_sum]}, s.result[s.cur_result ^ 1]);
+    s.cur_result ^= 1;
+    res.samples = opt_.spp;
+  }
+
+  Texture& out = s.result[s.cur_result];
+  gpu.download(out);
+  res.rgb.resize(size_t(W) * H * 3);
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      const float* t = out.texel(x, y);
+      for (int c = 0; c < 3; ++c) res.rgb[(size_t(y) * W + x) * 3 + c] = t[c];
+    }
+  res.stats = gpu.stats();
+  if (opt_.spp <= 1) res.first_frame_passes = res.stats.totals.passes;
+  res.rays_traced = r.counts.rays_traced;
+  res.rays_unfinished = r.counts.rays_unfinished;
+  res.batch_walk = r.counts.batch_walk;
+  res.render_ms = ms_since(t0);
+  return res;
+}
+
+void StreamTracer::frame(const Camera& cam, const vgpu::Program& generate, RenderResult& res,
+                         bool aovs, int& iteration_number) {
+  vgpu::Device& gpu = *gpu_;
+  State& s = *s_;
+  PassRunner& r = *s.runner;
+  const int W = opt_.width, H = opt_.height;
   int ro = 0;  // origins[ro]: this iteration's ray origins; origins[ro ^ 1]: its hit points
   gpu.clear(s.origins[ro], {cam.position.x, cam.position.y, cam.position.z, 0});
-  r.pass(s.generate, {}, s.rays[s.cur_rays]);
+  r.pass(generate, {}, s.rays[s.cur_rays]);
   gpu.clear(s.result[s.cur_result], {0, 0, 0, 1});
 
   const int iterations = 1 + std::max(0, opt_.bounces);
   for (int it = 0; it < iterations; ++it) {
-    if (opt_.trace_pixel && opt_.trace_out) *opt_.trace_out << "iteration " << it + 1 << ":\n";
-    res.iterations = it + 1;
+    const int number = ++iteration_number;  // 1-based, counted over the sample frames
+    if (opt_.trace_pixel && opt_.trace_out) *opt_.trace_out << "iteration " << number << ":\n";
+    res.iterations = std::max(res.iterations, it + 1);
     if (opt_.progress) opt_.progress(it + 1, iterations);
-    if (opt_.observer) opt_.observer->iteration(it + 1);
+    if (opt_.observer) opt_.observer->iteration(number);
     Texture& rays = s.rays[s.cur_rays];
     if (opt_.observer)
       opt_.observer->trace_begin(it ? PassObserver::TraceKind::reflected
@@ -209,7 +270,7 @@ RenderResult StreamTracer::render(const Camera& cam) {
     trace(s.origins[ro], rays, it == 0, cam);
     if (opt_.observer) opt_.observer->trace_end();
     Texture& hits = s.isect[s.cur_isect];
-    if (it == 0) {
+    if (it == 0 && aovs) {
       gpu.download(hits);
       res.depth.assign(size_t(W) * H, 0.0f);
       res.hit_id.assign(size_t(W) * H, -1.0f);
@@ -256,21 +317,6 @@ RenderResult StreamTracer::render(const Camera& cam) {
     s.cur_rays ^= 1;
     ro ^= 1;
   }
-
-  Texture& out = s.result[s.cur_result];
-  gpu.download(out);
-  res.rgb.resize(size_t(W) * H * 3);
-  for (int y = 0; y < H; ++y)
-    for (int x = 0; x < W; ++x) {
-      const float* t = out.texel(x, y);
-      for (int c = 0; c < 3; ++c) res.rgb[(size_t(y) * W + x) * 3 + c] = t[c];
-    }
-  res.stats = gpu.stats();
-  res.rays_traced = r.counts.rays_traced;
-  res.rays_unfinished = r.counts.rays_unfinished;
-  res.batch_walk = r.counts.batch_walk;
-  res.render_ms = ms_since(t0);
-  return res;
 }
 
 }  // namespace host

@@ -34,6 +34,12 @@ class StreamTracer {
   // One ray stream (primary, shadow or reflected) through the grid: the walk of
   // host/trace/grid_walk.h.
   void trace(vgpu::Texture& origins, vgpu::Texture& rays, bool primary, const Camera& cam);
+  // One frame of the paper's pipeline with the rays `generate` makes: trace, shade, reflect,
+  // up to 1 + bounces iterations (iteration_number counts them over the sample frames, for the
+  // observer and --trace-pixel). Leaves the colour in the current result texture; with `aovs`,
+  // the primary hits' depth and id go into res.
+  void frame(const Camera& cam, const vgpu::Program& generate, RenderResult& res, bool aovs,
+             int& iteration_number);
 
   const Scene& scene_;
   const Grid& grid_;

@@ -174,6 +174,13 @@ TEST_CASE("out-of-range numbers are refused with their allowed range") {
   check_refused("--lanes 3", "--lanes", "3 not in {1,4,8,16}");
 }
 
+TEST_CASE("sample counts that are not squares from 1 to 256 are refused, naming the count") {
+  check_refused("--spp 0", "--spp", "0 samples per pixel: they go from 1 to 256");
+  check_refused("--spp 7", "--spp", "7 samples per pixel: not a square");
+  check_refused("--spp 1024", "--spp", "1024 samples per pixel: they go from 1 to 256");
+  check_refused("--spp four", "--spp", "expected a square from 1 to 256, got 'four'");
+}
+
 TEST_CASE("an image size past the limit names the limit, not a parse failure") {
   const Outcome o = run("render bunny-low --size 100000x100000");
   CHECK(o.status == 2);
@@ -376,8 +383,9 @@ TEST_CASE("a render writes the image, the AOVs and the statistics asked for, and
   // The statistics: the keys README.md promises, with this run's values.
   nlohmann::json j;
   REQUIRE_NOTHROW(j = nlohmann::json::parse(slurp(dir / "stats.json")));
-  for (const char* key : {"scene", "triangles", "grid", "profile", "size", "init_ms", "render_ms",
-                          "totals", "kernels", "masks", "mrt", "fused_programs", "kernel_variant"})
+  for (const char* key :
+       {"scene", "triangles", "grid", "profile", "size", "init_ms", "render_ms", "totals",
+        "kernels", "masks", "mrt", "fused_programs", "kernel_variant", "sampling"})
     CHECK_MESSAGE(j.contains(key), key);
   CHECK(j.value("scene", "") == "sphere");
   CHECK(j.value("profile", "") == "gf5700");
@@ -391,6 +399,10 @@ TEST_CASE("a render writes the image, the AOVs and the statistics asked for, and
   CHECK(j["mrt"] == false);
   CHECK(j["fused_programs"] == nlohmann::json::array());
   CHECK(j["kernel_variant"] == "multipass");
+  CHECK(j["sampling"] == nlohmann::json({{"spp", 1},
+                                         {"samples_per_pixel_mean", 1.0},
+                                         {"samples_per_pixel_max", 1},
+                                         {"passes_added", 0}}));
   const nlohmann::json& totals = j["totals"];
   for (const char* key : {"passes", "fragments_launched", "fragments_shaded", "texture_fetches",
                           "bytes_read", "bytes_written", "program_loads", "query_readbacks"}) {

@@ -1,0 +1,51 @@
+// Where the samples of a pixel lie (host/trace/sampling.h).
+#include "host/trace/sampling.h"
+
+#include <cmath>
+
+namespace host {
+
+namespace {
+
+int side_of(int spp) {
+  int n = 1;
+  while (n * n < spp) ++n;
+  return n;
+}
+
+// splitmix64 (Steele, Lea & Flood 2014): one 64-bit step.
+uint64_t splitmix(uint64_t& s) {
+  uint64_t z = (s += 0x9e3779b97f4a7c15ull);
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+  return z ^ (z >> 31);
+}
+
+// A float in [0, 1) with 24 random bits (exact in float).
+float unit(uint64_t& s) {
+  return float(splitmix(s) >> 40) / float(1 << 24);
+}
+
+}  // namespace
+
+std::string spp_refusal(int spp) {
+  if (spp < 1 || spp > kMaxSpp)
+    return std::to_string(spp) + " samples per pixel: they go from 1 to " + std::to_string(kMaxSpp);
+  const int n = side_of(spp);
+  if (n * n != spp)
+    return std::to_string(spp) +
+           " samples per pixel: not a square (the samples form an n x n grid: 1, 4, 9, 16, ..., "
+           "256)";
+  return {};
+}
+
+glm::vec2 sample_offset(int spp, int s, uint64_t seed) {
+  if (spp <= 1) return {0.5f, 0.5f};
+  const int n = side_of(spp);
+  uint64_t state = seed * 0x100000001b3ull + uint64_t(s);
+  const float u = unit(state), v = unit(state);
+  // (i + u) / n rounds below 1 for every u < 1 and n <= 16.
+  return {(float(s % n) + u) / float(n), (float(s / n) + v) / float(n)};
+}
+
+}  // namespace host

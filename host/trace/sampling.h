@@ -1,0 +1,24 @@
+// Supersampling (--spp N): where the samples of a pixel lie, the same for both engines. The
+// stream tracer renders one sample frame per sample and accumulates them (the accumulation
+// buffer of 2004), the CPU tracer averages the same rays per pixel.
+#pragma once
+
+#include <cstdint>
+#include <glm/glm.hpp>
+#include <string>
+
+namespace host {
+
+inline constexpr int kMaxSpp = 256;
+
+// Why `spp` is not a sample count --spp takes (empty: it is): a square from 1 to 256.
+// Names the count, not the option.
+std::string spp_refusal(int spp);
+
+// Sample s (0 <= s < spp) within a pixel, in [0, 1)^2 from its top-left corner (x right, y
+// down): the pixel split into n x n strata (n = sqrt(spp)), sample s in stratum (s mod n,
+// s div n), placed at a uniform random point of it drawn from a splitmix64 stream seeded by
+// `seed` and s (the same positions every run). spp 1: the pixel centre (0.5, 0.5), today's ray.
+glm::vec2 sample_offset(int spp, int s, uint64_t seed);
+
+}  // namespace host

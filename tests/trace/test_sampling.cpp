@@ -1,0 +1,129 @@
+// Supersampling (--spp N, host/trace/sampling.h): where the samples lie, a known-answer edge
+// pixel, and the stream tracer against the CPU tracer on the same sample positions.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <cstring>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "host/accel/grid.h"
+#include "host/trace/cpu_tracer.h"
+#include "host/trace/sampling.h"
+#include "host/trace/stream_tracer.h"
+
+namespace {
+
+// A white square on black: x in [0, 4], y in [-2, 2] at z = 0, seen from z = 4 by a 5x1 image
+// whose middle pixel the square's left edge (x = 0) cuts in half; one light far above the
+// camera, diffuse shading, no shadows or reflections.
+struct EdgeCase {
+  host::Scene scene;
+  host::Grid grid;
+  host::Camera camera;
+  EdgeCase() {
+    scene.name = "edge";
+    scene.materials = {{{1.0f, 1.0f, 1.0f}, 0.0f}};
+    scene.add_flat_triangle({0, -2, 0}, {4, -2, 0}, {4, 2, 0}, 0, 0);
+    scene.add_flat_triangle({0, -2, 0}, {4, 2, 0}, {0, 2, 0}, 0, 1);
+    scene.input_triangles = 2;
+    scene.lights = {{{0, 0, 1000}, {1, 1, 1}}};
+    grid = host::build_grid(scene, host::GridSpec{glm::ivec3(4, 4, 1)});
+    camera.position = {0, 0, 4};
+    camera.forward = {0, 0, -1};
+    camera.up = {0, 1, 0};
+    // 5 pixels across 2 * 4 * tan(yfov / 2) * aspect: one pixel is 0.4 wide at z = 0, so the
+    // middle pixel spans x in [-0.2, 0.2] and the edge halves it.
+    camera.yfov = 2.0f * std::atan(0.05f);
+  }
+};
+
+host::RenderOptions edge_options(int spp) {
+  host::RenderOptions opt;
+  opt.width = 5;
+  opt.height = 1;
+  opt.bounces = 0;
+  opt.shadows = false;
+  opt.shading = kernels::ShadingModel::diffuse;
+  opt.profile = "gf6600";
+  opt.spp = spp;
+  return opt;
+}
+
+}  // namespace
+
+TEST_CASE("sample positions take one stratum each, inside the pixel, the same every run") {
+  CHECK(host::sample_offset(1, 0, 7) == glm::vec2(0.5f, 0.5f));
+  for (const int spp : {4, 9, 16, 64, 256}) {
+    CAPTURE(spp);
+    const int n = int(std::lround(std::sqrt(double(spp))));
+    std::vector<int> taken(size_t(spp), 0);
+    for (int s = 0; s < spp; ++s) {
+      const glm::vec2 p = host::sample_offset(spp, s, 1);
+      REQUIRE(p.x >= 0.0f);
+      REQUIRE(p.x < 1.0f);
+      REQUIRE(p.y >= 0.0f);
+      REQUIRE(p.y < 1.0f);
+      ++taken[size_t(int(p.y * float(n)) * n + int(p.x * float(n)))];
+      CHECK(host::sample_offset(spp, s, 1) == p);  // no hidden state
+    }
+    for (int k = 0; k < spp; ++k) CHECK(taken[size_t(k)] == 1);
+  }
+  // Another seed moves the samples within their strata.
+  CHECK(host::sample_offset(16, 5, 1) != host::sample_offset(16, 5, 2));
+}
+
+TEST_CASE("sample counts other than the squares from 1 to 256 are refused, naming the count") {
+  for (const int ok : {1, 4, 9, 16, 25, 100, 256}) CHECK(host::spp_refusal(ok).empty());
+  CHECK(host::spp_refusal(0).find("from 1 to 256") != std::string::npos);
+  CHECK(host::spp_refusal(324).find("from 1 to 256") != std::string::npos);
+  CHECK(host::spp_refusal(7).find("7 samples per pixel: not a square") != std::string::npos);
+  EdgeCase e;
+  CHECK_THROWS_AS(host::StreamTracer(e.scene, e.grid, edge_options(8)), std::invalid_argument);
+}
+
+TEST_CASE("a pixel half covered by a white surface on black resolves to half the white") {
+  EdgeCase e;
+  for (const int spp : {4, 16, 64}) {
+    CAPTURE(spp);
+    host::StreamTracer tracer(e.scene, e.grid, edge_options(spp));
+    const host::RenderResult r = tracer.render(e.camera);
+    REQUIRE(r.samples == spp);
+    const float white = r.rgb[3 * 3];  // pixel 3: covered by every sample
+    REQUIRE(white > 0.5f);
+    CHECK(r.rgb[0] == 0.0f);  // pixel 0: no sample hits
+    // An even n puts exactly half the strata columns right of the edge; the samples' shading
+    // varies by well under 1% across the pixel.
+    const int n = int(std::lround(std::sqrt(double(spp))));
+    CHECK(std::fabs(r.rgb[2 * 3] - 0.5f * white) <= white / float(n * n) + 0.01f * white);
+    // The CPU tracer averages the same sample positions.
+    const host::RenderResult c = host::render_cpu(e.scene, e.grid, e.camera, edge_options(spp));
+    for (int i = 0; i < 5 * 3; ++i) CHECK(std::fabs(c.rgb[size_t(i)] - r.rgb[size_t(i)]) < 1e-4f);
+  }
+}
+
+TEST_CASE("a supersampled frame is its sample frames, one accumulation each and one resolve") {
+  EdgeCase e;
+  host::StreamTracer one(e.scene, e.grid, edge_options(1));
+  const host::RenderResult a = one.render(e.camera);
+  host::StreamTracer four(e.scene, e.grid, edge_options(4));
+  const host::RenderResult b = four.render(e.camera);
+  CHECK(a.samples == 1);
+  CHECK(a.first_frame_passes == a.stats.totals.passes);
+  CHECK(b.first_frame_passes < b.stats.totals.passes);
+  // Rays entering the grid (the square's box): the centre frame's pixels 2 (on the edge), 3 and
+  // 4; each sample frame's pixels 3 and 4, and pixel 2 in the 2 of 4 frames whose sample lies
+  // right of the edge.
+  CHECK(a.rays_traced == 3);
+  CHECK(b.rays_traced == 4 * 2 + 2);
+  auto passes_of = [&b](const std::string& name) {
+    for (const auto& p : b.stats.programs)
+      if (p.name == name) return int(p.counters.passes);
+    return 0;
+  };
+  CHECK(passes_of("generate rays") == 0);  // every frame's rays are jittered
+  CHECK(passes_of("generate sample rays") == 4);
+  CHECK(passes_of("accumulate samples") == 4);
+  CHECK(passes_of("resolve samples") == 1);
+}
