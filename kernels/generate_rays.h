@@ -42,12 +42,20 @@ struct GenerateSampleRays : GenerateRays {
   static constexpr const char* name = "generate sample rays";
   static constexpr const char* paper_name = "generadorRayosMuestra (extension)";
 
+  enum Unit { kMarks };
+  static constexpr std::array<const char*, 1> units{"marks"};
+
   float jitter_x = 0.5f, jitter_y = 0.5f;  // in [0, 1): 0 the pixel's left / top edge
+  // --aa adaptive: only pixels marked for more samples (marks x > 0) get a ray; the others
+  // get none (tmax -1), so their walk ends at once and masks skip them.
+  bool gated = false;
 
   template <class L>
   void operator()(Fragments<L>& f) const {
     using F = typename L::F;
-    f.out(0) = ray_through<L>(f.x + F(jitter_x - 0.5f), f.y + F(jitter_y - 0.5f));
+    Vec4<F> ray = ray_through<L>(f.x + F(jitter_x - 0.5f), f.y + F(jitter_y - 0.5f));
+    if (gated) ray.w = select(f.fetch_own(kMarks).x > F(0.0f), ray.w, F(kNone));
+    f.out(0) = ray;
   }
 };
 

@@ -7,7 +7,9 @@
 #include "kernels/generate_rays.h"
 #include "kernels/init_traversal.h"
 #include "kernels/intersections.h"
+#include "kernels/keep_hits.h"
 #include "kernels/looping_traversal.h"
+#include "kernels/mark_pixels.h"
 #include "kernels/next_triangle.h"
 #include "kernels/rays_in_grid.h"
 #include "kernels/rays_intersecting.h"
@@ -45,3 +47,6 @@ extern template class vgpu::KernelProgram<kernels::LoopingTraversal>;
 extern template class vgpu::KernelProgram<kernels::GenerateSampleRays>;
 extern template class vgpu::KernelProgram<kernels::AccumulateSamples>;
 extern template class vgpu::KernelProgram<kernels::ResolveSamples>;
+extern template class vgpu::KernelProgram<kernels::KeepHits>;
+extern template class vgpu::KernelProgram<kernels::MarkPixels>;
+extern template class vgpu::KernelProgram<kernels::MarkedPixels>;

@@ -1,6 +1,7 @@
 // The compiled programs of the ray kernels: generadorRayos, rayosSombra, inicioReflejo,
 // direccionReflejo, shader, rayosReflejados, and supersampling's generadorRayosMuestra,
-// acumularMuestras, resolverMuestras (kernels/kernels.h declares them; every lane family of each is
+// acumularMuestras, resolverMuestras, and adaptive sampling's guardarImpactos,
+// marcarPixeles, pixelesMarcados (kernels/kernels.h declares them; every lane family of each is
 // compiled here, once).
 #include "kernels/kernels.h"
 
@@ -13,3 +14,6 @@ template class vgpu::KernelProgram<kernels::ReflectedRays>;
 template class vgpu::KernelProgram<kernels::GenerateSampleRays>;
 template class vgpu::KernelProgram<kernels::AccumulateSamples>;
 template class vgpu::KernelProgram<kernels::ResolveSamples>;
+template class vgpu::KernelProgram<kernels::KeepHits>;
+template class vgpu::KernelProgram<kernels::MarkPixels>;
+template class vgpu::KernelProgram<kernels::MarkedPixels>;

@@ -31,6 +31,10 @@ inline std::vector<std::unique_ptr<vgpu::Program>> all_programs() {
   v.push_back(std::make_unique<vgpu::KernelProgram<GenerateSampleRays>>());
   v.push_back(std::make_unique<vgpu::KernelProgram<AccumulateSamples>>());
   v.push_back(std::make_unique<vgpu::KernelProgram<ResolveSamples>>());
+  // Adaptive supersampling (--aa adaptive): surface keys, marks, the count of marked pixels.
+  v.push_back(std::make_unique<vgpu::KernelProgram<KeepHits>>());
+  v.push_back(std::make_unique<vgpu::KernelProgram<MarkPixels>>());
+  v.push_back(std::make_unique<vgpu::KernelProgram<MarkedPixels>>());
   // The fused programs of --mrt on (kernels/fused.h), two outputs each.
   v.push_back(std::make_unique<vgpu::KernelProgram<IntersectNext>>());
   v.push_back(std::make_unique<vgpu::KernelProgram<TraverseUpdate>>());

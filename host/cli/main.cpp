@@ -66,6 +66,8 @@ struct RenderArgs {
   std::string walk = "batches";
   int steps_per_pass = 32;
   int spp = 1;
+  std::string aa = "none";
+  float aa_threshold = 0.1f;
   bool steps_given = false;
   bool walk_given = false;
 };
@@ -135,6 +137,18 @@ const CLI::Validator kSppCheck(
              "'";
     },
     "1, 4, 9, ..., 256", "N");
+
+const CLI::Validator kThresholdCheck(
+    [](std::string& text) -> std::string {
+      try {
+        size_t used = 0;
+        const double v = std::stod(text, &used);
+        if (used == text.size() && std::isfinite(v) && v >= 0) return {};
+      } catch (const std::exception&) {
+      }
+      return "expected a colour difference of 0 or more (linear, 1 = white), got '" + text + "'";
+    },
+    "0 or more", "T");
 
 // An output file: the extension is one of `exts` and its directory exists and is writable.
 CLI::Validator output_check(std::vector<std::string> exts) {
@@ -293,6 +307,19 @@ void add_render_options(CLI::App& render, RenderArgs& a) {
       ->check(kSppCheck)
       ->capture_default_str();
   render
+      .add_option("--aa", a.aa,
+                  "Anti-aliasing: none (--spp rays in every pixel) or adaptive (one ray per "
+                  "pixel, then levels of 4, 16, ... up to --spp only where neighbours hit another "
+                  "surface or differ in colour by more than --aa-threshold)")
+      ->check(CLI::IsMember({"none", "adaptive"}))
+      ->capture_default_str();
+  render
+      .add_option("--aa-threshold", a.aa_threshold,
+                  "With --aa adaptive: the colour difference (linear, per channel) to a "
+                  "neighbour that marks a pixel for more samples")
+      ->check(kThresholdCheck)
+      ->capture_default_str();
+  render
       .add_option("--steps-per-pass", a.steps_per_pass,
                   "With --kernels looping: loop iterations per pass before the host's occlusion "
                   "query (the profile's loop limit applies: gf6600 255)")
@@ -318,6 +345,8 @@ int run_render(const RenderArgs& a, bool lanes_given) {
   opt.steps_per_pass = a.steps_per_pass;
   opt.batch_walk = a.walk == "batches";
   opt.spp = a.spp;
+  opt.adaptive = a.aa == "adaptive";
+  opt.aa_threshold = a.aa_threshold;
   if (opt.mrt && opt.looping)
     throw UsageError(
         "--mrt on with --kernels looping: the looping program already writes the traversal, "
@@ -484,10 +513,22 @@ int run_render(const RenderArgs& a, bool lanes_given) {
   j["rays_traced"] = r.rays_traced;
   j["rays_unfinished"] = r.rays_unfinished;
   // Supersampling (--spp): samples per pixel and the passes it added to the first sample frame.
-  j["sampling"] = {{"spp", opt.spp},
-                   {"samples_per_pixel_mean", double(r.samples)},
-                   {"samples_per_pixel_max", r.samples},
-                   {"passes_added", cpu ? 0 : r.stats.totals.passes - r.first_frame_passes}};
+  {
+    double mean = double(r.samples);
+    uint64_t most = uint64_t(r.samples);
+    if (!r.rays_per_pixel.empty()) {
+      uint64_t total = 0;
+      most = 0;
+      for (const uint32_t n : r.rays_per_pixel) total += n, most = std::max<uint64_t>(most, n);
+      mean = double(total) / double(r.rays_per_pixel.size());
+    }
+    j["sampling"] = {{"mode", opt.adaptive && opt.spp > 1 ? "adaptive" : "uniform"},
+                     {"spp", opt.spp},
+                     {"samples_per_pixel_mean", mean},
+                     {"samples_per_pixel_max", most},
+                     {"passes_added", cpu ? 0 : r.stats.totals.passes - r.first_frame_passes}};
+    if (opt.adaptive) j["sampling"]["threshold"] = opt.aa_threshold;
+  }
   {
     nlohmann::ordered_json stats = r.stats.json();
     if (gl)  // the emulator's SIMD model: a driver does not show its lanes

@@ -26,8 +26,8 @@
 #include "kernels/registry.h"
 #include "vgpu/glsl.h"
 
-// tinygltf's base64 encoder (tiny_gltf.h, compiled once in host/scene/gltf_file.cpp): no second copy here
-// and no OpenImageIO in the report.
+// tinygltf's base64 encoder (tiny_gltf.h, compiled once in host/scene/gltf_file.cpp): no second
+// copy here and no OpenImageIO in the report.
 namespace tinygltf {
 std::string base64_encode(unsigned char const* bytes, unsigned int len);
 }
@@ -371,8 +371,10 @@ void write_report(const std::string& path, const FrameRecorder& rec, const Rende
       chain[m * bytes + i] = rec.masks()[m][i] ^ (m ? rec.masks()[m - 1][i] : 0);
   d["mask_count"] = rec.masks().size();
   d["masks"] = pack(chain);
-  // Primary rays per pixel (--spp: the same in every pixel).
-  const std::vector<uint32_t> rays(n, uint32_t(std::max(res.samples, 1)));
+  // Primary rays per pixel (--spp: the same in every pixel; --aa adaptive: per pixel).
+  const std::vector<uint32_t> rays =
+      res.rays_per_pixel.size() == n ? res.rays_per_pixel
+                                     : std::vector<uint32_t>(n, uint32_t(std::max(res.samples, 1)));
   d["maps"] = {{"voxels", pack(rec.voxel_steps())},
                {"tests", pack(rec.triangle_tests())},
                {"idle", pack(rec.idle_passes())},

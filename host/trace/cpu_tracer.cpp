@@ -177,6 +177,16 @@ class Tracer {
     }
   }
 
+  // The colour through point (jx, jy) of pixel (x, y), in [0, 1)^2 from its top-left corner.
+  glm::dvec3 sample(int x, int y, glm::vec2 j, Hit* primary, Counters& c) const {
+    return radiance(glm::dvec3(cam_.position), primary_.dir(x, y, j.x, j.y), 0, 1.0, primary, c);
+  }
+  // The material a primary hit's triangle has, -1 for a miss (guardarImpactos' surface key).
+  int surface_key(const Hit& h) const {
+    return h.tri < 0 ? -1 : int(scene_.material[size_t(h.tri)]);
+  }
+  uint32_t input_id(int64_t tri) const { return scene_.id[size_t(tri)]; }
+
   // One pixel: the primary ray and, recursively, its reflections.
   void pixel(int x, int y, RenderResult& out, Counters& c) const {
     const size_t idx = size_t(y) * size_t(opt_.width) + size_t(x);
@@ -272,6 +282,71 @@ class Tracer {
   double specular_ = 0, min_weight_ = 0;
 };
 
+// --aa adaptive as the stream tracer runs it (host/trace/stream_tracer.cpp, render_adaptive):
+// the centre ray, then levels of n x n samples where marcarPixeles' rule marks the pixel,
+// each level's samples replacing the pixel's earlier ones.
+void adaptive(const Tracer& tracer, const RenderOptions& opt, unsigned workers,
+              std::vector<Counters>& counters, RenderResult& res) {
+  const int W = opt.width, H = opt.height;
+  const size_t n = size_t(W) * size_t(H);
+  std::vector<glm::dvec3> estimate(n);
+  std::vector<int> key(n), samples(n, 1);
+  std::vector<uint8_t> candidate(n, 1), marked(n, 0);
+  for_each_row(H, workers, [&](unsigned worker, int y) {
+    for (int x = 0; x < W; ++x) {
+      const size_t i = size_t(y) * size_t(W) + size_t(x);
+      Hit h;
+      estimate[i] = tracer.sample(x, y, {0.5f, 0.5f}, &h, counters[worker]);
+      key[i] = tracer.surface_key(h);
+      if (h.tri >= 0) {
+        res.depth[i] = float(h.t);
+        res.hit_id[i] = float(tracer.input_id(h.tri));
+      }
+    }
+  });
+  for (const int side : adaptive_levels(opt.spp)) {
+    // The 4-neighbours, clamped at the image's edge as the texture units clamp.
+    size_t count = 0;
+    for (int y = 0; y < H; ++y)
+      for (int x = 0; x < W; ++x) {
+        const size_t i = size_t(y) * size_t(W) + size_t(x);
+        bool edge = false;
+        for (const glm::ivec2 d : {glm::ivec2(-1, 0), {1, 0}, {0, -1}, {0, 1}}) {
+          const int nx = std::clamp(x + d.x, 0, W - 1), ny = std::clamp(y + d.y, 0, H - 1);
+          const size_t j = size_t(ny) * size_t(W) + size_t(nx);
+          const glm::dvec3 diff = glm::abs(estimate[j] - estimate[i]);
+          edge = edge || key[j] != key[i] ||
+                 std::max({diff.x, diff.y, diff.z}) > double(opt.aa_threshold);
+        }
+        marked[i] = candidate[i] && edge;
+        count += marked[i];
+      }
+    if (count == 0) break;
+    const int m = side * side;
+    for_each_row(H, workers, [&](unsigned worker, int y) {
+      for (int x = 0; x < W; ++x) {
+        const size_t i = size_t(y) * size_t(W) + size_t(x);
+        if (!marked[i]) continue;
+        glm::dvec3 sum(0.0);
+        for (int k = 0; k < m; ++k)
+          sum +=
+              tracer.sample(x, y, sample_offset(m, k, opt.sample_seed), nullptr, counters[worker]);
+        estimate[i] = sum / double(m);
+        samples[i] = m;
+      }
+    });
+    candidate = marked;
+  }
+  res.rays_per_pixel.resize(n);
+  int most = 1;
+  for (size_t i = 0; i < n; ++i) {
+    for (int c = 0; c < 3; ++c) res.rgb[i * 3 + size_t(c)] = float(estimate[i][c]);
+    res.rays_per_pixel[i] = adaptive_rays(opt.spp, samples[i]);
+    most = std::max(most, samples[i]);
+  }
+  res.samples = most;
+}
+
 }  // namespace
 
 glm::dvec3 cpu_primary_dir(const Camera& camera, int W, int H, int x, int y) {
@@ -298,9 +373,12 @@ RenderResult render_cpu(const Scene& scene, const Grid& grid, const Camera& came
       options.threads > 0 ? unsigned(options.threads) : cores, 1u, unsigned(std::max(H, 1)));
   std::vector<Counters> counters(workers);
   // Every pixel is independent, so the order in which rows are handed out does not matter.
-  for_each_row(H, workers, [&](unsigned worker, int y) {
-    for (int x = 0; x < W; ++x) tracer.pixel(x, y, res, counters[worker]);
-  });
+  if (options.adaptive && options.spp > 1)
+    adaptive(tracer, options, workers, counters, res);
+  else
+    for_each_row(H, workers, [&](unsigned worker, int y) {
+      for (int x = 0; x < W; ++x) tracer.pixel(x, y, res, counters[worker]);
+    });
 
   CpuStats total;
   for (const Counters& c : counters) {
@@ -311,7 +389,7 @@ RenderResult render_cpu(const Scene& scene, const Grid& grid, const Camera& came
     res.iterations = std::max(res.iterations, c.iterations);
   }
   if (stats) *stats = total;
-  res.samples = std::max(options.spp, 1);
+  if (res.rays_per_pixel.empty()) res.samples = std::max(options.spp, 1);
   res.render_ms = ms_since(t0);
   return res;
 }

@@ -92,6 +92,12 @@ struct RenderOptions {
   // through each pixel's centre, the paper's image.
   int spp = 1;
   uint64_t sample_seed = 1;
+  // Adaptive supersampling (--aa adaptive): one ray through each pixel's centre, then levels of
+  // 4, 16, ... up to spp samples (host/trace/sampling.h) only where a pixel's 4-neighbourhood
+  // hit another surface (material, or a miss) or differs in colour by more than aa_threshold
+  // (linear, per channel); a level's samples replace the pixel's earlier ones.
+  bool adaptive = false;
+  float aa_threshold = 0.1f;
   std::optional<glm::ivec2> trace_pixel;  // print every pass this pixel took part in
   std::ostream* trace_out = nullptr;
   bool keep_pass_records = false;
@@ -113,6 +119,9 @@ struct RenderResult {
   bool batch_walk = false;          // the grid walks ran in batches (RenderOptions::batch_walk)
   int samples = 1;                  // sample frames rendered (RenderOptions::spp)
   uint64_t first_frame_passes = 0;  // passes of the first sample frame (the rest is sampling's)
+  // Primary rays per pixel where they differ between pixels (--aa adaptive); empty: `samples`
+  // in every pixel.
+  std::vector<uint32_t> rays_per_pixel;
 };
 
 }  // namespace host

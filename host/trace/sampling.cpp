@@ -48,4 +48,21 @@ glm::vec2 sample_offset(int spp, int s, uint64_t seed) {
   return {(float(s % n) + u) / float(n), (float(s / n) + v) / float(n)};
 }
 
+std::vector<int> adaptive_levels(int spp) {
+  const int n = side_of(spp);
+  std::vector<int> levels;
+  for (int side = 2; side < n; side *= 2) levels.push_back(side);
+  if (n > 1) levels.push_back(n);
+  return levels;
+}
+
+uint32_t adaptive_rays(int spp, int samples) {
+  uint32_t rays = 1;
+  for (const int side : adaptive_levels(spp)) {
+    if (side * side > samples) break;
+    rays += uint32_t(side * side);
+  }
+  return rays;
+}
+
 }  // namespace host

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <glm/glm.hpp>
 #include <string>
+#include <vector>
 
 namespace host {
 
@@ -20,5 +21,13 @@ std::string spp_refusal(int spp);
 // s div n), placed at a uniform random point of it drawn from a splitmix64 stream seeded by
 // `seed` and s (the same positions every run). spp 1: the pixel centre (0.5, 0.5), today's ray.
 glm::vec2 sample_offset(int spp, int s, uint64_t seed);
+
+// The levels of adaptive supersampling up to `spp` samples: the side n of each level's n x n
+// grid, doubling from 2 and ending at sqrt(spp) (spp 16: 2, 4; spp 9: 2, 3; spp 1: none).
+std::vector<int> adaptive_levels(int spp);
+
+// The primary rays a pixel took under adaptive supersampling when its final sample count is
+// `samples` (1: the centre ray alone; n*n: every level up to side n, after the centre ray).
+uint32_t adaptive_rays(int spp, int samples);
 
 }  // namespace host

@@ -46,6 +46,12 @@ struct StreamTracer::State {
   KernelProgram<ResolveSamples> resolve;
   Texture sum[2];
   int cur_sum = 0;
+  // Adaptive supersampling (--aa adaptive): surface keys and marks, each triangle's material.
+  KernelProgram<KeepHits> keep;
+  KernelProgram<MarkPixels> mark;
+  KernelProgram<MarkedPixels> marked;
+  Texture marks[2], materials;
+  int cur_mark = 0;
   // The walk through the acceleration structure, and how passes are issued.
   std::unique_ptr<GridWalk> walk;
   std::unique_ptr<PassRunner> runner;
@@ -141,6 +147,16 @@ StreamTracer::StreamTracer(const Scene& scene, const Grid& grid, const RenderOpt
     for (int i = 0; i < 2; ++i)
       s.sum[i] = gpu.make_texture(std::string("sample sum ") + (i ? "B" : "A"), W, H, 4,
                                   fm[Group::colour]);
+  if (opt_.adaptive && opt_.spp > 1) {
+    for (int i = 0; i < 2; ++i)
+      s.marks[i] = gpu.make_texture(std::string("marks ") + (i ? "B" : "A"), W, H, 4, Format::fp32);
+    s.materials = gpu.make_texture("triangle materials", sw, int(sh), 1);
+    for (size_t i = 0; i < ntri; ++i)
+      s.materials.texel_mut(int(i % sw), int(i / sw))[0] = float(scene.material[i]);
+    gpu.upload(s.materials);
+    s.keep.kernel.scene = SceneUniforms{float(sw)};
+    s.mark.kernel.threshold = opt_.aa_threshold;
+  }
   s.grid_mask = Stencil(W, H, 1);
   s.isect_mask = Stencil(W, H, 1);
   s.walk->make_state(gpu, {{&s.v[0], &s.v[1], &s.v[2]},
@@ -175,6 +191,8 @@ uint64_t StreamTracer::texture_bytes() const {
     for (const Texture* t : {&s_->rays[i], &s_->origins[i], &s_->isect[i], &s_->result[i]})
       b += t->bytes();
   if (opt_.spp > 1) b += s_->sum[0].bytes() + s_->sum[1].bytes();
+  if (opt_.adaptive && opt_.spp > 1)
+    b += s_->marks[0].bytes() + s_->marks[1].bytes() + s_->materials.bytes();
   return b;
 }
 
@@ -208,6 +226,9 @@ RenderResult StreamTracer::render(const Camera& cam) {
   int iteration_number = 0;
   if (opt_.spp <= 1) {
     frame(cam, s.generate, res, true, iteration_number);
+  } else if (opt_.adaptive) {
+    static_cast<GenerateRays&>(s.sample_generate.kernel) = g;
+    render_adaptive(cam, res, iteration_number);
   } else {
     // Supersampling as a 2004 card would: one whole frame per sample, each through its own
     // sub-pixel offset (generadorRayosMuestra), added into a sum texture (acumularMuestras),
@@ -245,15 +266,72 @@ RenderResult StreamTracer::render(const Camera& cam) {
   return res;
 }
 
+void StreamTracer::render_adaptive(const Camera& cam, RenderResult& res, int& iteration_number) {
+  vgpu::Device& gpu = *gpu_;
+  State& s = *s_;
+  PassRunner& r = *s.runner;
+  // The centre frame, the paper's, keeping each pixel's surface key; its colour is every
+  // pixel's first estimate (one sample).
+  frame(cam, s.generate, res, true, iteration_number, nullptr, true);
+  res.first_frame_passes = gpu.stats().totals.passes;
+  gpu.clear(s.sum[s.cur_sum], {0, 0, 0, 0});
+  s.accumulate.kernel.gated = false;
+  r.pass(s.accumulate, {&s.sum[s.cur_sum], &s.result[s.cur_result]}, s.sum[s.cur_sum ^ 1]);
+  s.cur_sum ^= 1;
+  const std::vector<int> levels = adaptive_levels(opt_.spp);
+  for (size_t l = 0; l < levels.size(); ++l) {
+    // marcarPixeles on the current estimate, then pixelesMarcados: how many get more samples.
+    r.pass(s.mark, {&s.marks[s.cur_mark], &s.result[s.cur_result]}, s.marks[s.cur_mark ^ 1]);
+    s.cur_mark ^= 1;
+    if (r.count(s.marked, s.marks[s.cur_mark], nullptr, nullptr) == 0) break;
+    // The level's n x n samples, only in marked pixels, replacing their earlier ones.
+    const int n = levels[l] * levels[l];
+    s.sample_generate.kernel.gated = true;
+    s.accumulate.kernel.gated = true;
+    for (int k = 0; k < n; ++k) {
+      const glm::vec2 j = sample_offset(n, k, opt_.sample_seed);
+      s.sample_generate.kernel.jitter_x = j.x;
+      s.sample_generate.kernel.jitter_y = j.y;
+      frame(cam, s.sample_generate, res, false, iteration_number, &s.marks[s.cur_mark]);
+      s.accumulate.kernel.restart = k == 0;
+      r.pass(s.accumulate, {&s.sum[s.cur_sum], &s.result[s.cur_result], &s.marks[s.cur_mark]},
+             s.sum[s.cur_sum ^ 1]);
+      s.cur_sum ^= 1;
+    }
+    // The new estimate: the next level's marks read it, and after the last level it is the
+    // image. (Where no pixel is marked at all, the centre frame's colour stays the image.)
+    r.pass(s.resolve, {&s.sum[s.cur_sum]}, s.result[s.cur_result ^ 1]);
+    s.cur_result ^= 1;
+  }
+  s.sample_generate.kernel.gated = false;
+  s.accumulate.kernel.gated = false;
+  // Each pixel's final sample count, for the rays-per-pixel statistics and map.
+  Texture& sum = s.sum[s.cur_sum];
+  gpu.download(sum);
+  const int W = opt_.width, H = opt_.height;
+  res.rays_per_pixel.resize(size_t(W) * size_t(H));
+  int most = 1;
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      const int samples = int(sum.texel(x, y)[3]);
+      most = std::max(most, samples);
+      res.rays_per_pixel[size_t(y) * size_t(W) + size_t(x)] = adaptive_rays(opt_.spp, samples);
+    }
+  res.samples = most;
+}
+
 void StreamTracer::frame(const Camera& cam, const vgpu::Program& generate, RenderResult& res,
-                         bool aovs, int& iteration_number) {
+                         bool aovs, int& iteration_number, const Texture* marks, bool keep_hits) {
   vgpu::Device& gpu = *gpu_;
   State& s = *s_;
   PassRunner& r = *s.runner;
   const int W = opt_.width, H = opt_.height;
   int ro = 0;  // origins[ro]: this iteration's ray origins; origins[ro ^ 1]: its hit points
   gpu.clear(s.origins[ro], {cam.position.x, cam.position.y, cam.position.z, 0});
-  r.pass(generate, {}, s.rays[s.cur_rays]);
+  if (marks)
+    r.pass(generate, {marks}, s.rays[s.cur_rays]);
+  else
+    r.pass(generate, {}, s.rays[s.cur_rays]);
   gpu.clear(s.result[s.cur_result], {0, 0, 0, 1});
 
   const int iterations = 1 + std::max(0, opt_.bounces);
@@ -270,6 +348,9 @@ void StreamTracer::frame(const Camera& cam, const vgpu::Program& generate, Rende
     trace(s.origins[ro], rays, it == 0, cam);
     if (opt_.observer) opt_.observer->trace_end();
     Texture& hits = s.isect[s.cur_isect];
+    // guardarImpactos: the primary hits' surface keys (--aa adaptive), before later traces
+    // overwrite the intersections.
+    if (it == 0 && keep_hits) r.pass(s.keep, {&hits, &s.materials}, s.marks[s.cur_mark]);
     if (it == 0 && aovs) {
       gpu.download(hits);
       res.depth.assign(size_t(W) * H, 0.0f);

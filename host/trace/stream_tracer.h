@@ -38,8 +38,13 @@ class StreamTracer {
   // up to 1 + bounces iterations (iteration_number counts them over the sample frames, for the
   // observer and --trace-pixel). Leaves the colour in the current result texture; with `aovs`,
   // the primary hits' depth and id go into res.
+  // `marks` (if any) is the ray generator's input; with `keep_hits`, guardarImpactos writes
+  // the primary hits' surface keys into the current marks texture.
   void frame(const Camera& cam, const vgpu::Program& generate, RenderResult& res, bool aovs,
-             int& iteration_number);
+             int& iteration_number, const vgpu::Texture* marks = nullptr, bool keep_hits = false);
+  // --aa adaptive (RenderOptions::adaptive): the centre frame, then levels of samples where the
+  // marks say; leaves the resolved colour in the current result texture.
+  void render_adaptive(const Camera& cam, RenderResult& res, int& iteration_number);
 
   const Scene& scene_;
   const Grid& grid_;

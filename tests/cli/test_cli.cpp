@@ -179,6 +179,11 @@ TEST_CASE("sample counts that are not squares from 1 to 256 are refused, naming 
   check_refused("--spp 7", "--spp", "7 samples per pixel: not a square");
   check_refused("--spp 1024", "--spp", "1024 samples per pixel: they go from 1 to 256");
   check_refused("--spp four", "--spp", "expected a square from 1 to 256, got 'four'");
+  check_refused("--aa magic", "--aa", "magic not in {none,adaptive}");
+  check_refused("--aa adaptive --aa-threshold -0.5", "--aa-threshold",
+                "expected a colour difference of 0 or more (linear, 1 = white), got '-0.5'");
+  check_refused("--aa adaptive --aa-threshold nan", "--aa-threshold",
+                "expected a colour difference of 0 or more (linear, 1 = white), got 'nan'");
 }
 
 TEST_CASE("an image size past the limit names the limit, not a parse failure") {
@@ -399,7 +404,8 @@ TEST_CASE("a render writes the image, the AOVs and the statistics asked for, and
   CHECK(j["mrt"] == false);
   CHECK(j["fused_programs"] == nlohmann::json::array());
   CHECK(j["kernel_variant"] == "multipass");
-  CHECK(j["sampling"] == nlohmann::json({{"spp", 1},
+  CHECK(j["sampling"] == nlohmann::json({{"mode", "uniform"},
+                                         {"spp", 1},
                                          {"samples_per_pixel_mean", 1.0},
                                          {"samples_per_pixel_max", 1},
                                          {"passes_added", 0}}));

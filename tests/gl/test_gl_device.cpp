@@ -24,11 +24,13 @@ struct Frame {
 };
 
 Frame render(const std::string& scene_name, const std::string& device, int size, bool keep_passes,
-             bool mrt = false, const std::string& readback = "auto", int spp = 1) {
+             bool mrt = false, const std::string& readback = "auto", int spp = 1,
+             bool adaptive = false) {
   const host::Scene scene = host::load_scene(host::resolve_scene(scene_name));
   host::RenderOptions opt;
   opt.width = opt.height = size;
   opt.spp = spp;
+  opt.adaptive = adaptive;
   opt.device = device;
   opt.gl_readback = readback;
   if (mrt) {  // fused two-output passes need a profile with multiple render targets
@@ -160,21 +162,26 @@ TEST_CASE("the fused MRT passes on the GL device give the vgpu's query counts, h
 }
 
 TEST_CASE("supersampling on the GL device gives the vgpu's passes, query counts and image") {
-  const Frame v = render("classic", "vgpu", 48, true, false, "auto", 4),
-              g = render("classic", "gl", 48, true, false, "auto", 4);
-  const auto& pv = v.result.stats.passes;
-  const auto& pg = g.result.stats.passes;
-  REQUIRE(pv.size() == pg.size());
-  int accumulations = 0;
-  for (size_t i = 0; i < pv.size(); ++i) {
-    CAPTURE(i);
-    REQUIRE(pv[i].program == pg[i].program);
-    REQUIRE(pv[i].query_result == pg[i].query_result);
-    accumulations += pv[i].program == "accumulate samples";
+  for (const bool adaptive : {false, true}) {
+    CAPTURE(adaptive);
+    const Frame v = render("classic", "vgpu", 48, true, false, "auto", 4, adaptive),
+                g = render("classic", "gl", 48, true, false, "auto", 4, adaptive);
+    const auto& pv = v.result.stats.passes;
+    const auto& pg = g.result.stats.passes;
+    REQUIRE(pv.size() == pg.size());
+    int accumulations = 0;
+    for (size_t i = 0; i < pv.size(); ++i) {
+      CAPTURE(i);
+      REQUIRE(pv[i].program == pg[i].program);
+      REQUIRE(pv[i].query_result == pg[i].query_result);
+      accumulations += pv[i].program == "accumulate samples";
+    }
+    // Uniform: one per sample frame; adaptive: the centre frame's, then one per sample frame.
+    CHECK(accumulations == (adaptive ? 5 : 4));
+    CHECK(g.result.rays_per_pixel == v.result.rays_per_pixel);
+    gltest::check_same_frame(g.device, "intersections", v.result.hit_id, g.result.hit_id,
+                             v.result.depth, g.result.depth, v.result.rgb, g.result.rgb);
   }
-  CHECK(accumulations == 4);
-  gltest::check_same_frame(g.device, "intersections", v.result.hit_id, g.result.hit_id,
-                           v.result.depth, g.result.depth, v.result.rgb, g.result.rgb);
 }
 
 TEST_CASE(
