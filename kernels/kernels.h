@@ -21,6 +21,7 @@
 #include "kernels/shader.h"
 #include "kernels/shadow_rays.h"
 #include "kernels/traversal.h"
+#include "kernels/undersample.h"
 #include "kernels/update_voxel.h"
 #include "vgpu/program.h"
 
@@ -50,3 +51,6 @@ extern template class vgpu::KernelProgram<kernels::ResolveSamples>;
 extern template class vgpu::KernelProgram<kernels::KeepHits>;
 extern template class vgpu::KernelProgram<kernels::MarkPixels>;
 extern template class vgpu::KernelProgram<kernels::MarkedPixels>;
+extern template class vgpu::KernelProgram<kernels::MarkLattice>;
+extern template class vgpu::KernelProgram<kernels::MarkGaps>;
+extern template class vgpu::KernelProgram<kernels::FillGaps>;

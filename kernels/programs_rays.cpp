@@ -1,7 +1,8 @@
 // The compiled programs of the ray kernels: generadorRayos, rayosSombra, inicioReflejo,
 // direccionReflejo, shader, rayosReflejados, and supersampling's generadorRayosMuestra,
 // acumularMuestras, resolverMuestras, and adaptive sampling's guardarImpactos,
-// marcarPixeles, pixelesMarcados (kernels/kernels.h declares them; every lane family of each is
+// marcarPixeles, pixelesMarcados, and undersampling's marcarReticula, marcarHuecos, rellenarHuecos
+// (kernels/kernels.h declares them; every lane family of each is
 // compiled here, once).
 #include "kernels/kernels.h"
 
@@ -17,3 +18,6 @@ template class vgpu::KernelProgram<kernels::ResolveSamples>;
 template class vgpu::KernelProgram<kernels::KeepHits>;
 template class vgpu::KernelProgram<kernels::MarkPixels>;
 template class vgpu::KernelProgram<kernels::MarkedPixels>;
+template class vgpu::KernelProgram<kernels::MarkLattice>;
+template class vgpu::KernelProgram<kernels::MarkGaps>;
+template class vgpu::KernelProgram<kernels::FillGaps>;

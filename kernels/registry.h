@@ -35,6 +35,10 @@ inline std::vector<std::unique_ptr<vgpu::Program>> all_programs() {
   v.push_back(std::make_unique<vgpu::KernelProgram<KeepHits>>());
   v.push_back(std::make_unique<vgpu::KernelProgram<MarkPixels>>());
   v.push_back(std::make_unique<vgpu::KernelProgram<MarkedPixels>>());
+  // Adaptive undersampling (--aa undersample:K): the lattice, the gaps to trace, the fill.
+  v.push_back(std::make_unique<vgpu::KernelProgram<MarkLattice>>());
+  v.push_back(std::make_unique<vgpu::KernelProgram<MarkGaps>>());
+  v.push_back(std::make_unique<vgpu::KernelProgram<FillGaps>>());
   // The fused programs of --mrt on (kernels/fused.h), two outputs each.
   v.push_back(std::make_unique<vgpu::KernelProgram<IntersectNext>>());
   v.push_back(std::make_unique<vgpu::KernelProgram<TraverseUpdate>>());

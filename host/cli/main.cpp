@@ -138,6 +138,26 @@ const CLI::Validator kSppCheck(
     },
     "1, 4, 9, ..., 256", "N");
 
+// --aa's value: none, adaptive, undersample or undersample:K; K (default 2) for undersample,
+// 0 otherwise, or nullopt.
+std::optional<int> parse_aa(const std::string& text) {
+  if (text == "none" || text == "adaptive") return 0;
+  std::smatch m;
+  if (!std::regex_match(text, m, std::regex(R"(undersample(:(\d{1,4}))?)"))) return std::nullopt;
+  const int k = m[2].matched ? std::stoi(m[2]) : 2;
+  if (k < 1 || k > 64) return std::nullopt;
+  return k;
+}
+
+const CLI::Validator kAaCheck(
+    [](std::string& text) -> std::string {
+      return parse_aa(text) ? ""
+                            : "expected none, adaptive, undersample or undersample:K (K 1 to 64), "
+                              "got '" +
+                                  text + "'";
+    },
+    "none | adaptive | undersample[:K]", "MODE");
+
 const CLI::Validator kThresholdCheck(
     [](std::string& text) -> std::string {
       try {
@@ -308,10 +328,12 @@ void add_render_options(CLI::App& render, RenderArgs& a) {
       ->capture_default_str();
   render
       .add_option("--aa", a.aa,
-                  "Anti-aliasing: none (--spp rays in every pixel) or adaptive (one ray per "
+                  "Anti-aliasing: none (--spp rays in every pixel), adaptive (one ray per "
                   "pixel, then levels of 4, 16, ... up to --spp only where neighbours hit another "
-                  "surface or differ in colour by more than --aa-threshold)")
-      ->check(CLI::IsMember({"none", "adaptive"}))
+                  "surface or differ in colour by more than --aa-threshold) or undersample[:K] "
+                  "(one ray through every K-th pixel in x and y, default 2, then through the "
+                  "pixels between those that hit different surfaces; the rest blended)")
+      ->check(kAaCheck)
       ->capture_default_str();
   render
       .add_option("--aa-threshold", a.aa_threshold,
@@ -346,6 +368,10 @@ int run_render(const RenderArgs& a, bool lanes_given) {
   opt.batch_walk = a.walk == "batches";
   opt.spp = a.spp;
   opt.adaptive = a.aa == "adaptive";
+  opt.undersample = a.aa == "adaptive" || a.aa == "none" ? 0 : *parse_aa(a.aa);
+  if (opt.undersample > 0 && opt.spp > 1)
+    throw UsageError("--aa " + a.aa + " traces one ray per traced pixel; drop --spp " +
+                     std::to_string(opt.spp));
   opt.aa_threshold = a.aa_threshold;
   if (opt.mrt && opt.looping)
     throw UsageError(
@@ -522,12 +548,15 @@ int run_render(const RenderArgs& a, bool lanes_given) {
       for (const uint32_t n : r.rays_per_pixel) total += n, most = std::max<uint64_t>(most, n);
       mean = double(total) / double(r.rays_per_pixel.size());
     }
-    j["sampling"] = {{"mode", opt.adaptive && opt.spp > 1 ? "adaptive" : "uniform"},
+    j["sampling"] = {{"mode", opt.undersample > 0           ? "undersample"
+                              : opt.adaptive && opt.spp > 1 ? "adaptive"
+                                                            : "uniform"},
                      {"spp", opt.spp},
                      {"samples_per_pixel_mean", mean},
                      {"samples_per_pixel_max", most},
                      {"passes_added", cpu ? 0 : r.stats.totals.passes - r.first_frame_passes}};
     if (opt.adaptive) j["sampling"]["threshold"] = opt.aa_threshold;
+    if (opt.undersample > 0) j["sampling"]["k"] = opt.undersample;
   }
   {
     nlohmann::ordered_json stats = r.stats.json();

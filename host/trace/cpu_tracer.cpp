@@ -347,6 +347,67 @@ void adaptive(const Tracer& tracer, const RenderOptions& opt, unsigned workers,
   res.samples = most;
 }
 
+// --aa undersample:K as the stream tracer runs it (render_undersampled): the lattice pixels,
+// then the pixels of lattice cells whose corners' surface keys disagree, the rest blended
+// bilinearly from their cell's corners; AOVs of pixels never traced from the nearest corner.
+void undersample(const Tracer& tracer, const RenderOptions& opt, unsigned workers,
+                 std::vector<Counters>& counters, RenderResult& res) {
+  const int W = opt.width, H = opt.height, K = opt.undersample;
+  const size_t n = size_t(W) * size_t(H);
+  std::vector<glm::dvec3> colour(n);
+  std::vector<int> key(n, -1);
+  std::vector<uint8_t> traced(n, 0);
+  auto trace = [&](unsigned worker, int x, int y) {
+    const size_t i = size_t(y) * size_t(W) + size_t(x);
+    Hit h;
+    colour[i] = tracer.sample(x, y, {0.5f, 0.5f}, &h, counters[worker]);
+    key[i] = tracer.surface_key(h);
+    if (h.tri >= 0) {
+      res.depth[i] = float(h.t);
+      res.hit_id[i] = float(tracer.input_id(h.tri));
+    }
+    traced[i] = 1;
+  };
+  for_each_row(H, workers, [&](unsigned worker, int y) {
+    for (int x = 0; x < W; ++x)
+      if (on_lattice(x, y, K, W, H)) trace(worker, x, y);
+  });
+  for_each_row(H, workers, [&](unsigned worker, int y) {
+    for (int x = 0; x < W; ++x) {
+      if (on_lattice(x, y, K, W, H)) continue;
+      const glm::ivec4 c = lattice_cell(x, y, K, W, H);
+      const int k00 = key[size_t(c.z) * size_t(W) + size_t(c.x)];
+      if (key[size_t(c.z) * size_t(W) + size_t(c.y)] != k00 ||
+          key[size_t(c.w) * size_t(W) + size_t(c.x)] != k00 ||
+          key[size_t(c.w) * size_t(W) + size_t(c.y)] != k00)
+        trace(worker, x, y);
+    }
+  });
+  res.rays_per_pixel.assign(n, 0);
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      const size_t i = size_t(y) * size_t(W) + size_t(x);
+      glm::dvec3 c = colour[i];
+      if (traced[i]) {
+        res.rays_per_pixel[i] = 1;
+      } else {
+        const glm::ivec4 q = lattice_cell(x, y, K, W, H);
+        auto at = [&](int px, int py) { return colour[size_t(py) * size_t(W) + size_t(px)]; };
+        const double tx = q.y > q.x ? double(x - q.x) / double(q.y - q.x) : 0.0;
+        const double ty = q.w > q.z ? double(y - q.z) / double(q.w - q.z) : 0.0;
+        const glm::dvec3 top = at(q.x, q.z) + (at(q.y, q.z) - at(q.x, q.z)) * tx;
+        const glm::dvec3 bottom = at(q.x, q.w) + (at(q.y, q.w) - at(q.x, q.w)) * tx;
+        c = top + (bottom - top) * ty;
+        const int nx = x - q.x <= q.y - x ? q.x : q.y, ny = y - q.z <= q.w - y ? q.z : q.w;
+        const size_t j = size_t(ny) * size_t(W) + size_t(nx);
+        res.depth[i] = res.depth[j];
+        res.hit_id[i] = res.hit_id[j];
+      }
+      for (int ch = 0; ch < 3; ++ch) res.rgb[i * 3 + size_t(ch)] = float(c[ch]);
+    }
+  res.samples = 1;
+}
+
 }  // namespace
 
 glm::dvec3 cpu_primary_dir(const Camera& camera, int W, int H, int x, int y) {
@@ -373,7 +434,9 @@ RenderResult render_cpu(const Scene& scene, const Grid& grid, const Camera& came
       options.threads > 0 ? unsigned(options.threads) : cores, 1u, unsigned(std::max(H, 1)));
   std::vector<Counters> counters(workers);
   // Every pixel is independent, so the order in which rows are handed out does not matter.
-  if (options.adaptive && options.spp > 1)
+  if (options.undersample > 0)
+    undersample(tracer, options, workers, counters, res);
+  else if (options.adaptive && options.spp > 1)
     adaptive(tracer, options, workers, counters, res);
   else
     for_each_row(H, workers, [&](unsigned worker, int y) {

@@ -98,6 +98,11 @@ struct RenderOptions {
   // (linear, per channel); a level's samples replace the pixel's earlier ones.
   bool adaptive = false;
   float aa_threshold = 0.1f;
+  // Adaptive undersampling (--aa undersample:K, 0: off): one ray through the centre of every
+  // K-th pixel in x and y (and the last row and column), then of the pixels between lattice
+  // pixels whose surfaces (host/trace/sampling.h) disagree; the rest are blended from the four
+  // lattice pixels around them. One ray per traced pixel (spp 1).
+  int undersample = 0;
   std::optional<glm::ivec2> trace_pixel;  // print every pass this pixel took part in
   std::ostream* trace_out = nullptr;
   bool keep_pass_records = false;

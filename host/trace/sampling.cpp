@@ -1,6 +1,7 @@
 // Where the samples of a pixel lie (host/trace/sampling.h).
 #include "host/trace/sampling.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace host {
@@ -63,6 +64,15 @@ uint32_t adaptive_rays(int spp, int samples) {
     rays += uint32_t(side * side);
   }
   return rays;
+}
+
+bool on_lattice(int x, int y, int k, int width, int height) {
+  return (x % k == 0 || x == width - 1) && (y % k == 0 || y == height - 1);
+}
+
+glm::ivec4 lattice_cell(int x, int y, int k, int width, int height) {
+  const int x0 = x / k * k, y0 = y / k * k;
+  return {x0, std::min(x0 + k, width - 1), y0, std::min(y0 + k, height - 1)};
 }
 
 }  // namespace host

@@ -30,4 +30,10 @@ std::vector<int> adaptive_levels(int spp);
 // `samples` (1: the centre ray alone; n*n: every level up to side n, after the centre ray).
 uint32_t adaptive_rays(int spp, int samples);
 
+// Undersampling's lattice (--aa undersample:K): whether pixel (x, y) of a W x H image is traced
+// first (x a multiple of K or the last column, y likewise), and the lattice pixels around it
+// (x0 <= x <= x1, y0 <= y <= y1).
+bool on_lattice(int x, int y, int k, int width, int height);
+glm::ivec4 lattice_cell(int x, int y, int k, int width, int height);  // x0, x1, y0, y1
+
 }  // namespace host

@@ -52,6 +52,10 @@ struct StreamTracer::State {
   KernelProgram<MarkedPixels> marked;
   Texture marks[2], materials;
   int cur_mark = 0;
+  // Adaptive undersampling (--aa undersample:K): the lattice, the gaps, the fill.
+  KernelProgram<MarkLattice> mark_lattice;
+  KernelProgram<MarkGaps> mark_gaps;
+  KernelProgram<FillGaps> fill;
   // The walk through the acceleration structure, and how passes are issued.
   std::unique_ptr<GridWalk> walk;
   std::unique_ptr<PassRunner> runner;
@@ -95,6 +99,11 @@ StreamTracer::StreamTracer(const Scene& scene, const Grid& grid, const RenderOpt
   }
   if (const std::string why = spp_refusal(opt_.spp); !why.empty())
     throw std::invalid_argument("spp: " + why);
+  if (opt_.undersample < 0 || (opt_.undersample > 0 && (opt_.spp > 1 || opt_.adaptive)))
+    throw std::invalid_argument(
+        "undersample: K must be 1 or more, with one ray per traced pixel (spp 1, not adaptive)");
+  const bool sums = opt_.spp > 1 || opt_.undersample > 0;
+  const bool marking = (opt_.adaptive && opt_.spp > 1) || opt_.undersample > 0;
   const int maxs = gpu.profile().max_texture_size;
 
   // Scene textures: triangle i at texel (i mod width, i div width).
@@ -143,11 +152,11 @@ StreamTracer::StreamTracer(const Scene& scene, const Grid& grid, const RenderOpt
   s.shadow_rays = gpu.make_texture("shadow rays", W, H, 4, fm[Group::rays]);
   // Counting passes need a colour target; only their query result matters.
   s.counter = gpu.make_texture("counter", W, H, 1, Format::fp16);
-  if (opt_.spp > 1)
+  if (sums)
     for (int i = 0; i < 2; ++i)
       s.sum[i] = gpu.make_texture(std::string("sample sum ") + (i ? "B" : "A"), W, H, 4,
                                   fm[Group::colour]);
-  if (opt_.adaptive && opt_.spp > 1) {
+  if (marking) {
     for (int i = 0; i < 2; ++i)
       s.marks[i] = gpu.make_texture(std::string("marks ") + (i ? "B" : "A"), W, H, 4, Format::fp32);
     s.materials = gpu.make_texture("triangle materials", sw, int(sh), 1);
@@ -156,6 +165,10 @@ StreamTracer::StreamTracer(const Scene& scene, const Grid& grid, const RenderOpt
     gpu.upload(s.materials);
     s.keep.kernel.scene = SceneUniforms{float(sw)};
     s.mark.kernel.threshold = opt_.aa_threshold;
+    const LatticeUniforms lattice{float(std::max(opt_.undersample, 1)), float(W), float(H)};
+    s.mark_lattice.kernel.lattice = lattice;
+    s.mark_gaps.kernel.lattice = lattice;
+    s.fill.kernel.lattice = lattice;
   }
   s.grid_mask = Stencil(W, H, 1);
   s.isect_mask = Stencil(W, H, 1);
@@ -190,8 +203,8 @@ uint64_t StreamTracer::texture_bytes() const {
   for (int i = 0; i < 2; ++i)
     for (const Texture* t : {&s_->rays[i], &s_->origins[i], &s_->isect[i], &s_->result[i]})
       b += t->bytes();
-  if (opt_.spp > 1) b += s_->sum[0].bytes() + s_->sum[1].bytes();
-  if (opt_.adaptive && opt_.spp > 1)
+  if (opt_.spp > 1 || opt_.undersample > 0) b += s_->sum[0].bytes() + s_->sum[1].bytes();
+  if ((opt_.adaptive && opt_.spp > 1) || opt_.undersample > 0)
     b += s_->marks[0].bytes() + s_->marks[1].bytes() + s_->materials.bytes();
   return b;
 }
@@ -224,7 +237,10 @@ RenderResult StreamTracer::render(const Camera& cam) {
   if (opt_.trace_pixel && opt_.trace_out)
     *opt_.trace_out << "pixel " << opt_.trace_pixel->x << "," << opt_.trace_pixel->y << ":\n";
   int iteration_number = 0;
-  if (opt_.spp <= 1) {
+  if (opt_.undersample > 0) {
+    static_cast<GenerateRays&>(s.sample_generate.kernel) = g;
+    render_undersampled(cam, res, iteration_number);
+  } else if (opt_.spp <= 1) {
     frame(cam, s.generate, res, true, iteration_number);
   } else if (opt_.adaptive) {
     static_cast<GenerateRays&>(s.sample_generate.kernel) = g;
@@ -258,7 +274,7 @@ RenderResult StreamTracer::render(const Camera& cam) {
       for (int c = 0; c < 3; ++c) res.rgb[(size_t(y) * W + x) * 3 + c] = t[c];
     }
   res.stats = gpu.stats();
-  if (opt_.spp <= 1) res.first_frame_passes = res.stats.totals.passes;
+  if (opt_.spp <= 1 && opt_.undersample == 0) res.first_frame_passes = res.stats.totals.passes;
   res.rays_traced = r.counts.rays_traced;
   res.rays_unfinished = r.counts.rays_unfinished;
   res.batch_walk = r.counts.batch_walk;
@@ -318,6 +334,66 @@ void StreamTracer::render_adaptive(const Camera& cam, RenderResult& res, int& it
       res.rays_per_pixel[size_t(y) * size_t(W) + size_t(x)] = adaptive_rays(opt_.spp, samples);
     }
   res.samples = most;
+}
+
+void StreamTracer::render_undersampled(const Camera& cam, RenderResult& res,
+                                       int& iteration_number) {
+  vgpu::Device& gpu = *gpu_;
+  State& s = *s_;
+  PassRunner& r = *s.runner;
+  const int W = opt_.width, H = opt_.height, K = opt_.undersample;
+  // marcarReticula into marks A; the lattice frame through the lattice pixels' centres, keeping
+  // their surface keys in marks B; their colours into the sum.
+  r.pass(s.mark_lattice, {}, s.marks[0]);
+  s.cur_mark = 1;
+  s.sample_generate.kernel.jitter_x = s.sample_generate.kernel.jitter_y = 0.5f;
+  s.sample_generate.kernel.gated = true;
+  frame(cam, s.sample_generate, res, true, iteration_number, &s.marks[0], true);
+  res.first_frame_passes = gpu.stats().totals.passes;
+  gpu.clear(s.sum[s.cur_sum], {0, 0, 0, 0});
+  s.accumulate.kernel.gated = true;
+  s.accumulate.kernel.restart = false;
+  r.pass(s.accumulate, {&s.sum[s.cur_sum], &s.result[s.cur_result], &s.marks[0]},
+         s.sum[s.cur_sum ^ 1]);
+  s.cur_sum ^= 1;
+  // marcarHuecos into marks A (the lattice flags are done with), pixelesMarcados counts them;
+  // the gaps' frame traces them.
+  r.pass(s.mark_gaps, {&s.marks[1]}, s.marks[0]);
+  std::vector<uint8_t> gap(size_t(W) * size_t(H), 0);
+  if (r.count(s.marked, s.marks[0], nullptr, nullptr) > 0) {
+    const std::vector<float> depth = res.depth, hit_id = res.hit_id;
+    frame(cam, s.sample_generate, res, true, iteration_number, &s.marks[0]);
+    r.pass(s.accumulate, {&s.sum[s.cur_sum], &s.result[s.cur_result], &s.marks[0]},
+           s.sum[s.cur_sum ^ 1]);
+    s.cur_sum ^= 1;
+    // The AOVs: the gaps' from this frame, the lattice's from the first.
+    gpu.download(s.marks[0]);
+    for (size_t i = 0; i < gap.size(); ++i) {
+      gap[i] = s.marks[0].texel(int(i % size_t(W)), int(i / size_t(W)))[0] > 0.0f;
+      if (!gap[i]) res.depth[i] = depth[i], res.hit_id[i] = hit_id[i];
+    }
+  }
+  s.sample_generate.kernel.gated = false;
+  s.accumulate.kernel.gated = false;
+  // rellenarHuecos: the traced pixels' colours, the rest blended from their lattice cell.
+  r.pass(s.fill, {&s.sum[s.cur_sum]}, s.result[s.cur_result ^ 1]);
+  s.cur_result ^= 1;
+  // The AOVs of a pixel never traced: its lattice cell's nearest corner's.
+  res.rays_per_pixel.assign(gap.size(), 0);
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      const size_t i = size_t(y) * size_t(W) + size_t(x);
+      if (on_lattice(x, y, K, W, H) || gap[i]) {
+        res.rays_per_pixel[i] = 1;
+        continue;
+      }
+      const glm::ivec4 c = lattice_cell(x, y, K, W, H);
+      const int nx = x - c.x <= c.y - x ? c.x : c.y, ny = y - c.z <= c.w - y ? c.z : c.w;
+      const size_t j = size_t(ny) * size_t(W) + size_t(nx);
+      res.depth[i] = res.depth[j];
+      res.hit_id[i] = res.hit_id[j];
+    }
+  res.samples = 1;
 }
 
 void StreamTracer::frame(const Camera& cam, const vgpu::Program& generate, RenderResult& res,

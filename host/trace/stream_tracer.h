@@ -45,6 +45,8 @@ class StreamTracer {
   // --aa adaptive (RenderOptions::adaptive): the centre frame, then levels of samples where the
   // marks say; leaves the resolved colour in the current result texture.
   void render_adaptive(const Camera& cam, RenderResult& res, int& iteration_number);
+  // --aa undersample:K (RenderOptions::undersample): the lattice frame, the gaps' frame, the fill.
+  void render_undersampled(const Camera& cam, RenderResult& res, int& iteration_number);
 
   const Scene& scene_;
   const Grid& grid_;

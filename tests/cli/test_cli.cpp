@@ -179,7 +179,13 @@ TEST_CASE("sample counts that are not squares from 1 to 256 are refused, naming 
   check_refused("--spp 7", "--spp", "7 samples per pixel: not a square");
   check_refused("--spp 1024", "--spp", "1024 samples per pixel: they go from 1 to 256");
   check_refused("--spp four", "--spp", "expected a square from 1 to 256, got 'four'");
-  check_refused("--aa magic", "--aa", "magic not in {none,adaptive}");
+  check_refused("--aa magic", "--aa",
+                "expected none, adaptive, undersample or undersample:K (K 1 to 64), got 'magic'");
+  check_refused("--aa undersample:0", "--aa",
+                "expected none, adaptive, undersample or undersample:K (K 1 to 64), got "
+                "'undersample:0'");
+  check_refused("--aa undersample --spp 4", "--aa undersample",
+                "traces one ray per traced pixel; drop --spp 4");
   check_refused("--aa adaptive --aa-threshold -0.5", "--aa-threshold",
                 "expected a colour difference of 0 or more (linear, 1 = white), got '-0.5'");
   check_refused("--aa adaptive --aa-threshold nan", "--aa-threshold",

@@ -25,12 +25,13 @@ struct Frame {
 
 Frame render(const std::string& scene_name, const std::string& device, int size, bool keep_passes,
              bool mrt = false, const std::string& readback = "auto", int spp = 1,
-             bool adaptive = false) {
+             bool adaptive = false, int undersample = 0) {
   const host::Scene scene = host::load_scene(host::resolve_scene(scene_name));
   host::RenderOptions opt;
   opt.width = opt.height = size;
   opt.spp = spp;
   opt.adaptive = adaptive;
+  opt.undersample = undersample;
   opt.device = device;
   opt.gl_readback = readback;
   if (mrt) {  // fused two-output passes need a profile with multiple render targets
@@ -182,6 +183,22 @@ TEST_CASE("supersampling on the GL device gives the vgpu's passes, query counts 
     gltest::check_same_frame(g.device, "intersections", v.result.hit_id, g.result.hit_id,
                              v.result.depth, g.result.depth, v.result.rgb, g.result.rgb);
   }
+}
+
+TEST_CASE("undersampling on the GL device traces the vgpu's pixels and gives its image") {
+  const Frame v = render("classic", "vgpu", 48, true, false, "auto", 1, false, 2),
+              g = render("classic", "gl", 48, true, false, "auto", 1, false, 2);
+  const auto& pv = v.result.stats.passes;
+  const auto& pg = g.result.stats.passes;
+  REQUIRE(pv.size() == pg.size());
+  for (size_t i = 0; i < pv.size(); ++i) {
+    CAPTURE(i);
+    REQUIRE(pv[i].program == pg[i].program);
+    REQUIRE(pv[i].query_result == pg[i].query_result);
+  }
+  CHECK(g.result.rays_per_pixel == v.result.rays_per_pixel);
+  gltest::check_same_frame(g.device, "intersections", v.result.hit_id, g.result.hit_id,
+                           v.result.depth, g.result.depth, v.result.rgb, g.result.rgb);
 }
 
 TEST_CASE(
