@@ -1,7 +1,7 @@
 // Adaptive undersampling (an extension, --aa undersample:K, after Akimoto, Mase & Suenaga 1991,
 // the paper's reference 7): trace every K-th pixel in x and y (the lattice, with the last row
-// and column), then only the pixels between lattice pixels whose surface keys disagree; fill
-// the rest from the four lattice pixels around them.
+// and column), then only the pixels between lattice pixels whose surface keys or colours
+// disagree; fill the rest from the four lattice pixels around them.
 #pragma once
 
 #include "kernels/common.h"
@@ -46,15 +46,17 @@ struct MarkLattice {
 };
 
 // marcarHuecos: x = 1 on a pixel between lattice pixels whose surface keys (guardarImpactos'
-// y) are not all the same: it is traced; 0 elsewhere (lattice pixels were traced already).
+// y) are not all the same, or whose colours differ by more than the threshold in some channel:
+// it is traced; 0 elsewhere (lattice pixels were traced already).
 struct MarkGaps {
   static constexpr const char* name = "mark gaps";
   static constexpr const char* paper_name = "marcarHuecos (extension)";
   static constexpr int outputs = 1;  // -> marks
-  enum Unit { kKeys };
-  static constexpr std::array<const char*, 1> units{"surface_keys"};
+  enum Unit { kKeys, kSum };
+  static constexpr std::array<const char*, 2> units{"surface_keys", "sample_sum"};
 
   LatticeUniforms lattice;
+  float threshold = 0.1f;  // colour units (linear, 1 = white)
 
   template <class L>
   void operator()(Fragments<L>& f) const {
@@ -67,7 +69,18 @@ struct MarkGaps {
     const F k11 = f.fetch(kKeys, c.x1 + F(0.5f), c.y1 + F(0.5f)).y;
     const auto on_x = (xi == c.x0) || (xi == F(lattice.width - 1.0f));
     const auto on_y = (yi == c.y0) || (yi == F(lattice.height - 1.0f));
-    const auto disagree = (k10 != k00) || (k01 != k00) || (k11 != k00);
+    // The lattice pixels' colours (one sample each in the sum).
+    const Vec4<F> c00 = f.fetch(kSum, c.x0 + F(0.5f), c.y0 + F(0.5f));
+    const Vec4<F> c10 = f.fetch(kSum, c.x1 + F(0.5f), c.y0 + F(0.5f));
+    const Vec4<F> c01 = f.fetch(kSum, c.x0 + F(0.5f), c.y1 + F(0.5f));
+    const Vec4<F> c11 = f.fetch(kSum, c.x1 + F(0.5f), c.y1 + F(0.5f));
+    auto spread = [](const F& a, const F& b, const F& c, const F& d) {
+      return max(max(a, b), max(c, d)) - min(min(a, b), min(c, d));
+    };
+    const F colour =
+        max(max(spread(c00.x, c10.x, c01.x, c11.x), spread(c00.y, c10.y, c01.y, c11.y)),
+            spread(c00.z, c10.z, c01.z, c11.z));
+    const auto disagree = (k10 != k00) || (k01 != k00) || (k11 != k00) || (colour > F(threshold));
     const auto gap = !(on_x && on_y) && disagree;
     f.out(0) = {select(gap, F(1.0f), F(0.0f)), F(0.0f), F(0.0f), F(0.0f)};
   }

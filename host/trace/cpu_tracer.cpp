@@ -348,8 +348,9 @@ void adaptive(const Tracer& tracer, const RenderOptions& opt, unsigned workers,
 }
 
 // --aa undersample:K as the stream tracer runs it (render_undersampled): the lattice pixels,
-// then the pixels of lattice cells whose corners' surface keys disagree, the rest blended
-// bilinearly from their cell's corners; AOVs of pixels never traced from the nearest corner.
+// then the pixels of lattice cells whose corners' surface keys or colours disagree, the rest
+// blended bilinearly from their cell's corners; AOVs of pixels never traced from the nearest
+// corner.
 void undersample(const Tracer& tracer, const RenderOptions& opt, unsigned workers,
                  std::vector<Counters>& counters, RenderResult& res) {
   const int W = opt.width, H = opt.height, K = opt.undersample;
@@ -376,10 +377,18 @@ void undersample(const Tracer& tracer, const RenderOptions& opt, unsigned worker
     for (int x = 0; x < W; ++x) {
       if (on_lattice(x, y, K, W, H)) continue;
       const glm::ivec4 c = lattice_cell(x, y, K, W, H);
-      const int k00 = key[size_t(c.z) * size_t(W) + size_t(c.x)];
-      if (key[size_t(c.z) * size_t(W) + size_t(c.y)] != k00 ||
-          key[size_t(c.w) * size_t(W) + size_t(c.x)] != k00 ||
-          key[size_t(c.w) * size_t(W) + size_t(c.y)] != k00)
+      const size_t corner[4] = {
+          size_t(c.z) * size_t(W) + size_t(c.x), size_t(c.z) * size_t(W) + size_t(c.y),
+          size_t(c.w) * size_t(W) + size_t(c.x), size_t(c.w) * size_t(W) + size_t(c.y)};
+      glm::dvec3 lo = colour[corner[0]], hi = lo;
+      bool disagree = false;
+      for (const size_t j : corner) {
+        disagree = disagree || key[j] != key[corner[0]];
+        lo = glm::min(lo, colour[j]);
+        hi = glm::max(hi, colour[j]);
+      }
+      const glm::dvec3 spread = hi - lo;
+      if (disagree || std::max({spread.x, spread.y, spread.z}) > double(opt.aa_threshold))
         trace(worker, x, y);
     }
   });

@@ -168,6 +168,7 @@ StreamTracer::StreamTracer(const Scene& scene, const Grid& grid, const RenderOpt
     const LatticeUniforms lattice{float(std::max(opt_.undersample, 1)), float(W), float(H)};
     s.mark_lattice.kernel.lattice = lattice;
     s.mark_gaps.kernel.lattice = lattice;
+    s.mark_gaps.kernel.threshold = opt_.aa_threshold;
     s.fill.kernel.lattice = lattice;
   }
   s.grid_mask = Stencil(W, H, 1);
@@ -358,7 +359,7 @@ void StreamTracer::render_undersampled(const Camera& cam, RenderResult& res,
   s.cur_sum ^= 1;
   // marcarHuecos into marks A (the lattice flags are done with), pixelesMarcados counts them;
   // the gaps' frame traces them.
-  r.pass(s.mark_gaps, {&s.marks[1]}, s.marks[0]);
+  r.pass(s.mark_gaps, {&s.marks[1], &s.sum[s.cur_sum]}, s.marks[0]);
   std::vector<uint8_t> gap(size_t(W) * size_t(H), 0);
   if (r.count(s.marked, s.marks[0], nullptr, nullptr) > 0) {
     const std::vector<float> depth = res.depth, hit_id = res.hit_id;

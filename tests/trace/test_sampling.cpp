@@ -224,10 +224,11 @@ TEST_CASE("undersampling every pixel (K = 1) is the full render, bit for bit") {
 TEST_CASE(
     "undersampling traces the lattice and the gaps between different surfaces, and blends "
     "the rest") {
-  // One surface in view: only the lattice (every 2nd pixel and the last row and column) is
-  // traced, and a pixel between two lattice pixels is their mean.
+  // One surface in view and a threshold no colour change reaches: only the lattice (every 2nd
+  // pixel and the last row and column) is traced, and a pixel between two lattice pixels is
+  // their mean.
   InsideCase inside;
-  host::RenderOptions opt = adaptive_options(1, 0);
+  host::RenderOptions opt = adaptive_options(1, 10.0f);
   opt.adaptive = false;
   opt.undersample = 2;
   const host::RenderResult r =
@@ -244,6 +245,12 @@ TEST_CASE(
     const float right = r.rgb[size_t(2 * 8 + 4) * 3 + size_t(c)];
     CHECK(r.rgb[size_t(2 * 8 + 3) * 3 + size_t(c)] == doctest::Approx(0.5f * (left + right)));
   }
+  // Threshold 0: the shading changes across every cell, so every pixel is traced.
+  host::RenderOptions all = opt;
+  all.aa_threshold = 0.0f;
+  const host::RenderResult t =
+      host::StreamTracer(inside.scene, inside.grid, all).render(inside.camera);
+  for (const uint32_t n : t.rays_per_pixel) CHECK(n == 1);
   // The edge: the cells the square's edge crosses have corners on both surfaces, so their
   // pixels are traced; the CPU tracer traces the same pixels and agrees.
   EdgeCase e;
