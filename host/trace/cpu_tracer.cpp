@@ -181,11 +181,20 @@ class Tracer {
   glm::dvec3 sample(int x, int y, glm::vec2 j, Hit* primary, Counters& c) const {
     return radiance(glm::dvec3(cam_.position), primary_.dir(x, y, j.x, j.y), 0, 1.0, primary, c);
   }
-  // The material a primary hit's triangle has, -1 for a miss (guardarImpactos' surface key).
-  int surface_key(const Hit& h) const {
-    return h.tri < 0 ? -1 : int(scene_.material[size_t(h.tri)]);
+  // The centre ray of pixel (x, y) for adaptive sampling and undersampling: its colour; its
+  // hit's depth and input id into the AOVs; in `key`, the material its triangle has, -1 for a
+  // miss (guardarImpactos' surface key).
+  glm::dvec3 centre(int x, int y, RenderResult& out, int& key, Counters& c) const {
+    const size_t i = size_t(y) * size_t(opt_.width) + size_t(x);
+    Hit h;
+    const glm::dvec3 colour = sample(x, y, {0.5f, 0.5f}, &h, c);
+    key = h.tri < 0 ? -1 : int(scene_.material[size_t(h.tri)]);
+    if (h.tri >= 0) {
+      out.depth[i] = float(h.t);
+      out.hit_id[i] = float(scene_.id[size_t(h.tri)]);
+    }
+    return colour;
   }
-  uint32_t input_id(int64_t tri) const { return scene_.id[size_t(tri)]; }
 
   // One pixel: the primary ray and, recursively, its reflections.
   void pixel(int x, int y, RenderResult& out, Counters& c) const {
@@ -295,13 +304,7 @@ void adaptive(const Tracer& tracer, const RenderOptions& opt, unsigned workers,
   for_each_row(H, workers, [&](unsigned worker, int y) {
     for (int x = 0; x < W; ++x) {
       const size_t i = size_t(y) * size_t(W) + size_t(x);
-      Hit h;
-      estimate[i] = tracer.sample(x, y, {0.5f, 0.5f}, &h, counters[worker]);
-      key[i] = tracer.surface_key(h);
-      if (h.tri >= 0) {
-        res.depth[i] = float(h.t);
-        res.hit_id[i] = float(tracer.input_id(h.tri));
-      }
+      estimate[i] = tracer.centre(x, y, res, key[i], counters[worker]);
     }
   });
   for (const int side : adaptive_levels(opt.spp)) {
@@ -360,13 +363,7 @@ void undersample(const Tracer& tracer, const RenderOptions& opt, unsigned worker
   std::vector<uint8_t> traced(n, 0);
   auto trace = [&](unsigned worker, int x, int y) {
     const size_t i = size_t(y) * size_t(W) + size_t(x);
-    Hit h;
-    colour[i] = tracer.sample(x, y, {0.5f, 0.5f}, &h, counters[worker]);
-    key[i] = tracer.surface_key(h);
-    if (h.tri >= 0) {
-      res.depth[i] = float(h.t);
-      res.hit_id[i] = float(tracer.input_id(h.tri));
-    }
+    colour[i] = tracer.centre(x, y, res, key[i], counters[worker]);
     traced[i] = 1;
   };
   for_each_row(H, workers, [&](unsigned worker, int y) {
