@@ -33,6 +33,7 @@ MODES = [  # (label, options)
     ("spp 16", ["--spp", "16"]),
     ("spp 64", ["--spp", "64"]),
     ("adaptive 16, T 0.05", ["--spp", "16", "--aa", "adaptive", "--aa-threshold", "0.05"]),
+    ("adaptive 16, T 0.07", ["--spp", "16", "--aa", "adaptive", "--aa-threshold", "0.07"]),
     ("adaptive 16, T 0.1", ["--spp", "16", "--aa", "adaptive", "--aa-threshold", "0.1"]),
     ("adaptive 16, T 0.2", ["--spp", "16", "--aa", "adaptive", "--aa-threshold", "0.2"]),
     ("adaptive 64, T 0.1", ["--spp", "64", "--aa", "adaptive", "--aa-threshold", "0.1"]),
