@@ -8,23 +8,37 @@
 
 namespace kernels {
 
-// The lattice cell around a pixel: its corners' coordinates (pixels) and whether the pixel is
-// one of them. xi, yi are the pixel's integer coordinates.
+// The lattice: its step and the image size.
 struct LatticeUniforms {
   float k = 2;                  // lattice step, pixels
   float width = 1, height = 1;  // image size, pixels
 };
 
-template <class F>
+// The lattice cell around a fragment's pixel: its corners (pixel coordinates) and whether the
+// pixel is one of them.
+template <class L>
 struct LatticeCell {
-  F x0, x1, y0, y1;
-};
+  using F = typename L::F;
+  F xi, yi;              // the pixel
+  F x0, x1, y0, y1;      // its cell's corners
+  typename L::M corner;  // the pixel is a lattice pixel (traced first)
 
-template <class F>
-inline LatticeCell<F> lattice_cell(const F& xi, const F& yi, const LatticeUniforms& u) {
-  const F x0 = floor(xi / F(u.k)) * F(u.k), y0 = floor(yi / F(u.k)) * F(u.k);
-  return {x0, min(x0 + F(u.k), F(u.width - 1.0f)), y0, min(y0 + F(u.k), F(u.height - 1.0f))};
-}
+  LatticeCell(const Fragments<L>& f, const LatticeUniforms& u)
+      : xi(f.x - F(0.5f)),
+        yi(f.y - F(0.5f)),
+        x0(floor(xi / F(u.k)) * F(u.k)),
+        x1(min(x0 + F(u.k), F(u.width - 1.0f))),
+        y0(floor(yi / F(u.k)) * F(u.k)),
+        y1(min(y0 + F(u.k), F(u.height - 1.0f))),
+        corner(((xi == x0) || (xi == F(u.width - 1.0f))) &&
+               ((yi == y0) || (yi == F(u.height - 1.0f)))) {}
+
+  // The four corners' texels of unit `unit`: (x0, y0), (x1, y0), (x0, y1), (x1, y1).
+  std::array<Vec4<F>, 4> fetch(const Fragments<L>& f, int unit) const {
+    return {f.fetch(unit, x0 + F(0.5f), y0 + F(0.5f)), f.fetch(unit, x1 + F(0.5f), y0 + F(0.5f)),
+            f.fetch(unit, x0 + F(0.5f), y1 + F(0.5f)), f.fetch(unit, x1 + F(0.5f), y1 + F(0.5f))};
+  }
+};
 
 // marcarReticula: x = 1 on lattice pixels, 0 elsewhere.
 struct MarkLattice {
@@ -37,11 +51,8 @@ struct MarkLattice {
   template <class L>
   void operator()(Fragments<L>& f) const {
     using F = typename L::F;
-    const F xi = f.x - F(0.5f), yi = f.y - F(0.5f);
-    const LatticeCell<F> c = lattice_cell(xi, yi, lattice);
-    const auto on_x = (xi == c.x0) || (xi == F(lattice.width - 1.0f));
-    const auto on_y = (yi == c.y0) || (yi == F(lattice.height - 1.0f));
-    f.out(0) = {select(on_x && on_y, F(1.0f), F(0.0f)), F(0.0f), F(0.0f), F(0.0f)};
+    const LatticeCell<L> c(f, lattice);
+    f.out(0) = {select(c.corner, F(1.0f), F(0.0f)), F(0.0f), F(0.0f), F(0.0f)};
   }
 };
 
@@ -61,27 +72,19 @@ struct MarkGaps {
   template <class L>
   void operator()(Fragments<L>& f) const {
     using F = typename L::F;
-    const F xi = f.x - F(0.5f), yi = f.y - F(0.5f);
-    const LatticeCell<F> c = lattice_cell(xi, yi, lattice);
-    const F k00 = f.fetch(kKeys, c.x0 + F(0.5f), c.y0 + F(0.5f)).y;
-    const F k10 = f.fetch(kKeys, c.x1 + F(0.5f), c.y0 + F(0.5f)).y;
-    const F k01 = f.fetch(kKeys, c.x0 + F(0.5f), c.y1 + F(0.5f)).y;
-    const F k11 = f.fetch(kKeys, c.x1 + F(0.5f), c.y1 + F(0.5f)).y;
-    const auto on_x = (xi == c.x0) || (xi == F(lattice.width - 1.0f));
-    const auto on_y = (yi == c.y0) || (yi == F(lattice.height - 1.0f));
+    const LatticeCell<L> c(f, lattice);
+    const std::array<Vec4<F>, 4> k = c.fetch(f, kKeys);
     // The lattice pixels' colours (one sample each in the sum).
-    const Vec4<F> c00 = f.fetch(kSum, c.x0 + F(0.5f), c.y0 + F(0.5f));
-    const Vec4<F> c10 = f.fetch(kSum, c.x1 + F(0.5f), c.y0 + F(0.5f));
-    const Vec4<F> c01 = f.fetch(kSum, c.x0 + F(0.5f), c.y1 + F(0.5f));
-    const Vec4<F> c11 = f.fetch(kSum, c.x1 + F(0.5f), c.y1 + F(0.5f));
+    const std::array<Vec4<F>, 4> s = c.fetch(f, kSum);
     auto spread = [](const F& a, const F& b, const F& c, const F& d) {
       return max(max(a, b), max(c, d)) - min(min(a, b), min(c, d));
     };
     const F colour =
-        max(max(spread(c00.x, c10.x, c01.x, c11.x), spread(c00.y, c10.y, c01.y, c11.y)),
-            spread(c00.z, c10.z, c01.z, c11.z));
-    const auto disagree = (k10 != k00) || (k01 != k00) || (k11 != k00) || (colour > F(threshold));
-    const auto gap = !(on_x && on_y) && disagree;
+        max(max(spread(s[0].x, s[1].x, s[2].x, s[3].x), spread(s[0].y, s[1].y, s[2].y, s[3].y)),
+            spread(s[0].z, s[1].z, s[2].z, s[3].z));
+    const auto disagree =
+        (k[1].y != k[0].y) || (k[2].y != k[0].y) || (k[3].y != k[0].y) || (colour > F(threshold));
+    const auto gap = !c.corner && disagree;
     f.out(0) = {select(gap, F(1.0f), F(0.0f)), F(0.0f), F(0.0f), F(0.0f)};
   }
 };
@@ -100,21 +103,17 @@ struct FillGaps {
   template <class L>
   void operator()(Fragments<L>& f) const {
     using F = typename L::F;
-    const F xi = f.x - F(0.5f), yi = f.y - F(0.5f);
-    const LatticeCell<F> c = lattice_cell(xi, yi, lattice);
+    const LatticeCell<L> c(f, lattice);
     const Vec4<F> own = f.fetch_own(kSum);
-    const Vec4<F> s00 = f.fetch(kSum, c.x0 + F(0.5f), c.y0 + F(0.5f));
-    const Vec4<F> s10 = f.fetch(kSum, c.x1 + F(0.5f), c.y0 + F(0.5f));
-    const Vec4<F> s01 = f.fetch(kSum, c.x0 + F(0.5f), c.y1 + F(0.5f));
-    const Vec4<F> s11 = f.fetch(kSum, c.x1 + F(0.5f), c.y1 + F(0.5f));
-    const F tx = select(c.x1 > c.x0, (xi - c.x0) / max(c.x1 - c.x0, F(1.0f)), F(0.0f));
-    const F ty = select(c.y1 > c.y0, (yi - c.y0) / max(c.y1 - c.y0, F(1.0f)), F(0.0f));
-    auto mean = [](const Vec4<F>& s) {
-      const F n = max(s.w, F(1.0f));
-      return Vec3<F>{s.x / n, s.y / n, s.z / n};
+    const std::array<Vec4<F>, 4> s = c.fetch(f, kSum);
+    const F tx = select(c.x1 > c.x0, (c.xi - c.x0) / max(c.x1 - c.x0, F(1.0f)), F(0.0f));
+    const F ty = select(c.y1 > c.y0, (c.yi - c.y0) / max(c.y1 - c.y0, F(1.0f)), F(0.0f));
+    auto mean = [](const Vec4<F>& v) {
+      const F n = max(v.w, F(1.0f));
+      return Vec3<F>{v.x / n, v.y / n, v.z / n};
     };
-    const Vec3<F> top = mean(s00) + (mean(s10) - mean(s00)) * tx;
-    const Vec3<F> bottom = mean(s01) + (mean(s11) - mean(s01)) * tx;
+    const Vec3<F> top = mean(s[0]) + (mean(s[1]) - mean(s[0])) * tx;
+    const Vec3<F> bottom = mean(s[2]) + (mean(s[3]) - mean(s[2])) * tx;
     const Vec3<F> blend = top + (bottom - top) * ty;
     const Vec3<F> traced = mean(own);
     const auto was_traced = own.w > F(0.0f);
