@@ -238,19 +238,18 @@ RenderResult StreamTracer::render(const Camera& cam) {
   if (opt_.trace_pixel && opt_.trace_out)
     *opt_.trace_out << "pixel " << opt_.trace_pixel->x << "," << opt_.trace_pixel->y << ":\n";
   int iteration_number = 0;
+  // The sample frames' generator takes the same camera (its jitter and gate are set per frame).
+  static_cast<GenerateRays&>(s.sample_generate.kernel) = g;
   if (opt_.undersample > 0) {
-    static_cast<GenerateRays&>(s.sample_generate.kernel) = g;
     render_undersampled(cam, res, iteration_number);
   } else if (opt_.spp <= 1) {
     frame(cam, s.generate, res, true, iteration_number);
   } else if (opt_.adaptive) {
-    static_cast<GenerateRays&>(s.sample_generate.kernel) = g;
     render_adaptive(cam, res, iteration_number);
   } else {
     // Supersampling as a 2004 card would: one whole frame per sample, each through its own
     // sub-pixel offset (generadorRayosMuestra), added into a sum texture (acumularMuestras),
     // then one box-filter pass (resolverMuestras). No texture grows with the sample count.
-    static_cast<GenerateRays&>(s.sample_generate.kernel) = g;
     gpu.clear(s.sum[s.cur_sum], {0, 0, 0, 0});
     for (int k = 0; k < opt_.spp; ++k) {
       const glm::vec2 j = sample_offset(opt_.spp, k, opt_.sample_seed);
