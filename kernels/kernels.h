@@ -3,6 +3,7 @@
 #pragma once
 
 #include "kernels/accumulate_samples.h"
+#include "kernels/bvh.h"
 #include "kernels/fused.h"
 #include "kernels/generate_rays.h"
 #include "kernels/init_traversal.h"
@@ -54,3 +55,10 @@ extern template class vgpu::KernelProgram<kernels::MarkedPixels>;
 extern template class vgpu::KernelProgram<kernels::MarkLattice>;
 extern template class vgpu::KernelProgram<kernels::MarkGaps>;
 extern template class vgpu::KernelProgram<kernels::FillGaps>;
+extern template class vgpu::KernelProgram<kernels::BvhEnter>;
+extern template class vgpu::KernelProgram<kernels::BvhStep>;
+extern template class vgpu::KernelProgram<kernels::BvhLoadLeaf>;
+extern template class vgpu::KernelProgram<kernels::BvhIntersections>;
+extern template class vgpu::KernelProgram<kernels::BvhStepLoad>;
+extern template class vgpu::KernelProgram<kernels::BvhIntersectNext>;
+extern template class vgpu::KernelProgram<kernels::BvhLooping>;

@@ -42,6 +42,13 @@ inline std::vector<std::unique_ptr<vgpu::Program>> all_programs() {
   // The fused programs of --mrt on (kernels/fused.h), two outputs each.
   v.push_back(std::make_unique<vgpu::KernelProgram<IntersectNext>>());
   v.push_back(std::make_unique<vgpu::KernelProgram<TraverseUpdate>>());
+  // The BVH walk (an extension, kernels/bvh.h): --accel bvh; its fused and looping forms.
+  v.push_back(std::make_unique<vgpu::KernelProgram<BvhEnter>>());
+  v.push_back(std::make_unique<vgpu::KernelProgram<BvhStep>>());
+  v.push_back(std::make_unique<vgpu::KernelProgram<BvhLoadLeaf>>());
+  v.push_back(std::make_unique<vgpu::KernelProgram<BvhIntersections>>());
+  v.push_back(std::make_unique<vgpu::KernelProgram<BvhStepLoad>>());
+  v.push_back(std::make_unique<vgpu::KernelProgram<BvhIntersectNext>>());
   return v;
 }
 

@@ -16,6 +16,7 @@
 #include <optional>
 #include <regex>
 
+#include "host/accel/accel.h"
 #include "host/accel/grid.h"
 #include "host/image/image_io.h"
 #include "host/model/cost_model.h"
@@ -44,6 +45,7 @@ struct RenderArgs {
   std::string shading = "phong";
   std::string shadows = "on";
   std::string grid = "auto";
+  std::string accel = "grid";
   std::string profile = "gf5700";
   int threads = 0;
   int lanes = vgpu::kLanes;
@@ -227,6 +229,13 @@ void add_render_options(CLI::App& render, RenderArgs& a) {
       ->capture_default_str();
   render.add_option("--grid", a.grid, "Grid voxels per axis")
       ->check(kGridCheck)
+      ->capture_default_str();
+  render
+      .add_option("--accel", a.accel,
+                  "Acceleration structure the rays walk: grid (the paper's uniform grid) | bvh "
+                  "(a SAH bounding volume hierarchy walked stackless, an extension; docs/"
+                  "structures.md)")
+      ->check(CLI::IsMember({"grid", "bvh"}))
       ->capture_default_str();
   render
       .add_option("--profile", a.profile,
@@ -471,8 +480,15 @@ int run_render(const RenderArgs& a, bool lanes_given) {
   const std::string path = host::resolve_scene(a.scene);
   const host::Scene scene = host::load_scene(path);
   const auto t0 = std::chrono::steady_clock::now();
-  const host::Grid grid =
-      host::build_grid(scene, host::grid_spec_for(grid_spec, scene, vgpu::profile(opt.profile)));
+  const host::AccelKind accel_kind = host::parse_accel_kind(a.accel);
+  // With another structure the grid is one voxel: it gives the scene box only.
+  const host::Grid grid = host::build_grid(
+      scene, accel_kind == host::AccelKind::grid
+                 ? host::grid_spec_for(grid_spec, scene, vgpu::profile(opt.profile))
+                 : host::GridSpec{glm::ivec3(1)});
+  std::optional<host::Bvh> bvh;
+  if (accel_kind == host::AccelKind::bvh) bvh = host::build_bvh(scene);
+  const host::Accel accel{accel_kind, &grid, bvh ? &*bvh : nullptr};
   opt.formats = host::resolve(formats, scene, grid, vgpu::profile(opt.profile));
   if (opt.mrt) {
     const std::string why = host::mrt_refusal(vgpu::profile(opt.profile), opt.formats);
@@ -488,12 +504,12 @@ int run_render(const RenderArgs& a, bool lanes_given) {
       std::fflush(stderr);
     };
   std::optional<host::StreamTracer> tracer;
-  if (!cpu) tracer.emplace(scene, grid, opt);
+  if (!cpu) tracer.emplace(scene, accel, opt);
   const double init_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   host::CpuStats cpu_stats;
   const host::RenderResult r =
-      cpu ? host::render_cpu(scene, grid, cam, opt, &cpu_stats) : tracer->render(cam);
+      cpu ? host::render_cpu(scene, accel, cam, opt, &cpu_stats) : tracer->render(cam);
   if (tty) std::fprintf(stderr, "\n");
   if (recorder) recorder->finish(r.stats);
 
@@ -511,6 +527,24 @@ int run_render(const RenderArgs& a, bool lanes_given) {
   j["dropped_degenerate"] = scene.dropped_degenerate;
   j["grid"] = {grid.res.x, grid.res.y, grid.res.z};
   j["grid_references"] = grid.references();
+  {
+    nlohmann::ordered_json acc;
+    acc["structure"] = host::accel_name(accel_kind);
+    if (bvh) {
+      acc["nodes"] = bvh->nodes.size();
+      acc["leaves"] = bvh->leaves;
+      acc["depth"] = bvh->depth;
+      acc["max_leaf"] = bvh->max_leaf;
+      acc["references"] = bvh->references();
+      acc["sah_cost"] = bvh->sah_cost;
+      acc["build_ms"] = bvh->build_ms;
+    } else {
+      acc["voxels"] = {grid.res.x, grid.res.y, grid.res.z};
+      acc["references"] = grid.references();
+      acc["build_ms"] = grid.build_ms;
+    }
+    j["accel"] = acc;
+  }
   j["profile"] = opt.profile;
   j["size"] = {r.width, r.height};
   j["bounces"] = opt.bounces;
@@ -535,7 +569,8 @@ int run_render(const RenderArgs& a, bool lanes_given) {
   if (cpu)
     j["cpu"] = {{"rays", cpu_stats.rays},
                 {"voxel_steps", cpu_stats.voxel_steps},
-                {"triangle_tests", cpu_stats.triangle_tests}};
+                {"triangle_tests", cpu_stats.triangle_tests},
+                {"nodes_visited", cpu_stats.nodes_visited}};
   j["rays_traced"] = r.rays_traced;
   j["rays_unfinished"] = r.rays_unfinished;
   // Supersampling (--spp): samples per pixel and the passes it added to the first sample frame.
@@ -625,6 +660,7 @@ int run_render(const RenderArgs& a, bool lanes_given) {
         "scene %s: %zu triangles (%u dropped as degenerate), grid %dx%dx%d (%llu references)\n",
         scene.name.c_str(), scene.triangle_count(), scene.dropped_degenerate, grid.res.x,
         grid.res.y, grid.res.z, static_cast<unsigned long long>(grid.references()));
+    if (bvh) std::printf("%s (%.1f ms to build)\n", host::describe(*bvh).c_str(), bvh->build_ms);
     std::printf("%s %s, %dx%d, %d iteration(s), %s shading, shadows %s, masks %s, mrt %s\n",
                 cpu ? "engine" : "profile", cpu ? "cpu" : opt.profile.c_str(), r.width, r.height,
                 r.iterations, a.shading.c_str(), a.shadows.c_str(), a.masks.c_str(), a.mrt.c_str());
@@ -652,6 +688,7 @@ int run_kernels(const std::string& name, bool glsl) {
   auto programs = kernels::all_programs();
   // The looping variant's program (--kernels looping) is listed after the paper's.
   programs.push_back(std::make_unique<vgpu::KernelProgram<kernels::LoopingTraversal>>());
+  programs.push_back(std::make_unique<vgpu::KernelProgram<kernels::BvhLooping>>());
   auto spelled = [](std::string n) {
     for (char& c : n)
       if (c == ' ') c = '-';

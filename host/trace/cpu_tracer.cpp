@@ -33,7 +33,7 @@ struct Hit {
 // Per-thread counters, summed at the end; each on its own cache line, so the workers do not
 // share one.
 struct alignas(64) Counters {
-  uint64_t rays = 0, entered = 0, voxel_steps = 0, triangle_tests = 0;
+  uint64_t rays = 0, entered = 0, voxel_steps = 0, triangle_tests = 0, nodes_visited = 0;
   int iterations = 0;
 };
 
@@ -81,9 +81,10 @@ struct PrimaryRays {
 
 class Tracer {
  public:
-  Tracer(const Scene& scene, const Grid& grid, const Camera& camera, const RenderOptions& opt)
+  Tracer(const Scene& scene, const Accel& accel, const Camera& camera, const RenderOptions& opt)
       : scene_(scene),
-        grid_(grid),
+        grid_(*accel.grid),
+        bvh_(accel.kind == AccelKind::bvh ? accel.bvh : nullptr),
         cam_(camera),
         opt_(opt),
         primary_(camera, opt.width, opt.height) {
@@ -95,6 +96,7 @@ class Tracer {
           tris_.emplace_back(Tri{p0, glm::dvec3(scene.p1[i]) - p0, glm::dvec3(scene.p2[i]) - p0});
       geo_normals_.push_back(glm::normalize(glm::cross(tri.e1, tri.e2)));
     }
+    const Grid& grid = grid_;
     const double diag = glm::length(glm::dvec3(grid.hi) - glm::dvec3(grid.lo));
     slack_ = kSlackOfDiagonal * diag;
     offset_ = kOffsetOfDiagonal * diag;
@@ -116,6 +118,7 @@ class Tracer {
   Hit trace(const glm::dvec3& o, const glm::dvec3& d, double tmax, bool any_hit,
             Counters& c) const {
     ++c.rays;
+    if (bvh_) return trace_bvh(o, d, tmax, any_hit, c);
     Hit best;
     // Slab test against the grid box.
     double tnear = 0.0, tfar = tmax;
@@ -275,9 +278,55 @@ class Tracer {
     return colour;
   }
 
+  // The stackless BVH walk (kernels/bvh.h) in double: every node in depth-first order whose
+  // padded box the ray meets before the nearest hit so far, its escape otherwise.
+  Hit trace_bvh(const glm::dvec3& o, const glm::dvec3& d, double tmax, bool any_hit,
+                Counters& c) const {
+    Hit best;
+    if (!(tmax >= 0.0)) return best;
+    ++c.entered;
+    const std::vector<BvhNode>& nodes = bvh_->nodes;
+    const int32_t count = int32_t(nodes.size());
+    for (int32_t i = 0; i >= 0 && i < count;) {
+      ++c.nodes_visited;
+      const BvhNode& n = nodes[size_t(i)];
+      double tn = 0.0, tf = std::min(best.t, tmax);
+      for (int a = 0; a < 3 && tn <= tf; ++a) {
+        if (d[a] == 0.0) {
+          if (o[a] < n.lo[a] || o[a] > n.hi[a]) tf = -kInf;
+          continue;
+        }
+        double t0 = (double(n.lo[a]) - o[a]) / d[a], t1 = (double(n.hi[a]) - o[a]) / d[a];
+        if (t0 > t1) std::swap(t0, t1);
+        tn = std::max(tn, t0);
+        tf = std::min(tf, t1);
+      }
+      if (!(tn <= tf)) {
+        i = n.escape;
+        continue;
+      }
+      if (n.count == 0 && n.leaf < 0) {
+        ++i;
+        continue;
+      }
+      for (int32_t k = n.leaf; k >= 0 && bvh_->lists[size_t(k)] >= 0; ++k) {
+        const auto tri = size_t(bvh_->lists[size_t(k)]);
+        ++c.triangle_tests;
+        double t, u, v;
+        if (!intersect(o, d, tris_[tri], t, u, v)) continue;
+        if (!(t < tmax) || !(t < best.t)) continue;
+        best = Hit{int64_t(tri), t, u, v};
+        if (any_hit) return best;
+      }
+      i = n.escape;
+    }
+    return best;
+  }
+
  private:
   const Scene& scene_;
   const Grid& grid_;
+  const Bvh* bvh_ = nullptr;
   const Camera& cam_;
   const RenderOptions& opt_;
   const PrimaryRays primary_;
@@ -422,6 +471,12 @@ glm::dvec3 cpu_primary_dir(const Camera& camera, int W, int H, int x, int y) {
 
 RenderResult render_cpu(const Scene& scene, const Grid& grid, const Camera& camera,
                         const RenderOptions& options, CpuStats* stats) {
+  return render_cpu(scene, Accel{AccelKind::grid, &grid, nullptr}, camera, options, stats);
+}
+
+RenderResult render_cpu(const Scene& scene, const Accel& accel, const Camera& camera,
+                        const RenderOptions& options, CpuStats* stats) {
+  const Grid& grid = *accel.grid;
   const auto t0 = std::chrono::steady_clock::now();
   if (grid.start.size() != grid.voxels() + 1)
     throw std::invalid_argument("render_cpu: the grid has no voxel lists (not built)");
@@ -434,7 +489,7 @@ RenderResult render_cpu(const Scene& scene, const Grid& grid, const Camera& came
   res.depth.assign(pixels, 0.0f);
   res.hit_id.assign(pixels, -1.0f);
 
-  const Tracer tracer(scene, grid, camera, options);
+  const Tracer tracer(scene, accel, camera, options);
   const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
   const unsigned workers = std::clamp<unsigned>(
       options.threads > 0 ? unsigned(options.threads) : cores, 1u, unsigned(std::max(H, 1)));
@@ -454,6 +509,7 @@ RenderResult render_cpu(const Scene& scene, const Grid& grid, const Camera& came
     total.rays += c.rays;
     total.voxel_steps += c.voxel_steps;
     total.triangle_tests += c.triangle_tests;
+    total.nodes_visited += c.nodes_visited;
     res.rays_traced += c.entered;
     res.iterations = std::max(res.iterations, c.iterations);
   }

@@ -20,6 +20,7 @@ struct CpuStats {
   uint64_t voxel_steps = 0;  // voxels examined by the 3D-DDA, summed over every ray
   uint64_t triangle_tests = 0;  // ray-triangle tests (no mailbox: a triangle listed in several
                                 // voxels may be tested once per voxel)
+  uint64_t nodes_visited = 0;   // BVH nodes whose box was tested (--accel bvh)
 };
 
 // Renders with the options the stream tracer takes; the GPU-only ones (profile, lanes, masks,
@@ -45,6 +46,11 @@ struct CpuStats {
 // empty; rays_traced counts the rays that enter the grid, as the stream tracer's queries do;
 // render_ms is the wall time of the whole call. Counters go to *stats when given.
 RenderResult render_cpu(const Scene& scene, const Grid& grid, const Camera& camera,
+                        const RenderOptions& options, CpuStats* stats = nullptr);
+// The same over the structure `accel` names: with a BVH, the stackless walk of kernels/bvh.h
+// in double (every node whose padded box the ray meets before the nearest hit so far; every
+// triangle of a leaf tested; no voxel rule), counted in CpuStats::nodes_visited.
+RenderResult render_cpu(const Scene& scene, const Accel& accel, const Camera& camera,
                         const RenderOptions& options, CpuStats* stats = nullptr);
 
 // host::primary_dir's contract (camera.h) evaluated in double from the camera's float fields:

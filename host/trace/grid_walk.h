@@ -9,6 +9,7 @@
 #include "host/accel/grid.h"
 #include "host/model/formats.h"
 #include "host/scene/scene.h"
+#include "host/trace/accel_walk.h"
 #include "host/trace/passes.h"
 #include "host/trace/render_options.h"
 #include "kernels/kernels.h"
@@ -22,7 +23,7 @@ inline constexpr double kSlackOfDiagonal = 1e-5;   // GridUniforms::t_slack (in-
 inline constexpr double kOffsetOfDiagonal = 1e-4;  // ReflectionOrigin::offset (origin lift)
 inline constexpr double kAttenOfDiagonal = 0.5;    // Shader::atten_dist
 
-class GridWalk {
+class GridWalk : public AccelWalk {
  public:
   // The passes of the walk, by where the walk issues them. With the step (-1 before the first)
   // and the triangle index k within a step (-1 outside the triangle loop), a site names one
@@ -41,30 +42,22 @@ class GridWalk {
     kSites
   };
 
-  // The tracer's textures and masks the walk reads and writes: the scene's vertices, the
-  // intersection state (nearest hit so far) and the two masks of walking and testing rays.
-  struct Shared {
-    const vgpu::Texture* vertices[3];
-    vgpu::Texture* isect[2];
-    int* cur_isect;  // which of isect is current
-    vgpu::Stencil* grid_mask;
-    vgpu::Stencil* isect_mask;
-  };
+  using Shared = WalkShared;
 
   // The grid's static textures, built and checked against the profile's limits (throws
   // vgpu::Error naming the limit); the walk's programs, each computing in its group's format.
   GridWalk(vgpu::Device& gpu, const Grid& grid, const RenderOptions& options, float scene_width);
   // The per-pixel state textures (traversal, voxel state), made after the tracer's own.
-  void make_state(vgpu::Device& gpu, const Shared& shared);
+  void make_state(vgpu::Device& gpu, const Shared& shared) override;
   // Video memory gets the static textures once, at initialization.
-  void upload(vgpu::Device& gpu) const;
-  uint64_t texture_bytes() const;
+  void upload(vgpu::Device& gpu) const override;
+  uint64_t texture_bytes() const override;
 
   // One stream of rays through the grid: enter it (initTraversal for primary rays, from the eye;
   // reinicializarTraversal otherwise), then walk it until no ray is walking. Leaves the nearest
   // hits in the current intersection texture.
   void trace(PassRunner& r, vgpu::Texture& origins, vgpu::Texture& rays, bool primary,
-             glm::vec3 eye);
+             glm::vec3 eye) override;
 
   // Where the walk is: the rays it traces and the current texture of each ping-pong pair.
   struct Cursor {

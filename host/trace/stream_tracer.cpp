@@ -13,6 +13,7 @@
 #include <stdexcept>
 
 #include "host/common/parallel.h"
+#include "host/trace/bvh_walk.h"
 #include "host/trace/devices.h"
 #include "host/trace/passes.h"
 #include "host/trace/sampling.h"
@@ -57,7 +58,7 @@ struct StreamTracer::State {
   KernelProgram<MarkGaps> mark_gaps;
   KernelProgram<FillGaps> fill;
   // The walk through the acceleration structure, and how passes are issued.
-  std::unique_ptr<GridWalk> walk;
+  std::unique_ptr<AccelWalk> walk;
   std::unique_ptr<PassRunner> runner;
 };
 
@@ -70,7 +71,11 @@ kernels::ShadingModel parse_shading(const std::string& name) {
 }
 
 StreamTracer::StreamTracer(const Scene& scene, const Grid& grid, const RenderOptions& options)
-    : scene_(scene), grid_(grid), opt_(options) {
+    : StreamTracer(scene, Accel{AccelKind::grid, &grid, nullptr}, options) {}
+
+StreamTracer::StreamTracer(const Scene& scene, const Accel& accel, const RenderOptions& options)
+    : scene_(scene), grid_(*accel.grid), opt_(options) {
+  const Grid& grid = grid_;
   const auto t0 = std::chrono::steady_clock::now();
   gpu_ = make_device(opt_);
   s_ = std::make_unique<State>();
@@ -132,8 +137,11 @@ StreamTracer::StreamTracer(const Scene& scene, const Grid& grid, const RenderOpt
     t[0] = m.color.r, t[1] = m.color.g, t[2] = m.color.b, t[3] = m.reflect;
   }
 
-  // The acceleration structure's textures and walk (host/trace/grid_walk.h).
-  s.walk = std::make_unique<GridWalk>(gpu, grid, opt_, float(sw));
+  // The acceleration structure's textures and walk (host/trace/grid_walk.h, bvh_walk.h).
+  if (accel.kind == AccelKind::bvh)
+    s.walk = std::make_unique<BvhWalk>(gpu, *accel.bvh, opt_, float(sw));
+  else
+    s.walk = std::make_unique<GridWalk>(gpu, grid, opt_, float(sw));
 
   // Video memory gets the static textures once, at initialization.
   for (const Texture* t : {&s.v[0], &s.v[1], &s.v[2], &s.n[0], &s.n[1], &s.n[2], &s.colors})

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "host/accel/accel.h"
 #include "host/accel/grid.h"
 #include "host/model/formats.h"
 #include "host/scene/scene.h"
@@ -23,6 +24,8 @@ class StreamTracer {
   // Initialization, timed apart from rendering: the static textures (scene and grid) are built
   // and checked against the profile's limits. Throws vgpu::Error naming the limit.
   StreamTracer(const Scene& scene, const Grid& grid, const RenderOptions& options);
+  // The same with the structure `accel` names (its grid gives the scene box).
+  StreamTracer(const Scene& scene, const Accel& accel, const RenderOptions& options);
   ~StreamTracer();
   RenderResult render(const Camera& camera);
   double init_ms() const { return init_ms_; }

@@ -1,0 +1,72 @@
+// The stackless BVH walk (an extension; kernels/bvh.h): the hierarchy's textures, and which
+// pass runs next, steered by which query, in the grid walk's manner (grid_walk.h): one node per
+// pass for every walking ray, then the triangles of the leaves entered, one per pass.
+#pragma once
+
+#include <cstdint>
+
+#include "host/accel/bvh.h"
+#include "host/trace/accel_walk.h"
+#include "host/trace/passes.h"
+#include "host/trace/render_options.h"
+#include "kernels/kernels.h"
+#include "vgpu/vgpu.h"
+
+namespace host {
+
+class BvhWalk : public AccelWalk {
+ public:
+  // Passes of the walk by where it issues them (walk::PassKey).
+  enum Site : int {
+    kEnter,          // rayosEnGrilla after inicioBVH
+    kStep,           // recorridoBVH
+    kLoad,           // cargarHoja
+    kStepLoad,       // recorridoBVH + cargarHoja (--mrt on)
+    kTesting,        // rayosIntersectando after the leaves are loaded
+    kIntersect,      // interseccionesBVH
+    kNext,           // proximoTriangulo
+    kIntersectNext,  // interseccionesBVH + proximoTriangulo (--mrt on)
+    kTestingOn,      // rayosIntersectando in the triangle loop
+    kWalking,        // rayosEnGrilla after the step
+    kSites
+  };
+
+  // The hierarchy's static textures, checked against the profile's limits (throws vgpu::Error
+  // naming the limit); the walk's programs in their groups' formats.
+  BvhWalk(vgpu::Device& gpu, const Bvh& bvh, const RenderOptions& options, float scene_width);
+  void make_state(vgpu::Device& gpu, const WalkShared& shared) override;
+  void upload(vgpu::Device& gpu) const override;
+  uint64_t texture_bytes() const override;
+  void trace(PassRunner& r, vgpu::Texture& origins, vgpu::Texture& rays, bool primary,
+             glm::vec3 eye) override;
+
+  struct Cursor {
+    vgpu::Texture *origins, *rays;
+    int trav, vs, isect;
+  };
+  template <class X>
+  void walk(X& x, Cursor& c);
+  WriteBack write_back(const Cursor& c) const;
+
+ private:
+  void walk_looping(PassRunner& r, vgpu::Texture& origins, vgpu::Texture& rays, uint64_t walking);
+
+  const RenderOptions& opt_;
+  int nodes_ = 0, max_leaf_ = 0;
+  WalkShared sh_{};
+  vgpu::Texture nodes_lo_, nodes_hi_, lists_;
+  vgpu::Texture trav_[2], vs_[2];
+  int cur_trav_ = 0, cur_vs_ = 0;
+  vgpu::KernelProgram<kernels::BvhEnter> enter_;
+  vgpu::KernelProgram<kernels::BvhStep> step_;
+  vgpu::KernelProgram<kernels::BvhLoadLeaf> load_;
+  vgpu::KernelProgram<kernels::BvhIntersections> intersect_;
+  vgpu::KernelProgram<kernels::NextTriangle> next_;
+  vgpu::KernelProgram<kernels::RaysIntersecting> intersecting_;
+  vgpu::KernelProgram<kernels::RaysInGrid> walking_;
+  vgpu::KernelProgram<kernels::BvhStepLoad> step_load_;
+  vgpu::KernelProgram<kernels::BvhIntersectNext> intersect_next_;
+  vgpu::KernelProgram<kernels::BvhLooping> looping_;
+};
+
+}  // namespace host
