@@ -24,6 +24,7 @@
 #include "host/report/report.h"
 #include "host/scene/camera.h"
 #include "host/scene/gltf_loader.h"
+#include "host/trace/accel_choice.h"
 #include "host/trace/cpu_tracer.h"
 #include "host/trace/devices.h"
 #include "host/trace/sampling.h"
@@ -233,9 +234,10 @@ void add_render_options(CLI::App& render, RenderArgs& a) {
   render
       .add_option("--accel", a.accel,
                   "Acceleration structure the rays walk: grid (the paper's uniform grid) | bvh "
-                  "(a SAH bounding volume hierarchy walked stackless, an extension; docs/"
-                  "structures.md)")
-      ->check(CLI::IsMember({"grid", "bvh"}))
+                  "(a SAH bounding volume hierarchy walked stackless, an extension) | auto (builds "
+                  "both, renders a probe at a quarter of the size with each and keeps the one the "
+                  "cost model predicts cheapest on --profile; docs/structures.md)")
+      ->check(CLI::IsMember({"grid", "bvh", "auto"}))
       ->capture_default_str();
   render
       .add_option("--profile", a.profile,
@@ -480,16 +482,26 @@ int run_render(const RenderArgs& a, bool lanes_given) {
   const std::string path = host::resolve_scene(a.scene);
   const host::Scene scene = host::load_scene(path);
   const auto t0 = std::chrono::steady_clock::now();
-  const host::AccelKind accel_kind = host::parse_accel_kind(a.accel);
-  // With another structure the grid is one voxel: it gives the scene box only.
-  const host::Grid grid = host::build_grid(
-      scene, accel_kind == host::AccelKind::grid
-                 ? host::grid_spec_for(grid_spec, scene, vgpu::profile(opt.profile))
-                 : host::GridSpec{glm::ivec3(1)});
+  // With a structure other than the grid, the grid is one voxel: it gives the scene box only.
+  const bool auto_accel = a.accel == "auto";
+  host::AccelKind accel_kind = auto_accel ? host::AccelKind::grid : host::parse_accel_kind(a.accel);
+  const host::Grid grid =
+      accel_kind == host::AccelKind::grid
+          ? host::build_grid(scene,
+                             host::grid_spec_for(grid_spec, scene, vgpu::profile(opt.profile)))
+          : host::Grid{};
+  std::optional<host::Grid> box;
   std::optional<host::Bvh> bvh;
-  if (accel_kind == host::AccelKind::bvh) bvh = host::build_bvh(scene);
-  const host::Accel accel{accel_kind, &grid, bvh ? &*bvh : nullptr};
-  opt.formats = host::resolve(formats, scene, grid, vgpu::profile(opt.profile));
+  if (auto_accel || accel_kind == host::AccelKind::bvh) {
+    box = host::build_grid(scene, host::GridSpec{glm::ivec3(1)});
+    bvh = host::build_bvh(scene);
+  }
+  auto formats_for = [&](host::AccelKind k) {
+    return k == host::AccelKind::grid
+               ? host::resolve(formats, scene, grid, vgpu::profile(opt.profile))
+               : host::resolve(formats, scene, *box, vgpu::profile(opt.profile), bvh->lists.size());
+  };
+  opt.formats = formats_for(accel_kind);
   if (opt.mrt) {
     const std::string why = host::mrt_refusal(vgpu::profile(opt.profile), opt.formats);
     if (!why.empty()) throw UsageError(why);
@@ -503,6 +515,15 @@ int run_render(const RenderArgs& a, bool lanes_given) {
                    n);
       std::fflush(stderr);
     };
+  std::optional<host::AccelChoice> choice;
+  if (auto_accel) {
+    choice = host::choose_accel(scene, grid, *box, *bvh, opt, cam);
+    accel_kind = choice->kind;
+    opt.formats = formats_for(accel_kind);
+  }
+  const host::Grid& walk_grid = accel_kind == host::AccelKind::grid ? grid : *box;
+  const host::Accel accel{accel_kind, &walk_grid,
+                          accel_kind == host::AccelKind::bvh ? &*bvh : nullptr};
   std::optional<host::StreamTracer> tracer;
   if (!cpu) tracer.emplace(scene, accel, opt);
   const double init_ms =
@@ -525,12 +546,12 @@ int run_render(const RenderArgs& a, bool lanes_given) {
   j["triangles"] = scene.triangle_count();
   j["input_triangles"] = scene.input_triangles;
   j["dropped_degenerate"] = scene.dropped_degenerate;
-  j["grid"] = {grid.res.x, grid.res.y, grid.res.z};
-  j["grid_references"] = grid.references();
+  j["grid"] = {walk_grid.res.x, walk_grid.res.y, walk_grid.res.z};
+  j["grid_references"] = walk_grid.references();
   {
     nlohmann::ordered_json acc;
     acc["structure"] = host::accel_name(accel_kind);
-    if (bvh) {
+    if (accel_kind == host::AccelKind::bvh) {
       acc["nodes"] = bvh->nodes.size();
       acc["leaves"] = bvh->leaves;
       acc["depth"] = bvh->depth;
@@ -539,9 +560,19 @@ int run_render(const RenderArgs& a, bool lanes_given) {
       acc["sah_cost"] = bvh->sah_cost;
       acc["build_ms"] = bvh->build_ms;
     } else {
-      acc["voxels"] = {grid.res.x, grid.res.y, grid.res.z};
-      acc["references"] = grid.references();
-      acc["build_ms"] = grid.build_ms;
+      acc["voxels"] = {walk_grid.res.x, walk_grid.res.y, walk_grid.res.z};
+      acc["references"] = walk_grid.references();
+      acc["build_ms"] = walk_grid.build_ms;
+    }
+    if (choice) {
+      nlohmann::ordered_json au;
+      au["probe_size"] = {choice->probe_width, choice->probe_height};
+      au["profile"] = opt.profile;
+      au["predicted_ms"] = choice->predicted_ms;
+      au["probe_passes"] = choice->probe_passes;
+      au["probe_ms"] = choice->probe_ms;
+      au["why"] = choice->why;
+      acc["auto"] = au;
     }
     j["accel"] = acc;
   }
@@ -563,7 +594,7 @@ int run_render(const RenderArgs& a, bool lanes_given) {
   j["precision"] = a.precision;
   if (!cpu) j["formats"] = host::to_json(opt.formats);
   j["init_ms"] = init_ms;
-  j["grid_build_ms"] = grid.build_ms;
+  j["grid_build_ms"] = walk_grid.build_ms;
   j["render_ms"] = r.render_ms;
   if (tracer) j["texture_bytes"] = tracer->texture_bytes();
   if (cpu)
@@ -658,16 +689,19 @@ int run_render(const RenderArgs& a, bool lanes_given) {
       std::cout << r.stats.to_table();
     std::printf(
         "scene %s: %zu triangles (%u dropped as degenerate), grid %dx%dx%d (%llu references)\n",
-        scene.name.c_str(), scene.triangle_count(), scene.dropped_degenerate, grid.res.x,
-        grid.res.y, grid.res.z, static_cast<unsigned long long>(grid.references()));
-    if (bvh) std::printf("%s (%.1f ms to build)\n", host::describe(*bvh).c_str(), bvh->build_ms);
+        scene.name.c_str(), scene.triangle_count(), scene.dropped_degenerate, walk_grid.res.x,
+        walk_grid.res.y, walk_grid.res.z, static_cast<unsigned long long>(walk_grid.references()));
+    if (accel_kind == host::AccelKind::bvh)
+      std::printf("%s (%.1f ms to build)\n", host::describe(*bvh).c_str(), bvh->build_ms);
+    if (choice)
+      std::printf("accel auto: %s (probes %.0f ms)\n", choice->why.c_str(), choice->probe_ms);
     std::printf("%s %s, %dx%d, %d iteration(s), %s shading, shadows %s, masks %s, mrt %s\n",
                 cpu ? "engine" : "profile", cpu ? "cpu" : opt.profile.c_str(), r.width, r.height,
                 r.iterations, a.shading.c_str(), a.shadows.c_str(), a.masks.c_str(), a.mrt.c_str());
     if (!cpu)
       std::cout << "formats (texture and arithmetic, per group):\n" << describe(opt.formats);
     std::printf("initialization %.1f ms (grid %.1f ms), render %.1f ms (%s)\n", init_ms,
-                grid.build_ms, r.render_ms,
+                walk_grid.build_ms, r.render_ms,
                 cpu            ? "host CPU"
                 : gl           ? "wall, GL device"
                 : r.batch_walk ? "host, emulated, walks in batches"

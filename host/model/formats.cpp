@@ -74,8 +74,9 @@ FormatRequest parse_format_request(const std::string& precision, const std::stri
 }
 
 Formats resolve(const FormatRequest& request, const Scene& scene, const Grid& grid,
-                const vgpu::Profile& profile) {
-  Formats f = request.automatic ? auto_formats(scene, grid, profile) : Formats::all(request.all);
+                const vgpu::Profile& profile, uint64_t list_entries) {
+  Formats f = request.automatic ? auto_formats(scene, grid, profile, list_entries)
+                                : Formats::all(request.all);
   for (Group g : kGroups)
     if (request.given[size_t(g)]) {
       f.set(g, request.overrides[g], request.overrides.arithmetic(g));
@@ -84,12 +85,12 @@ Formats resolve(const FormatRequest& request, const Scene& scene, const Grid& gr
   return f;
 }
 
-IntegerRanges integer_ranges(const Scene& scene, const Grid& grid) {
+IntegerRanges integer_ranges(const Scene& scene, const Grid& grid, uint64_t list_entries) {
   IntegerRanges r;
   uint64_t nonempty = 0;
   for (size_t v = 0; v < grid.voxels(); ++v) nonempty += grid.start[v + 1] > grid.start[v];
   // As the stream tracer lays the lists out: a shared -1, then each non-empty list and its -1.
-  r.list_entries = 1 + grid.tris.size() + nonempty;
+  r.list_entries = list_entries ? list_entries : 1 + grid.tris.size() + nonempty;
   r.triangles = scene.triangle_count();
   r.pointer_texels = uint64_t(grid.res.x) * uint64_t(grid.res.y);
   r.voxels_per_axis = uint64_t(std::max({grid.res.x, grid.res.y, grid.res.z}));
@@ -117,8 +118,9 @@ std::string name(Format f) {
 
 }  // namespace
 
-Formats auto_formats(const Scene& scene, const Grid& grid, const vgpu::Profile& profile) {
-  const IntegerRanges r = integer_ranges(scene, grid);
+Formats auto_formats(const Scene& scene, const Grid& grid, const vgpu::Profile& profile,
+                     uint64_t list_entries) {
+  const IntegerRanges r = integer_ranges(scene, grid, list_entries);
   const std::vector<Format> can = formats_of(profile);
   const Format finest = can.back();
   Formats f = Formats::all(finest);

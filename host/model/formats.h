@@ -62,8 +62,10 @@ struct FormatRequest {
 };
 // Throws std::invalid_argument naming the option and the part it cannot parse.
 FormatRequest parse_format_request(const std::string& precision, const std::string& formats);
+// `list_entries`, when not 0, replaces the grid's list length (another structure's lists: the
+// BVH's, host/accel/bvh.h).
 Formats resolve(const FormatRequest& request, const Scene& scene, const Grid& grid,
-                const vgpu::Profile& profile);
+                const vgpu::Profile& profile, uint64_t list_entries = 0);
 
 // The largest integers each group must hold exactly in this scene and grid.
 struct IntegerRanges {
@@ -72,7 +74,7 @@ struct IntegerRanges {
   uint64_t pointer_texels = 0;  // voxel pointer texture width: X * sizeY + Y < res.x * res.y
   uint64_t voxels_per_axis = 0;
 };
-IntegerRanges integer_ranges(const Scene& scene, const Grid& grid);
+IntegerRanges integer_ranges(const Scene& scene, const Grid& grid, uint64_t list_entries = 0);
 // Integers n the kernels still add a texel centre (+ 1/2) to and address with exactly in format
 // f: 0 .. 2^(bits - 1) - 1 (fp16 1023, fp24 65535). Stored alone an integer is exact up to
 // 2^bits (fp16 2048, fp24 131072), but every id and position here is also an address.
@@ -81,7 +83,8 @@ uint64_t exact_addresses(vgpu::Format f);
 // Per group, the fewest bits among the formats the part has (Profile::has_fp16, precision) that
 // keep this scene's integers exact, with the reason in Formats::why. Values that decide which
 // triangle is hit, or whether a light is shadowed, get no tolerance: auto keeps fp32's hit ids.
-Formats auto_formats(const Scene& scene, const Grid& grid, const vgpu::Profile& profile);
+Formats auto_formats(const Scene& scene, const Grid& grid, const vgpu::Profile& profile,
+                     uint64_t list_entries = 0);
 
 // {"rays": {"texels": "fp32", "arithmetic": "fp32", "why": "..."}, ...}
 nlohmann::ordered_json to_json(const Formats& f);
