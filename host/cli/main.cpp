@@ -564,6 +564,13 @@ int run_render(const RenderArgs& a, bool lanes_given) {
       acc["references"] = walk_grid.references();
       acc["build_ms"] = walk_grid.build_ms;
     }
+    if (!cpu) {
+      const host::WalkWork w = host::walk_work(r.stats);
+      acc["work"] = {{"voxel_steps", w.voxel_steps},
+                     {"nodes_visited", w.nodes_visited},
+                     {"triangle_tests", w.triangle_tests},
+                     {"loop_iterations", w.loop_iterations}};
+    }
     if (choice) {
       nlohmann::ordered_json au;
       au["probe_size"] = {choice->probe_width, choice->probe_height};

@@ -187,8 +187,14 @@ void FrameRecorder::pass(const PassObserver::Pass& p) {
   const int W = p.record.width, H = p.record.height;
   const size_t n = size_t(W) * size_t(H);
   const uint8_t* work = has_work_ ? work_.data() : nullptr;
-  const bool trav = r.program == kernels::Traversal::name;
-  const bool isect = r.program == kernels::Intersections::name;
+  // Walk steps: a voxel (grid) or a node (BVH); triangle tests: either walk's intersection pass
+  // (alone or fused, --mrt on).
+  const bool trav = r.program == kernels::Traversal::name ||
+                    r.program == kernels::TraverseUpdate::name ||
+                    r.program == kernels::BvhStep::name || r.program == kernels::BvhStepLoad::name;
+  const bool isect =
+      r.program == kernels::Intersections::name || r.program == kernels::IntersectNext::name ||
+      r.program == kernels::BvhIntersections::name || r.program == kernels::BvhIntersectNext::name;
   if (work && W == w_ && H == h_) {
     r.work_mask = work_id_;
     // Plain loops over 0/1 bytes: they vectorize (this runs for every pass of the frame).

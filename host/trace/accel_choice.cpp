@@ -7,8 +7,28 @@
 
 #include "host/model/cost_model.h"
 #include "host/trace/stream_tracer.h"
+#include "kernels/kernels.h"
 
 namespace host {
+
+WalkWork walk_work(const vgpu::FrameStats& stats) {
+  WalkWork w;
+  auto useful = [&](const char* name) -> uint64_t {
+    const vgpu::FrameStats::ProgramTotals* p = stats.find(name);
+    if (!p) return 0;
+    const vgpu::Counters& c = p->counters;
+    return c.fragments_shaded - std::min(c.lanes_idle, c.fragments_shaded);
+  };
+  using namespace kernels;
+  w.voxel_steps = useful(Traversal::name) + useful(TraverseUpdate::name);
+  w.nodes_visited = useful(BvhStep::name) + useful(BvhStepLoad::name);
+  w.triangle_tests = useful(Intersections::name) + useful(IntersectNext::name) +
+                     useful(BvhIntersections::name) + useful(BvhIntersectNext::name);
+  for (const char* name : {LoopingTraversal::name, BvhLooping::name})
+    if (const vgpu::FrameStats::ProgramTotals* p = stats.find(name))
+      w.loop_iterations += p->counters.loop_iterations;
+  return w;
+}
 
 AccelChoice choose_accel(const Scene& scene, const Grid& grid, const Grid& box, const Bvh& bvh,
                          const RenderOptions& options, const Camera& camera) {

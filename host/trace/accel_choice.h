@@ -25,6 +25,17 @@ struct AccelChoice {
   std::string why;      // one sentence
 };
 
+// What a frame's walks did, from its statistics: useful fragments (those with work, not idle in
+// the branch) of the walk's step passes and intersection passes, alone or fused. A looping walk
+// does both in one program: its loop iterations instead.
+struct WalkWork {
+  uint64_t voxel_steps = 0;      // grid: traversal passes' walking fragments
+  uint64_t nodes_visited = 0;    // bvh: recorridoBVH passes' walking fragments (one node each)
+  uint64_t triangle_tests = 0;   // either: intersection passes' testing fragments
+  uint64_t loop_iterations = 0;  // looping kernels: iterations run (a node, voxel or triangle each)
+};
+WalkWork walk_work(const vgpu::FrameStats& stats);
+
 // `grid` is the grid --accel grid would walk; `bvh` the BVH (built by the caller). Throws what
 // StreamTracer throws for a candidate no profile limit allows only if no candidate is left.
 AccelChoice choose_accel(const Scene& scene, const Grid& grid, const Grid& box, const Bvh& bvh,
