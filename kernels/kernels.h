@@ -8,6 +8,7 @@
 #include "kernels/generate_rays.h"
 #include "kernels/init_traversal.h"
 #include "kernels/intersections.h"
+#include "kernels/kdtree.h"
 #include "kernels/keep_hits.h"
 #include "kernels/looping_traversal.h"
 #include "kernels/mark_pixels.h"
@@ -62,3 +63,10 @@ extern template class vgpu::KernelProgram<kernels::BvhIntersections>;
 extern template class vgpu::KernelProgram<kernels::BvhStepLoad>;
 extern template class vgpu::KernelProgram<kernels::BvhIntersectNext>;
 extern template class vgpu::KernelProgram<kernels::BvhLooping>;
+extern template class vgpu::KernelProgram<kernels::KdEnter>;
+extern template class vgpu::KernelProgram<kernels::KdStep>;
+extern template class vgpu::KernelProgram<kernels::KdLoadLeaf>;
+extern template class vgpu::KernelProgram<kernels::KdIntersections>;
+extern template class vgpu::KernelProgram<kernels::KdStepLoad>;
+extern template class vgpu::KernelProgram<kernels::KdIntersectNext>;
+extern template class vgpu::KernelProgram<kernels::KdLooping>;

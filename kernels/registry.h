@@ -49,6 +49,13 @@ inline std::vector<std::unique_ptr<vgpu::Program>> all_programs() {
   v.push_back(std::make_unique<vgpu::KernelProgram<BvhIntersections>>());
   v.push_back(std::make_unique<vgpu::KernelProgram<BvhStepLoad>>());
   v.push_back(std::make_unique<vgpu::KernelProgram<BvhIntersectNext>>());
+  // The kd-tree walk (an extension, kernels/kdtree.h): --accel kdtree; its fused forms.
+  v.push_back(std::make_unique<vgpu::KernelProgram<KdEnter>>());
+  v.push_back(std::make_unique<vgpu::KernelProgram<KdStep>>());
+  v.push_back(std::make_unique<vgpu::KernelProgram<KdLoadLeaf>>());
+  v.push_back(std::make_unique<vgpu::KernelProgram<KdIntersections>>());
+  v.push_back(std::make_unique<vgpu::KernelProgram<KdStepLoad>>());
+  v.push_back(std::make_unique<vgpu::KernelProgram<KdIntersectNext>>());
   return v;
 }
 

@@ -58,6 +58,7 @@ def main():
     for name, path in scenes:
         for mode, mopts in MODES.items():
             for acc, extra in (("grid", ["--accel", "grid"]), ("bvh", ["--accel", "bvh"]),
+                               ("kdtree", ["--accel", "kdtree"]),
                                ("auto gf6600", ["--accel", "auto", "--profile", "gf6600"]),
                                ("auto h200", ["--accel", "auto", "--profile", "h200"])):
                 runs = [run(a.vgpu_rt, path, size + mopts + extra, js)
@@ -141,10 +142,10 @@ def chart(a, rows):
     for ax, key, title in ((axes[0], "gf6600", "modeled GeForce 6600 (multipass)"),
                            (axes[1], "h200", "modeled H200 (multipass)"),
                            (axes[2], "emu_ms", "emulator host ms (2 threads)")):
-        w = 0.38
-        for k, acc in enumerate(("grid", "bvh")):
+        w = 0.27
+        for k, acc in enumerate(("grid", "bvh", "kdtree")):
             vals = [get(rows, s, "primary", acc)[key] for s in scenes]
-            ax.bar([i + (k - 0.5) * w for i in range(len(scenes))], vals, w, label=acc)
+            ax.bar([i + (k - 1) * w for i in range(len(scenes))], vals, w, label=acc)
         ch = [get(rows, s, "primary", "auto gf6600" if key != "h200" else "auto h200")["chosen"]
               for s in scenes]
         ax.set_xticks(range(len(scenes)))
@@ -153,7 +154,7 @@ def chart(a, rows):
         ax.set_ylabel("ms per frame (log)")
         ax.set_title(title + ", primary rays", fontsize=10)
         ax.legend(fontsize=8)
-    fig.suptitle(f"Grid against BVH, {a.size}x{a.size}: where each structure wins")
+    fig.suptitle(f"Grid, BVH and kd-tree, {a.size}x{a.size}: where each structure wins")
     fig.tight_layout()
     fig.savefig(os.path.join(a.out, "structures.png"), dpi=110)
     print(f"wrote {a.out}/structures.png", file=sys.stderr)

@@ -9,28 +9,31 @@
 
 #include "host/accel/bvh.h"
 #include "host/accel/grid.h"
+#include "host/accel/kdtree.h"
 
 namespace host {
 
-enum class AccelKind { grid, bvh };
+enum class AccelKind { grid, bvh, kdtree };
+inline constexpr AccelKind kAccelKinds[] = {AccelKind::grid, AccelKind::bvh, AccelKind::kdtree};
 
 inline std::string_view accel_name(AccelKind k) {
-  return k == AccelKind::grid ? "grid" : "bvh";
+  return k == AccelKind::grid ? "grid" : k == AccelKind::bvh ? "bvh" : "kdtree";
 }
 
-// "grid" or "bvh"; throws std::invalid_argument naming the text and the known names.
+// "grid", "bvh" or "kdtree"; throws std::invalid_argument naming the text and the known names.
 inline AccelKind parse_accel_kind(const std::string& text) {
-  if (text == "grid") return AccelKind::grid;
-  if (text == "bvh") return AccelKind::bvh;
+  for (AccelKind k : kAccelKinds)
+    if (text == accel_name(k)) return k;
   throw std::invalid_argument("unknown acceleration structure '" + text +
-                              "' (known: grid, bvh, auto)");
+                              "' (known: grid, bvh, kdtree, auto)");
 }
 
-// The structures of one scene, not owned: `grid` always; `bvh` where kind is bvh.
+// The structures of one scene, not owned: `grid` always; `bvh` or `kd` where kind names it.
 struct Accel {
   AccelKind kind = AccelKind::grid;
   const Grid* grid = nullptr;
   const Bvh* bvh = nullptr;
+  const KdTree* kd = nullptr;
 };
 
 }  // namespace host

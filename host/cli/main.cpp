@@ -234,10 +234,11 @@ void add_render_options(CLI::App& render, RenderArgs& a) {
   render
       .add_option("--accel", a.accel,
                   "Acceleration structure the rays walk: grid (the paper's uniform grid) | bvh "
-                  "(a SAH bounding volume hierarchy walked stackless, an extension) | auto (builds "
-                  "both, renders a probe at a quarter of the size with each and keeps the one the "
-                  "cost model predicts cheapest on --profile; docs/structures.md)")
-      ->check(CLI::IsMember({"grid", "bvh", "auto"}))
+                  "(a SAH bounding volume hierarchy walked stackless) | kdtree (a SAH kd-tree "
+                  "walked by kd-restart) | auto (builds each, renders a probe at a quarter of the "
+                  "size with each and keeps the one the cost model predicts cheapest on "
+                  "--profile). bvh and kdtree are extensions; docs/structures.md")
+      ->check(CLI::IsMember({"grid", "bvh", "kdtree", "auto"}))
       ->capture_default_str();
   render
       .add_option("--profile", a.profile,
@@ -485,21 +486,29 @@ int run_render(const RenderArgs& a, bool lanes_given) {
   // With a structure other than the grid, the grid is one voxel: it gives the scene box only.
   const bool auto_accel = a.accel == "auto";
   host::AccelKind accel_kind = auto_accel ? host::AccelKind::grid : host::parse_accel_kind(a.accel);
+  const bool want_grid = auto_accel || accel_kind == host::AccelKind::grid;
   const host::Grid grid =
-      accel_kind == host::AccelKind::grid
-          ? host::build_grid(scene,
-                             host::grid_spec_for(grid_spec, scene, vgpu::profile(opt.profile)))
-          : host::Grid{};
+      want_grid ? host::build_grid(
+                      scene, host::grid_spec_for(grid_spec, scene, vgpu::profile(opt.profile)))
+                : host::Grid{};
   std::optional<host::Grid> box;
   std::optional<host::Bvh> bvh;
-  if (auto_accel || accel_kind == host::AccelKind::bvh) {
+  std::optional<host::KdTree> kd;
+  if (auto_accel || accel_kind != host::AccelKind::grid)
     box = host::build_grid(scene, host::GridSpec{glm::ivec3(1)});
-    bvh = host::build_bvh(scene);
-  }
+  if (auto_accel || accel_kind == host::AccelKind::bvh) bvh = host::build_bvh(scene);
+  if (auto_accel || accel_kind == host::AccelKind::kdtree)
+    kd = host::build_kdtree(scene, box->lo, box->hi);
+  auto accel_of = [&](host::AccelKind k) {
+    return host::Accel{k, k == host::AccelKind::grid ? &grid : &*box,
+                       k == host::AccelKind::bvh ? &*bvh : nullptr,
+                       k == host::AccelKind::kdtree ? &*kd : nullptr};
+  };
   auto formats_for = [&](host::AccelKind k) {
-    return k == host::AccelKind::grid
-               ? host::resolve(formats, scene, grid, vgpu::profile(opt.profile))
-               : host::resolve(formats, scene, *box, vgpu::profile(opt.profile), bvh->lists.size());
+    const vgpu::Profile& p = vgpu::profile(opt.profile);
+    return k == host::AccelKind::grid  ? host::resolve(formats, scene, grid, p)
+           : k == host::AccelKind::bvh ? host::resolve(formats, scene, *box, p, bvh->lists.size())
+                                       : host::resolve(formats, scene, *box, p, kd->lists.size());
   };
   opt.formats = formats_for(accel_kind);
   if (opt.mrt) {
@@ -517,13 +526,14 @@ int run_render(const RenderArgs& a, bool lanes_given) {
     };
   std::optional<host::AccelChoice> choice;
   if (auto_accel) {
-    choice = host::choose_accel(scene, grid, *box, *bvh, opt, cam);
+    std::vector<host::AccelCandidate> candidates;
+    for (host::AccelKind k : host::kAccelKinds) candidates.push_back({accel_of(k), formats_for(k)});
+    choice = host::choose_accel(scene, candidates, opt, cam);
     accel_kind = choice->kind;
     opt.formats = formats_for(accel_kind);
   }
-  const host::Grid& walk_grid = accel_kind == host::AccelKind::grid ? grid : *box;
-  const host::Accel accel{accel_kind, &walk_grid,
-                          accel_kind == host::AccelKind::bvh ? &*bvh : nullptr};
+  const host::Accel accel = accel_of(accel_kind);
+  const host::Grid& walk_grid = *accel.grid;
   std::optional<host::StreamTracer> tracer;
   if (!cpu) tracer.emplace(scene, accel, opt);
   const double init_ms =
@@ -559,6 +569,15 @@ int run_render(const RenderArgs& a, bool lanes_given) {
       acc["references"] = bvh->references();
       acc["sah_cost"] = bvh->sah_cost;
       acc["build_ms"] = bvh->build_ms;
+    } else if (accel_kind == host::AccelKind::kdtree) {
+      acc["nodes"] = kd->nodes.size();
+      acc["leaves"] = kd->leaves;
+      acc["empty_leaves"] = kd->empty_leaves;
+      acc["depth"] = kd->depth;
+      acc["max_leaf"] = kd->max_leaf;
+      acc["references"] = kd->references();
+      acc["sah_cost"] = kd->sah_cost;
+      acc["build_ms"] = kd->build_ms;
     } else {
       acc["voxels"] = {walk_grid.res.x, walk_grid.res.y, walk_grid.res.z};
       acc["references"] = walk_grid.references();
@@ -608,7 +627,8 @@ int run_render(const RenderArgs& a, bool lanes_given) {
     j["cpu"] = {{"rays", cpu_stats.rays},
                 {"voxel_steps", cpu_stats.voxel_steps},
                 {"triangle_tests", cpu_stats.triangle_tests},
-                {"nodes_visited", cpu_stats.nodes_visited}};
+                {"nodes_visited", cpu_stats.nodes_visited},
+                {"restarts", cpu_stats.restarts}};
   j["rays_traced"] = r.rays_traced;
   j["rays_unfinished"] = r.rays_unfinished;
   // Supersampling (--spp): samples per pixel and the passes it added to the first sample frame.
@@ -700,6 +720,8 @@ int run_render(const RenderArgs& a, bool lanes_given) {
         walk_grid.res.y, walk_grid.res.z, static_cast<unsigned long long>(walk_grid.references()));
     if (accel_kind == host::AccelKind::bvh)
       std::printf("%s (%.1f ms to build)\n", host::describe(*bvh).c_str(), bvh->build_ms);
+    if (accel_kind == host::AccelKind::kdtree)
+      std::printf("%s (%.1f ms to build)\n", host::describe(*kd).c_str(), kd->build_ms);
     if (choice)
       std::printf("accel auto: %s (probes %.0f ms)\n", choice->why.c_str(), choice->probe_ms);
     std::printf("%s %s, %dx%d, %d iteration(s), %s shading, shadows %s, masks %s, mrt %s\n",
@@ -730,6 +752,7 @@ int run_kernels(const std::string& name, bool glsl) {
   // The looping variant's program (--kernels looping) is listed after the paper's.
   programs.push_back(std::make_unique<vgpu::KernelProgram<kernels::LoopingTraversal>>());
   programs.push_back(std::make_unique<vgpu::KernelProgram<kernels::BvhLooping>>());
+  programs.push_back(std::make_unique<vgpu::KernelProgram<kernels::KdLooping>>());
   auto spelled = [](std::string n) {
     for (char& c : n)
       if (c == ' ') c = '-';

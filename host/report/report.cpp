@@ -189,9 +189,10 @@ void FrameRecorder::pass(const PassObserver::Pass& p) {
   const uint8_t* work = has_work_ ? work_.data() : nullptr;
   // Walk steps: a voxel (grid) or a node (BVH); triangle tests: either walk's intersection pass
   // (alone or fused, --mrt on).
-  const bool trav = r.program == kernels::Traversal::name ||
-                    r.program == kernels::TraverseUpdate::name ||
-                    r.program == kernels::BvhStep::name || r.program == kernels::BvhStepLoad::name;
+  const bool trav =
+      r.program == kernels::Traversal::name || r.program == kernels::TraverseUpdate::name ||
+      r.program == kernels::BvhStep::name || r.program == kernels::BvhStepLoad::name ||
+      r.program == kernels::KdStep::name || r.program == kernels::KdStepLoad::name;
   const bool isect =
       r.program == kernels::Intersections::name || r.program == kernels::IntersectNext::name ||
       r.program == kernels::BvhIntersections::name || r.program == kernels::BvhIntersectNext::name;

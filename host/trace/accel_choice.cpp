@@ -21,16 +21,18 @@ WalkWork walk_work(const vgpu::FrameStats& stats) {
   };
   using namespace kernels;
   w.voxel_steps = useful(Traversal::name) + useful(TraverseUpdate::name);
-  w.nodes_visited = useful(BvhStep::name) + useful(BvhStepLoad::name);
+  w.nodes_visited = useful(BvhStep::name) + useful(BvhStepLoad::name) + useful(KdStep::name) +
+                    useful(KdStepLoad::name);
   w.triangle_tests = useful(Intersections::name) + useful(IntersectNext::name) +
-                     useful(BvhIntersections::name) + useful(BvhIntersectNext::name);
-  for (const char* name : {LoopingTraversal::name, BvhLooping::name})
+                     useful(BvhIntersections::name) + useful(BvhIntersectNext::name) +
+                     useful(KdIntersections::name) + useful(KdIntersectNext::name);
+  for (const char* name : {LoopingTraversal::name, BvhLooping::name, KdLooping::name})
     if (const vgpu::FrameStats::ProgramTotals* p = stats.find(name))
       w.loop_iterations += p->counters.loop_iterations;
   return w;
 }
 
-AccelChoice choose_accel(const Scene& scene, const Grid& grid, const Grid& box, const Bvh& bvh,
+AccelChoice choose_accel(const Scene& scene, const std::vector<AccelCandidate>& candidates,
                          const RenderOptions& options, const Camera& camera) {
   const auto t0 = std::chrono::steady_clock::now();
   AccelChoice c;
@@ -50,10 +52,11 @@ AccelChoice choose_accel(const Scene& scene, const Grid& grid, const Grid& box, 
   std::string refused;
   double best = 0;
   bool any = false;
-  for (const AccelKind kind : {AccelKind::grid, AccelKind::bvh}) {
-    const Accel accel{kind, kind == AccelKind::grid ? &grid : &box,
-                      kind == AccelKind::bvh ? &bvh : nullptr};
+  for (const AccelCandidate& cand : candidates) {
+    const Accel& accel = cand.accel;
+    const AccelKind kind = accel.kind;
     const std::string name(accel_name(kind));
+    probe.formats = cand.formats;
     try {
       StreamTracer tracer(scene, accel, probe);
       const RenderResult r = tracer.render(camera);
@@ -72,17 +75,19 @@ AccelChoice choose_accel(const Scene& scene, const Grid& grid, const Grid& box, 
     }
   }
   if (!any) throw vgpu::Error("--accel auto: no structure fits: " + refused);
-  char line[256];
-  const std::string other = c.kind == AccelKind::grid ? "bvh" : "grid";
-  if (c.predicted_ms.count(other))
-    std::snprintf(line, sizeof line,
-                  "%s predicted %.1f ms on %s against %s's %.1f ms (%.2fx), from %dx%d probes",
-                  std::string(accel_name(c.kind)).c_str(), best, profile.name.c_str(),
-                  other.c_str(), c.predicted_ms[other], c.predicted_ms[other] / best, probe.width,
-                  probe.height);
-  else
-    std::snprintf(line, sizeof line, "%s: the only structure the profile's limits allow (%s)",
-                  std::string(accel_name(c.kind)).c_str(), refused.c_str());
+  std::string others;
+  for (const auto& [name, ms] : c.predicted_ms)
+    if (name != accel_name(c.kind)) {
+      char part[96];
+      std::snprintf(part, sizeof part, "%s%s %.1f ms (%.2fx)", others.empty() ? "" : ", ",
+                    name.c_str(), ms, ms / best);
+      others += part;
+    }
+  char line[512];
+  std::snprintf(line, sizeof line, "%s predicted %.1f ms on %s against %s, from %dx%d probes%s%s",
+                std::string(accel_name(c.kind)).c_str(), best, profile.name.c_str(),
+                others.empty() ? "nothing else" : others.c_str(), probe.width, probe.height,
+                refused.empty() ? "" : "; refused: ", refused.c_str());
   c.why = line;
   c.probe_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();

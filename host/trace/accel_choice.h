@@ -9,6 +9,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "host/accel/accel.h"
 #include "host/scene/scene.h"
@@ -36,9 +37,13 @@ struct WalkWork {
 };
 WalkWork walk_work(const vgpu::FrameStats& stats);
 
-// `grid` is the grid --accel grid would walk; `bvh` the BVH (built by the caller). Throws what
-// StreamTracer throws for a candidate no profile limit allows only if no candidate is left.
-AccelChoice choose_accel(const Scene& scene, const Grid& grid, const Grid& box, const Bvh& bvh,
+// The candidates (built by the caller), each with the formats it renders with. A candidate the
+// profile's limits refuse (vgpu::Error) drops out; throws vgpu::Error if none is left.
+struct AccelCandidate {
+  Accel accel;
+  Formats formats;
+};
+AccelChoice choose_accel(const Scene& scene, const std::vector<AccelCandidate>& candidates,
                          const RenderOptions& options, const Camera& camera);
 
 }  // namespace host

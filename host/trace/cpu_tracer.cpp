@@ -33,7 +33,8 @@ struct Hit {
 // Per-thread counters, summed at the end; each on its own cache line, so the workers do not
 // share one.
 struct alignas(64) Counters {
-  uint64_t rays = 0, entered = 0, voxel_steps = 0, triangle_tests = 0, nodes_visited = 0;
+  uint64_t rays = 0, entered = 0, voxel_steps = 0, triangle_tests = 0, nodes_visited = 0,
+           restarts = 0;
   int iterations = 0;
 };
 
@@ -85,6 +86,7 @@ class Tracer {
       : scene_(scene),
         grid_(*accel.grid),
         bvh_(accel.kind == AccelKind::bvh ? accel.bvh : nullptr),
+        kd_(accel.kind == AccelKind::kdtree ? accel.kd : nullptr),
         cam_(camera),
         opt_(opt),
         primary_(camera, opt.width, opt.height) {
@@ -119,6 +121,7 @@ class Tracer {
             Counters& c) const {
     ++c.rays;
     if (bvh_) return trace_bvh(o, d, tmax, any_hit, c);
+    if (kd_) return trace_kd(o, d, tmax, any_hit, c);
     Hit best;
     // Slab test against the grid box.
     double tnear = 0.0, tfar = tmax;
@@ -323,10 +326,67 @@ class Tracer {
     return best;
   }
 
+  // kd-restart (kernels/kdtree.h) in double: descend to the first leaf the segment reaches, test
+  // its triangles with the in-leaf rule (the segment widened by the slack), restart past it.
+  Hit trace_kd(const glm::dvec3& o, const glm::dvec3& d, double tmax, bool any_hit,
+               Counters& c) const {
+    Hit best;
+    if (!(tmax >= 0.0)) return best;
+    double tn = 0.0, tend = tmax;
+    for (int a = 0; a < 3; ++a) {
+      if (d[a] == 0.0) {
+        if (o[a] < kd_->lo[a] || o[a] > kd_->hi[a]) return best;
+        continue;
+      }
+      double t0 = (double(kd_->lo[a]) - o[a]) / d[a], t1 = (double(kd_->hi[a]) - o[a]) / d[a];
+      if (t0 > t1) std::swap(t0, t1);
+      tn = std::max(tn, t0);
+      tend = std::min(tend, t1);
+    }
+    if (!(tn <= tend)) return best;
+    ++c.entered;
+    double tmin = tn, tmx = tend;
+    int32_t i = 0;
+    for (;;) {
+      ++c.nodes_visited;
+      const KdNode& n = kd_->nodes[size_t(i)];
+      if (n.axis == 3) {
+        for (int32_t k = n.leaf; kd_->lists[size_t(k)] >= 0; ++k) {
+          const auto tri = size_t(kd_->lists[size_t(k)]);
+          ++c.triangle_tests;
+          double t, u, v;
+          if (!intersect(o, d, tris_[tri], t, u, v)) continue;
+          if (t < tmin - slack_ || t > tmx + slack_ || !(t < tmax) || !(t < best.t)) continue;
+          best = Hit{int64_t(tri), t, u, v};
+          if (any_hit) return best;
+        }
+        if (best.tri >= 0 || tmx >= tend) return best;
+        ++c.restarts;
+        tmin = tmx;
+        tmx = tend;
+        i = 0;
+        continue;
+      }
+      const int a = n.axis;
+      const double s = double(n.split);
+      const double ts = (s - o[a]) / d[a];
+      const bool below = o[a] < s || (o[a] == s && d[a] <= 0.0);
+      const int32_t near = below ? i + 1 : n.right, far = below ? n.right : i + 1;
+      const bool near_only = d[a] == 0.0 || ts >= tmx || ts <= 0.0;
+      if (!near_only && ts <= tmin) {
+        i = far;
+      } else {
+        i = near;
+        if (!near_only) tmx = ts;
+      }
+    }
+  }
+
  private:
   const Scene& scene_;
   const Grid& grid_;
   const Bvh* bvh_ = nullptr;
+  const KdTree* kd_ = nullptr;
   const Camera& cam_;
   const RenderOptions& opt_;
   const PrimaryRays primary_;
@@ -510,6 +570,7 @@ RenderResult render_cpu(const Scene& scene, const Accel& accel, const Camera& ca
     total.voxel_steps += c.voxel_steps;
     total.triangle_tests += c.triangle_tests;
     total.nodes_visited += c.nodes_visited;
+    total.restarts += c.restarts;
     res.rays_traced += c.entered;
     res.iterations = std::max(res.iterations, c.iterations);
   }

@@ -20,7 +20,8 @@ struct CpuStats {
   uint64_t voxel_steps = 0;  // voxels examined by the 3D-DDA, summed over every ray
   uint64_t triangle_tests = 0;  // ray-triangle tests (no mailbox: a triangle listed in several
                                 // voxels may be tested once per voxel)
-  uint64_t nodes_visited = 0;   // BVH nodes whose box was tested (--accel bvh)
+  uint64_t nodes_visited = 0;   // BVH nodes whose box was tested, kd-tree nodes descended
+  uint64_t restarts = 0;        // kd-restart: walks begun again from the root (--accel kdtree)
 };
 
 // Renders with the options the stream tracer takes; the GPU-only ones (profile, lanes, masks,

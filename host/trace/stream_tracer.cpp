@@ -15,6 +15,7 @@
 #include "host/common/parallel.h"
 #include "host/trace/bvh_walk.h"
 #include "host/trace/devices.h"
+#include "host/trace/kd_walk.h"
 #include "host/trace/passes.h"
 #include "host/trace/sampling.h"
 
@@ -140,6 +141,9 @@ StreamTracer::StreamTracer(const Scene& scene, const Accel& accel, const RenderO
   // The acceleration structure's textures and walk (host/trace/grid_walk.h, bvh_walk.h).
   if (accel.kind == AccelKind::bvh)
     s.walk = std::make_unique<BvhWalk>(gpu, *accel.bvh, opt_, float(sw));
+  else if (accel.kind == AccelKind::kdtree)
+    s.walk = std::make_unique<KdWalk>(gpu, *accel.kd, opt_, float(sw),
+                                      float(kSlackOfDiagonal) * glm::length(grid.hi - grid.lo));
   else
     s.walk = std::make_unique<GridWalk>(gpu, grid, opt_, float(sw));
 

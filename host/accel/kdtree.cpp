@@ -1,0 +1,166 @@
+// The kd-tree's host build (see kdtree.h): SAH over clipped bounding-box events, depth first.
+#include "host/accel/kdtree.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+
+namespace host {
+
+namespace {
+
+struct Box {
+  glm::dvec3 lo, hi;
+  double area() const {
+    const glm::dvec3 e = glm::max(hi - lo, glm::dvec3(0.0));
+    return 2.0 * (e.x * e.y + e.y * e.z + e.z * e.x);
+  }
+};
+
+class Builder {
+ public:
+  Builder(const Scene& scene, const KdSpec& spec, KdTree& out) : spec_(spec), out_(out) {
+    const size_t n = scene.triangle_count();
+    tri_lo_.resize(n);
+    tri_hi_.resize(n);
+    for (size_t i = 0; i < n; ++i) {
+      const glm::dvec3 a(scene.p0[i]), b(scene.p1[i]), c(scene.p2[i]);
+      tri_lo_[i] = glm::min(a, glm::min(b, c));
+      tri_hi_[i] = glm::max(a, glm::max(b, c));
+    }
+    max_depth_ = spec.max_depth > 0
+                     ? spec.max_depth
+                     : int(std::lround(8.0 + 1.3 * std::log2(double(std::max<size_t>(n, 1)))));
+    out_.lists.push_back(-1);
+  }
+
+  double build(const std::vector<uint32_t>& tris, const Box& box, int depth) {
+    out_.depth = std::max(out_.depth, depth + 1);
+    const size_t me = out_.nodes.size();
+    out_.nodes.emplace_back();
+    const double n = double(tris.size());
+    const double leaf_cost = spec_.triangle_cost * n;
+    int axis = -1;
+    double split = 0, best = leaf_cost;
+    if (depth < max_depth_ && tris.size() > 1) find_split(tris, box, axis, split, best);
+    if (axis < 0) {
+      KdNode& node = out_.nodes[me];
+      node.axis = 3;
+      node.count = int32_t(tris.size());
+      node.leaf = tris.empty() ? 0 : int32_t(out_.lists.size());
+      for (uint32_t t : tris) out_.lists.push_back(int32_t(t));
+      if (!tris.empty()) out_.lists.push_back(-1);
+      ++out_.leaves;
+      out_.empty_leaves += tris.empty();
+      out_.max_leaf = std::max(out_.max_leaf, int(tris.size()));
+      return leaf_cost;
+    }
+    // The split is stored as a float: partition by the float plane, so the walk and the build
+    // agree on which side a point lies.
+    const float fsplit = float(split);
+    const double s = double(fsplit);
+    std::vector<uint32_t> left, right;
+    for (uint32_t t : tris) {
+      const double lo = std::max(tri_lo_[t][axis], box.lo[axis]);
+      const double hi = std::min(tri_hi_[t][axis], box.hi[axis]);
+      if (lo <= s) left.push_back(t);
+      if (hi >= s) right.push_back(t);
+    }
+    Box lb = box, rb = box;
+    lb.hi[axis] = s;
+    rb.lo[axis] = s;
+    out_.nodes[me].axis = axis;
+    out_.nodes[me].split = fsplit;
+    const double cl = build(left, lb, depth + 1);
+    out_.nodes[me].right = int32_t(out_.nodes.size());
+    const double cr = build(right, rb, depth + 1);
+    const double a = box.area();
+    return spec_.node_cost + (a > 0 ? (lb.area() * cl + rb.area() * cr) / a : cl + cr);
+  }
+
+ private:
+  // The SAH's cheapest plane among the triangles' clipped box faces (strictly inside the box).
+  void find_split(const std::vector<uint32_t>& tris, const Box& box, int& best_axis,
+                  double& best_split, double& best) const {
+    const double area = box.area();
+    if (!(area > 0)) return;
+    const size_t n = tris.size();
+    std::vector<std::pair<double, int>> ev;  // (position, 0 = a box ends, 1 = a box starts)
+    ev.reserve(2 * n);
+    for (int a = 0; a < 3; ++a) {
+      if (!(box.hi[a] > box.lo[a])) continue;
+      ev.clear();
+      for (uint32_t t : tris) {
+        ev.emplace_back(std::max(tri_lo_[t][a], box.lo[a]), 1);
+        ev.emplace_back(std::min(tri_hi_[t][a], box.hi[a]), 0);
+      }
+      std::sort(ev.begin(), ev.end());
+      size_t nl = 0, nr = n;
+      for (size_t i = 0; i < ev.size();) {
+        const double p = ev[i].first;
+        size_t ends = 0, starts = 0;
+        for (; i < ev.size() && ev[i].first == p; ++i) (ev[i].second ? starts : ends) += 1;
+        nr -= ends;  // boxes ending at p lie left of a plane just after it
+        if (p > box.lo[a] && p < box.hi[a]) {
+          Box lb = box, rb = box;
+          lb.hi[a] = p;
+          rb.lo[a] = p;
+          // Boxes touching the plane go to both sides (as the partition does).
+          const double cl = double(nl + starts), cr = double(nr + ends);
+          double cost =
+              spec_.node_cost + spec_.triangle_cost * (lb.area() * cl + rb.area() * cr) / area;
+          if (cl == 0 || cr == 0) cost *= 1.0 - spec_.empty_bonus;
+          if (cost < best) {
+            best = cost;
+            best_axis = a;
+            best_split = p;
+          }
+        }
+        nl += starts;
+      }
+    }
+    // A plane that would not move through float unchanged, or splits nothing off, is no split.
+    if (best_axis >= 0) {
+      const double s = double(float(best_split));
+      if (!(s > box.lo[best_axis] && s < box.hi[best_axis])) best_axis = -1;
+    }
+  }
+
+  const KdSpec& spec_;
+  KdTree& out_;
+  std::vector<glm::dvec3> tri_lo_, tri_hi_;
+  int max_depth_ = 0;
+};
+
+}  // namespace
+
+uint64_t KdTree::references() const {
+  uint64_t r = 0;
+  for (const KdNode& n : nodes) r += uint64_t(n.axis == 3 ? n.count : 0);
+  return r;
+}
+
+KdTree build_kdtree(const Scene& scene, glm::vec3 lo, glm::vec3 hi, const KdSpec& spec) {
+  const auto t0 = std::chrono::steady_clock::now();
+  KdTree kd;
+  kd.lo = lo;
+  kd.hi = hi;
+  Builder b(scene, spec, kd);
+  std::vector<uint32_t> all(scene.triangle_count());
+  for (size_t i = 0; i < all.size(); ++i) all[i] = uint32_t(i);
+  kd.sah_cost = b.build(all, Box{glm::dvec3(lo), glm::dvec3(hi)}, 0);
+  kd.build_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  return kd;
+}
+
+std::string describe(const KdTree& kd) {
+  char line[200];
+  std::snprintf(line, sizeof line,
+                "kd-tree: %zu nodes, depth %d, %d leaves (%d empty) of at most %d triangles",
+                kd.nodes.size(), kd.depth, kd.leaves, kd.empty_leaves, kd.max_leaf);
+  return line;
+}
+
+}  // namespace host

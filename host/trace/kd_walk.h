@@ -1,0 +1,74 @@
+// The kd-restart walk (an extension; kernels/kdtree.h): the tree's textures, and which pass runs
+// next, steered by which query, in the grid walk's manner (grid_walk.h): one node per pass for
+// every walking ray, then the triangles of the leaves reached, one per pass. The pass sequence
+// is the BVH walk's (bvh_walk.h) with the kd-tree's kernels.
+#pragma once
+
+#include <cstdint>
+
+#include "host/accel/kdtree.h"
+#include "host/trace/accel_walk.h"
+#include "host/trace/passes.h"
+#include "host/trace/render_options.h"
+#include "kernels/kernels.h"
+#include "vgpu/vgpu.h"
+
+namespace host {
+
+class KdWalk : public AccelWalk {
+ public:
+  // Passes of the walk by where it issues them (walk::PassKey).
+  enum Site : int {
+    kEnter,          // rayosEnGrilla after inicioKd
+    kStep,           // recorridoKd
+    kLoad,           // cargarHojaKd
+    kStepLoad,       // recorridoKd + cargarHojaKd (--mrt on)
+    kTesting,        // rayosIntersectando after the leaves are loaded
+    kIntersect,      // interseccionesKd
+    kNext,           // proximoTriangulo
+    kIntersectNext,  // interseccionesKd + proximoTriangulo (--mrt on)
+    kTestingOn,      // rayosIntersectando in the triangle loop
+    kWalking,        // rayosEnGrilla after the step
+    kSites
+  };
+
+  // The tree's static textures, checked against the profile's limits (throws vgpu::Error
+  // naming the limit); the walk's programs in their groups' formats.
+  KdWalk(vgpu::Device& gpu, const KdTree& kd, const RenderOptions& options, float scene_width,
+         float t_slack);
+  void make_state(vgpu::Device& gpu, const WalkShared& shared) override;
+  void upload(vgpu::Device& gpu) const override;
+  uint64_t texture_bytes() const override;
+  void trace(PassRunner& r, vgpu::Texture& origins, vgpu::Texture& rays, bool primary,
+             glm::vec3 eye) override;
+
+  struct Cursor {
+    vgpu::Texture *origins, *rays;
+    int trav, vs, isect;
+  };
+  template <class X>
+  void walk(X& x, Cursor& c);
+  WriteBack write_back(const Cursor& c) const;
+
+ private:
+  void walk_looping(PassRunner& r, vgpu::Texture& origins, vgpu::Texture& rays, uint64_t walking);
+
+  const RenderOptions& opt_;
+  int nodes_ = 0, max_leaf_ = 0, depth_ = 0, leaves_ = 0;
+  WalkShared sh_{};
+  vgpu::Texture tree_, lists_;
+  vgpu::Texture trav_[2], vs_[2];
+  int cur_trav_ = 0, cur_vs_ = 0;
+  vgpu::KernelProgram<kernels::KdEnter> enter_;
+  vgpu::KernelProgram<kernels::KdStep> step_;
+  vgpu::KernelProgram<kernels::KdLoadLeaf> load_;
+  vgpu::KernelProgram<kernels::KdIntersections> intersect_;
+  vgpu::KernelProgram<kernels::NextTriangle> next_;
+  vgpu::KernelProgram<kernels::RaysIntersecting> intersecting_;
+  vgpu::KernelProgram<kernels::RaysInGrid> walking_;
+  vgpu::KernelProgram<kernels::KdStepLoad> step_load_;
+  vgpu::KernelProgram<kernels::KdIntersectNext> intersect_next_;
+  vgpu::KernelProgram<kernels::KdLooping> looping_;
+};
+
+}  // namespace host
