@@ -3,6 +3,7 @@
 #include "host/trace/bvh_walk.h"
 
 #include <algorithm>
+#include <tuple>
 
 #include "host/trace/walk.h"
 
@@ -55,6 +56,18 @@ BvhWalk::BvhWalk(vgpu::Device& gpu, const Bvh& bvh, const RenderOptions& options
     if (vgpu::significand_bits(fm.arithmetic(g)) > vgpu::significand_bits(loop_arith))
       loop_arith = fm.arithmetic(g);
   looping_.set_precision(loop_arith);
+  // Node indices and list positions are texel addresses: refuse a format that cannot hold them
+  // (a walk would stall at an index that no longer counts up, as the grid's does past its cap).
+  for (const auto& [count, g, kind] :
+       {std::tuple{uint64_t(bvh.nodes.size()), Group::traversal, "node indices"},
+        std::tuple{uint64_t(bvh.lists.size()), Group::voxel, "list positions"}})
+    for (const Format f : {fm[g], fm.arithmetic(g)})
+      if (count - 1 > exact_addresses(f))
+        throw vgpu::Error(
+            "bvh: " + std::string(kind) + " reach " + std::to_string(count - 1) + "; the " +
+            std::string(group_name(g)) + " group's " + std::string(vgpu::format_name(f)) +
+            " addresses texels exactly only to " + std::to_string(exact_addresses(f)) +
+            " (give it fp24 or fp32: --formats " + std::string(group_name(g)) + "=fp32)");
 
   nodes_lo_ = entry_texture(gpu, "bvh nodes lo", bvh.nodes.size(), 4, "nodes");
   nodes_hi_ = entry_texture(gpu, "bvh nodes hi", bvh.nodes.size(), 4, "nodes");

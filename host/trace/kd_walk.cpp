@@ -3,6 +3,7 @@
 #include "host/trace/kd_walk.h"
 
 #include <algorithm>
+#include <tuple>
 
 #include "host/trace/walk.h"
 
@@ -59,6 +60,18 @@ KdWalk::KdWalk(vgpu::Device& gpu, const KdTree& kd, const RenderOptions& options
     if (vgpu::significand_bits(fm.arithmetic(g)) > vgpu::significand_bits(loop_arith))
       loop_arith = fm.arithmetic(g);
   looping_.set_precision(loop_arith);
+  // Node indices and list positions are texel addresses: refuse a format that cannot hold them
+  // (a walk would stall at an index that no longer counts up, as the grid's does past its cap).
+  for (const auto& [count, g, kind] :
+       {std::tuple{uint64_t(kd.nodes.size()), Group::traversal, "node indices"},
+        std::tuple{uint64_t(kd.lists.size()), Group::voxel, "list positions"}})
+    for (const Format f : {fm[g], fm.arithmetic(g)})
+      if (count - 1 > exact_addresses(f))
+        throw vgpu::Error(
+            "kd-tree: " + std::string(kind) + " reach " + std::to_string(count - 1) + "; the " +
+            std::string(group_name(g)) + " group's " + std::string(vgpu::format_name(f)) +
+            " addresses texels exactly only to " + std::to_string(exact_addresses(f)) +
+            " (give it fp24 or fp32: --formats " + std::string(group_name(g)) + "=fp32)");
 
   // Node i: (split, axis or 3 for a leaf, right child, leaf list start).
   tree_ = entry_texture(gpu, "kd nodes", kd.nodes.size(), 4, "nodes");
