@@ -12,6 +12,17 @@
 //                          (paper: texturaTriangulos)
 //   voxel pointers  x      index of the voxel's first list entry; voxel (X,Y,Z) at texel
 //                          (X*sizeY + Y, Z) (paper: texturaTriangulosEnVoxel)
+// Static (BVH, --accel bvh; kernels/bvh.h), node i at (i mod width, i div width):
+//   bvh nodes lo    xyz = box minimum (padded), w = escape: the node after i's subtree, -1 at
+//                   the end; the left child of an inner node is node i + 1
+//   bvh nodes hi    xyz = box maximum (padded), w = the leaf's first list entry, -1 for an inner
+//                   node
+//   bvh lists       x      triangle ids of each leaf, closed by -1 (entry 0: a -1)
+// Static (kd-tree, --accel kdtree; kernels/kdtree.h), node i at (i mod width, i div width):
+//   kd nodes        x = split position, y = axis (0, 1, 2; 3 for a leaf), z = right child (the
+//                   left child is node i + 1), w = the leaf's first list entry, -1 for an inner
+//                   node
+//   kd lists        x      triangle ids of each leaf, closed by -1 (entry 0: a -1)
 //
 // Dynamic (per pixel):
 //   origins         xyz = ray origin, world space; w unused    (paper: texturaInicioRayos)
@@ -22,6 +33,12 @@
 //                   (paper: texturaEstadoTraversal)
 //   voxel state     x = position in the triangle lists, w = triangle to test next;
 //                   w = -1: nothing left to test in this voxel   (paper: texturaEstadoVoxel)
+//   bvh traversal   x = next node (the node count: the walk ends at the next step; -1: done),
+//                   y = list position of the leaf just entered (-1: none)   (--accel bvh)
+//   kd traversal    x = node (-1: done), y = list position of the leaf being tested (-1: none),
+//                   z, w = tmin, tmax of the ray's segment        (--accel kdtree)
+//   leaf state      as the voxel state, over the tree's lists; the kd-tree's looping kernel
+//                   keeps its push-down node in y and a "segment cut" flag in z
 //   intersection    x = t of the nearest valid hit so far, w = its triangle, -1 for none;
 //                   yz = barycentrics (u, v) of that hit      (paper: texturaEstadoInterseccion)
 //   surface         xyz = hit point (offset off the surface, the next ray's origin),

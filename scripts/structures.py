@@ -49,8 +49,22 @@ def main():
     ap.add_argument("--size", type=int, default=256)
     ap.add_argument("--runs", type=int, default=3)
     ap.add_argument("--h200", help="docs/structures_h200.json (H200 GL wall ms per frame)")
+    ap.add_argument("--h200-runs", help="a folder of scripts/structures_h200.sh's JSON files: "
+                    "summarized into docs/structures_h200.json, then used as --h200")
     ap.add_argument("--out", default=os.path.join(ROOT, "docs"))
     a = ap.parse_args()
+    if a.h200_runs:
+        runs = {}
+        for f in sorted(glob.glob(os.path.join(a.h200_runs, "*_r[0-9].json"))):
+            j = json.load(open(f))
+            key = os.path.basename(f).rsplit("_r", 1)[0]
+            e = runs.setdefault(key, {"wall_ms": [], "passes": j["totals"]["passes"],
+                                      "query_readbacks": j["totals"]["query_readbacks"],
+                                      "device": j.get("device", ""), "gpu_ms": []})
+            e["wall_ms"].append(j["render_ms"])
+            e["gpu_ms"].append(j["totals"].get("device_ms"))
+        a.h200 = os.path.join(a.out, "structures_h200.json")
+        json.dump(runs, open(a.h200, "w"), indent=1)
     tmp = tempfile.mkdtemp(prefix="structures_")
     subprocess.run([sys.executable, os.path.join(ROOT, "scripts", "uneven_scenes.py"), tmp],
                    check=True, stdout=subprocess.DEVNULL)
