@@ -6,6 +6,8 @@
 #include <cmath>
 #include <cstdio>
 #include <numeric>
+#include <stdexcept>
+#include <string>
 
 namespace host {
 
@@ -194,12 +196,60 @@ Bvh build_bvh(const Scene& scene, const BvhSpec& spec) {
   const auto t0 = std::chrono::steady_clock::now();
   Bvh bvh;
   Builder b(scene, spec, bvh);
-  bvh.sah_cost = b.build(0, scene.triangle_count(), 0);
+  b.build(0, scene.triangle_count(), 0);
   for (BvhNode& n : bvh.nodes)
     if (n.escape >= int32_t(bvh.nodes.size())) n.escape = -1;
+  // The SAH cost as refit_bvh computes it (from the unpadded boxes), so a refit of an unmoved
+  // scene reproduces the build exactly, boxes and cost.
+  refit_bvh(bvh, scene);
   bvh.build_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   return bvh;
+}
+
+void refit_bvh(Bvh& bvh, const Scene& scene) {
+  const auto t0 = std::chrono::steady_clock::now();
+  if (bvh.references() != scene.triangle_count() && !(bvh.nodes.size() == 1 && !bvh.nodes[0].count))
+    throw std::invalid_argument("refit: the BVH holds " + std::to_string(bvh.references()) +
+                                " triangles, the scene " + std::to_string(scene.triangle_count()));
+  const Bounds sb = scene.bounds();
+  double mag = 0.0, diag = 0.0;
+  if (!sb.empty()) {
+    diag = glm::length(glm::dvec3(sb.hi) - glm::dvec3(sb.lo));
+    for (int a = 0; a < 3; ++a)
+      mag = std::max({mag, std::abs(double(sb.lo[a])), std::abs(double(sb.hi[a]))});
+  }
+  const float pad = float(std::max(kBoxPadOfDiagonal * diag, 1e-6 * mag));
+  std::vector<Box> box(bvh.nodes.size());
+  std::vector<double> cost(bvh.nodes.size(), 0.0);
+  // Children follow their parent in the layout: visiting nodes last to first meets every child
+  // before its parent. An inner node's right child is its left child's escape.
+  for (size_t k = bvh.nodes.size(); k-- > 0;) {
+    BvhNode& n = bvh.nodes[k];
+    Box b;
+    if (n.leaf >= 0) {
+      for (int32_t e = n.leaf; bvh.lists[size_t(e)] >= 0; ++e) {
+        const auto t = size_t(bvh.lists[size_t(e)]);
+        b.extend(scene.p0[t]);
+        b.extend(scene.p1[t]);
+        b.extend(scene.p2[t]);
+      }
+      cost[k] = kNodeCost + kTriangleCost * double(n.count);
+    } else {
+      const size_t l = k + 1, r = size_t(bvh.nodes[l].escape);
+      b.extend(box[l]);
+      b.extend(box[r]);
+      const double a = b.area();
+      cost[k] = kNodeCost + (a > 0 ? (box[l].area() * cost[l] + box[r].area() * cost[r]) / a
+                                   : cost[l] + cost[r]);
+    }
+    box[k] = b;
+    n.lo = b.empty() ? glm::vec3(0.0f) : b.lo - pad;
+    n.hi = b.empty() ? glm::vec3(0.0f) : b.hi + pad;
+  }
+  bvh.sah_cost = cost.empty() ? 0.0 : cost[0];
+  bvh.build_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
 std::string describe(const Bvh& bvh) {

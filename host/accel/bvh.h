@@ -50,6 +50,13 @@ struct Bvh {
 // gives one empty leaf.
 Bvh build_bvh(const Scene& scene, const BvhSpec& spec = {});
 
+// Refits the hierarchy to the scene's current vertices (the same triangles, moved): every box
+// is recomputed bottom up from its triangles (leaves) or children (inner nodes), padded as the
+// build pads, keeping the topology, the layout and the lists. Updates sah_cost (which grows as
+// the triangles of a node move apart: the refitted tree's quality) and build_ms (the refit's
+// time). Throws std::invalid_argument if the scene's triangle count differs from the build's.
+void refit_bvh(Bvh& bvh, const Scene& scene);
+
 // "bvh: 12,345 nodes, depth 21, 6,173 leaves of at most 4 triangles"
 std::string describe(const Bvh& bvh);
 
