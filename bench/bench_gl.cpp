@@ -11,10 +11,12 @@
 #include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 
 #include "gl/context.h"
 #include "gl/gl_device.h"
+#include "host/accel/accel.h"
 #include "host/accel/grid.h"
 #include "host/model/cost_model.h"
 #include "host/scene/camera.h"
@@ -127,10 +129,10 @@ struct FrameRun {
   std::string device;
 };
 
-FrameRun run_frames(const host::Scene& scene, const host::Grid& grid, const host::Camera& cam,
+FrameRun run_frames(const host::Scene& scene, const host::Accel& accel, const host::Camera& cam,
                     host::RenderOptions opt, int runs) {
   FrameRun fr;
-  host::StreamTracer tracer(scene, grid, opt);
+  host::StreamTracer tracer(scene, accel, opt);
   fr.device = tracer.device().description();
   auto* gld = dynamic_cast<gl::GlDevice*>(&tracer.device());
   for (int r = 0; r <= runs; ++r) {  // run 0 warms up (the GL device compiles its programs)
@@ -160,6 +162,8 @@ int main(int argc, char** argv) {
   bool no_stream = false, no_frames = false;
   std::string wait_mode = "block";
   std::vector<std::string> variants = {"multipass"};
+  std::vector<std::string> accels = {"grid"};
+  int bounces = 2;
   app.add_option("--gl-device", device, "auto, or an EGL device index")->capture_default_str();
   app.add_option("--scenes", scenes, "Scene names or .gltf paths")->capture_default_str();
   app.add_option("--sizes", sizes, "Image sizes (square)")
@@ -187,6 +191,15 @@ int main(int argc, char** argv) {
                  "both, or none (no GL frames: the emulator's counts and predictions only)")
       ->check(CLI::IsMember({"block", "poll", "both", "none"}))
       ->capture_default_str();
+  app.add_option("--accel", accels,
+                 "Acceleration structures per frame: grid (the paper's, --grid), bvh, kdtree")
+      ->check(CLI::IsMember({"grid", "bvh", "kdtree"}))
+      ->capture_default_str();
+  app.add_option("--bounces", bounces,
+                 "Reflection iterations after the primary one (0: primary "
+                 "rays only)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 16));
   app.add_flag("--no-frames", no_frames, "Only the fixed costs");
   app.add_option("--json", json_path, "Also write every figure as JSON to this file");
   CLI11_PARSE(app, argc, argv);
@@ -278,7 +291,7 @@ int main(int argc, char** argv) {
         for (int size : sizes) {
           host::RenderOptions opt;  // docs/table1.md's settings
           opt.width = opt.height = size;
-          opt.bounces = 2;
+          opt.bounces = bounces;
           opt.shading = kernels::ShadingModel::phong;
           opt.shadows = false;
           opt.threads = threads;
@@ -286,74 +299,88 @@ int main(int argc, char** argv) {
           const host::Grid grid =
               host::build_grid(scene, host::grid_spec_for(host::parse_grid_spec(grid_text), scene,
                                                           vgpu::profile(opt.profile)));
-          const host::Camera cam = host::scene_camera(scene);
-          for (const std::string& variant : variants) {
-            // The paper's pipeline at Table 1's profile; its future work (MRT fused passes, the
-            // looping kernels) needs a profile with several outputs and loops: the h200's.
-            opt.mrt = variant == "mrt";
-            opt.looping = variant == "looping";
-            opt.profile = variant == "multipass" ? "gf5700" : "h200";
-            for (const std::string& engine : engines) {
-              const bool gl = engine != "stream";
-              opt.device = gl ? "gl" : "vgpu";
-              opt.gl_readback = engine == "gl-poll" ? "poll" : "block";
-              const FrameRun fr = run_frames(scene, grid, cam, opt, runs);
-              json f = {{"scene", scene.name},
-                        {"variant", variant},
-                        {"size", size},
-                        {"engine", engine},
-                        {"device", fr.device},
-                        {"runs", runs},
-                        {"wall_ms", median(fr.wall)},
-                        {"gpu_ms", gl ? json(median(fr.gpu)) : json()},
-                        {"readback_wait_ms", gl ? json(median(fr.wait)) : json()},
-                        {"passes", fr.stats.totals.passes},
-                        {"query_readbacks", fr.stats.totals.query_readbacks},
-                        {"program_loads", fr.stats.totals.program_loads},
-                        {"fragments_shaded", fr.stats.totals.fragments_shaded}};
-              json kernels = json::array();
-              for (const auto& p : fr.stats.programs) {
-                json k = {{"name", p.name},
-                          {"paper_name", p.paper_name},
-                          {"passes", p.counters.passes},
-                          {"gpu_ms", gl ? json(median(fr.kernel_gpu.at(p.name))) : json()},
-                          {"host_ms", median(fr.kernel_host.at(p.name))}};
-                if (!gl) {  // the cost model per kernel: its passes' work and fixed costs
-                  vgpu::FrameStats one;
-                  one.programs = {p};
-                  one.totals = p.counters;
-                  const vgpu::Profile& hp = vgpu::profile("h200");
-                  const host::CostBreakdown b = host::predict(one, hp, params_for(hp));
-                  k["predicted_h200_ms"] = b.total_ms;
-                  k["predicted_h200_work_ms"] = b.arithmetic_ms + b.texture_ms + b.memory_ms;
-                }
-                kernels.push_back(k);
-              }
-              f["kernels"] = kernels;
-              if (!gl) {
-                json pred;
-                for (const vgpu::Profile& p : vgpu::profiles())
-                  pred[p.name] = host::predict(fr.stats, p, params_for(p)).total_ms;
-                f["predicted_ms"] = pred;
-                json h200 = json::object();
-                const vgpu::Profile& hp = vgpu::profile("h200");
-                for (const auto& [k, v] : host::predict(fr.stats, hp, params_for(hp)).items())
-                  h200[k] = v;
-                f["predicted_h200"] = h200;
-              }
-              std::printf("%-14s %4dx%-4d %-9s %-7s wall %9.1f ms", scene.name.c_str(), size, size,
-                          variant.c_str(), engine.c_str(), median(fr.wall));
-              if (gl)
-                std::printf("  gpu %9.1f ms  wait %8.1f ms", median(fr.gpu), median(fr.wait));
-              else
-                std::printf("  h200 predicted %8.1f ms", f["predicted_ms"]["h200"].get<double>());
-              std::printf("  passes %6llu  read-backs %5llu\n",
-                          static_cast<unsigned long long>(fr.stats.totals.passes),
-                          static_cast<unsigned long long>(fr.stats.totals.query_readbacks));
-              std::fflush(stdout);
-              frames.push_back(f);
-            }
+          const host::Grid box = host::build_grid(scene, host::GridSpec{glm::ivec3(1)});
+          std::optional<host::Bvh> bvh;
+          std::optional<host::KdTree> kd;
+          for (const std::string& a : accels) {
+            if (a == "bvh" && !bvh) bvh = host::build_bvh(scene);
+            if (a == "kdtree" && !kd) kd = host::build_kdtree(scene, box.lo, box.hi);
           }
+          const host::Camera cam = host::scene_camera(scene);
+          for (const std::string& accel_name : accels)
+            for (const std::string& variant : variants) {
+              const host::AccelKind kind = host::parse_accel_kind(accel_name);
+              const host::Accel accel{kind, kind == host::AccelKind::grid ? &grid : &box,
+                                      bvh ? &*bvh : nullptr, kd ? &*kd : nullptr};
+              // The paper's pipeline at Table 1's profile; its future work (MRT fused passes, the
+              // looping kernels) needs a profile with several outputs and loops: the h200's.
+              opt.mrt = variant == "mrt";
+              opt.looping = variant == "looping";
+              opt.profile = variant == "multipass" ? "gf5700" : "h200";
+              for (const std::string& engine : engines) {
+                const bool gl = engine != "stream";
+                opt.device = gl ? "gl" : "vgpu";
+                opt.gl_readback = engine == "gl-poll" ? "poll" : "block";
+                const FrameRun fr = run_frames(scene, accel, cam, opt, runs);
+                json f = {{"scene", scene.name},
+                          {"accel", accel_name},
+                          {"bounces", opt.bounces},
+                          {"variant", variant},
+                          {"size", size},
+                          {"engine", engine},
+                          {"device", fr.device},
+                          {"runs", runs},
+                          {"wall_ms", median(fr.wall)},
+                          {"gpu_ms", gl ? json(median(fr.gpu)) : json()},
+                          {"readback_wait_ms", gl ? json(median(fr.wait)) : json()},
+                          {"passes", fr.stats.totals.passes},
+                          {"query_readbacks", fr.stats.totals.query_readbacks},
+                          {"program_loads", fr.stats.totals.program_loads},
+                          {"fragments_shaded", fr.stats.totals.fragments_shaded}};
+                json kernels = json::array();
+                for (const auto& p : fr.stats.programs) {
+                  json k = {{"name", p.name},
+                            {"paper_name", p.paper_name},
+                            {"passes", p.counters.passes},
+                            {"gpu_ms", gl ? json(median(fr.kernel_gpu.at(p.name))) : json()},
+                            {"host_ms", median(fr.kernel_host.at(p.name))}};
+                  if (!gl) {  // the cost model per kernel: its passes' work and fixed costs
+                    vgpu::FrameStats one;
+                    one.programs = {p};
+                    one.totals = p.counters;
+                    const vgpu::Profile& hp = vgpu::profile("h200");
+                    const host::CostBreakdown b = host::predict(one, hp, params_for(hp));
+                    k["predicted_h200_ms"] = b.total_ms;
+                    k["predicted_h200_work_ms"] = b.arithmetic_ms + b.texture_ms + b.memory_ms;
+                  }
+                  kernels.push_back(k);
+                }
+                f["kernels"] = kernels;
+                if (!gl) {
+                  json pred;
+                  for (const vgpu::Profile& p : vgpu::profiles())
+                    pred[p.name] = host::predict(fr.stats, p, params_for(p)).total_ms;
+                  f["predicted_ms"] = pred;
+                  json h200 = json::object();
+                  const vgpu::Profile& hp = vgpu::profile("h200");
+                  for (const auto& [k, v] : host::predict(fr.stats, hp, params_for(hp)).items())
+                    h200[k] = v;
+                  f["predicted_h200"] = h200;
+                }
+                std::printf("%-14s %4dx%-4d %-6s %-9s %-7s wall %9.1f ms", scene.name.c_str(), size,
+                            size, accel_name.c_str(), variant.c_str(), engine.c_str(),
+                            median(fr.wall));
+                if (gl)
+                  std::printf("  gpu %9.1f ms  wait %8.1f ms", median(fr.gpu), median(fr.wait));
+                else
+                  std::printf("  h200 predicted %8.1f ms", f["predicted_ms"]["h200"].get<double>());
+                std::printf("  passes %6llu  read-backs %5llu\n",
+                            static_cast<unsigned long long>(fr.stats.totals.passes),
+                            static_cast<unsigned long long>(fr.stats.totals.query_readbacks));
+                std::fflush(stdout);
+                frames.push_back(f);
+              }
+            }
         }
       }
       out["frames"] = frames;
