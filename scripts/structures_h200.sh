@@ -1,37 +1,32 @@
 #!/usr/bin/env bash
-# The structures on an H200 through the GL device (docs/structures.md): every scene x structure x
-# rays x kernels, 3 runs each. Prepare here (Debian 12), from the repository root:
-#   cmake --build build --target vgpu-rt && mkdir -p .h200 && cp build/host/vgpu-rt .h200/
+# The structures on an H200 through the GL device (docs/structures.md). Prepare here (Debian 12),
+# from the repository root:
+#   cmake --build build --target bench_gl && mkdir -p .h200 && cp build/bench/bench_gl .h200/
 #   scripts/uneven_scenes.py .h200
 #   mkdir -p .gl && (cd .gl && apt-get download libegl1 libglvnd0 libopengl0 libgl1 libglx0)
 # copy the repository with .h200 and .gl to the GPU host and run there, from its root:
 #   OUT=DIR scripts/structures_h200.sh
-# then here: /usr/bin/python3 scripts/structures.py --h200-runs DIR/r (it writes
-# docs/structures_h200.json from the runs and the document from it).
+# then copy DIR's files to docs/structures_h200_{primary,full}.json and _clocks.csv, and run here:
+#   /usr/bin/python3 scripts/structures.py --h200 docs/structures_h200_primary.json \
+#     docs/structures_h200_full.json
 set -u
-for f in .gl/*.deb; do dpkg -x "$f" /; done; ldconfig
+out="${OUT:?set OUT to a folder}"
+if [ -d .gl ]; then
+  for f in .gl/*.deb; do dpkg -x "$f" /; done
+  ldconfig
+fi
 j=/usr/local/nvidia/share/glvnd/egl_vendor.d/10_nvidia.json
 [ -f "$j" ] && export __EGL_VENDOR_LIBRARY_FILENAMES="$j"
-mkdir -p "$OUT/r"
-nvidia-smi --query-gpu=name,driver_version,clocks.sm,clocks.max.sm --format=csv > "$OUT/r/gpu.csv" 2>&1
-.h200/vgpu-rt gl-devices > "$OUT/r/devices.txt" 2>&1
-for s in sphere bunny bunny-refl classic teapot .h200/stadium.gltf .h200/scales.gltf; do
-  n=$(basename "$s" .gltf)
-  for acc in grid bvh kdtree; do
-    for mode in primary full looping; do
-      case $mode in
-        primary) o="--bounces 0 --shadows off";;
-        full) o="";;
-        looping) o="--bounces 0 --shadows off --kernels looping";;
-      esac
-      for r in 1 2 3; do
-        timeout 120 .h200/vgpu-rt render "$s" --engine gl --profile h200 --accel $acc $o \
-          --gl-readback poll --threads 16 --stats none -q \
-          --stats-json "$OUT/r/${n}_${acc}_${mode}_r$r.json" 2>>"$OUT/r/errors.txt" ||
-          echo "$n $acc $mode $r failed: $?" >> "$OUT/r/errors.txt"
-      done
-      echo "$n $acc $mode done $(date +%T)"
-    done
-  done
-done
-
+# The GPU clock while measured, every 500 ms in the background.
+nvidia-smi --query-gpu=timestamp,clocks.sm,clocks.mem,utilization.gpu --format=csv -lms 500 \
+  > "$out/clocks.csv" &
+sampler=$!
+trap 'kill $sampler 2>/dev/null || true' EXIT
+S="scenes/sphere.gltf scenes/bunny.gltf scenes/bunny-refl.gltf scenes/classic.gltf"
+S="$S scenes/teapot.gltf .h200/stadium.gltf .h200/scales.gltf"
+.h200/bench_gl --runs 3 --sizes 256 --threads 16 --readback-wait poll --grid auto \
+  --accel grid bvh kdtree --variants multipass looping --bounces 0 --scenes $S \
+  --json "$out/structures_primary.json"
+.h200/bench_gl --runs 3 --sizes 256 --threads 16 --readback-wait poll --grid auto \
+  --accel grid bvh kdtree --variants multipass --bounces 2 --micro-passes 10 --scenes $S \
+  --json "$out/structures_full.json"
