@@ -448,3 +448,75 @@ TEST_CASE("a render writes the image, the AOVs and the statistics asked for, and
     CHECK_MESSAGE(names.count(kernel) == 1, kernel);
   fs::remove_all(dir);
 }
+
+// --accel kdtree and --accel auto (tests/trace/test_kd_walk.cpp tests the walk itself).
+namespace {
+
+// A render of bunny-low at 32x32 with the statistics JSON read back; "" args added.
+nlohmann::json render_json(const std::string& args, const fs::path& dir, Outcome& o) {
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  o = run("render bunny-low --size 32x32 -q --stats none --out " + (dir / "image.png").string() +
+          " --stats-json " + (dir / "stats.json").string() + " " + args);
+  if (o.status != 0 || !fs::exists(dir / "stats.json")) return nlohmann::json();
+  return nlohmann::json::parse(slurp(dir / "stats.json"));
+}
+
+}  // namespace
+
+TEST_CASE("accel kdtree renders and its JSON names the kd-tree with its nodes, leaves and depth") {
+  const fs::path dir = fs::temp_directory_path() / ("vgpu_cli_kd_" + std::to_string(::getpid()));
+  Outcome o;
+  const nlohmann::json j = render_json("--accel kdtree", dir, o);
+  INFO("vgpu-rt render --accel kdtree -> " << o.err);
+  REQUIRE(o.status == 0);
+  CHECK(o.err.empty());
+  CHECK(read_png_header(dir / "image.png").width == 32);
+  REQUIRE(j.contains("accel"));
+  const nlohmann::json& a = j["accel"];
+  CHECK(a["structure"] == "kdtree");
+  const uint64_t nodes = a["nodes"].get<uint64_t>(), leaves = a["leaves"].get<uint64_t>();
+  CHECK(leaves > 1);
+  CHECK(nodes == 2 * leaves - 1);  // every inner node has two children
+  CHECK(a["depth"].get<int>() > 1);
+  CHECK(a["max_leaf"].get<int>() > 0);
+  CHECK(a["references"].get<uint64_t>() > 0);
+  CHECK(a["work"]["nodes_visited"].get<uint64_t>() > 0);
+  CHECK(a["work"]["triangle_tests"].get<uint64_t>() > 0);
+  CHECK(a["work"]["voxel_steps"].get<uint64_t>() == 0);
+  CHECK_FALSE(a.contains("auto"));
+  fs::remove_all(dir);
+}
+
+TEST_CASE(
+    "accel auto's JSON gives the predicted time of the grid, the BVH and the kd-tree and why") {
+  const fs::path dir = fs::temp_directory_path() / ("vgpu_cli_auto_" + std::to_string(::getpid()));
+  Outcome o;
+  const nlohmann::json j = render_json("--accel auto", dir, o);
+  INFO("vgpu-rt render --accel auto -> " << o.err);
+  REQUIRE(o.status == 0);
+  REQUIRE(j.contains("accel"));
+  const nlohmann::json& a = j["accel"];
+  REQUIRE(a.contains("auto"));
+  const nlohmann::json& au = a["auto"];
+  const std::string chosen = a["structure"].get<std::string>();
+  CHECK((chosen == "grid" || chosen == "bvh" || chosen == "kdtree"));
+  REQUIRE(au["predicted_ms"].is_object());
+  CHECK(au["predicted_ms"].size() == 3);
+  double best = 1e300;
+  for (const char* k : {"grid", "bvh", "kdtree"}) {
+    CAPTURE(k);
+    REQUIRE(au["predicted_ms"].contains(k));
+    CHECK(au["predicted_ms"][k].get<double>() > 0);
+    best = std::min(best, au["predicted_ms"][k].get<double>());
+  }
+  CHECK(au["predicted_ms"][chosen].get<double>() == best);  // the cheapest was taken
+  const std::string why = au["why"].get<std::string>();
+  CHECK(why.rfind(chosen + " predicted ", 0) == 0);  // a sentence naming the choice first
+  CHECK(why.find('\n') == std::string::npos);
+  fs::remove_all(dir);
+}
+
+TEST_CASE("an unknown acceleration structure is refused with one line, exit 2 and no image") {
+  check_refused("--accel nonsense", "--accel", "nonsense");
+}
