@@ -1,8 +1,9 @@
-// The image module: OpenImageIO writes and comparisons behind the C interface of
+// The image module: OpenImageIO reads (textures), writes and comparisons behind the C interface of
 // host/image/image_module.h. Built as libvgpu-image.so and loaded on first use by
 // host/image/image_io.cpp.
 #include "host/image/image_module.h"
 
+#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>
 #include <OpenImageIO/imageio.h>
@@ -56,5 +57,31 @@ extern "C" int vgpu_image_compare(const char* a, const char* b, double threshold
                 err, err_size);
   const auto r = OIIO::ImageBufAlgo::compare(A, B, float(threshold), float(threshold));
   *out = {sa.width, sa.height, sa.nchannels, double(r.nfail), r.rms_error, r.PSNR, r.maxerror};
+  return 0;
+}
+
+extern "C" int vgpu_image_read(const unsigned char* bytes, size_t n,
+                               float* (*alloc)(void* ctx, size_t count), void* ctx, int* width,
+                               int* height, int* channels, char* err, size_t err_size) {
+  // The format from the content, not from a name: glTF's mimeType and file extensions may lie.
+  const char* format = nullptr;
+  if (n >= 8 && bytes[0] == 0x89 && bytes[1] == 'P' && bytes[2] == 'N' && bytes[3] == 'G')
+    format = "memory.png";
+  else if (n >= 3 && bytes[0] == 0xFF && bytes[1] == 0xD8 && bytes[2] == 0xFF)
+    format = "memory.jpg";
+  if (!format) return fail("not a PNG or JPEG image", err, err_size);
+  OIIO::Filesystem::IOMemReader mem(bytes, n);
+  auto in = OIIO::ImageInput::open(format, nullptr, &mem);
+  if (!in) return fail("cannot decode: " + OIIO::geterror(), err, err_size);
+  const OIIO::ImageSpec& spec = in->spec();
+  if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || spec.depth != 1)
+    return fail("not a 2D image", err, err_size);
+  *width = spec.width;
+  *height = spec.height;
+  *channels = spec.nchannels;
+  float* out = alloc(ctx, size_t(spec.width) * size_t(spec.height) * size_t(spec.nchannels));
+  if (!out) return fail("out of memory", err, err_size);
+  if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, out))
+    return fail("cannot decode: " + in->geterror(), err, err_size);
   return 0;
 }
