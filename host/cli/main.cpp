@@ -492,9 +492,7 @@ int run_render(const RenderArgs& a, bool lanes_given) {
   }
 
   const std::string path = host::resolve_scene(a.scene);
-  host::LoadOptions load;
-  load.read_image = host::decode_image;
-  const host::Scene scene = host::load_scene(path, load);
+  const host::Scene scene = host::load_scene(path, host::with_images());
   const auto t0 = std::chrono::steady_clock::now();
   // With a structure other than the grid, the grid is one voxel: it gives the scene box only.
   const bool auto_accel = a.accel == "auto";
@@ -871,9 +869,7 @@ int main(int argc, char** argv) {
     if (*scenes) {
       for (const auto& [name, path] : host::list_scenes()) {
         try {
-          host::LoadOptions load;
-          load.read_image = host::decode_image;
-          const host::Scene s = host::load_scene(path, load);
+          const host::Scene s = host::load_scene(path, host::with_images());
           std::printf("%-14s %7zu triangles  %s\n", name.c_str(), s.triangle_count(), path.c_str());
         } catch (const std::exception& e) {
           std::printf("%-14s (unreadable: %s)\n", name.c_str(), e.what());

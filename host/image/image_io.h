@@ -34,6 +34,12 @@ struct ImageComparison {
 // std::runtime_error with the reason (the loader names the file and the image).
 ImagePixels decode_image(const std::vector<unsigned char>& bytes);
 
+// `options` with read_image = decode_image: what a caller that renders textures loads with.
+inline LoadOptions with_images(LoadOptions options = {}) {
+  options.read_image = decode_image;
+  return options;
+}
+
 // OpenImageIO's ImageBufAlgo::compare over every channel.
 ImageComparison compare_images(const std::string& a, const std::string& b, double threshold);
 

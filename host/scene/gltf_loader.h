@@ -27,7 +27,7 @@ struct LoadOptions {
   // Decodes a PNG or JPEG image (host::decode_image); throws std::exception with the reason.
   // Unset: a file whose materials use a texture is refused (the scene room cannot decode images;
   // host/image, above it, can).
-  std::function<ImagePixels(const std::vector<unsigned char>&)> read_image;
+  std::function<ImagePixels(const std::vector<unsigned char>&)> read_image{};
 };
 
 // Loads the default scene (or scene 0, or every root node when the file has no scenes).
