@@ -448,3 +448,47 @@ TEST_CASE("a render writes the image, the AOVs and the statistics asked for, and
     CHECK_MESSAGE(names.count(kernel) == 1, kernel);
   fs::remove_all(dir);
 }
+
+TEST_CASE("the texture filter is checked against its set and listed in --help") {
+  check_refused("--texture-filter anisotropic", "--texture-filter",
+                "anisotropic not in {nearest,bilinear,trilinear}");
+  const Outcome o = run("render --help");
+  CHECK(o.out.find("--texture-filter") != std::string::npos);
+  CHECK(o.out.find("nearest,bilinear,trilinear") != std::string::npos);
+}
+
+TEST_CASE("a texture that cannot be read or a UV accessor of the wrong type: one line, no image") {
+  const std::string data = std::string(VGPU_TEST_DATA) + "/gltf/";
+  const fs::path out =
+      fs::temp_directory_path() / ("vgpu_cli_texture_" + std::to_string(::getpid()) + ".png");
+  struct Case {
+    const char* file;
+    const char* problem;
+  };
+  for (const Case& c :
+       {Case{"texture_missing.gltf", "image 0 (no_such_texture.png): cannot read"},
+        Case{"texture_not_an_image.gltf",
+             "image 0: cannot read the image: not a PNG or JPEG image"},
+        Case{"texcoord_vec3.gltf", "TEXCOORD_0: accessor 0 must be VEC2 of float"}}) {
+    CAPTURE(c.file);
+    for (const char* engine : {"stream", "cpu"}) {
+      CAPTURE(engine);
+      const Outcome o = run("render " + data + c.file + " -q --stats none --engine " + engine +
+                            " --out " + out.string());
+      CHECK(o.status != 0);
+      check_one_line(o, data + c.file, c.problem);
+      CHECK_FALSE(fs::exists(out));
+    }
+  }
+}
+
+TEST_CASE("a textured glTF renders its texture's colours through the CLI") {
+  const fs::path out =
+      fs::temp_directory_path() / ("vgpu_cli_duck_" + std::to_string(::getpid()) + ".png");
+  const Outcome o = run("render " + std::string(VGPU_TEST_DATA) +
+                        "/gltf/textured.glb -q --stats none --size 32x32 --out " + out.string());
+  INFO(o.err);
+  CHECK(o.status == 0);
+  CHECK(fs::exists(out));
+  fs::remove(out);
+}
