@@ -619,6 +619,10 @@ int run_render(const RenderArgs& a, bool lanes_given) {
   j["iterations"] = r.iterations;
   j["shading"] = a.shading;
   j["shadows"] = opt.shadows;
+  if (!scene.textures.empty()) {  // base-colour textures (kernels/base_color.h)
+    j["textures"] = scene.textures.size();
+    j["texture_filter"] = a.texture_filter;
+  }
   j["masks"] = opt.masks;
   j["mrt"] = opt.mrt;  // fused two-output passes (kernels/fused.h)
   j["fused_programs"] = opt.mrt ? host::mrt_programs() : std::vector<std::string>{};

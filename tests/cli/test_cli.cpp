@@ -482,13 +482,27 @@ TEST_CASE("a texture that cannot be read or a UV accessor of the wrong type: one
   }
 }
 
-TEST_CASE("a textured glTF renders its texture's colours through the CLI") {
-  const fs::path out =
-      fs::temp_directory_path() / ("vgpu_cli_duck_" + std::to_string(::getpid()) + ".png");
+TEST_CASE("a textured glb renders through the CLI, its JSON naming the textures and the filter") {
+  const std::string id = std::to_string(::getpid());
+  const fs::path out = fs::temp_directory_path() / ("vgpu_cli_duck_" + id + ".png"),
+                 js = fs::temp_directory_path() / ("vgpu_cli_duck_" + id + ".json");
   const Outcome o = run("render " + std::string(VGPU_TEST_DATA) +
-                        "/gltf/textured.glb -q --stats none --size 32x32 --out " + out.string());
+                        "/gltf/textured.glb -q --stats none --size 32x32 --texture-filter bilinear "
+                        "--out " +
+                        out.string() + " --stats-json " + js.string());
   INFO(o.err);
-  CHECK(o.status == 0);
+  REQUIRE(o.status == 0);
   CHECK(fs::exists(out));
+  const auto j = nlohmann::json::parse(slurp(js));
+  CHECK(j["textures"] == 1);
+  CHECK(j["texture_filter"] == "bilinear");
+  // An untextured scene's JSON has neither.
+  const Outcome plain =
+      run("render bunny-low -q --stats none --size 16x16 --stats-json " + js.string());
+  REQUIRE(plain.status == 0);
+  const auto p = nlohmann::json::parse(slurp(js));
+  CHECK_FALSE(p.contains("textures"));
+  CHECK_FALSE(p.contains("texture_filter"));
   fs::remove(out);
+  fs::remove(js);
 }
