@@ -7,11 +7,37 @@
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>
 #include <OpenImageIO/imageio.h>
+#include <fcntl.h>
+#include <unistd.h>
 
 #include <cstdio>
 #include <string>
 
 namespace {
+
+// Points file descriptor 2 at /dev/null for its lifetime (flushing stderr first and after).
+class QuietStderr {
+ public:
+  QuietStderr() {
+    std::fflush(stderr);
+    saved_ = ::dup(2);
+    const int null = ::open("/dev/null", O_WRONLY);
+    if (saved_ >= 0 && null >= 0) ::dup2(null, 2);
+    if (null >= 0) ::close(null);
+  }
+  ~QuietStderr() {
+    std::fflush(stderr);
+    if (saved_ >= 0) {
+      ::dup2(saved_, 2);
+      ::close(saved_);
+    }
+  }
+  QuietStderr(const QuietStderr&) = delete;
+  QuietStderr& operator=(const QuietStderr&) = delete;
+
+ private:
+  int saved_ = -1;
+};
 
 int fail(std::string reason, char* err, size_t err_size) {
   for (char& c : reason)
@@ -70,6 +96,9 @@ extern "C" int vgpu_image_read(const unsigned char* bytes, size_t n,
   else if (n >= 3 && bytes[0] == 0xFF && bytes[1] == 0xD8 && bytes[2] == 0xFF)
     format = "memory.jpg";
   if (!format) return fail("not a PNG or JPEG image", err, err_size);
+  // libpng prints its errors on stderr before OpenImageIO returns them: the caller's one-line
+  // message would get a second line. stderr is quiet while decoding.
+  const QuietStderr quiet;
   OIIO::Filesystem::IOMemReader mem(bytes, n);
   auto in = OIIO::ImageInput::open(format, nullptr, &mem);
   if (!in) return fail("cannot decode: " + OIIO::geterror(), err, err_size);

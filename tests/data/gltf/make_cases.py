@@ -409,11 +409,13 @@ def textured_cases():
     # KHR_texture_transform: u + 0.5 (and REPEAT would wrap; CLAMP_TO_EDGE is what the sampler says).
     b, d = textured_quad({"uri": png_uri}, transform={"offset": [0.5, 0], "scale": [2, 1]})
     write_gltf("textured_transform.gltf", d, b.bin)
-    # Bad: a missing file, bytes that are no image, a TEXCOORD_0 of VEC3.
+    # Bad: a missing file, bytes that are no image, a PNG cut short, a TEXCOORD_0 of VEC3.
     b, d = textured_quad({"uri": "no_such_texture.png"})
     write_gltf("texture_missing.gltf", d, b.bin)
     b, d = textured_quad({"uri": "data:image/png;base64," + base64.b64encode(b"not an image").decode()})
     write_gltf("texture_not_an_image.gltf", d, b.bin)
+    b, d = textured_quad({"uri": "data:image/png;base64," + base64.b64encode(png[:40]).decode()})
+    write_gltf("texture_truncated.gltf", d, b.bin)
     b, d = textured_quad({"uri": png_uri}, uv_type="VEC3")
     write_gltf("texcoord_vec3.gltf", d, b.bin)
 
