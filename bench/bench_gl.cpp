@@ -18,6 +18,7 @@
 #include "gl/gl_device.h"
 #include "host/accel/accel.h"
 #include "host/accel/grid.h"
+#include "host/image/image_io.h"
 #include "host/model/cost_model.h"
 #include "host/scene/camera.h"
 #include "host/scene/gltf_loader.h"
@@ -287,7 +288,7 @@ int main(int argc, char** argv) {
     if (!no_frames) {
       json frames = json::array();
       for (const std::string& name : scenes) {
-        const host::Scene scene = host::load_scene(host::resolve_scene(name));
+        const host::Scene scene = host::load_scene(host::resolve_scene(name), host::with_images());
         for (int size : sizes) {
           host::RenderOptions opt;  // docs/table1.md's settings
           opt.width = opt.height = size;

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "host/accel/grid.h"
+#include "host/image/image_io.h"
 #include "host/scene/camera.h"
 #include "host/scene/gltf_loader.h"
 #include "host/trace/stream_tracer.h"
@@ -101,7 +102,7 @@ int main(int argc, char** argv) {
   const std::vector<std::string> names = argc > 1 ? std::vector<std::string>(argv + 1, argv + argc)
                                                   : std::vector<std::string>{"bunny"};
   for (const std::string& name : names) {
-    const host::Scene s = host::load_scene(host::resolve_scene(name));
+    const host::Scene s = host::load_scene(host::resolve_scene(name), host::with_images());
     for (int threads : {1, ncores}) {
       bench(name + ", primary only", s, 0, threads, reps);
       bench(name + ", 3 reflections", s, 3, threads, reps);

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "host/accel/grid.h"
+#include "host/image/image_io.h"
 #include "host/scene/camera.h"
 #include "host/scene/gltf_loader.h"
 #include "host/trace/cpu_tracer.h"
@@ -50,7 +51,7 @@ host::Grid auto_grid(const host::Scene& s) {
 Case scene_file(const std::string& name, int bounces) {
   Case c;
   c.label = name + (bounces ? ", " + std::to_string(bounces) + " bounces" : ", primary");
-  c.scene = host::load_scene(host::resolve_scene(name));
+  c.scene = host::load_scene(host::resolve_scene(name), host::with_images());
   c.grid = auto_grid(c.scene);
   c.camera = host::scene_camera(c.scene);
   c.bounces = bounces;

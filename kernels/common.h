@@ -93,11 +93,17 @@ namespace kernels {
 
 // The triangle `tri` seen at world point p: barycentric weights from its corners, the
 // interpolated shading normal (unit) and the geometric normal (unit). Both normals face the
-// side the incoming direction d comes from.
+// side the incoming direction d comes from. The barycentric solve is kept for the texture
+// coordinates and their derivatives (kernels/base_color.h).
 template <class F>
 struct Surface {
   Vec3<F> n;   // shading normal
   Vec3<F> ng;  // geometric normal
+  F b1, b2;    // barycentric weights of corners 1 and 2 at p
+  // The solve: edges e1 = p1 - p0, e2 = p2 - p0 (world space), their dot products and the
+  // inverse determinant; a world-space step dp changes b1 by (d11 dp.e1 - d01 dp.e2) inv.
+  Vec3<F> e1, e2;
+  F d00, d01, d11, inv;
 };
 
 template <class L>
@@ -120,7 +126,7 @@ inline Surface<typename L::F> surface_at(const Fragments<L>& f, const typename L
   Vec3<F> ng = normalize(cross(e1, e2));
   n = select(dot(n, d) > F(0.0f), -n, n);
   ng = select(dot(ng, d) > F(0.0f), -ng, ng);
-  return {n, ng};
+  return {n, ng, b1, b2, e1, e2, d00, d01, d11, inv};
 }
 
 }  // namespace kernels

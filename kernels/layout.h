@@ -6,6 +6,15 @@
 //   vertices0/1/2   xyz    corner positions, world space       (paper: texturaVertices)
 //   normals0/1/2    xyz    corner normals, world space, unit   (paper: texturaNormales)
 //   colors          rgba   rgb = colour, a = reflection coefficient (paper: texturaColores)
+//   uvs01           xyzw   texture coordinates of corners 0 (xy) and 1 (zw)     (scenes with a
+//   uvs2            xyz    xy = corner 2's coordinates, z = the triangle's       textured
+//                          texture (row of the texture table), -1: untextured    material only)
+// Static (base-colour textures, kernels/base_color.h; scenes with a textured material only):
+//   texture table   rgba   one row per texture: texel 0 = (mip levels, wrap s, wrap t, 0)
+//                          (wraps as vgpu::Wrap), texel 1 + k = level k's rectangle in the
+//                          atlas (x, y, width, height), texels
+//   texture atlas   rgba   every texture's mip chain (linear rgb, alpha), each level a
+//                          rectangle: level 0 with levels 1.. stacked at its right
 // Static (grid):
 //   triangle lists  x      triangle ids of each voxel, voxels one after another, each list
 //                          closed by -1; texel of list entry k at (k mod width, k div width)
@@ -52,6 +61,8 @@
 
 #include <glm/glm.hpp>
 
+#include "vgpu/sampler.h"
+
 namespace kernels {
 
 // "No triangle" and "ray done" markers, and the parameter standing for infinity (it survives
@@ -71,6 +82,17 @@ struct GridUniforms {
 // Uniforms describing the scene textures' layout.
 struct SceneUniforms {
   float width = 1;  // width of the vertex/normal/color textures, texels
+};
+
+// Base-colour textures (kernels/base_color.h): off for a scene without any, so its programs and
+// images are the untextured ones.
+struct TextureUniforms {
+  bool on = false;
+  vgpu::Filter filter = vgpu::Filter::trilinear;
+  // The level of detail's ray differentials (Igehy 1999): the camera's right and up (unit,
+  // world space) and the angle between neighbouring pixels' rays, 2 tan(yfov / 2) / height.
+  glm::vec3 right{1, 0, 0}, up{0, 1, 0};
+  float spread = 0;
 };
 
 }  // namespace kernels

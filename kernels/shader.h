@@ -5,8 +5,11 @@
 //   diffuse:      kd (ambient + sum over lights of vis * max(n.l, 0))
 //   phong:        + vis * ks * max(r.v, 0)^32
 //   phong-atten:  the per-light terms divided by 1 + (dist / atten_dist)^2 (paper Fig. 3)
+// With base-colour textures (texture.on), kd is the material's colour times the filtered texel
+// (kernels/base_color.h), through five more units: 16 in all, fp30's every texture image unit.
 #pragma once
 
+#include "kernels/base_color.h"
 #include "kernels/common.h"
 
 namespace kernels {
@@ -17,12 +20,31 @@ struct Shader {
   static constexpr const char* name = "shader";
   static constexpr const char* paper_name = "shader";
   static constexpr int outputs = 1;  // -> result
-  enum Unit { kSurface, kRays, kResult, kShadow, kColors, kV0, kV1, kV2, kN0, kN1, kN2 };
-  static constexpr std::array<const char*, 11> units{
-      "surface",   "rays",      "result",   "shadow_hits", "colors",  "vertices0",
-      "vertices1", "vertices2", "normals0", "normals1",    "normals2"};
+  enum Unit {
+    kSurface,
+    kRays,
+    kResult,
+    kShadow,
+    kColors,
+    kV0,
+    kV1,
+    kV2,
+    kN0,
+    kN1,
+    kN2,
+    kOrigins,  // the rays' origins, the uvs, the table and the atlas: textured scenes only
+    kUv01,
+    kUv2,
+    kTable,
+    kAtlas
+  };
+  static constexpr std::array<const char*, 16> units{
+      "surface",   "rays",      "result",        "shadow_hits",  "colors",   "vertices0",
+      "vertices1", "vertices2", "normals0",      "normals1",     "normals2", "origins",
+      "uvs01",     "uvs2",      "texture_table", "texture_atlas"};
 
   SceneUniforms scene;
+  TextureUniforms texture;
   ShadingModel model = ShadingModel::diffuse;
   glm::vec3 light{0.0f}, light_color{1.0f};  // world space; rgb x intensity
   bool first_light = true, last_light = true;
@@ -44,8 +66,15 @@ struct Shader {
     F weight = last_light ? F(0.0f) : w;
     if (f.branch(hit)) {
       const Vec4<F> mat = fetch_id(f, kColors, surf.w, scene.width);
-      const Vec3<F> kd = mat.xyz();
+      Vec3<F> kd = mat.xyz();
       const Surface<F> s = surface_at(f, surf.w, surf.xyz(), d, kV0, kN0, scene);
+      if (texture.on) {
+        typename L::M textured;
+        const Vec3<F> origin = f.fetch_own(kOrigins).xyz();
+        const Vec4<F> texel = base_color(f, texture, scene, surf.w, surf.xyz(), d, origin, s, kUv01,
+                                         kUv2, kTable, kAtlas, textured);
+        kd = select(textured, kd * texel.xyz(), kd);
+      }
       const Vec3<F> to = splat<F>(light) - surf.xyz();
       const F dist = sqrt(dot(to, to));
       const Vec3<F> l = to * (F(1.0f) / dist);

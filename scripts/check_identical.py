@@ -28,6 +28,7 @@ CASES = [  # (scene, extra options)
     ("sphere-alone", ["--shading", "phong-atten", "--grid", "15"]),
     ("bunny-refl", ["--profile", "gf6600", "--mrt", "on"]),
     ("classic", ["--profile", "gf6600", "--kernels", "looping", "--size", "96x96"]),
+    ("textured", ["--size", "96x96", "--texture-filter", "trilinear"]),  # both binaries need textures
 ]
 TIMING = ("_ms",)
 

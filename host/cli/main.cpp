@@ -44,6 +44,7 @@ struct RenderArgs {
   std::string out;
   int bounces = 2;
   std::string shading = "phong";
+  std::string texture_filter = "trilinear";
   std::string shadows = "on";
   std::string grid = "auto";
   std::string accel = "grid";
@@ -225,6 +226,13 @@ void add_render_options(CLI::App& render, RenderArgs& a) {
   render.add_option("--shading", a.shading, "Shading model")
       ->check(CLI::IsMember({"diffuse", "phong", "phong-atten"}))
       ->capture_default_str();
+  render
+      .add_option("--texture-filter", a.texture_filter,
+                  "How the shader's texture unit filters base-colour textures: nearest (1 "
+                  "texel), bilinear (4), trilinear (8, mipmapped; level of detail from ray "
+                  "differentials)")
+      ->check(CLI::IsMember({"nearest", "bilinear", "trilinear"}))
+      ->capture_default_str();
   render.add_option("--shadows", a.shadows, "Shadow rays")
       ->check(CLI::IsMember(on_off))
       ->capture_default_str();
@@ -373,6 +381,9 @@ int run_render(const RenderArgs& a, bool lanes_given) {
   opt.bounces = a.bounces;
   opt.shading = host::parse_shading(a.shading);
   opt.shadows = a.shadows == "on";
+  opt.texture_filter = a.texture_filter == "nearest"    ? vgpu::Filter::nearest
+                       : a.texture_filter == "bilinear" ? vgpu::Filter::bilinear
+                                                        : vgpu::Filter::trilinear;
   opt.masks = a.masks == "on";
   opt.mrt = a.mrt == "on";
   opt.looping = a.kernels == "looping";
@@ -481,7 +492,7 @@ int run_render(const RenderArgs& a, bool lanes_given) {
   }
 
   const std::string path = host::resolve_scene(a.scene);
-  const host::Scene scene = host::load_scene(path);
+  const host::Scene scene = host::load_scene(path, host::with_images());
   const auto t0 = std::chrono::steady_clock::now();
   // With a structure other than the grid, the grid is one voxel: it gives the scene box only.
   const bool auto_accel = a.accel == "auto";
@@ -608,6 +619,10 @@ int run_render(const RenderArgs& a, bool lanes_given) {
   j["iterations"] = r.iterations;
   j["shading"] = a.shading;
   j["shadows"] = opt.shadows;
+  if (!scene.textures.empty()) {  // base-colour textures (kernels/base_color.h)
+    j["textures"] = scene.textures.size();
+    j["texture_filter"] = a.texture_filter;
+  }
   j["masks"] = opt.masks;
   j["mrt"] = opt.mrt;  // fused two-output passes (kernels/fused.h)
   j["fused_programs"] = opt.mrt ? host::mrt_programs() : std::vector<std::string>{};
@@ -858,7 +873,13 @@ int main(int argc, char** argv) {
     if (*scenes) {
       for (const auto& [name, path] : host::list_scenes()) {
         try {
-          const host::Scene s = host::load_scene(path);
+          // The listing counts triangles: images are not decoded (loading the image module
+          // would take the listing from 0.1 s to 1 s), each stands as one white texel.
+          host::LoadOptions listing;
+          listing.read_image = [](const std::vector<unsigned char>&) {
+            return host::ImagePixels{1, 1, 3, {1.0f, 1.0f, 1.0f}};
+          };
+          const host::Scene s = host::load_scene(path, listing);
           std::printf("%-14s %7zu triangles  %s\n", name.c_str(), s.triangle_count(), path.c_str());
         } catch (const std::exception& e) {
           std::printf("%-14s (unreadable: %s)\n", name.c_str(), e.what());

@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <mutex>
+#include <stdexcept>
 
 #include "host/image/image_module.h"
 #include "host/scene/scene.h"
@@ -51,6 +52,7 @@ namespace {
 struct ImageModule {
   decltype(&vgpu_image_write) write = nullptr;
   decltype(&vgpu_image_compare) compare = nullptr;
+  decltype(&vgpu_image_read) read = nullptr;
 };
 
 // The directory of the running executable (/proc/self/exe), or empty.
@@ -76,7 +78,8 @@ const ImageModule& image_module(const std::string& user) {
     if (!h) return;
     m.write = reinterpret_cast<decltype(m.write)>(::dlsym(h, VGPU_IMAGE_WRITE));
     m.compare = reinterpret_cast<decltype(m.compare)>(::dlsym(h, VGPU_IMAGE_COMPARE));
-    if (!m.write || !m.compare) {
+    m.read = reinterpret_cast<decltype(m.read)>(::dlsym(h, VGPU_IMAGE_READ));
+    if (!m.write || !m.compare || !m.read) {
       m = {};
       error = std::string(VGPU_IMAGE_MODULE_NAME) + " lacks its entry points";
     }
@@ -108,6 +111,21 @@ void write_image(const std::string& path, int width, int height, int channels,
     std::remove(tmp.c_str());
     throw InputError(path + ": cannot write image: " + ec.message());
   }
+}
+
+ImagePixels decode_image(const std::vector<unsigned char>& bytes) {
+  const ImageModule& im = image_module("an image");
+  ImagePixels out;
+  auto alloc = [](void* ctx, size_t count) -> float* {
+    auto& v = static_cast<ImagePixels*>(ctx)->pixels;
+    v.assign(count, 0.0f);
+    return v.data();
+  };
+  char err[512] = "";
+  if (im.read(bytes.data(), bytes.size(), alloc, &out, &out.width, &out.height, &out.channels, err,
+              sizeof err) != 0)
+    throw std::runtime_error(err);
+  return out;
 }
 
 ImageComparison compare_images(const std::string& a, const std::string& b, double threshold) {

@@ -5,6 +5,8 @@
 #include <string>
 #include <vector>
 
+#include "host/scene/gltf_loader.h"
+
 namespace host {
 
 // Writes width x height pixels of `channels` floats (row 0 = top). The format follows the
@@ -28,6 +30,16 @@ struct ImageComparison {
   double rms_error = 0, psnr = 0, max_error = 0;
   double threshold = 0;
 };
+// Decodes a PNG or JPEG image held in memory (glTF textures: LoadOptions::read_image). Throws
+// std::runtime_error with the reason (the loader names the file and the image).
+ImagePixels decode_image(const std::vector<unsigned char>& bytes);
+
+// `options` with read_image = decode_image: what a caller that renders textures loads with.
+inline LoadOptions with_images(LoadOptions options = {}) {
+  options.read_image = decode_image;
+  return options;
+}
+
 // OpenImageIO's ImageBufAlgo::compare over every channel.
 ImageComparison compare_images(const std::string& a, const std::string& b, double threshold);
 

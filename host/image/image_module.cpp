@@ -1,16 +1,43 @@
-// The image module: OpenImageIO writes and comparisons behind the C interface of
+// The image module: OpenImageIO reads (textures), writes and comparisons behind the C interface of
 // host/image/image_module.h. Built as libvgpu-image.so and loaded on first use by
 // host/image/image_io.cpp.
 #include "host/image/image_module.h"
 
+#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>
 #include <OpenImageIO/imageio.h>
+#include <fcntl.h>
+#include <unistd.h>
 
 #include <cstdio>
 #include <string>
 
 namespace {
+
+// Points file descriptor 2 at /dev/null for its lifetime (flushing stderr first and after).
+class QuietStderr {
+ public:
+  QuietStderr() {
+    std::fflush(stderr);
+    saved_ = ::dup(2);
+    const int null = ::open("/dev/null", O_WRONLY);
+    if (saved_ >= 0 && null >= 0) ::dup2(null, 2);
+    if (null >= 0) ::close(null);
+  }
+  ~QuietStderr() {
+    std::fflush(stderr);
+    if (saved_ >= 0) {
+      ::dup2(saved_, 2);
+      ::close(saved_);
+    }
+  }
+  QuietStderr(const QuietStderr&) = delete;
+  QuietStderr& operator=(const QuietStderr&) = delete;
+
+ private:
+  int saved_ = -1;
+};
 
 int fail(std::string reason, char* err, size_t err_size) {
   for (char& c : reason)
@@ -56,5 +83,34 @@ extern "C" int vgpu_image_compare(const char* a, const char* b, double threshold
                 err, err_size);
   const auto r = OIIO::ImageBufAlgo::compare(A, B, float(threshold), float(threshold));
   *out = {sa.width, sa.height, sa.nchannels, double(r.nfail), r.rms_error, r.PSNR, r.maxerror};
+  return 0;
+}
+
+extern "C" int vgpu_image_read(const unsigned char* bytes, size_t n,
+                               float* (*alloc)(void* ctx, size_t count), void* ctx, int* width,
+                               int* height, int* channels, char* err, size_t err_size) {
+  // The format from the content, not from a name: glTF's mimeType and file extensions may lie.
+  const char* format = nullptr;
+  if (n >= 8 && bytes[0] == 0x89 && bytes[1] == 'P' && bytes[2] == 'N' && bytes[3] == 'G')
+    format = "memory.png";
+  else if (n >= 3 && bytes[0] == 0xFF && bytes[1] == 0xD8 && bytes[2] == 0xFF)
+    format = "memory.jpg";
+  if (!format) return fail("not a PNG or JPEG image", err, err_size);
+  // libpng prints its errors on stderr before OpenImageIO returns them: the caller's one-line
+  // message would get a second line. stderr is quiet while decoding.
+  const QuietStderr quiet;
+  OIIO::Filesystem::IOMemReader mem(bytes, n);
+  auto in = OIIO::ImageInput::open(format, nullptr, &mem);
+  if (!in) return fail("cannot decode: " + OIIO::geterror(), err, err_size);
+  const OIIO::ImageSpec& spec = in->spec();
+  if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || spec.depth != 1)
+    return fail("not a 2D image", err, err_size);
+  *width = spec.width;
+  *height = spec.height;
+  *channels = spec.nchannels;
+  float* out = alloc(ctx, size_t(spec.width) * size_t(spec.height) * size_t(spec.nchannels));
+  if (!out) return fail("out of memory", err, err_size);
+  if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, out))
+    return fail("cannot decode: " + in->geterror(), err, err_size);
   return 0;
 }

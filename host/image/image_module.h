@@ -22,8 +22,16 @@ int vgpu_image_write(const char* path, int width, int height, int channels, cons
 // `threshold` as the failure and warning level. Returns 0, or -1 with "PATH: reason" in err.
 int vgpu_image_compare(const char* a, const char* b, double threshold, VgpuImageComparison* out,
                        char* err, size_t err_size);
+
+// Decodes a PNG or JPEG image held in memory (n bytes): its size and channels, and its texels
+// as floats (the stored values scaled to [0, 1], no colour conversion), row 0 = top, written
+// into the width * height * channels floats alloc(ctx, count) returns. Returns 0, or -1 with a
+// one-line reason in err.
+int vgpu_image_read(const unsigned char* bytes, size_t n, float* (*alloc)(void* ctx, size_t count),
+                    void* ctx, int* width, int* height, int* channels, char* err, size_t err_size);
 }
 
 // The names image_io.cpp looks up with dlsym.
 #define VGPU_IMAGE_WRITE "vgpu_image_write"
 #define VGPU_IMAGE_COMPARE "vgpu_image_compare"
+#define VGPU_IMAGE_READ "vgpu_image_read"

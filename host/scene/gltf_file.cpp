@@ -366,7 +366,7 @@ std::string first_line(const std::string& text) {
 namespace gltf_detail {
 
 std::vector<uint64_t> parse_file(const std::string& path, tinygltf::Model& model,
-                                 std::vector<std::string>& warnings) {
+                                 std::vector<std::string>& warnings, std::string& textures) {
   const std::vector<unsigned char> bytes = read_bytes(path);  // freed once parsed
   if (bytes.empty()) fail(path, "the file is empty");
   GlbParts glb;
@@ -386,7 +386,22 @@ std::vector<uint64_t> parse_file(const std::string& path, tinygltf::Model& model
 
   json doc;
   std::vector<uint64_t> lengths = precheck_json(path, text, is_glb ? &glb : nullptr, doc);
-  // Never needed, and tinygltf reads image buffer views without checking their range.
+  // Textures are read by the loader (gltf_loader.cpp), not by tinygltf, which reads image buffer
+  // views without checking their range; animations and skins are never needed.
+  json tex = json::object();
+  for (const char* key : {"images", "textures", "samplers"})
+    tex[key] = doc.contains(key) && doc[key].is_array() ? doc[key] : json::array();
+  tex["base_color"] = json::array();
+  if (doc.contains("materials") && doc["materials"].is_array())
+    for (const json& m : doc["materials"]) {
+      const json* info = nullptr;
+      if (m.is_object() && m.contains("pbrMetallicRoughness")) {
+        const json& pbr = m["pbrMetallicRoughness"];
+        if (pbr.is_object() && pbr.contains("baseColorTexture")) info = &pbr["baseColorTexture"];
+      }
+      tex["base_color"].push_back(info ? *info : json());
+    }
+  textures = tex.dump();
   for (const char* key : {"images", "textures", "samplers", "animations", "skins"}) doc.erase(key);
   const std::string clean = doc.dump();
   if (clean.size() > kMaxFileBytes - 64) fail(path, "the JSON is larger than 4 GiB");

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <glm/glm.hpp>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -10,6 +11,11 @@
 namespace tinygltf {
 class Model;
 }
+
+namespace host {
+struct LoadOptions;
+struct Scene;
+}  // namespace host
 
 namespace host::gltf_detail {
 
@@ -25,8 +31,25 @@ inline uint32_t le32(const unsigned char* p) {
 
 // Reads `path` (a .gltf or .glb), pre-checks its JSON and buffer sizes and parses it with
 // tinygltf into `model`; tinygltf's warnings go to `warnings`. Returns each buffer's declared
-// byteLength. Any problem throws InputError.
+// byteLength. Any problem throws InputError. tinygltf never sees the images, textures and samplers
+// (it reads image buffer views unchecked): `textures` gets them as JSON text, an object with
+// "images", "textures", "samplers" and "base_color" (each material's baseColorTexture or null).
 std::vector<uint64_t> parse_file(const std::string& path, tinygltf::Model& model,
-                                 std::vector<std::string>& warnings);
+                                 std::vector<std::string>& warnings, std::string& textures);
+
+// A material's baseColorTexture as the loader applies it: which Scene::textures entry, which
+// TEXCOORD_n set, and KHR_texture_transform's matrix (identity without it).
+struct BaseColorTexture {
+  int texture = -1;
+  int tex_coord = 0;
+  glm::dmat3 transform{1.0};
+};
+
+// Every material's baseColorTexture (gltf_textures.cpp), from parse_file's `textures` JSON:
+// appends each (image, wraps) pair's decoded texture to scene.textures and returns one entry per
+// material (texture -1 where it has none). Any problem throws InputError.
+std::vector<BaseColorTexture> read_textures(const std::string& path, const std::string& textures,
+                                            const tinygltf::Model& model,
+                                            const LoadOptions& options, Scene& scene);
 
 }  // namespace host::gltf_detail

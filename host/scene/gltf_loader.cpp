@@ -42,6 +42,8 @@ struct PrimitiveGeometry {
   bool normals_from_file = false;
   std::vector<uint32_t> corners;  // 3 vertex indices per triangle, input order
   uint32_t material = 0;
+  // Per vertex: texture coordinates of the material's texture, transformed (null: untextured).
+  std::shared_ptr<const std::vector<glm::vec2>> uvs;
 };
 
 struct PendingLight {
@@ -123,12 +125,15 @@ class Loader {
  public:
   Loader(std::string path, const LoadOptions& options)
       : path_(std::move(path)),
-        max_triangles_(std::min<uint64_t>(options.max_triangles, 0xFFFFFFFFull)) {}
+        max_triangles_(std::min<uint64_t>(options.max_triangles, 0xFFFFFFFFull)),
+        options_(options) {}
 
   Scene load() {
-    declared_lengths_ = parse_file(path_, model_, scene_.warnings);  // gltf_file.cpp
+    std::string textures;
+    declared_lengths_ = parse_file(path_, model_, scene_.warnings, textures);  // gltf_file.cpp
     check_buffers_and_views();
     check_accessors();
+    base_color_ = gltf_detail::read_textures(path_, textures, model_, options_, scene_);
     convert_materials();
     walk(root_nodes());
     finish();
@@ -286,6 +291,33 @@ class Loader {
     return out;
   }
 
+  // TEXCOORD_n: VEC2 of float, or normalized unsigned byte or short (the glTF spec's types).
+  std::shared_ptr<const std::vector<glm::vec2>> read_uvs(int index, const std::string& use) {
+    if (auto it = uv_cache_.find(index); it != uv_cache_.end()) return it->second;
+    const tinygltf::Accessor& acc = accessor_for(index, use);
+    const int ct = acc.componentType;
+    const bool ok = acc.type == TINYGLTF_TYPE_VEC2 &&
+                    (ct == TINYGLTF_COMPONENT_TYPE_FLOAT ||
+                     (acc.normalized && (ct == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE ||
+                                         ct == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT)));
+    if (!ok)
+      fail(path_, use + ": accessor " + std::to_string(index) +
+                      " must be VEC2 of float, or of normalized unsigned byte or short components");
+    const int comp = tinygltf::GetComponentSizeInBytes(uint32_t(ct));
+    auto out = std::make_shared<std::vector<glm::vec2>>(acc.count);
+    const Elements element = elements(acc);
+    for (size_t i = 0; i < acc.count; ++i) {
+      const unsigned char* p = element[i];
+      glm::vec2& v = (*out)[i];
+      for (int c = 0; c < 2; ++c) v[c] = read_component(p + c * comp, ct, acc.normalized);
+      if (!std::isfinite(v.x) || !std::isfinite(v.y))
+        fail(path_, use + ": accessor " + std::to_string(index) + " element " + std::to_string(i) +
+                        " is not finite");
+    }
+    uv_cache_[index] = out;
+    return out;
+  }
+
   // -- materials -------------------------------------------------------------------------------
 
   void convert_materials() {
@@ -310,6 +342,7 @@ class Loader {
           out.reflect = float(std::clamp(value, 0.0, 1.0));
         }
       }
+      if (m < base_color_.size()) out.texture = base_color_[m].texture;
       scene_.materials.push_back(out);
     }
   }
@@ -554,6 +587,23 @@ class Loader {
     } else {
       g.normals = smooth_normals(*g.positions, g.corners);
     }
+
+    if (g.material < base_color_.size() && base_color_[g.material].texture >= 0) {
+      const gltf_detail::BaseColorTexture& tex = base_color_[g.material];
+      const std::string set = "TEXCOORD_" + std::to_string(tex.tex_coord);
+      const auto uv = prim.attributes.find(set);
+      if (uv == prim.attributes.end())
+        fail(path_, name + ": material " + std::to_string(g.material) +
+                        " has a baseColorTexture but the primitive has no " + set);
+      const auto raw = read_uvs(uv->second, name + " " + set);
+      if (raw->size() != vertex_count)
+        fail(path_, name + ": " + set + " has " + std::to_string(raw->size()) +
+                        " elements but POSITION has " + std::to_string(vertex_count));
+      auto uvs = std::make_shared<std::vector<glm::vec2>>(raw->size());
+      for (size_t i = 0; i < raw->size(); ++i)
+        (*uvs)[i] = glm::vec2(tex.transform * glm::dvec3(glm::dvec2((*raw)[i]), 1.0));
+      g.uvs = uvs;
+    }
     return g;
   }
 
@@ -641,6 +691,12 @@ class Loader {
         }
       }
       scene_.add_triangle(p[0], p[1], p[2], n[0], n[1], n[2], g.material, id);
+      if (!scene_.textures.empty()) {
+        const std::vector<glm::vec2>* uv = g.uvs.get();
+        scene_.uv0.push_back(uv ? (*uv)[v[0]] : glm::vec2(0.0f));
+        scene_.uv1.push_back(uv ? (*uv)[v[1]] : glm::vec2(0.0f));
+        scene_.uv2.push_back(uv ? (*uv)[v[2]] : glm::vec2(0.0f));
+      }
     }
   }
 
@@ -687,6 +743,9 @@ class Loader {
   std::vector<uint64_t> declared_lengths_;
   std::map<int, std::shared_ptr<const std::vector<glm::vec3>>> position_cache_, normal_cache_;
   std::map<int, std::shared_ptr<const std::vector<uint32_t>>> index_cache_;
+  std::map<int, std::shared_ptr<const std::vector<glm::vec2>>> uv_cache_;
+  const LoadOptions& options_;
+  std::vector<gltf_detail::BaseColorTexture> base_color_;  // per file material
   std::map<std::pair<size_t, size_t>, PrimitiveGeometry> primitives_;
   std::optional<uint32_t> default_material_;
   std::vector<PendingLight> lights_;

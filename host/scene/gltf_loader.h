@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -12,10 +13,21 @@
 
 namespace host {
 
+// An image's texels as decoded (host/image's decode_image): the stored values scaled to [0, 1],
+// no colour conversion, row 0 = top, `channels` floats per texel.
+struct ImagePixels {
+  int width = 0, height = 0, channels = 0;
+  std::vector<float> pixels;
+};
+
 struct LoadOptions {
   // Input triangles (degenerate ones included) above this throw InputError. Values above
   // 2^32 - 1 act as 2^32 - 1, since triangle ids are 32-bit.
   uint64_t max_triangles = 50'000'000;
+  // Decodes a PNG or JPEG image (host::decode_image); throws std::exception with the reason.
+  // Unset: a file whose materials use a texture is refused (the scene room cannot decode images;
+  // host/image, above it, can).
+  std::function<ImagePixels(const std::vector<unsigned char>&)> read_image{};
 };
 
 // Loads the default scene (or scene 0, or every root node when the file has no scenes).
@@ -45,6 +57,16 @@ struct LoadOptions {
 //   [0, 1], with the glTF defaults (white, metallicFactor 1) when absent; a number
 //   `extras.reflect` in [0, 1] on the material overrides reflect. A primitive without a material
 //   gets Material{} (0.8 grey, reflect 0), appended after the file's materials.
+// Textures
+// - pbrMetallicRoughness.baseColorTexture: its texture's image (a data: URI, a buffer view, or a
+//   file beside the .gltf; PNG or JPEG, decoded by LoadOptions::read_image) and its sampler's
+//   wrapS / wrapT (REPEAT, CLAMP_TO_EDGE, MIRRORED_REPEAT; filters are the renderer's option).
+//   Texels are decoded from sRGB to linear (glTF's rule for base colour); the material's colour
+//   multiplies them, alpha is ignored. The texture's texCoord set (TEXCOORD_n: VEC2 of float,
+//   or normalized unsigned byte or short) gives each corner's coordinates, with
+//   KHR_texture_transform (offset, rotation, scale; its texCoord override) applied per corner.
+//   A textured primitive without that set, a texture, image or sampler out of range, an image
+//   that cannot be read or decoded: InputError naming the image or accessor.
 // Camera
 // - The first camera node met in the walk; perspective only (orthographic is an error):
 //   position = world translation, forward = world -Z, up = world +Y made orthogonal, yfov as is.

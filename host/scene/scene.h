@@ -21,6 +21,21 @@ struct InputError : std::runtime_error {
 struct Material {
   glm::vec3 color{0.8f};  // linear rgb, from baseColorFactor
   float reflect = 0.0f;   // reflection coefficient a_i of the paper's blend formula
+  int texture = -1;       // index into Scene::textures (baseColorTexture), -1: none
+};
+
+// The sampler's wrap modes (glTF's REPEAT, CLAMP_TO_EDGE, MIRRORED_REPEAT), numbered as
+// vgpu::Wrap.
+enum class WrapMode { repeat = 0, clamp_to_edge = 1, mirrored_repeat = 2 };
+
+// A base-colour texture: its image's texels, linear rgb (decoded from sRGB as glTF says) with
+// alpha, row 0 = the image's top row, and its sampler's wraps. The material's colour multiplies
+// it. One per (image, sampler) pair the materials use.
+struct SceneTexture {
+  std::string name;  // for messages, e.g. "image 0 (duck.png)"
+  int width = 0, height = 0;
+  std::vector<glm::vec4> texels;  // width * height, row-major
+  WrapMode wrap_s = WrapMode::repeat, wrap_t = WrapMode::repeat;
 };
 
 // glTF conventions: looks down local -Z, +Y up, yfov vertical (radians).
@@ -58,6 +73,11 @@ struct Scene {
   std::vector<uint32_t> material;     // index into materials, per triangle
   std::vector<uint32_t> id;           // input triangle id, per triangle
   std::vector<Material> materials;
+  // Texture coordinates of each triangle's corners (glTF's, (0, 0) the image's top-left, with
+  // KHR_texture_transform applied), per triangle like p0/p1/p2; empty when no material has a
+  // texture. A triangle whose material has none holds (0, 0).
+  std::vector<glm::vec2> uv0, uv1, uv2;
+  std::vector<SceneTexture> textures;
   std::optional<Camera> camera;       // first camera node met depth-first, if any
   std::vector<PointLight> lights;     // KHR_lights_punctual point lights, or the default light
   bool default_light = false;         // true when lights holds the documented default

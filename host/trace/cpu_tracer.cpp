@@ -12,6 +12,7 @@
 
 #include "host/common/parallel.h"
 #include "host/trace/sampling.h"
+#include "host/trace/textures.h"
 #include "kernels/kernels.h"
 
 namespace host {
@@ -113,6 +114,39 @@ class Tracer {
     background_ = glm::dvec3(shader.background);
     specular_ = shader.specular;
     min_weight_ = kernels::ReflectedRays{}.min_weight;
+    for (const SceneTexture& t : scene.textures) chains_.push_back(build_mip_chain(t));
+    spread_ = 2.0 * primary_.t / double(opt.height);
+  }
+
+  // The base-colour texel of hit h of the ray o + t d, as kernels/base_color.h filters it: the
+  // corners' coordinates interpolated, the level of detail from the ray's differentials.
+  glm::dvec4 base_texel(const Hit& h, const glm::dvec3& d, int texture) const {
+    const size_t k = size_t(h.tri);
+    const glm::dvec2 uv0(scene_.uv0[k]), uv1(scene_.uv1[k]), uv2(scene_.uv2[k]);
+    const glm::dvec2 d1 = uv1 - uv0, d2 = uv2 - uv0;
+    const glm::dvec2 uv = uv0 + d1 * h.u + d2 * h.v;
+    const MipChain& chain = chains_[size_t(texture)];
+    const SceneTexture& tex = scene_.textures[size_t(texture)];
+    double rho = 0.0;
+    if (opt_.texture_filter == vgpu::Filter::trilinear) {
+      const Tri& tri = tris_[k];
+      const glm::dvec3 ng = geo_normals_[k];
+      const double d00 = glm::dot(tri.e1, tri.e1), d01 = glm::dot(tri.e1, tri.e2),
+                   d11 = glm::dot(tri.e2, tri.e2);
+      const double inv = 1.0 / (d00 * d11 - d01 * d01);
+      const glm::dvec2 size(chain.levels[0].width, chain.levels[0].height);
+      double rho2 = 0.0;
+      for (const glm::dvec3& axis : {primary_.right, primary_.up}) {
+        const glm::dvec3 w = (axis - d * glm::dot(axis, d)) * (h.t * spread_);
+        const glm::dvec3 dp = w - d * (glm::dot(w, ng) / glm::dot(d, ng));
+        const double q1 = glm::dot(dp, tri.e1), q2 = glm::dot(dp, tri.e2);
+        const double db1 = (d11 * q1 - d01 * q2) * inv, db2 = (d00 * q2 - d01 * q1) * inv;
+        const glm::dvec2 step = (d1 * db1 + d2 * db2) * size;
+        rho2 = std::max(rho2, glm::dot(step, step));
+      }
+      rho = std::sqrt(rho2);
+    }
+    return sample_chain(chain, tex.wrap_s, tex.wrap_t, opt_.texture_filter, uv.x, uv.y, rho);
   }
 
   // The nearest valid hit along o + t d, 0 < t < tmax (d unit, world space). any_hit: stop at
@@ -247,7 +281,8 @@ class Tracer {
     if (glm::dot(n, d) > 0.0) n = -n;
 
     const Material& mat = scene_.materials[scene_.material[k]];
-    const glm::dvec3 kd(mat.color);
+    glm::dvec3 kd(mat.color);
+    if (mat.texture >= 0) kd *= glm::dvec3(base_texel(h, d, mat.texture));
     glm::dvec3 local = kd * ambient_;
     for (const PointLight& light : scene_.lights) {
       const glm::dvec3 lp(light.position);
@@ -398,6 +433,8 @@ class Tracer {
   // kernels::Shader's and rayosReflejados' constants, so both tracers read them from one place.
   glm::dvec3 ambient_, background_;
   double specular_ = 0, min_weight_ = 0;
+  std::vector<MipChain> chains_;  // per Scene::textures entry
+  double spread_ = 0;             // angle between neighbouring pixels' rays (base_texel)
 };
 
 // --aa adaptive as the stream tracer runs it (host/trace/stream_tracer.cpp, render_adaptive):

@@ -50,6 +50,8 @@ struct RenderOptions {
   int bounces = 2;                // reflection iterations after the primary one (Fig. 1: 3 in all)
   kernels::ShadingModel shading = kernels::ShadingModel::phong;
   bool shadows = true;
+  // How the shader's texture unit filters base-colour textures (kernels/base_color.h).
+  vgpu::Filter texture_filter = vgpu::Filter::trilinear;
   std::string profile = "gf5700";
   // The device the passes run on: "vgpu" (the emulator) or "gl" (a real OpenGL driver, EGL
   // device gl_device: "auto" or an index).

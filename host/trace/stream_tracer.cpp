@@ -18,6 +18,7 @@
 #include "host/trace/kd_walk.h"
 #include "host/trace/passes.h"
 #include "host/trace/sampling.h"
+#include "host/trace/textures.h"
 
 namespace host {
 
@@ -30,6 +31,10 @@ using vgpu::Texture;
 struct StreamTracer::State {
   // Static textures: the scene, triangle i at texel (i mod width, i div width).
   Texture v[3], n[3], colors;
+  // Base-colour textures (scenes with a textured material): the corners' coordinates, the
+  // texture table and the atlas of mip chains (kernels/layout.h).
+  bool textured = false;
+  Texture uvs01, uvs2, texture_table, atlas;
   // Dynamic textures (ping-pong pairs where a pass reads what it replaces).
   Texture rays[2], origins[2], shadow_rays, isect[2], result[2], counter;
   int cur_rays = 0, cur_isect = 0, cur_result = 0;
@@ -138,6 +143,47 @@ StreamTracer::StreamTracer(const Scene& scene, const Accel& accel, const RenderO
     t[0] = m.color.r, t[1] = m.color.g, t[2] = m.color.b, t[3] = m.reflect;
   }
 
+  if (!scene.textures.empty()) {
+    std::vector<MipChain> chains;
+    size_t levels = 0;
+    for (const SceneTexture& t : scene.textures) {
+      chains.push_back(build_mip_chain(t));
+      levels = std::max(levels, chains.back().levels.size());
+    }
+    const TextureAtlas atlas = pack_atlas(chains, maxs);
+    const std::string why = atlas_refusal(atlas, scene.textures.size(), maxs, gpu.profile().name);
+    if (!why.empty()) throw vgpu::Error(why);
+    s.textured = true;
+    s.atlas = gpu.make_texture("texture atlas", atlas.width, atlas.height, 4);
+    for (int y = 0; y < atlas.height; ++y)
+      for (int x = 0; x < atlas.width; ++x) {
+        const glm::vec4& c = atlas.texels[size_t(y) * size_t(atlas.width) + size_t(x)];
+        float* t = s.atlas.texel_mut(x, y);
+        for (int k = 0; k < 4; ++k) t[k] = c[k];
+      }
+    s.texture_table = gpu.make_texture("texture table", int(1 + levels), int(chains.size()), 4);
+    for (size_t i = 0; i < chains.size(); ++i) {
+      float* head = s.texture_table.texel_mut(0, int(i));
+      head[0] = float(chains[i].levels.size());
+      head[1] = float(scene.textures[i].wrap_s);
+      head[2] = float(scene.textures[i].wrap_t);
+      for (size_t k = 0; k < chains[i].levels.size(); ++k) {
+        float* r = s.texture_table.texel_mut(int(1 + k), int(i));
+        for (int c = 0; c < 4; ++c) r[c] = float(atlas.rects[i][k][c]);
+      }
+    }
+    s.uvs01 = gpu.make_texture("uvs01", sw, int(sh), 4);
+    s.uvs2 = gpu.make_texture("uvs2", sw, int(sh), 4);
+    for (size_t i = 0; i < ntri; ++i) {
+      float* a = s.uvs01.texel_mut(int(i % sw), int(i / sw));
+      float* b = s.uvs2.texel_mut(int(i % sw), int(i / sw));
+      a[0] = scene.uv0[i].x, a[1] = scene.uv0[i].y, a[2] = scene.uv1[i].x, a[3] = scene.uv1[i].y;
+      b[0] = scene.uv2[i].x, b[1] = scene.uv2[i].y;
+      b[2] = float(scene.materials[scene.material[i]].texture);
+    }
+    for (const Texture* t : {&s.uvs01, &s.uvs2, &s.texture_table, &s.atlas}) gpu.upload(*t);
+  }
+
   // The acceleration structure's textures and walk (host/trace/grid_walk.h, bvh_walk.h).
   if (accel.kind == AccelKind::bvh)
     s.walk = std::make_unique<BvhWalk>(gpu, *accel.bvh, opt_, float(sw));
@@ -199,6 +245,8 @@ StreamTracer::StreamTracer(const Scene& scene, const Accel& accel, const RenderO
   s.shader.kernel.model = opt_.shading;
   s.shader.kernel.shadows = opt_.shadows;
   s.shader.kernel.atten_dist = float(kAttenOfDiagonal) * diag;
+  s.shader.kernel.texture.on = s.textured;
+  s.shader.kernel.texture.filter = opt_.texture_filter;
   s.origin.kernel.scene = su;
   s.origin.kernel.offset = float(kOffsetOfDiagonal) * diag;
   s.direction.kernel.scene = su;
@@ -219,6 +267,9 @@ uint64_t StreamTracer::texture_bytes() const {
   if (opt_.spp > 1 || opt_.undersample > 0) b += s_->sum[0].bytes() + s_->sum[1].bytes();
   if ((opt_.adaptive && opt_.spp > 1) || opt_.undersample > 0)
     b += s_->marks[0].bytes() + s_->marks[1].bytes() + s_->materials.bytes();
+  if (s_->textured)
+    for (const Texture* t : {&s_->uvs01, &s_->uvs2, &s_->texture_table, &s_->atlas})
+      b += t->bytes();
   return b;
 }
 
@@ -247,6 +298,10 @@ RenderResult StreamTracer::render(const Camera& cam) {
   g.aspect = float(W) / float(H);
   g.width = float(W);
   g.height = float(H);
+  // The shader's ray differentials: the neighbouring pixels' rays (kernels/base_color.h).
+  s.shader.kernel.texture.right = g.right;
+  s.shader.kernel.texture.up = g.up;
+  s.shader.kernel.texture.spread = 2.0f * g.tan_half_fov / float(H);
   if (opt_.trace_pixel && opt_.trace_out)
     *opt_.trace_out << "pixel " << opt_.trace_pixel->x << "," << opt_.trace_pixel->y << ":\n";
   int iteration_number = 0;
@@ -470,10 +525,17 @@ void StreamTracer::frame(const Camera& cam, const vgpu::Program& generate, Rende
         trace(surface, s.shadow_rays, false, cam);
         if (opt_.observer) opt_.observer->trace_end();
       }
-      r.pass(s.shader,
-             {&surface, &rays, &s.result[s.cur_result], &s.isect[s.cur_isect], &s.colors, &s.v[0],
-              &s.v[1], &s.v[2], &s.n[0], &s.n[1], &s.n[2]},
-             s.result[s.cur_result ^ 1]);
+      if (s.textured)
+        r.pass(s.shader,
+               {&surface, &rays, &s.result[s.cur_result], &s.isect[s.cur_isect], &s.colors, &s.v[0],
+                &s.v[1], &s.v[2], &s.n[0], &s.n[1], &s.n[2], &s.origins[ro], &s.uvs01, &s.uvs2,
+                &s.texture_table, &s.atlas},
+               s.result[s.cur_result ^ 1]);
+      else
+        r.pass(s.shader,
+               {&surface, &rays, &s.result[s.cur_result], &s.isect[s.cur_isect], &s.colors, &s.v[0],
+                &s.v[1], &s.v[2], &s.n[0], &s.n[1], &s.n[2]},
+               s.result[s.cur_result ^ 1]);
       s.cur_result ^= 1;
     }
     if (it + 1 == iterations) break;

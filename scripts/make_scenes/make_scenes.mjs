@@ -19,6 +19,7 @@
 import { readFileSync, writeFileSync, mkdirSync } from 'node:fs';
 import { createRequire } from 'node:module';
 import { dirname, join } from 'node:path';
+import { deflateSync } from 'node:zlib';
 import { fileURLToPath } from 'node:url';
 import { MeshoptSimplifier } from 'meshoptimizer';
 
@@ -199,6 +200,62 @@ function quadXY(sx, sy) {
   };
 }
 
+// UV sphere with texture coordinates: (segments + 1) x (bands + 1) vertices, the seam and the
+// poles repeated so that u runs 0..1 around (from +Z towards +X) and v 0..1 from the top pole.
+function uvSphereTextured(radius, segments, bands) {
+  const positions = [], normals = [], uvs = [], tris = [];
+  for (let i = 0; i <= bands; i++) {
+    const theta = (Math.PI * i) / bands;
+    for (let j = 0; j <= segments; j++) {
+      const phi = (2 * Math.PI * j) / segments;
+      const n = [Math.sin(theta) * Math.sin(phi), Math.cos(theta), Math.sin(theta) * Math.cos(phi)];
+      normals.push(n);
+      positions.push(scl(n, radius));
+      uvs.push([j / segments, i / bands]);
+    }
+  }
+  const v = (i, j) => i * (segments + 1) + j;
+  for (let i = 0; i < bands; i++) {
+    for (let j = 0; j < segments; j++) {
+      if (i > 0) tris.push([v(i, j), v(i + 1, j), v(i, j + 1)]);
+      if (i < bands - 1) tris.push([v(i, j + 1), v(i + 1, j), v(i + 1, j + 1)]);
+    }
+  }
+  return { positions, normals, uvs, tris };
+}
+
+// An 8-bit RGB PNG of w x h texels, texel(x, y) -> [r, g, b] (0..255), row 0 at the top.
+const CRC_TABLE = Array.from({ length: 256 }, (_, n) => {
+  let c = n;
+  for (let k = 0; k < 8; k++) c = c & 1 ? 0xedb88320 ^ (c >>> 1) : c >>> 1;
+  return c >>> 0;
+});
+function crc32(bytes) {
+  let c = 0xffffffff;
+  for (const b of bytes) c = CRC_TABLE[(c ^ b) & 0xff] ^ (c >>> 8);
+  return (c ^ 0xffffffff) >>> 0;
+}
+function png(w, h, texel) {
+  const raw = Buffer.alloc(h * (1 + 3 * w));
+  for (let y = 0; y < h; y++) {
+    raw[y * (1 + 3 * w)] = 0;
+    for (let x = 0; x < w; x++) raw.set(texel(x, y), y * (1 + 3 * w) + 1 + 3 * x);
+  }
+  const chunk = (type, body) => {
+    const len = Buffer.alloc(4), crc = Buffer.alloc(4);
+    len.writeUInt32BE(body.length);
+    const tb = Buffer.concat([Buffer.from(type, 'latin1'), body]);
+    crc.writeUInt32BE(crc32(tb));
+    return Buffer.concat([len, tb, crc]);
+  };
+  const ihdr = Buffer.alloc(13);
+  ihdr.writeUInt32BE(w, 0);
+  ihdr.writeUInt32BE(h, 4);
+  ihdr.set([8, 2, 0, 0, 0], 8);
+  return Buffer.concat([Buffer.from([0x89, 0x50, 0x4e, 0x47, 0x0d, 0x0a, 0x1a, 0x0a]), chunk('IHDR', ihdr),
+    chunk('IDAT', deflateSync(raw, { level: 9 })), chunk('IEND', Buffer.alloc(0))]);
+}
+
 // Checkerboard of n x n separate squares of side `cell` in the XZ plane, centred at the origin.
 // Returns two meshes: squares where (i + j) is even, and where it is odd.
 function checker(n, cell) {
@@ -358,6 +415,27 @@ class Gltf {
     return this.json.accessors.length - 1;
   }
 
+  addVec2Accessor(vectors, name) {
+    const f = new Float32Array(vectors.length * 2);
+    vectors.forEach((v, i) => f.set(v, i * 2));
+    const view = this.addBytes(f, 34962);
+    this.json.accessors.push({ name, bufferView: view, byteOffset: 0, componentType: 5126, count: vectors.length, type: 'VEC2' });
+    return this.json.accessors.length - 1;
+  }
+
+  // A PNG image in the buffer with its sampler (glTF wrap enums); returns the texture index.
+  texture(name, pngBytes, wrapS, wrapT) {
+    this.json.images ??= [];
+    this.json.samplers ??= [];
+    this.json.textures ??= [];
+    const view = this.addBytes(new Uint8Array(pngBytes), undefined);
+    this.json.images.push({ name, bufferView: view, mimeType: 'image/png' });
+    this.json.samplers.push({ magFilter: 9729, minFilter: 9987, wrapS, wrapT });
+    this.json.textures.push({ name, source: this.json.images.length - 1, sampler: this.json.samplers.length - 1 });
+    (this.textureInfo ??= []).push(name);
+    return this.json.textures.length - 1;
+  }
+
   addIndexAccessor(tris, vertexCount, name) {
     const flat = tris.flat();
     const u16 = vertexCount <= 65535;
@@ -370,12 +448,11 @@ class Gltf {
   }
 
   // reflect: reflection coefficient (0 = none); roughness only matters to other viewers.
-  material(name, color, reflect, roughness = 0.5) {
-    this.json.materials.push({
-      name,
-      pbrMetallicRoughness: { baseColorFactor: [...roundv(color, 4), 1], metallicFactor: reflect, roughnessFactor: roughness },
-      extras: { reflect },
-    });
+  // texture: a texture index for baseColorTexture (multiplied by color), or undefined.
+  material(name, color, reflect, roughness = 0.5, texture = undefined) {
+    const pbr = { baseColorFactor: [...roundv(color, 4), 1], metallicFactor: reflect, roughnessFactor: roughness };
+    if (texture !== undefined) pbr.baseColorTexture = { index: texture };
+    this.json.materials.push({ name, pbrMetallicRoughness: pbr, extras: { reflect } });
     this.materialInfo.push({ name, color: roundv(color, 4), reflect });
     return this.json.materials.length - 1;
   }
@@ -388,6 +465,7 @@ class Gltf {
         attributes: {
           POSITION: this.addVec3Accessor(mesh.positions, `${tag} POSITION`),
           NORMAL: this.addVec3Accessor(mesh.normals, `${tag} NORMAL`),
+          ...(mesh.uvs ? { TEXCOORD_0: this.addVec2Accessor(mesh.uvs, `${tag} TEXCOORD_0`) } : {}),
         },
         indices: this.addIndexAccessor(mesh.tris, mesh.positions.length, `${tag} indices`),
         material,
@@ -621,6 +699,47 @@ for (const [file, mesh, what, src] of [
   g.camera([2.0, 3.4, 6.5], [0.25, 1.1, 0], placed(teapotMesh, S, t), 0.88);
   g.light('light', [-3, 6, 6], WHITE);
   summary.push(g.write('teapot.gltf'));
+}
+
+// ---------------------------------------------------------------------------------------------
+// 7. textured.gltf — base-colour textures (issue 25): three textures, one per wrap mode
+// ---------------------------------------------------------------------------------------------
+{
+  const g = new Gltf('textured', 'base-colour textures, one per wrap mode: a tiled 16 x 16 floor (64 x 64 tile texture repeated 8 x 8: REPEAT, minified into the distance), a globe (128 x 64 texture, REPEAT around, CLAMP_TO_EDGE at the poles), a wall sign (64 x 64, MIRRORED_REPEAT three times across) and an untextured mirror sphere that reflects them', `${SRC_PROC}; textures procedural PNGs in the buffer`);
+  const REPEAT = 10497, CLAMP = 33071, MIRROR = 33648;
+  const tiles = g.texture('tiles', png(64, 64, (x, y) => {
+    if (x % 32 < 2 || y % 32 < 2) return [70, 60, 55]; // grout
+    return (x < 32) === (y < 32) ? [225, 210, 180] : [170, 75, 50];
+  }), REPEAT, REPEAT);
+  const globe = g.texture('globe', png(128, 64, (x, y) => {
+    if (x % 16 === 0 || y % 16 === 0) return [250, 250, 250]; // meridians and parallels
+    const band = Math.floor(x / 16);
+    const hues = [[40, 90, 200], [40, 160, 80], [200, 170, 60], [180, 60, 60], [90, 60, 170], [40, 150, 170], [210, 110, 40], [120, 120, 120]];
+    const shade = 0.55 + 0.45 * Math.sin((Math.PI * (y + 0.5)) / 64);
+    return hues[band].map((c) => Math.round(c * shade));
+  }), REPEAT, CLAMP);
+  const sign = g.texture('sign', png(64, 64, (x, y) => {
+    const ink = (x >= 12 && x < 22 && y >= 8 && y < 56) || (x >= 12 && x < 50 && y >= 8 && y < 18) || (x >= 12 && x < 40 && y >= 28 && y < 37);
+    return ink ? [30, 40, 110] : [235, 230, 215]; // an "F": mirrored copies show which way they face
+  }), MIRROR, CLAMP);
+  const mFloor = g.material('floor-tiles', WHITE, 0.0, 0.6, tiles);
+  const mGlobe = g.material('globe', WHITE, 0.0, 0.3, globe);
+  const mSign = g.material('wall-sign', WHITE, 0.0, 0.7, sign);
+  const mMirror = g.material('mirror-sphere', [0.9, 0.9, 0.92], 0.6, 0.05);
+  const floor = quadXZ(16, 16);
+  floor.uvs = [[0, 0], [0, 8], [8, 8], [8, 0]];
+  const wall = quadXY(9, 4.5);
+  wall.uvs = [[0, 1], [3, 1], [3, 0], [0, 0]];
+  const globeMesh = uvSphereTextured(1.4, 32, 16);
+  const mirror = uvSphere(1.0, 24, 12);
+  const cGlobe = [-1.9, 1.4, 0.2], cMirror = [2.1, 1.0, 1.2], tWall = [0, 0, -4];
+  g.instance('floor', g.mesh('floor', [{ mesh: floor, material: mFloor }]));
+  g.instance('wall', g.mesh('wall', [{ mesh: wall, material: mSign }]), { t: tWall });
+  g.instance('globe', g.mesh('globe', [{ mesh: globeMesh, material: mGlobe }]), { t: cGlobe });
+  g.instance('mirror-sphere', g.mesh('mirror-sphere', [{ mesh: mirror, material: mMirror }]), { t: cMirror });
+  g.camera([0, 3.0, 9.0], [0, 1.4, 0], placed(globeMesh, 1, cGlobe).concat(placed(mirror, 1, cMirror), placed(wall, 1, tWall)), 0.9);
+  g.light('light', [-4, 8, 6], WHITE);
+  summary.push(g.write('textured.gltf'));
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -519,4 +519,63 @@ TEST_CASE(
 
 TEST_CASE("an unknown acceleration structure is refused with one line, exit 2 and no image") {
   check_refused("--accel nonsense", "--accel", "nonsense");
+
+TEST_CASE("the texture filter is checked against its set and listed in --help") {
+  check_refused("--texture-filter anisotropic", "--texture-filter",
+                "anisotropic not in {nearest,bilinear,trilinear}");
+  const Outcome o = run("render --help");
+  CHECK(o.out.find("--texture-filter") != std::string::npos);
+  CHECK(o.out.find("nearest,bilinear,trilinear") != std::string::npos);
+}
+
+TEST_CASE("a texture that cannot be read or a UV accessor of the wrong type: one line, no image") {
+  const std::string data = std::string(VGPU_TEST_DATA) + "/gltf/";
+  const fs::path out =
+      fs::temp_directory_path() / ("vgpu_cli_texture_" + std::to_string(::getpid()) + ".png");
+  struct Case {
+    const char* file;
+    const char* problem;
+  };
+  for (const Case& c :
+       {Case{"texture_missing.gltf", "image 0 (no_such_texture.png): cannot read"},
+        Case{"texture_not_an_image.gltf",
+             "image 0: cannot read the image: not a PNG or JPEG image"},
+        // libpng reports a PNG cut short on stderr too: still one line.
+        Case{"texture_truncated.gltf", "image 0: cannot read the image: "},
+        Case{"texcoord_vec3.gltf", "TEXCOORD_0: accessor 0 must be VEC2 of float"}}) {
+    CAPTURE(c.file);
+    for (const char* engine : {"stream", "cpu"}) {
+      CAPTURE(engine);
+      const Outcome o = run("render " + data + c.file + " -q --stats none --engine " + engine +
+                            " --out " + out.string());
+      CHECK(o.status != 0);
+      check_one_line(o, data + c.file, c.problem);
+      CHECK_FALSE(fs::exists(out));
+    }
+  }
+}
+
+TEST_CASE("a textured glb renders through the CLI, its JSON naming the textures and the filter") {
+  const std::string id = std::to_string(::getpid());
+  const fs::path out = fs::temp_directory_path() / ("vgpu_cli_duck_" + id + ".png"),
+                 js = fs::temp_directory_path() / ("vgpu_cli_duck_" + id + ".json");
+  const Outcome o = run("render " + std::string(VGPU_TEST_DATA) +
+                        "/gltf/textured.glb -q --stats none --size 32x32 --texture-filter bilinear "
+                        "--out " +
+                        out.string() + " --stats-json " + js.string());
+  INFO(o.err);
+  REQUIRE(o.status == 0);
+  CHECK(fs::exists(out));
+  const auto j = nlohmann::json::parse(slurp(js));
+  CHECK(j["textures"] == 1);
+  CHECK(j["texture_filter"] == "bilinear");
+  // An untextured scene's JSON has neither.
+  const Outcome plain =
+      run("render bunny-low -q --stats none --size 16x16 --stats-json " + js.string());
+  REQUIRE(plain.status == 0);
+  const auto p = nlohmann::json::parse(slurp(js));
+  CHECK_FALSE(p.contains("textures"));
+  CHECK_FALSE(p.contains("texture_filter"));
+  fs::remove(out);
+  fs::remove(js);
 }

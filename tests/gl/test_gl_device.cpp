@@ -10,6 +10,7 @@
 
 #include "gl/context.h"
 #include "host/accel/grid.h"
+#include "host/image/image_io.h"
 #include "host/scene/camera.h"
 #include "host/scene/gltf_loader.h"
 #include "host/trace/stream_tracer.h"
@@ -26,7 +27,7 @@ struct Frame {
 Frame render(const std::string& scene_name, const std::string& device, int size, bool keep_passes,
              bool mrt = false, const std::string& readback = "auto", int spp = 1,
              bool adaptive = false, int undersample = 0) {
-  const host::Scene scene = host::load_scene(host::resolve_scene(scene_name));
+  const host::Scene scene = host::load_scene(host::resolve_scene(scene_name), host::with_images());
   host::RenderOptions opt;
   opt.width = opt.height = size;
   opt.spp = spp;
@@ -217,4 +218,33 @@ TEST_CASE(
     ++scenes;
   }
   CHECK(scenes >= 8);
+}
+
+TEST_CASE("the textured scene on the GL device matches the vgpu for every texture filter") {
+  const host::Scene scene = host::load_scene(host::resolve_scene("textured"), host::with_images());
+  for (vgpu::Filter filter :
+       {vgpu::Filter::nearest, vgpu::Filter::bilinear, vgpu::Filter::trilinear}) {
+    CAPTURE(int(filter));
+    host::RenderResult frames[2];
+    std::string gl_name;
+    for (int k = 0; k < 2; ++k) {
+      host::RenderOptions opt;
+      opt.width = opt.height = 96;
+      opt.device = k ? "gl" : "vgpu";
+      opt.texture_filter = filter;
+      opt.threads = 2;
+      const host::Grid grid =
+          host::build_grid(scene, host::grid_spec_for({}, scene, vgpu::profile(opt.profile)));
+      host::StreamTracer tracer(scene, grid, opt);
+      frames[k] = tracer.render(host::scene_camera(scene));
+      if (k) gl_name = tracer.device().description();
+      // The shader's fetches: the same count on both devices (the counting run, not the driver).
+      const auto* shader = frames[k].stats.find("shader");
+      REQUIRE(shader != nullptr);
+    }
+    CHECK(frames[0].stats.find("shader")->counters.texture_fetches ==
+          frames[1].stats.find("shader")->counters.texture_fetches);
+    gltest::check_same_frame(gl_name, "intersections", frames[0].hit_id, frames[1].hit_id,
+                             frames[0].depth, frames[1].depth, frames[0].rgb, frames[1].rgb);
+  }
 }

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "host/accel/grid.h"
+#include "host/image/image_io.h"
 #include "host/scene/camera.h"
 #include "host/scene/gltf_loader.h"
 #include "host/trace/stream_tracer.h"
@@ -18,7 +19,7 @@ struct Frame {
 };
 
 Frame render(const std::string& scene_name, const std::string& device, int size) {
-  const host::Scene scene = host::load_scene(host::resolve_scene(scene_name));
+  const host::Scene scene = host::load_scene(host::resolve_scene(scene_name), host::with_images());
   host::RenderOptions opt;
   opt.width = opt.height = size;
   opt.device = device;

@@ -8,6 +8,7 @@
 #include <fstream>
 #include <iterator>
 #include <string>
+#include <vector>
 
 #include "host/image/image_io.h"
 #include "host/scene/scene.h"
@@ -67,4 +68,19 @@ TEST_CASE("a failed image write leaves no file behind") {
   CHECK_THROWS_AS(host::write_image(p.string(), 2, 2, 0, {}), host::InputError);
   CHECK(fs::is_empty(dir));
   fs::remove_all(dir);
+}
+
+TEST_CASE("decode_image reads a PNG texture from memory and refuses bytes that are no image") {
+  const std::string png = bytes_of(std::string(VGPU_TEST_DATA) + "/gltf/textured_external.png");
+  const host::ImagePixels px = host::decode_image({png.begin(), png.end()});
+  REQUIRE(px.width == 2);
+  REQUIRE(px.height == 2);
+  REQUIRE(px.channels == 3);
+  // Red, green / blue, white (tests/data/gltf/make_cases.py), row 0 at the top.
+  const std::vector<float> expected = {1, 0, 0, 0, 1, 0, 0, 0, 1, 1, 1, 1};
+  CHECK(px.pixels == expected);
+  const std::string junk = "not an image at all";
+  CHECK_THROWS_WITH(host::decode_image({junk.begin(), junk.end()}), "not a PNG or JPEG image");
+  // A PNG cut short.
+  CHECK_THROWS(host::decode_image({png.begin(), png.begin() + 40}));
 }

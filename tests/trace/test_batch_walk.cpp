@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "host/accel/grid.h"
+#include "host/image/image_io.h"
 #include "host/scene/camera.h"
 #include "host/scene/gltf_loader.h"
 #include "host/trace/stream_tracer.h"
@@ -130,7 +131,7 @@ struct Bundled {
   host::Grid grid;
   host::Camera camera;
   Bundled(const std::string& name, const std::string& profile, int w, int h)
-      : scene(host::load_scene(host::resolve_scene(name))),
+      : scene(host::load_scene(host::resolve_scene(name), host::with_images())),
         grid(host::build_grid(scene, host::grid_spec_for({}, scene, vgpu::profile(profile)))),
         camera(host::scene_camera(scene, float(w) / float(h))) {}
 };

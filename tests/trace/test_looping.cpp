@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "host/accel/grid.h"
+#include "host/image/image_io.h"
 #include "host/scene/camera.h"
 #include "host/scene/gltf_loader.h"
 #include "host/trace/stream_tracer.h"
@@ -63,7 +64,7 @@ TEST_CASE("looping kernels give the multipass hit ids, depths and colours on the
   REQUIRE(scenes.size() >= 8);
   for (const std::string& path : scenes) {
     CAPTURE(path);
-    const host::Scene scene = host::load_scene(path);
+    const host::Scene scene = host::load_scene(path, host::with_images());
     const host::Camera cam = host::scene_camera(scene);
     const host::Grid grid = host::build_grid(
         scene, host::grid_spec_for(host::GridSpec{}, scene, vgpu::profile("gf6600")));

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "host/accel/grid.h"
+#include "host/image/image_io.h"
 #include "host/scene/camera.h"
 #include "host/scene/gltf_loader.h"
 #include "host/trace/stream_tracer.h"
@@ -89,7 +90,7 @@ host::RenderResult render(const host::Scene& scene, const host::Grid& grid, cons
 TEST_CASE("every bundled scene at 64x64 gives identical hit ids, depths and images with mrt on") {
   for (const auto& [name, path] : host::list_scenes()) {
     CAPTURE(name);
-    const host::Scene scene = host::load_scene(path);
+    const host::Scene scene = host::load_scene(path, host::with_images());
     host::RenderOptions opt;
     opt.width = opt.height = 64;
     opt.profile = "gf6600";

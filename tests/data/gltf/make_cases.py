@@ -9,6 +9,7 @@ import json
 import math
 import os
 import struct
+import zlib
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 
@@ -345,7 +346,82 @@ def bad_cases():
     write_gltf("deep_json.gltf", d, b.bin)
 
 
+def png_bytes(width, height, rows):
+    """An 8-bit RGB PNG; rows: height lists of width (r, g, b) tuples, the top row first."""
+    def chunk(kind, body):
+        return struct.pack(">I", len(body)) + kind + body + struct.pack(">I", zlib.crc32(kind + body))
+    raw = b"".join(b"\0" + bytes(c for px in row for c in px) for row in rows)
+    return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, 8, 2, 0, 0, 0))
+            + chunk(b"IDAT", zlib.compress(raw)) + chunk(b"IEND", b""))
+
+
+# The Duck-like case's texture: red, green / blue, white (top row first).
+QUAD_TEXELS = [[(255, 0, 0), (0, 255, 0)], [(0, 0, 255), (255, 255, 255)]]
+REPEAT, CLAMP, MIRROR = 10497, 33071, 33648
+
+
+def textured_quad(image, uv_type="VEC2", transform=None):
+    """A 2 x 2 quad in z = 0 facing +z, (0, 0) of its texture at its top-left corner; a camera
+    2.5 in front and a light beside it; `image` is the glTF image object."""
+    b = Builder()
+    pos = [(-1, 1, 0), (1, 1, 0), (-1, -1, 0), (1, -1, 0)]
+    uvs = [(0, 0), (1, 0), (0, 1), (1, 1)]
+    if uv_type == "VEC2":
+        uv = b.accessor(b.view(b"".join(struct.pack("<2f", *t) for t in uvs)), FLOAT, "VEC2", 4)
+    else:  # a VEC3 accessor where TEXCOORD_0 must be VEC2
+        uv = b.accessor(b.view(b"".join(struct.pack("<3f", *t, 0) for t in uvs)), FLOAT, "VEC3", 4)
+    prim = {"attributes": {"POSITION": b.vec3(pos), "NORMAL": b.vec3([(0, 0, 1)] * 4),
+                           "TEXCOORD_0": uv},
+            "indices": b.indices([0, 2, 1, 1, 2, 3]), "material": 0}
+    info = {"index": 0}
+    if transform:
+        info["extensions"] = {"KHR_texture_transform": transform}
+    d = b.doc(scene=0, scenes=[{"nodes": [0, 1, 2]}],
+              nodes=[{"mesh": 0}, {"camera": 0, "translation": [0, 0, 2.5]},
+                     {"extensions": {"KHR_lights_punctual": {"light": 0}}, "translation": [0, 0, 2.5]}],
+              meshes=[{"primitives": [prim]}],
+              cameras=[{"type": "perspective", "perspective": {"yfov": 0.9, "znear": 0.1}}],
+              extensionsUsed=["KHR_lights_punctual"] + (["KHR_texture_transform"] if transform else []),
+              extensions={"KHR_lights_punctual": {"lights": [{"type": "point", "intensity": 1}]}},
+              materials=[{"pbrMetallicRoughness": {"baseColorTexture": info, "metallicFactor": 0}}],
+              textures=[{"source": 0, "sampler": 0}],
+              samplers=[{"wrapS": CLAMP, "wrapT": MIRROR}],
+              images=[image])
+    return b, d
+
+
+def textured_cases():
+    png = png_bytes(2, 2, QUAD_TEXELS)
+    png_uri = "data:image/png;base64," + base64.b64encode(png).decode()
+    b, d = textured_quad({"uri": png_uri})
+    write_gltf("textured.gltf", d, b.bin)
+    # The image in a buffer view of a .glb, as the Khronos Duck holds it.
+    b, d = textured_quad({"bufferView": 0, "mimeType": "image/png"})
+    view = b.view(png)
+    d["bufferViews"] = b.views
+    d["images"][0]["bufferView"] = view
+    d["buffers"] = [{"byteLength": len(b.bin)}]
+    write_bytes("textured.glb", glb_bytes(d, b.bin))
+    # Beside the file.
+    write_bytes("textured_external.png", png)
+    b, d = textured_quad({"uri": "textured_external.png"})
+    write_gltf("textured_external.gltf", d, b.bin)
+    # KHR_texture_transform: u + 0.5 (and REPEAT would wrap; CLAMP_TO_EDGE is what the sampler says).
+    b, d = textured_quad({"uri": png_uri}, transform={"offset": [0.5, 0], "scale": [2, 1]})
+    write_gltf("textured_transform.gltf", d, b.bin)
+    # Bad: a missing file, bytes that are no image, a PNG cut short, a TEXCOORD_0 of VEC3.
+    b, d = textured_quad({"uri": "no_such_texture.png"})
+    write_gltf("texture_missing.gltf", d, b.bin)
+    b, d = textured_quad({"uri": "data:image/png;base64," + base64.b64encode(b"not an image").decode()})
+    write_gltf("texture_not_an_image.gltf", d, b.bin)
+    b, d = textured_quad({"uri": "data:image/png;base64," + base64.b64encode(png[:40]).decode()})
+    write_gltf("texture_truncated.gltf", d, b.bin)
+    b, d = textured_quad({"uri": png_uri}, uv_type="VEC3")
+    write_gltf("texcoord_vec3.gltf", d, b.bin)
+
+
 if __name__ == "__main__":
+    textured_cases()
     triangle_cases()
     hierarchy_case()
     roots_case()

@@ -1,0 +1,195 @@
+// Base-colour textures through the tracers (kernels/base_color.h, host/trace/textures.h): the
+// Duck-like quad's colours come from its texture, the stream tracer agrees with the CPU tracer
+// for every filter, filtering costs the fetches it reads, lanes and threads change nothing, and
+// an atlas past a profile's texture size is refused.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "host/accel/grid.h"
+#include "host/image/image_io.h"
+#include "host/scene/camera.h"
+#include "host/scene/gltf_loader.h"
+#include "host/trace/cpu_tracer.h"
+#include "host/trace/stream_tracer.h"
+#include "host/trace/textures.h"
+
+namespace {
+
+using vgpu::Filter;
+
+host::Scene duck_like() {
+  return host::load_scene(std::string(VGPU_TEST_DATA) + "/gltf/textured.gltf", host::with_images());
+}
+
+host::RenderOptions options(Filter filter, int size = 32) {
+  host::RenderOptions opt;
+  opt.width = opt.height = size;
+  opt.texture_filter = filter;
+  opt.shading = kernels::ShadingModel::diffuse;
+  opt.shadows = false;
+  opt.bounces = 0;
+  opt.threads = 2;
+  return opt;
+}
+
+struct Frames {
+  host::RenderResult stream, cpu;
+};
+
+Frames render(const host::Scene& scene, const host::RenderOptions& opt) {
+  const host::Grid grid =
+      host::build_grid(scene, host::grid_spec_for({}, scene, vgpu::profile(opt.profile)));
+  const host::Camera cam = host::scene_camera(scene, float(opt.width) / float(opt.height));
+  host::StreamTracer tracer(scene, grid, opt);
+  Frames f;
+  f.stream = tracer.render(cam);
+  f.cpu = host::render_cpu(scene, grid, cam, opt);
+  return f;
+}
+
+glm::vec3 pixel(const host::RenderResult& r, int x, int y) {
+  const size_t i = 3 * (size_t(y) * size_t(r.width) + size_t(x));
+  return {r.rgb[i], r.rgb[i + 1], r.rgb[i + 2]};
+}
+
+float max_difference(const std::vector<float>& a, const std::vector<float>& b) {
+  float m = 0;
+  for (size_t i = 0; i < a.size(); ++i) m = std::max(m, std::abs(a[i] - b[i]));
+  return m;
+}
+
+constexpr Filter kFilters[] = {Filter::nearest, Filter::bilinear, Filter::trilinear};
+
+}  // namespace
+
+TEST_CASE("the Duck-like model's colours come from its texture, on both tracers and every filter") {
+  const host::Scene scene = duck_like();
+  for (Filter filter : kFilters) {
+    CAPTURE(int(filter));
+    const Frames f = render(scene, options(filter));
+    for (const host::RenderResult* r : {&f.stream, &f.cpu}) {
+      // The quad covers pixels 3 to 29; its quarters are red, green / blue, white. Pixels 6 and 25
+      // lie within a quarter texel of the quad's edges, where every filter (clamped in s,
+      // mirrored in t) reads only the corner's own texel.
+      const glm::vec3 tl = pixel(*r, 6, 6), tr = pixel(*r, 25, 6), bl = pixel(*r, 6, 25),
+                      br = pixel(*r, 25, 25);
+      CHECK(tl.r > 0.5f);
+      CHECK(tl.g < 0.02f * tl.r);
+      CHECK(tl.b < 0.02f * tl.r);
+      CHECK(tr.g > 0.5f);
+      CHECK(tr.r < 0.02f * tr.g);
+      CHECK(bl.b > 0.5f);
+      CHECK(bl.r < 0.02f * bl.b);
+      CHECK(br.r > 0.5f);
+      CHECK(br.g == doctest::Approx(br.r));
+      CHECK(br.b == doctest::Approx(br.r));
+    }
+    // Same filter, same chains: the emulator's fp32 within 1e-3 of the CPU tracer's doubles.
+    CHECK(max_difference(f.stream.rgb, f.cpu.rgb) < 1e-3f);
+    CHECK(f.stream.hit_id == f.cpu.hit_id);
+  }
+}
+
+TEST_CASE(
+    "the bundled textured scene renders alike on the stream and CPU tracers for every filter") {
+  const host::Scene scene = host::load_scene(host::resolve_scene("textured"), host::with_images());
+  REQUIRE(scene.textures.size() == 3);
+  for (Filter filter : kFilters) {
+    CAPTURE(int(filter));
+    host::RenderOptions opt = options(filter, 64);
+    opt.shading = kernels::ShadingModel::phong;
+    opt.shadows = true;
+    opt.bounces = 2;
+    const Frames f = render(scene, opt);
+    double sq = 0;
+    for (size_t i = 0; i < f.stream.rgb.size(); ++i) {
+      const double d = double(f.stream.rgb[i]) - double(f.cpu.rgb[i]);
+      sq += d * d;
+    }
+    const double rms = std::sqrt(sq / double(f.stream.rgb.size()));
+    CHECK(rms < 2e-3);
+  }
+}
+
+TEST_CASE(
+    "filtering costs fetches: bilinear 3 and trilinear 9 more per shaded fragment than nearest") {
+  const host::Scene scene = duck_like();
+  std::vector<double> per_fragment;
+  for (Filter filter : kFilters) {
+    const host::RenderOptions opt = options(filter, 16);
+    const host::Grid grid =
+        host::build_grid(scene, host::grid_spec_for({}, scene, vgpu::profile(opt.profile)));
+    host::StreamTracer tracer(scene, grid, opt);
+    const host::RenderResult r = tracer.render(host::scene_camera(scene));
+    const auto* shader = r.stats.find("shader");
+    REQUIRE(shader != nullptr);
+    REQUIRE(shader->counters.fragments_shaded > 0);
+    per_fragment.push_back(double(shader->counters.texture_fetches) /
+                           double(shader->counters.fragments_shaded));
+  }
+  // Bilinear: 4 texels for 1. Trilinear: 8 texels and two more level rectangles.
+  CHECK(per_fragment[1] - per_fragment[0] == 3.0);
+  CHECK(per_fragment[2] - per_fragment[0] == 9.0);
+}
+
+TEST_CASE("a textured frame is bit-identical at 1 and 8 lanes and 1 and 3 threads") {
+  const host::Scene scene = duck_like();
+  host::RenderOptions opt = options(Filter::trilinear, 24);
+  opt.shadows = true;
+  const host::Grid grid =
+      host::build_grid(scene, host::grid_spec_for({}, scene, vgpu::profile(opt.profile)));
+  const host::Camera cam = host::scene_camera(scene);
+  std::vector<std::vector<float>> images;
+  for (auto [lanes, threads] : {std::pair{1, 1}, std::pair{8, 3}, std::pair{4, 2}}) {
+    opt.lanes = lanes;
+    opt.threads = threads;
+    host::StreamTracer tracer(scene, grid, opt);
+    images.push_back(tracer.render(cam).rgb);
+  }
+  CHECK(images[1] == images[0]);
+  CHECK(images[2] == images[0]);
+}
+
+TEST_CASE("textures whose atlas passes the profile's texture size are refused naming the limit") {
+  host::Scene scene = duck_like();
+  // A 2048 x 1 texture: its chain (2048 + 1024 texels wide) passes r300's 2048.
+  host::SceneTexture wide;
+  wide.name = "wide";
+  wide.width = 2048;
+  wide.height = 1;
+  wide.texels.assign(2048, glm::vec4(1.0f));
+  scene.textures.push_back(wide);
+  host::RenderOptions opt = options(Filter::trilinear, 8);
+  opt.profile = "r300";
+  const host::Grid grid =
+      host::build_grid(scene, host::grid_spec_for({}, scene, vgpu::profile(opt.profile)));
+  try {
+    host::StreamTracer tracer(scene, grid, opt);
+    FAIL("not refused");
+  } catch (const vgpu::Error& e) {
+    const std::string m = e.what();
+    CHECK(m.find("atlas") != std::string::npos);
+    CHECK(m.find("profile r300 holds at most 2048x2048 texels") != std::string::npos);
+  }
+  opt.profile = "gf5700";  // 4096: fits
+  CHECK_NOTHROW(host::StreamTracer(scene, grid, opt));
+}
+
+TEST_CASE("a mip chain halves each level with a box filter down to 1x1") {
+  host::SceneTexture t;
+  t.width = 4;
+  t.height = 2;
+  for (int i = 0; i < 8; ++i) t.texels.push_back(glm::vec4(float(i)));
+  const host::MipChain c = host::build_mip_chain(t);
+  REQUIRE(c.levels.size() == 3);
+  CHECK(c.levels[1].width == 2);
+  CHECK(c.levels[1].height == 1);
+  CHECK(c.levels[1].texels[0].x == (0 + 1 + 4 + 5) / 4.0f);
+  CHECK(c.levels[1].texels[1].x == (2 + 3 + 6 + 7) / 4.0f);
+  CHECK(c.levels[2].width == 1);
+  CHECK(c.levels[2].texels[0].x == 3.5f);
+}
