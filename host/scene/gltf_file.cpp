@@ -366,7 +366,7 @@ std::string first_line(const std::string& text) {
 namespace gltf_detail {
 
 std::vector<uint64_t> parse_file(const std::string& path, tinygltf::Model& model,
-                                 std::vector<std::string>& warnings) {
+                                 std::vector<std::string>& warnings, bool keep_animations) {
   const std::vector<unsigned char> bytes = read_bytes(path);  // freed once parsed
   if (bytes.empty()) fail(path, "the file is empty");
   GlbParts glb;
@@ -386,8 +386,10 @@ std::vector<uint64_t> parse_file(const std::string& path, tinygltf::Model& model
 
   json doc;
   std::vector<uint64_t> lengths = precheck_json(path, text, is_glb ? &glb : nullptr, doc);
-  // Never needed, and tinygltf reads image buffer views without checking their range.
-  for (const char* key : {"images", "textures", "samplers", "animations", "skins"}) doc.erase(key);
+  // Never needed, and tinygltf reads image buffer views without checking their range. Animations
+  // only where asked for (host/scene/animation.cpp reads and checks them).
+  for (const char* key : {"images", "textures", "samplers", "skins"}) doc.erase(key);
+  if (!keep_animations) doc.erase("animations");
   const std::string clean = doc.dump();
   if (clean.size() > kMaxFileBytes - 64) fail(path, "the JSON is larger than 4 GiB");
 

@@ -1,11 +1,17 @@
-// What the glTF loader's two files share (gltf_file.cpp reads and parses, gltf_loader.cpp builds
-// the Scene): the one-line error messages, little-endian reads and the parse step itself.
+// What the glTF loader's files share (gltf_file.cpp reads and parses, gltf_loader.cpp builds
+// the Scene, animation.cpp poses it): the one-line error messages, little-endian reads, the parse
+// step itself and the loader kept open.
 #pragma once
 
 #include <cstdint>
+#include <glm/glm.hpp>
+#include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
+
+#include "host/scene/gltf_loader.h"
 
 namespace tinygltf {
 class Model;
@@ -25,8 +31,36 @@ inline uint32_t le32(const unsigned char* p) {
 
 // Reads `path` (a .gltf or .glb), pre-checks its JSON and buffer sizes and parses it with
 // tinygltf into `model`; tinygltf's warnings go to `warnings`. Returns each buffer's declared
-// byteLength. Any problem throws InputError.
+// byteLength. Any problem throws InputError. The file's animations are parsed only with
+// `keep_animations`.
 std::vector<uint64_t> parse_file(const std::string& path, tinygltf::Model& model,
-                                 std::vector<std::string>& warnings);
+                                 std::vector<std::string>& warnings, bool keep_animations);
+
+class Loader;
+
+// The loader kept open, so that one file's scene can be flattened again for other node
+// transforms (host/scene/animation.cpp, once per frame): the file is parsed and checked once,
+// each primitive decoded once.
+class OpenScene {
+ public:
+  // Parses and checks the file (throws InputError as load_scene does).
+  OpenScene(const std::string& path, const LoadOptions& options);
+  ~OpenScene();
+  // The default scene flattened as load_scene() does (gltf_loader.h's rules), with local[n],
+  // where set, as node n's local transform instead of the file's.
+  Scene flatten(const std::vector<std::optional<glm::dmat4>>& local = {});
+  const tinygltf::Model& model() const;
+  const std::string& path() const;
+  // The nodes the last flatten() walked, in walk order.
+  const std::vector<int>& walked() const;
+  // Accessor `accessor` read for `use` as doubles, `components` per element (1: SCALAR, 3:
+  // VEC3, 4: VEC4): float components, with `integers` also normalized byte and short ones.
+  // Checked like every accessor (in range, not sparse); a non-finite value throws InputError.
+  std::vector<double> read_doubles(int accessor, const std::string& use, int components,
+                                   bool integers) const;
+
+ private:
+  std::unique_ptr<Loader> loader_;
+};
 
 }  // namespace host::gltf_detail

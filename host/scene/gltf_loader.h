@@ -16,6 +16,8 @@ struct LoadOptions {
   // Input triangles (degenerate ones included) above this throw InputError. Values above
   // 2^32 - 1 act as 2^32 - 1, since triangle ids are 32-bit.
   uint64_t max_triangles = 50'000'000;
+  // Parse the file's animations too (host/scene/animation.h); load_scene never uses them.
+  bool animations = false;
 };
 
 // Loads the default scene (or scene 0, or every root node when the file has no scenes).
