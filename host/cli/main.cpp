@@ -18,10 +18,13 @@
 
 #include "host/accel/accel.h"
 #include "host/accel/grid.h"
+#include "host/cli/frames.h"
+#include "host/common/parallel.h"
 #include "host/image/image_io.h"
 #include "host/model/cost_model.h"
 #include "host/model/formats.h"
 #include "host/report/report.h"
+#include "host/scene/animation.h"
 #include "host/scene/camera.h"
 #include "host/scene/gltf_loader.h"
 #include "host/trace/accel_choice.h"
@@ -73,6 +76,11 @@ struct RenderArgs {
   float aa_threshold = 0.1f;
   bool steps_given = false;
   bool walk_given = false;
+  std::string time;       // --time T
+  std::string frames;     // --frames A:B:N
+  std::string animation;  // --animation NAME|INDEX
+  std::string update = "rebuild";
+  bool update_given = false;
 };
 
 struct UsageError : std::runtime_error {
@@ -172,6 +180,28 @@ const CLI::Validator kThresholdCheck(
       return "expected a colour difference of 0 or more (linear, 1 = white), got '" + text + "'";
     },
     "0 or more", "T");
+
+const CLI::Validator kTimeCheck([](std::string& text) { return cli::time_problem(text); },
+                                "seconds, 0 or more", "T");
+
+const CLI::Validator kFramesCheck(
+    [](std::string& text) {
+      cli::FrameRange range;
+      return cli::frames_problem(text, range);
+    },
+    "A:B:N, N frames from A to B seconds", "A:B:N");
+
+// --update: how the structure follows a moving scene. Only a rebuild exists so far.
+const CLI::Validator kUpdateCheck(
+    [](std::string& text) -> std::string {
+      if (text == "rebuild") return {};
+      if (text == "refit" || text == "auto")
+        return text +
+               ": refitting a BVH's boxes between frames is not implemented yet; every frame "
+               "rebuilds the structure (--update rebuild)";
+      return "expected rebuild, got '" + text + "'";
+    },
+    "rebuild", "MODE");
 
 // An output file: the extension is one of `exts` and its directory exists and is writable.
 CLI::Validator output_check(std::vector<std::string> exts) {
@@ -362,6 +392,29 @@ void add_render_options(CLI::App& render, RenderArgs& a) {
       ->capture_default_str();
   render.add_flag("--predict", a.predict,
                   "Print the cost model's predicted time for --profile, with its breakdown");
+  render
+      .add_option("--time", a.time,
+                  "Render the scene at T seconds of its animation (glTF; a static scene renders "
+                  "as it is; before the first key and after the last, the keys' values)")
+      ->check(kTimeCheck);
+  render
+      .add_option("--frames", a.frames,
+                  "Render N frames evenly from A to B seconds, both included (N = 1: A); --out "
+                  "and --aov need '#' in the file name for the frame number, zero-padded, "
+                  "numbered from 1 (frame_####.png: frame_0001.png, ...); --stats-json holds one "
+                  "record per frame")
+      ->check(kFramesCheck);
+  render.add_option("--animation", a.animation,
+                    "With --time or --frames: the animation to play, by name or index (default: "
+                    "the file's first)");
+  render
+      .add_option("--update", a.update,
+                  "With --time or --frames: how the acceleration structure follows the moving "
+                  "scene each frame: rebuild (the grid or BVH is built again; refit and auto are "
+                  "not implemented yet)")
+      ->check(kUpdateCheck)
+      ->each([&a](const std::string&) { a.update_given = true; })
+      ->capture_default_str();
 }
 
 int run_render(const RenderArgs& a, bool lanes_given) {
@@ -433,6 +486,35 @@ int run_render(const RenderArgs& a, bool lanes_given) {
                        "without passes, lanes or masks)");
   }
   if (a.steps_given && !opt.looping) throw UsageError("--steps-per-pass needs --kernels looping");
+  // Animation (issue 23): the frames' times, and what several frames need.
+  const bool animating = !a.time.empty() || !a.frames.empty();
+  if (!a.time.empty() && !a.frames.empty())
+    throw UsageError("--time and --frames: give one (--frames A:A:1 is --time A)");
+  if (!animating && (!a.animation.empty() || a.update_given))
+    throw UsageError(std::string(a.animation.empty() ? "--update" : "--animation") +
+                     " needs --time or --frames");
+  std::vector<double> times = {0.0};
+  if (!a.time.empty()) times = {cli::parse_time(a.time)};
+  if (!a.frames.empty()) {
+    cli::FrameRange range;
+    cli::frames_problem(a.frames, range);  // CLI11 checked it
+    times = cli::frame_times(range);
+  }
+  if (times.size() > 1) {
+    for (const auto& [option, file] : {std::pair<std::string, std::string>{"--out", a.out},
+                                       {"--aov", aov_depth},
+                                       {"--aov", aov_hit}})
+      if (!file.empty() && !cli::has_frame_number(file))
+        throw UsageError(option + " " + file + ": " + std::to_string(times.size()) +
+                         " frames need '#' in the file name for the frame number (e.g. "
+                         "frame_####.png)");
+    const char* one_frame = !a.report.empty()      ? "--report"
+                            : !a.stats_csv.empty() ? "--stats-csv"
+                            : opt.trace_pixel      ? "--trace-pixel"
+                                                   : nullptr;
+    if (one_frame)
+      throw UsageError(std::string(one_frame) + " follows one frame: render it with --time T");
+  }
   if (a.walk_given && a.engine != "stream")
     throw UsageError("--walk needs --engine stream (it says how the emulator runs the walk)");
   // Reduced precision runs at 1 or 8 lanes (vgpu/gpu.cpp): refuse another width.
@@ -480,17 +562,49 @@ int run_render(const RenderArgs& a, bool lanes_given) {
     opt.observer = &*recorder;
   }
 
+  // The scene: as the file has it, or posed at each frame's time (--time, --frames).
   const std::string path = host::resolve_scene(a.scene);
-  const host::Scene scene = host::load_scene(path);
+  std::optional<host::AnimatedScene> animated;
+  std::optional<size_t> animation;
+  if (animating) {
+    animated.emplace(path);
+    const std::vector<host::Animation>& list = animated->animations();
+    if (!a.animation.empty()) {
+      animation = animated->find(a.animation);
+      if (!animation) {
+        std::string known;
+        for (size_t i = 0; i < list.size(); ++i)
+          known += (i ? ", " : "") + std::to_string(i) + " '" + list[i].name + "'";
+        throw UsageError("--animation " + a.animation + ": " + path +
+                         " has no animation named or numbered '" + a.animation + "' (" +
+                         (known.empty() ? "it has none" : "it has " + known) + ")");
+      }
+    } else if (!list.empty()) {
+      animation = 0;  // the first, as --help says
+    }
+    animated->check(animation);  // skinned meshes, morph-target weights: one line, exit 2
+  }
+  nlohmann::ordered_json animation_json = nullptr;
+  if (animation) {
+    const host::Animation& an = animated->animations()[*animation];
+    animation_json = {
+        {"name", an.name}, {"index", *animation}, {"start", an.start}, {"end", an.end}};
+  }
+  auto pose_start = std::chrono::steady_clock::now();
+  host::Scene scene = animated ? animated->at(animation, times[0]) : host::load_scene(path);
+  double pose_ms = animated ? host::ms_since(pose_start) : 0.0;
+  const host::Scene& rest = animated ? animated->rest() : scene;  // frames a camera-less file
   const auto t0 = std::chrono::steady_clock::now();
   // With a structure other than the grid, the grid is one voxel: it gives the scene box only.
   const bool auto_accel = a.accel == "auto";
   host::AccelKind accel_kind = auto_accel ? host::AccelKind::grid : host::parse_accel_kind(a.accel);
   const bool want_grid = auto_accel || accel_kind == host::AccelKind::grid;
-  const host::Grid grid =
+  host::Grid grid =
       want_grid ? host::build_grid(
                       scene, host::grid_spec_for(grid_spec, scene, vgpu::profile(opt.profile)))
                 : host::Grid{};
+  // Later frames keep the first frame's resolution (so the voxel pointers keep their texture).
+  const host::GridSpec frame_grid{grid.res};
   std::optional<host::Grid> box;
   std::optional<host::Bvh> bvh;
   std::optional<host::KdTree> kd;
@@ -516,9 +630,13 @@ int run_render(const RenderArgs& a, bool lanes_given) {
     if (!why.empty()) throw UsageError(why);
   }
   const float aspect = float(opt.width) / float(opt.height);
-  const host::Camera cam = host::scene_camera(scene, aspect);
-  const bool tty = ::isatty(2) && !a.quiet;
-  if (!a.quiet)
+  // A frame's camera: the file's (moving with its node), else the rest scene's framing.
+  auto camera_for = [&](const host::Scene& s) {
+    return host::scene_camera(s.camera ? s : rest, aspect);
+  };
+  const bool several = times.size() > 1;
+  const bool tty = ::isatty(2) && !a.quiet && !several;
+  if (!a.quiet && !several)  // several frames: one line per frame instead
     opt.progress = [&](int it, int n) {
       std::fprintf(stderr, tty ? "\rvgpu-rt: iteration %d/%d" : "vgpu-rt: iteration %d/%d\n", it,
                    n);
@@ -528,168 +646,255 @@ int run_render(const RenderArgs& a, bool lanes_given) {
   if (auto_accel) {
     std::vector<host::AccelCandidate> candidates;
     for (host::AccelKind k : host::kAccelKinds) candidates.push_back({accel_of(k), formats_for(k)});
-    choice = host::choose_accel(scene, candidates, opt, cam);
+    choice = host::choose_accel(scene, candidates, opt, camera_for(scene));
     accel_kind = choice->kind;
     opt.formats = formats_for(accel_kind);
   }
   const host::Accel accel = accel_of(accel_kind);
   const host::Grid& walk_grid = *accel.grid;
+  // The host's build of the structure walked (and of its box), ms.
+  auto build_ms = [&] {
+    return accel_kind == host::AccelKind::grid  ? grid.build_ms
+           : accel_kind == host::AccelKind::bvh ? box->build_ms + bvh->build_ms
+                                                : box->build_ms + kd->build_ms;
+  };
   std::optional<host::StreamTracer> tracer;
   if (!cpu) tracer.emplace(scene, accel, opt);
   const double init_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   host::CpuStats cpu_stats;
-  const host::RenderResult r =
-      cpu ? host::render_cpu(scene, accel, cam, opt, &cpu_stats) : tracer->render(cam);
-  if (tty) std::fprintf(stderr, "\n");
-  if (recorder) recorder->finish(r.stats);
-
-  if (!a.out.empty()) host::write_image(a.out, r.width, r.height, 3, r.rgb);
-  if (!aov_depth.empty()) host::write_image(aov_depth, r.width, r.height, 1, r.depth);
-  if (!aov_hit.empty()) host::write_image(aov_hit, r.width, r.height, 1, r.hit_id);
-
-  nlohmann::ordered_json j;
-  j["scene"] = scene.name;
-  j["scene_path"] = path;
-  j["engine"] = a.engine;
-  if (tracer) j["device"] = tracer->device().description();
-  j["triangles"] = scene.triangle_count();
-  j["input_triangles"] = scene.input_triangles;
-  j["dropped_degenerate"] = scene.dropped_degenerate;
-  j["grid"] = {walk_grid.res.x, walk_grid.res.y, walk_grid.res.z};
-  j["grid_references"] = walk_grid.references();
-  {
-    nlohmann::ordered_json acc;
-    acc["structure"] = host::accel_name(accel_kind);
-    if (accel_kind == host::AccelKind::bvh) {
-      acc["nodes"] = bvh->nodes.size();
-      acc["leaves"] = bvh->leaves;
-      acc["depth"] = bvh->depth;
-      acc["max_leaf"] = bvh->max_leaf;
-      acc["references"] = bvh->references();
-      acc["sah_cost"] = bvh->sah_cost;
-      acc["build_ms"] = bvh->build_ms;
-    } else if (accel_kind == host::AccelKind::kdtree) {
-      acc["nodes"] = kd->nodes.size();
-      acc["leaves"] = kd->leaves;
-      acc["empty_leaves"] = kd->empty_leaves;
-      acc["depth"] = kd->depth;
-      acc["max_leaf"] = kd->max_leaf;
-      acc["references"] = kd->references();
-      acc["sah_cost"] = kd->sah_cost;
-      acc["build_ms"] = kd->build_ms;
-    } else {
-      acc["voxels"] = {walk_grid.res.x, walk_grid.res.y, walk_grid.res.z};
-      acc["references"] = walk_grid.references();
-      acc["build_ms"] = walk_grid.build_ms;
-    }
-    if (!cpu) {
-      const host::WalkWork w = host::walk_work(r.stats);
-      acc["work"] = {{"voxel_steps", w.voxel_steps},
-                     {"nodes_visited", w.nodes_visited},
-                     {"triangle_tests", w.triangle_tests},
-                     {"loop_iterations", w.loop_iterations}};
-    }
-    if (choice) {
-      nlohmann::ordered_json au;
-      au["probe_size"] = {choice->probe_width, choice->probe_height};
-      au["profile"] = opt.profile;
-      au["predicted_ms"] = choice->predicted_ms;
-      au["probe_passes"] = choice->probe_passes;
-      au["probe_ms"] = choice->probe_ms;
-      au["why"] = choice->why;
-      acc["auto"] = au;
-    }
-    j["accel"] = acc;
-  }
-  j["profile"] = opt.profile;
-  j["size"] = {r.width, r.height};
-  j["bounces"] = opt.bounces;
-  j["iterations"] = r.iterations;
-  j["shading"] = a.shading;
-  j["shadows"] = opt.shadows;
-  j["masks"] = opt.masks;
-  j["mrt"] = opt.mrt;  // fused two-output passes (kernels/fused.h)
-  j["fused_programs"] = opt.mrt ? host::mrt_programs() : std::vector<std::string>{};
-  j["kernel_variant"] = a.kernels;  // multipass | looping ("kernels" lists the programs)
-  if (opt.looping) j["steps_per_pass"] = opt.steps_per_pass;
-  j["threads"] = opt.threads;
-  j["lanes"] = opt.lanes;
-  // How the emulator ran the grid walks: in batches or pass by pass (same statistics).
-  if (!cpu && !gl) j["walk"] = r.batch_walk ? "batches" : "passes";
-  j["precision"] = a.precision;
-  if (!cpu) j["formats"] = host::to_json(opt.formats);
-  j["init_ms"] = init_ms;
-  j["grid_build_ms"] = walk_grid.build_ms;
-  j["render_ms"] = r.render_ms;
-  if (tracer) j["texture_bytes"] = tracer->texture_bytes();
-  if (cpu)
-    j["cpu"] = {{"rays", cpu_stats.rays},
-                {"voxel_steps", cpu_stats.voxel_steps},
-                {"triangle_tests", cpu_stats.triangle_tests},
-                {"nodes_visited", cpu_stats.nodes_visited},
-                {"restarts", cpu_stats.restarts}};
-  j["rays_traced"] = r.rays_traced;
-  j["rays_unfinished"] = r.rays_unfinished;
-  // Supersampling (--spp): samples per pixel and the passes it added to the first sample frame.
-  {
-    double mean = double(r.samples);
-    uint64_t most = uint64_t(r.samples);
-    if (!r.rays_per_pixel.empty()) {
-      uint64_t total = 0;
-      most = 0;
-      for (const uint32_t n : r.rays_per_pixel) total += n, most = std::max<uint64_t>(most, n);
-      mean = double(total) / double(r.rays_per_pixel.size());
-    }
-    j["sampling"] = {{"mode", opt.undersample > 0           ? "undersample"
-                              : opt.adaptive && opt.spp > 1 ? "adaptive"
-                                                            : "uniform"},
-                     {"spp", opt.spp},
-                     {"samples_per_pixel_mean", mean},
-                     {"samples_per_pixel_max", most},
-                     {"passes_added", cpu ? 0 : r.stats.totals.passes - r.first_frame_passes}};
-    if (opt.adaptive) j["sampling"]["threshold"] = opt.aa_threshold;
-    if (opt.undersample > 0) j["sampling"]["k"] = opt.undersample;
-  }
-  {
-    nlohmann::ordered_json stats = r.stats.json();
-    if (gl)  // the emulator's SIMD model: a driver does not show its lanes
-      for (const char* key :
-           {"lanes_idle", "idle_in_batch32", "idle_in_batch1024", "loop_iterations",
-            "loop_lane_slots", "loop_lanes_idle", "loop_batch_iterations", "loop_idle_instructions",
-            "loop_idle_fetches"}) {
-        stats["totals"][key] = nullptr;
-        for (auto& k : stats["programs"]) k[key] = nullptr;
+  host::RenderResult r;
+  // One frame's statistics object (the whole --stats-json of a render that is not animated).
+  auto record = [&](double frame_init_ms) {
+    nlohmann::ordered_json j;
+    j["scene"] = scene.name;
+    j["scene_path"] = path;
+    j["engine"] = a.engine;
+    if (tracer) j["device"] = tracer->device().description();
+    j["triangles"] = scene.triangle_count();
+    j["input_triangles"] = scene.input_triangles;
+    j["dropped_degenerate"] = scene.dropped_degenerate;
+    j["grid"] = {walk_grid.res.x, walk_grid.res.y, walk_grid.res.z};
+    j["grid_references"] = walk_grid.references();
+    {
+      nlohmann::ordered_json acc;
+      acc["structure"] = host::accel_name(accel_kind);
+      if (accel_kind == host::AccelKind::bvh) {
+        acc["nodes"] = bvh->nodes.size();
+        acc["leaves"] = bvh->leaves;
+        acc["depth"] = bvh->depth;
+        acc["max_leaf"] = bvh->max_leaf;
+        acc["references"] = bvh->references();
+        acc["sah_cost"] = bvh->sah_cost;
+        acc["build_ms"] = bvh->build_ms;
+      } else if (accel_kind == host::AccelKind::kdtree) {
+        acc["nodes"] = kd->nodes.size();
+        acc["leaves"] = kd->leaves;
+        acc["empty_leaves"] = kd->empty_leaves;
+        acc["depth"] = kd->depth;
+        acc["max_leaf"] = kd->max_leaf;
+        acc["references"] = kd->references();
+        acc["sah_cost"] = kd->sah_cost;
+        acc["build_ms"] = kd->build_ms;
+      } else {
+        acc["voxels"] = {walk_grid.res.x, walk_grid.res.y, walk_grid.res.z};
+        acc["references"] = walk_grid.references();
+        acc["build_ms"] = walk_grid.build_ms;
       }
-    j["totals"] = std::move(stats["totals"]);
-    j["downloads"] = stats["downloads"];
-    j["download_bytes"] = stats["download_bytes"];
-    j["kernels"] = std::move(stats["programs"]);
-  }
-  // The cost model's prediction for every built-in profile (the counters do not depend on it).
-  nlohmann::ordered_json predicted_ms, predicted_breakdown;
-  for (const vgpu::Profile& p : vgpu::profiles()) {
-    if (cpu || gl) break;  // no passes, or no SIMD counters to predict from
-    if (opt.looping && p.max_loop_iterations < opt.steps_per_pass) {
-      predicted_ms[p.name] = nullptr;  // the looping program cannot run there
-      continue;
+      if (!cpu) {
+        const host::WalkWork w = host::walk_work(r.stats);
+        acc["work"] = {{"voxel_steps", w.voxel_steps},
+                       {"nodes_visited", w.nodes_visited},
+                       {"triangle_tests", w.triangle_tests},
+                       {"loop_iterations", w.loop_iterations}};
+      }
+      if (choice) {
+        nlohmann::ordered_json au;
+        au["probe_size"] = {choice->probe_width, choice->probe_height};
+        au["profile"] = opt.profile;
+        au["predicted_ms"] = choice->predicted_ms;
+        au["probe_passes"] = choice->probe_passes;
+        au["probe_ms"] = choice->probe_ms;
+        au["why"] = choice->why;
+        acc["auto"] = au;
+      }
+      j["accel"] = acc;
     }
-    const host::CostBreakdown c = host::predict(r.stats, p);
-    predicted_ms[p.name] = c.total_ms;
-    for (const auto& [key, v] : c.items()) predicted_breakdown[p.name][key] = v;
+    j["profile"] = opt.profile;
+    j["size"] = {r.width, r.height};
+    j["bounces"] = opt.bounces;
+    j["iterations"] = r.iterations;
+    j["shading"] = a.shading;
+    j["shadows"] = opt.shadows;
+    j["masks"] = opt.masks;
+    j["mrt"] = opt.mrt;  // fused two-output passes (kernels/fused.h)
+    j["fused_programs"] = opt.mrt ? host::mrt_programs() : std::vector<std::string>{};
+    j["kernel_variant"] = a.kernels;  // multipass | looping ("kernels" lists the programs)
+    if (opt.looping) j["steps_per_pass"] = opt.steps_per_pass;
+    j["threads"] = opt.threads;
+    j["lanes"] = opt.lanes;
+    // How the emulator ran the grid walks: in batches or pass by pass (same statistics).
+    if (!cpu && !gl) j["walk"] = r.batch_walk ? "batches" : "passes";
+    j["precision"] = a.precision;
+    if (!cpu) j["formats"] = host::to_json(opt.formats);
+    j["init_ms"] = frame_init_ms;
+    j["grid_build_ms"] = walk_grid.build_ms;
+    j["render_ms"] = r.render_ms;
+    if (tracer) j["texture_bytes"] = tracer->texture_bytes();
+    if (cpu)
+      j["cpu"] = {{"rays", cpu_stats.rays},
+                  {"voxel_steps", cpu_stats.voxel_steps},
+                  {"triangle_tests", cpu_stats.triangle_tests},
+                  {"nodes_visited", cpu_stats.nodes_visited},
+                  {"restarts", cpu_stats.restarts}};
+    j["rays_traced"] = r.rays_traced;
+    j["rays_unfinished"] = r.rays_unfinished;
+    // Supersampling (--spp): samples per pixel and the passes it added to the first sample frame.
+    {
+      double mean = double(r.samples);
+      uint64_t most = uint64_t(r.samples);
+      if (!r.rays_per_pixel.empty()) {
+        uint64_t total = 0;
+        most = 0;
+        for (const uint32_t n : r.rays_per_pixel) total += n, most = std::max<uint64_t>(most, n);
+        mean = double(total) / double(r.rays_per_pixel.size());
+      }
+      j["sampling"] = {{"mode", opt.undersample > 0           ? "undersample"
+                                : opt.adaptive && opt.spp > 1 ? "adaptive"
+                                                              : "uniform"},
+                       {"spp", opt.spp},
+                       {"samples_per_pixel_mean", mean},
+                       {"samples_per_pixel_max", most},
+                       {"passes_added", cpu ? 0 : r.stats.totals.passes - r.first_frame_passes}};
+      if (opt.adaptive) j["sampling"]["threshold"] = opt.aa_threshold;
+      if (opt.undersample > 0) j["sampling"]["k"] = opt.undersample;
+    }
+    {
+      nlohmann::ordered_json stats = r.stats.json();
+      if (gl)  // the emulator's SIMD model: a driver does not show its lanes
+        for (const char* key :
+             {"lanes_idle", "idle_in_batch32", "idle_in_batch1024", "loop_iterations",
+              "loop_lane_slots", "loop_lanes_idle", "loop_batch_iterations",
+              "loop_idle_instructions", "loop_idle_fetches"}) {
+          stats["totals"][key] = nullptr;
+          for (auto& k : stats["programs"]) k[key] = nullptr;
+        }
+      j["totals"] = std::move(stats["totals"]);
+      j["downloads"] = stats["downloads"];
+      j["download_bytes"] = stats["download_bytes"];
+      j["kernels"] = std::move(stats["programs"]);
+    }
+    // The cost model's prediction for every built-in profile (the counters do not depend on it).
+    nlohmann::ordered_json predicted_ms, predicted_breakdown;
+    for (const vgpu::Profile& p : vgpu::profiles()) {
+      if (cpu || gl) break;  // no passes, or no SIMD counters to predict from
+      if (opt.looping && p.max_loop_iterations < opt.steps_per_pass) {
+        predicted_ms[p.name] = nullptr;  // the looping program cannot run there
+        continue;
+      }
+      const host::CostBreakdown c = host::predict(r.stats, p);
+      predicted_ms[p.name] = c.total_ms;
+      for (const auto& [key, v] : c.items()) predicted_breakdown[p.name][key] = v;
+    }
+    j["predicted_ms"] = predicted_ms;
+    j["predicted_breakdown"] = predicted_breakdown;
+    auto what_if = nlohmann::ordered_json::array();  // MRT and resident programs (docs/table1.md)
+    for (const auto& [name, s] :
+         cpu || gl ? decltype(host::what_ifs(r.stats)){} : host::what_ifs(r.stats)) {
+      nlohmann::ordered_json w = {{"name", name}, {"totals", vgpu::to_json(s.totals)}};
+      for (const vgpu::Profile& p : vgpu::profiles())
+        for (const auto& [key, v] : host::predict(s, p).items())
+          w["predicted_breakdown"][p.name][key] = v;
+      what_if.push_back(w);
+    }
+    j["predicted_what_if"] = what_if;
+    return j;
+  };
+
+  // Frame by frame: the scene posed, the grid rebuilt, the static textures that changed
+  // uploaded again (--update rebuild), the frame rendered and its files written.
+  nlohmann::ordered_json j, frames_json = nlohmann::ordered_json::array();
+  struct FrameLine {
+    double time, pose_ms, build_ms, write_ms, render_ms;
+    uint64_t uploaded, passes;
+    double predicted_ms;
+  };
+  std::vector<FrameLine> lines;
+  for (size_t f = 0; f < times.size(); ++f) {
+    const int number = int(f) + 1;
+    host::StreamTracer::Upload up;
+    double write_ms = 0;
+    if (f > 0) {
+      pose_start = std::chrono::steady_clock::now();
+      scene = animated->at(animation, times[f]);
+      pose_ms = host::ms_since(pose_start);
+      if (accel_kind == host::AccelKind::grid) {
+        grid = host::build_grid(scene, frame_grid);
+      } else {  // the structure walked, in the scene's new box
+        box = host::build_grid(scene, host::GridSpec{glm::ivec3(1)});
+        if (accel_kind == host::AccelKind::bvh) bvh = host::build_bvh(scene);
+        if (accel_kind == host::AccelKind::kdtree) kd = host::build_kdtree(scene, box->lo, box->hi);
+      }
+      const auto tu = std::chrono::steady_clock::now();
+      if (tracer) up = tracer->update(scene, accel);
+      write_ms = host::ms_since(tu);
+    } else if (tracer) {
+      up.bytes = tracer->static_bytes();  // the first frame's: initialization uploads them all
+    }
+    const host::Camera cam = camera_for(scene);
+    cpu_stats = {};
+    r = cpu ? host::render_cpu(scene, accel, cam, opt, &cpu_stats) : tracer->render(cam);
+    if (tty) std::fprintf(stderr, "\n");
+    if (recorder) recorder->finish(r.stats);
+
+    auto numbered = [&](const std::string& file) {
+      return animating ? cli::frame_path(file, number) : file;
+    };
+    if (!a.out.empty()) host::write_image(numbered(a.out), r.width, r.height, 3, r.rgb);
+    if (!aov_depth.empty()) host::write_image(numbered(aov_depth), r.width, r.height, 1, r.depth);
+    if (!aov_hit.empty()) host::write_image(numbered(aov_hit), r.width, r.height, 1, r.hit_id);
+
+    j = record(f == 0 ? init_ms : 0.0);
+    double predicted = 0;
+    if (!cpu && !gl) predicted = host::predict(r.stats, vgpu::profile(opt.profile)).total_ms;
+    if (animating) {
+      // What the frame's update cost: the host's work, the bytes sent to the device, and the
+      // cost model's charge for them on each profile (host/model/cost_model.h, predict_update).
+      nlohmann::ordered_json update = {
+          {"mode", f == 0 ? std::string("initial") : a.update},
+          {"pose_ms", pose_ms},
+          {"structure", host::accel_name(accel_kind)},
+          {"build_ms", build_ms()},
+          {"write_ms", write_ms},
+          {"uploaded_bytes", tracer ? nlohmann::ordered_json(up.bytes) : nullptr},
+          {"uploaded_textures", up.textures}};
+      nlohmann::ordered_json charged;
+      for (const vgpu::Profile& p : vgpu::profiles()) {
+        if (!tracer) break;
+        const host::UpdateCost c = host::predict_update(up.bytes, build_ms(), p);
+        charged[p.name] = {
+            {"upload_ms", c.upload_ms}, {"build_ms", c.build_ms}, {"total_ms", c.total_ms}};
+      }
+      update["predicted"] = charged;
+      j["frame"] = number;
+      j["time"] = times[f];
+      j["animation"] = animation_json;
+      j["update"] = update;
+      if (several) frames_json.push_back(j);
+      if (!a.quiet)
+        std::fprintf(stderr,
+                     "vgpu-rt: frame %d/%zu (t = %g s): update %.1f ms (pose %.1f, grid %.1f, "
+                     "textures %.1f), %llu bytes uploaded; render %.1f ms, %llu passes\n",
+                     number, times.size(), times[f], pose_ms + build_ms() + write_ms, pose_ms,
+                     build_ms(), write_ms, static_cast<unsigned long long>(up.bytes), r.render_ms,
+                     static_cast<unsigned long long>(r.stats.totals.passes));
+    }
+    lines.push_back({times[f], pose_ms, build_ms(), write_ms, r.render_ms, up.bytes,
+                     r.stats.totals.passes, predicted});
   }
-  j["predicted_ms"] = predicted_ms;
-  j["predicted_breakdown"] = predicted_breakdown;
-  auto what_if = nlohmann::ordered_json::array();  // MRT and resident programs (docs/table1.md)
-  for (const auto& [name, s] :
-       cpu || gl ? decltype(host::what_ifs(r.stats)){} : host::what_ifs(r.stats)) {
-    nlohmann::ordered_json w = {{"name", name}, {"totals", vgpu::to_json(s.totals)}};
-    for (const vgpu::Profile& p : vgpu::profiles())
-      for (const auto& [key, v] : host::predict(s, p).items())
-        w["predicted_breakdown"][p.name][key] = v;
-    what_if.push_back(w);
-  }
-  j["predicted_what_if"] = what_if;
+  if (several)
+    j = {{"scene", scene.name}, {"scene_path", path},          {"animation", animation_json},
+         {"update", a.update},  {"frame_count", times.size()}, {"frames", frames_json}};
   if (!a.stats_json.empty()) {
     const std::string tmp = a.stats_json + ".tmp";
     std::ofstream f(tmp);
@@ -704,6 +909,25 @@ int run_render(const RenderArgs& a, bool lanes_given) {
   if (!a.report.empty()) host::write_report(a.report, *recorder, r, j);
   if (a.stats == "json") {
     std::cout << j.dump(2) << "\n";
+  } else if (a.stats == "table" && several) {
+    std::printf("scene %s, animation %s, %zu frames, %s, --update %s, %dx%d, %s %s\n",
+                scene.name.c_str(),
+                animation ? ("'" + animated->animations()[*animation].name + "'").c_str()
+                          : "none (the scene is static)",
+                times.size(), std::string(host::accel_name(accel_kind)).c_str(), a.update.c_str(),
+                r.width, r.height, cpu ? "engine" : "profile", cpu ? "cpu" : opt.profile.c_str());
+    std::printf("%6s %9s %9s %9s %11s %12s %10s %8s%s\n", "frame", "time s", "pose ms", "build ms",
+                "textures ms", "uploaded B", "render ms", "passes",
+                a.predict ? "  predicted ms" : "");
+    for (size_t f = 0; f < lines.size(); ++f) {
+      const FrameLine& l = lines[f];
+      std::printf("%6zu %9.4g %9.2f %9.2f %11.2f %12llu %10.1f %8llu", f + 1, l.time, l.pose_ms,
+                  l.build_ms, l.write_ms, static_cast<unsigned long long>(l.uploaded), l.render_ms,
+                  static_cast<unsigned long long>(l.passes));
+      if (a.predict) std::printf("  %12.3f", l.predicted_ms);
+      std::printf("\n");
+    }
+    std::printf("initialization %.1f ms (the first frame's grid and uploads)\n", init_ms);
   } else if (a.stats == "table") {
     if (cpu)
       std::printf(
@@ -738,8 +962,13 @@ int run_render(const RenderArgs& a, bool lanes_given) {
     if (gl)
       std::printf("device %s: passes %.2f ms of GPU time (timer queries)\n",
                   tracer->device().description().c_str(), r.stats.totals.device_ms);
+    if (animating)
+      std::printf("time %g s of %s\n", times[0],
+                  animation
+                      ? ("animation '" + animated->animations()[*animation].name + "'").c_str()
+                      : "no animation (the scene is static)");
   }
-  if (a.predict) {
+  if (a.predict && !several) {
     const vgpu::Profile& p = vgpu::profile(opt.profile);
     std::cout << host::describe(host::predict(r.stats, p), p);
   }
@@ -858,8 +1087,15 @@ int main(int argc, char** argv) {
     if (*scenes) {
       for (const auto& [name, path] : host::list_scenes()) {
         try {
-          const host::Scene s = host::load_scene(path);
-          std::printf("%-14s %7zu triangles  %s\n", name.c_str(), s.triangle_count(), path.c_str());
+          const host::AnimatedScene s(path);
+          std::string animations;
+          for (const host::Animation& an : s.animations()) {
+            char range[64];
+            std::snprintf(range, sizeof range, " %g-%g s", an.start, an.end);
+            animations += (animations.empty() ? "  animations: '" : ", '") + an.name + "'" + range;
+          }
+          std::printf("%-14s %7zu triangles  %s%s\n", name.c_str(), s.rest().triangle_count(),
+                      path.c_str(), animations.c_str());
         } catch (const std::exception& e) {
           std::printf("%-14s (unreadable: %s)\n", name.c_str(), e.what());
         }
@@ -882,6 +1118,9 @@ int main(int argc, char** argv) {
       return 0;
     }
   } catch (const UsageError& e) {
+    std::fprintf(stderr, "vgpu-rt: %s\n", e.what());
+    return 2;
+  } catch (const host::UnsupportedFeature& e) {  // a feature a frame at a time cannot honour
     std::fprintf(stderr, "vgpu-rt: %s\n", e.what());
     return 2;
   } catch (const std::exception& e) {
