@@ -7,7 +7,7 @@ time and passes, and the cost model's charge on gf5700, gf6600 and h200 (the upl
 profile's bus, the frame's passes).
 
 Usage: /usr/bin/python3 scripts/animation.py [--vgpu-rt build/host/vgpu-rt] [--scene hop]
-         [--frames 0:2:25] [--size 256] [--threads 0] [--json FILE]
+         [--frames 0:2:25] [--size 256] [--threads 0] [--accel grid] [--json FILE]
   --json FILE  read an earlier run's --stats-json instead of rendering
 """
 import argparse
@@ -28,14 +28,15 @@ def main():
     ap.add_argument("--frames", default="0:2:25")
     ap.add_argument("--size", type=int, default=256)
     ap.add_argument("--threads", type=int, default=0)
+    ap.add_argument("--accel", default="grid", help="grid, bvh or kdtree")
     ap.add_argument("--json")
     opts = ap.parse_args()
     path = opts.json
     if not path:
         path = os.path.join(tempfile.mkdtemp(prefix="vgpu_animation_"), "frames.json")
         subprocess.run([opts.vgpu_rt, "render", opts.scene, "--frames", opts.frames, "--size",
-                        f"{opts.size}x{opts.size}", "--threads", str(opts.threads), "-q",
-                        "--stats", "none", "--stats-json", path], check=True)
+                        f"{opts.size}x{opts.size}", "--threads", str(opts.threads), "--accel",
+                        opts.accel, "-q", "--stats", "none", "--stats-json", path], check=True)
     with open(path) as f:
         run = json.load(f)
     frames = run["frames"]
@@ -50,13 +51,13 @@ def main():
     print(f"`{run['scene']}`, animation '{run['animation']['name']}', {len(frames)} frames "
           f"({opts.frames if not opts.json else 'from ' + opts.json}), "
           f"{first['size'][0]}x{first['size'][1]}, {first['triangles']} triangles, "
-          f"grid {'x'.join(map(str, first['grid']))}, threads {first['threads']}.\n")
+          f"structure {first['accel']['structure']}, threads {first['threads']}.\n")
     print("Medians over frames 2..N (frame 1's update is the initialization):\n")
     print("| quantity | median |")
     print("|---|---:|")
     rows = [
         ("pose (animation sampled, scene flattened), host ms", med(lambda r: u(r)["pose_ms"])),
-        ("grid rebuilt, host ms", med(lambda r: u(r)["build_ms"])),
+        (f"{u(first)['structure']} rebuilt, host ms", med(lambda r: u(r)["build_ms"])),
         ("static textures rewritten and compared, host ms", med(lambda r: u(r)["write_ms"])),
         ("update in all, host ms", med(host_update)),
         ("uploaded bytes", med(lambda r: u(r)["uploaded_bytes"])),
@@ -71,7 +72,7 @@ def main():
     for name, v in rows:
         print(f"| {name} | {v:,.0f} |" if v >= 1000 else f"| {name} | {v:.3g} |")
     print(f"\nFrame 1: {first['update']['uploaded_bytes']} bytes uploaded at initialization "
-          f"(init {first['init_ms']:.1f} ms host), grid {first['update']['build_ms']:.2f} ms.\n")
+          f"(init {first['init_ms']:.1f} ms host), build {first['update']['build_ms']:.2f} ms.\n")
     print("| frame | time s | update host ms | uploaded bytes | render ms | passes | "
           + " | ".join(f"{p} ms" for p in PROFILES) + " |")
     print("|---:|---:|---:|---:|---:|---:|" + "---:|" * len(PROFILES))

@@ -619,26 +619,30 @@ TEST_CASE("a static scene at any time renders as it is, and a render without a t
   fs::remove_all(dir);
 }
 
-TEST_CASE("with --accel bvh every frame rebuilds the BVH and uploads its changed textures") {
-  const fs::path dir = fs::temp_directory_path() / ("vgpu_cli_bvh_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  const std::string common = "render hop --accel bvh --size 32x24 -q --stats none";
-  const Outcome o = run(common + " --frames 0:1:2 --out " + (dir / "f_#.png").string() +
-                        " --stats-json " + (dir / "f.json").string());
-  INFO(o.err);
-  REQUIRE(o.status == 0);
-  const nlohmann::json j = nlohmann::json::parse(slurp(dir / "f.json"));
-  REQUIRE(j["frames"].size() == 2);
-  const nlohmann::json& second = j["frames"][1];
-  CHECK(second["accel"]["structure"] == "bvh");
-  CHECK(second["update"]["structure"] == "bvh");
-  CHECK(second["update"]["build_ms"].get<double>() > 0);
-  const auto& names = second["update"]["uploaded_textures"];
-  CHECK(std::find(names.begin(), names.end(), "bvh nodes lo") != names.end());
-  CHECK(std::find(names.begin(), names.end(), "vertices0") != names.end());
-  // The second frame, rendered by the updated tracer, is the frame rendered alone.
-  REQUIRE(run(common + " --time 1 --out " + (dir / "one.png").string()).status == 0);
-  CHECK(compare(dir / "one.png", dir / "f_2.png", 0).differing_percent == 0);
+TEST_CASE("with --accel bvh or kdtree every frame rebuilds the structure and uploads its changes") {
+  const fs::path dir = fs::temp_directory_path() / ("vgpu_cli_tree_" + std::to_string(::getpid()));
+  for (const std::string structure : {"bvh", "kdtree"}) {
+    CAPTURE(structure);
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    const std::string common = "render hop --accel " + structure + " --size 32x24 -q --stats none";
+    const Outcome o = run(common + " --frames 0:1:2 --out " + (dir / "f_#.png").string() +
+                          " --stats-json " + (dir / "f.json").string());
+    INFO(o.err);
+    REQUIRE(o.status == 0);
+    const nlohmann::json j = nlohmann::json::parse(slurp(dir / "f.json"));
+    REQUIRE(j["frames"].size() == 2);
+    const nlohmann::json& second = j["frames"][1];
+    CHECK(second["accel"]["structure"] == structure);
+    CHECK(second["update"]["structure"] == structure);
+    CHECK(second["update"]["build_ms"].get<double>() > 0);
+    const auto& names = second["update"]["uploaded_textures"];
+    const std::string nodes = structure == "bvh" ? "bvh nodes lo" : "kd nodes";
+    CHECK(std::find(names.begin(), names.end(), nodes) != names.end());
+    CHECK(std::find(names.begin(), names.end(), "vertices0") != names.end());
+    // The second frame, rendered by the updated tracer, is the frame rendered alone.
+    REQUIRE(run(common + " --time 1 --out " + (dir / "one.png").string()).status == 0);
+    CHECK(compare(dir / "one.png", dir / "f_2.png", 0).differing_percent == 0);
+  }
   fs::remove_all(dir);
 }

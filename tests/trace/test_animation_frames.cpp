@@ -157,35 +157,47 @@ TEST_CASE("a tracer updated between frames renders what a tracer made for the fr
   CHECK(std::count(grown_fresh.hit_id.begin(), grown_fresh.hit_id.end(), 110.0f) > 0);
 }
 
-TEST_CASE("a tracer walking a BVH, updated between frames, renders what a new tracer renders") {
+TEST_CASE(
+    "a tracer walking a BVH or a kd-tree, updated between frames, renders what a new one "
+    "renders") {
   const host::AnimatedScene a(data_path("animated.gltf"));
   const Scene first = a.at(0, 0.0), second = a.at(0, 2.0);
   const host::Camera cam = *first.camera;
-  // The BVH in its scene box (a one-voxel grid), as the CLI builds them every frame.
-  auto accel_of = [](const Scene& s, host::Grid& box, host::Bvh& bvh) {
-    box = host::build_grid(s, host::GridSpec{glm::ivec3(1)});
-    bvh = host::build_bvh(s);
-    return host::Accel{host::AccelKind::bvh, &box, &bvh};
-  };
-  host::Grid box1, box2;
-  host::Bvh bvh1, bvh2;
-  host::StreamTracer tracer(first, accel_of(first, box1, bvh1), options());
-  (void)tracer.render(cam);
-  const host::Accel accel2 = accel_of(second, box2, bvh2);
-  const host::StreamTracer::Upload up = tracer.update(second, accel2);
-  const RenderResult updated = tracer.render(cam);
-  host::StreamTracer fresh_tracer(second, accel2, options());
-  const RenderResult fresh = fresh_tracer.render(cam);
-  CHECK(differing(updated.rgb, fresh.rgb) == 0);
-  CHECK(differing(updated.hit_id, fresh.hit_id) == 0);
-  CHECK(differing(updated.depth, fresh.depth) == 0);
-  CHECK(updated.stats.totals.passes == fresh.stats.totals.passes);
-  for (const char* name : {"vertices0", "bvh nodes lo", "bvh nodes hi"})
-    CHECK_MESSAGE(std::find(up.textures.begin(), up.textures.end(), name) != up.textures.end(),
-                  name);
-  // The same frame walked through the grid hits the same triangles (the structures agree).
-  const RenderResult grid_frame = render(second, host::build_grid(second, {}), cam);
-  CHECK(differing(updated.hit_id, grid_frame.hit_id) <= int(updated.hit_id.size() / 200));
-  // A tracer made for a BVH is not handed a grid.
-  CHECK_THROWS_AS(tracer.update(second, host::build_grid(second, {})), std::invalid_argument);
+  for (const host::AccelKind kind : {host::AccelKind::bvh, host::AccelKind::kdtree}) {
+    CAPTURE(std::string(host::accel_name(kind)));
+    // The structure in its scene box (a one-voxel grid), as the CLI builds them every frame.
+    struct Built {
+      host::Grid box;
+      host::Bvh bvh;
+      host::KdTree kd;
+    };
+    auto accel_of = [kind](const Scene& s, Built& b) {
+      b.box = host::build_grid(s, host::GridSpec{glm::ivec3(1)});
+      if (kind == host::AccelKind::bvh) b.bvh = host::build_bvh(s);
+      if (kind == host::AccelKind::kdtree) b.kd = host::build_kdtree(s, b.box.lo, b.box.hi);
+      return host::Accel{kind, &b.box, kind == host::AccelKind::bvh ? &b.bvh : nullptr,
+                         kind == host::AccelKind::kdtree ? &b.kd : nullptr};
+    };
+    Built b1, b2;
+    host::StreamTracer tracer(first, accel_of(first, b1), options());
+    (void)tracer.render(cam);
+    const host::Accel accel2 = accel_of(second, b2);
+    const host::StreamTracer::Upload up = tracer.update(second, accel2);
+    const RenderResult updated = tracer.render(cam);
+    host::StreamTracer fresh_tracer(second, accel2, options());
+    const RenderResult fresh = fresh_tracer.render(cam);
+    CHECK(differing(updated.rgb, fresh.rgb) == 0);
+    CHECK(differing(updated.hit_id, fresh.hit_id) == 0);
+    CHECK(differing(updated.depth, fresh.depth) == 0);
+    CHECK(updated.stats.totals.passes == fresh.stats.totals.passes);
+    const char* nodes = kind == host::AccelKind::bvh ? "bvh nodes lo" : "kd nodes";
+    for (const char* name : {"vertices0", nodes})
+      CHECK_MESSAGE(std::find(up.textures.begin(), up.textures.end(), name) != up.textures.end(),
+                    name);
+    // The same frame walked through the grid hits the same triangles (the structures agree).
+    const RenderResult grid_frame = render(second, host::build_grid(second, {}), cam);
+    CHECK(differing(updated.hit_id, grid_frame.hit_id) <= int(updated.hit_id.size() / 200));
+    // A tracer made for another structure is not handed a grid.
+    CHECK_THROWS_AS(tracer.update(second, host::build_grid(second, {})), std::invalid_argument);
+  }
 }
