@@ -136,10 +136,6 @@ std::vector<Animation> read_animations(const gltf_detail::OpenScene& file) {
         fail(path, use + " refers to sampler " + std::to_string(ch.sampler) +
                        ", but the animation has " + std::to_string(anim.samplers.size()) +
                        " samplers");
-      if (ch.target_node < 0) continue;  // glTF: a channel without a node is ignored
-      if (size_t(ch.target_node) >= model.nodes.size())
-        fail(path, use + " targets node " + std::to_string(ch.target_node) + ", but the file has " +
-                       std::to_string(model.nodes.size()) + " nodes");
       AnimatedPath p;
       if (ch.target_path == "translation") {
         p = AnimatedPath::translation;
@@ -148,6 +144,8 @@ std::vector<Animation> read_animations(const gltf_detail::OpenScene& file) {
       } else if (ch.target_path == "scale") {
         p = AnimatedPath::scale;
       } else {
+        // Morph-target weights, or a path of an extension (KHR_animation_pointer's "pointer",
+        // which has no node): refused when this animation is played, never ignored.
         if (anim.unsupported.empty())
           anim.unsupported =
               ch.target_path == "weights"
@@ -156,6 +154,10 @@ std::vector<Animation> read_animations(const gltf_detail::OpenScene& file) {
                   : use + " animates '" + ch.target_path + "', which is not supported";
         continue;
       }
+      if (ch.target_node < 0) continue;  // glTF: a node's channel without a node is ignored
+      if (size_t(ch.target_node) >= model.nodes.size())
+        fail(path, use + " targets node " + std::to_string(ch.target_node) + ", but the file has " +
+                       std::to_string(model.nodes.size()) + " nodes");
       const std::string target = "node " + std::to_string(ch.target_node) + " " + path_name(p);
       if (!model.nodes[size_t(ch.target_node)].matrix.empty())
         fail(path, use + " animates node " + std::to_string(ch.target_node) +

@@ -226,6 +226,11 @@ TEST_CASE("skinned meshes and morph-target weights are refused with one line nam
             ": animation 0 channel 0 animates morph-target weights (node 0); morph targets are "
             "not supported");
   CHECK(message([&] { m.check(std::nullopt); }).empty());  // the rest pose is the file's
+  // A channel of an extension's path, without a node, is refused too, not skipped.
+  const std::string pointer = data_path("animation_pointer.gltf");
+  const host::AnimatedScene ptr(pointer);
+  CHECK(message([&] { ptr.at(0, 0.5); }) ==
+        pointer + ": animation 0 channel 0 animates 'pointer', which is not supported");
   // The static loader still reads both as before.
   CHECK(host::load_scene(skinned).triangle_count() == 1);
   CHECK(host::load_scene(morph).triangle_count() == 1);

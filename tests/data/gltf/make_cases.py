@@ -424,6 +424,17 @@ def animated_case():
     write_gltf("morph_weights.gltf", b.doc(**{k: v for k, v in d.items() if k not in (
         "asset", "buffers", "bufferViews", "accessors")}), b.bin)
 
+    # A channel of another path without a node (KHR_animation_pointer): refused, not ignored.
+    b, d = simple(TRI, idx=[0, 1, 2])
+    d["extensionsUsed"] = ["KHR_animation_pointer"]
+    d["animations"] = [{"samplers": [{"input": floats(b, [0, 1], "SCALAR"),
+                                      "output": floats(b, [(0, 0, 0), (1, 0, 0)], "VEC3")}],
+                        "channels": [{"sampler": 0, "target": {
+                            "path": "pointer", "extensions": {"KHR_animation_pointer": {
+                                "pointer": "/nodes/0/translation"}}}}]}]
+    write_gltf("animation_pointer.gltf", b.doc(**{k: v for k, v in d.items() if k not in (
+        "asset", "buffers", "bufferViews", "accessors")}), b.bin)
+
     # Broken: key times that go back.
     b, d = simple(TRI, idx=[0, 1, 2])
     d["animations"] = [{"samplers": [{"input": floats(b, [0, 2, 1], "SCALAR"),
