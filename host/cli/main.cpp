@@ -442,7 +442,7 @@ int run_render(const RenderArgs& a, bool lanes_given) {
     return j;
   };
 
-  // Frame by frame: the scene posed, the grid rebuilt, the static textures that changed
+  // Frame by frame: the scene posed, the structure rebuilt, the static textures that changed
   // uploaded again (--update rebuild), the frame rendered and its files written.
   nlohmann::ordered_json j, frames_json = nlohmann::ordered_json::array();
   struct FrameLine {
@@ -514,10 +514,11 @@ int run_render(const RenderArgs& a, bool lanes_given) {
       if (several) frames_json.push_back(j);
       if (!a.quiet)
         std::fprintf(stderr,
-                     "vgpu-rt: frame %d/%zu (t = %g s): update %.1f ms (pose %.1f, grid %.1f, "
+                     "vgpu-rt: frame %d/%zu (t = %g s): update %.1f ms (pose %.1f, %s %.1f, "
                      "textures %.1f), %llu bytes uploaded; render %.1f ms, %llu passes\n",
                      number, times.size(), times[f], pose_ms + build_ms() + write_ms, pose_ms,
-                     build_ms(), write_ms, static_cast<unsigned long long>(up.bytes), r.render_ms,
+                     std::string(host::accel_name(accel_kind)).c_str(), build_ms(), write_ms,
+                     static_cast<unsigned long long>(up.bytes), r.render_ms,
                      static_cast<unsigned long long>(r.stats.totals.passes));
     }
     lines.push_back({times[f], pose_ms, build_ms(), write_ms, r.render_ms, up.bytes,
