@@ -390,6 +390,17 @@ std::vector<uint64_t> parse_file(const std::string& path, tinygltf::Model& model
   // only where asked for (host/scene/animation.cpp reads and checks them).
   for (const char* key : {"images", "textures", "samplers", "skins"}) doc.erase(key);
   if (!keep_animations) doc.erase("animations");
+  // tinygltf drops a channel whose target has no node (KHR_animation_pointer's): give it node
+  // -1, so that the channel is kept and animation.cpp refuses its path instead of a frame
+  // silently missing it.
+  if (auto anims = doc.find("animations"); anims != doc.end() && anims->is_array())
+    for (json& anim : *anims) {
+      if (!anim.is_object() || !anim.contains("channels") || !anim["channels"].is_array()) continue;
+      for (json& channel : anim["channels"])
+        if (channel.is_object() && channel.contains("target") && channel["target"].is_object() &&
+            !channel["target"].contains("node"))
+          channel["target"]["node"] = -1;
+    }
   const std::string clean = doc.dump();
   if (clean.size() > kMaxFileBytes - 64) fail(path, "the JSON is larger than 4 GiB");
 
