@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <bit>
 #include <stdexcept>
 
 namespace vgpu {
@@ -67,6 +68,22 @@ Texture::Texture(std::string name, int width, int height, int channels, Format f
 void Texture::fill(std::span<const float> texel) {
   ++version_;
   for (size_t i = 0; i < data_.size(); ++i) data_[i] = round_to(format_, texel[i % channels_]);
+}
+
+bool Texture::replace(std::span<const float> texels) {
+  if (texels.size() != data_.size())
+    throw std::invalid_argument("texture " + name_ + ": replace() needs " +
+                                std::to_string(data_.size()) + " values, got " +
+                                std::to_string(texels.size()));
+  bool changed = false;
+  for (size_t i = 0; i < data_.size(); ++i) {
+    const float v = round_to(format_, texels[i]);
+    // Bit patterns, so that -0 for 0 or a NaN payload counts as a change too.
+    changed |= std::bit_cast<uint32_t>(v) != std::bit_cast<uint32_t>(data_[i]);
+    data_[i] = v;
+  }
+  if (changed) ++version_;
+  return changed;
 }
 
 uint64_t Stencil::count() const {

@@ -45,6 +45,9 @@ class Texture {
     data_[index(x, y) + c] = round_to(format_, v);
   }
   void fill(std::span<const float> texel);  // every texel = texel (channels() values)
+  // Every texel at once (channels() floats per texel, row-major, data().size() in all), rounded
+  // to the format; returns whether any stored value changed (what a host re-upload must send).
+  bool replace(std::span<const float> texels);
   // Raw texel storage: channels() floats per texel, row-major, already rounded.
   std::span<const float> data() const { return data_; }
   const float* texel(int x, int y) const { return data_.data() + index(x, y); }

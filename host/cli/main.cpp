@@ -1,5 +1,6 @@
 // vgpu-rt: the command line. `render` runs the stream ray tracer on the virtual GPU and prints
-// the pass statistics; `scenes` lists the bundled scenes; `compare` diffs two images.
+// the pass statistics (its options: options.h; a moving scene's frames: frames.h); `scenes`
+// lists the bundled scenes; `compare` diffs two images.
 
 // GCC 12 reports false positives inside nlohmann_json's templates.
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
@@ -14,14 +15,17 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
-#include <regex>
 
 #include "host/accel/accel.h"
 #include "host/accel/grid.h"
+#include "host/cli/frames.h"
+#include "host/cli/options.h"
+#include "host/common/parallel.h"
 #include "host/image/image_io.h"
 #include "host/model/cost_model.h"
 #include "host/model/formats.h"
 #include "host/report/report.h"
+#include "host/scene/animation.h"
 #include "host/scene/camera.h"
 #include "host/scene/gltf_loader.h"
 #include "host/trace/accel_choice.h"
@@ -38,339 +42,11 @@
 
 namespace {
 
-struct RenderArgs {
-  std::string scene = "bunny";
-  std::string size = "256x256";
-  std::string out;
-  int bounces = 2;
-  std::string shading = "phong";
-  std::string texture_filter = "trilinear";
-  std::string shadows = "on";
-  std::string grid = "auto";
-  std::string accel = "grid";
-  std::string profile = "gf5700";
-  int threads = 0;
-  int lanes = vgpu::kLanes;
-  std::string masks = "off";
-  std::string mrt = "off";
-  std::string stats = "table";
-  std::string stats_json;
-  std::string stats_csv;
-  std::string report;
-  std::vector<std::string> aovs;
-  std::string trace_pixel;
-  bool quiet = false;
-  bool predict = false;
-  std::string engine = "stream";
-  std::string gl_device = "auto";
-  std::string gl_readback = "auto";
-  std::string precision = "fp32";
-  std::string formats;
-  std::string kernels = "multipass";
-  std::string walk = "batches";
-  int steps_per_pass = 32;
-  int spp = 1;
-  std::string aa = "none";
-  float aa_threshold = 0.1f;
-  bool steps_given = false;
-  bool walk_given = false;
-};
-
-struct UsageError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
-
-// Largest image side: the render target limit of the largest profile (vgpu/profile.cpp).
-constexpr int kMaxImageSide = 16384;
-// Host threads: 0 (one per core) or 1..kMaxThreads; more than this only queues context switches.
-constexpr int kMaxThreads = 256;
-
-// "WxH" as two positive sides, or nullopt.
-std::optional<glm::ivec2> parse_size(const std::string& text) {
-  std::smatch m;
-  if (!std::regex_match(text, m, std::regex(R"((\d{1,9})[xX](\d{1,9}))"))) return std::nullopt;
-  return glm::ivec2(std::stoi(m[1]), std::stoi(m[2]));
-}
-
-// "X,Y" pixel coordinates, or nullopt.
-std::optional<glm::ivec2> parse_pixel(const std::string& text) {
-  std::smatch m;
-  if (!std::regex_match(text, m, std::regex(R"((\d{1,9}),(\d{1,9}))"))) return std::nullopt;
-  return glm::ivec2(std::stoi(m[1]), std::stoi(m[2]));
-}
-
-// CLI11 validators: each returns an empty string for a good value, else the problem (CLI11
-// prefixes the option name; main() prints it on one line and exits with 2).
-const CLI::Validator kSizeCheck(
-    [](std::string& text) -> std::string {
-      const std::optional<glm::ivec2> s = parse_size(text);
-      if (!s) return "expected WxH (e.g. 256x256), got '" + text + "'";
-      if (s->x < 1 || s->y < 1 || s->x > kMaxImageSide || s->y > kMaxImageSide)
-        return text + " is outside the limit 1x1.." + std::to_string(kMaxImageSide) + "x" +
-               std::to_string(kMaxImageSide);
-      return {};
-    },
-    "WxH in 1x1..16384x16384", "SIZE");
-
-const CLI::Validator kPixelCheck(
-    [](std::string& text) -> std::string {
-      return parse_pixel(text) ? "" : "expected X,Y (e.g. 128,128), got '" + text + "'";
-    },
-    "X,Y", "PIXEL");
-
-const CLI::Validator kGridCheck(
-    [](std::string& text) -> std::string {
-      try {
-        host::parse_grid_spec(text);
-        return {};
-      } catch (const std::invalid_argument& e) {
-        return e.what();
-      }
-    },
-    "auto | N | AxBxC, each 1.." + std::to_string(host::kMaxGridRes), "GRID");
-
-const CLI::Validator kSppCheck(
-    [](std::string& text) -> std::string {
-      try {
-        size_t used = 0;
-        const int n = std::stoi(text, &used);
-        if (used == text.size()) return host::spp_refusal(n);
-      } catch (const std::exception&) {
-      }
-      return "expected a square from 1 to " + std::to_string(host::kMaxSpp) + ", got '" + text +
-             "'";
-    },
-    "1, 4, 9, ..., 256", "N");
-
-// --aa's value: none, adaptive, undersample or undersample:K; K (default 2) for undersample,
-// 0 otherwise, or nullopt.
-std::optional<int> parse_aa(const std::string& text) {
-  if (text == "none" || text == "adaptive") return 0;
-  std::smatch m;
-  if (!std::regex_match(text, m, std::regex(R"(undersample(:(\d{1,4}))?)"))) return std::nullopt;
-  const int k = m[2].matched ? std::stoi(m[2]) : 2;
-  if (k < 1 || k > 64) return std::nullopt;
-  return k;
-}
-
-const CLI::Validator kAaCheck(
-    [](std::string& text) -> std::string {
-      return parse_aa(text) ? ""
-                            : "expected none, adaptive, undersample or undersample:K (K 1 to 64), "
-                              "got '" +
-                                  text + "'";
-    },
-    "none | adaptive | undersample[:K]", "MODE");
-
-const CLI::Validator kThresholdCheck(
-    [](std::string& text) -> std::string {
-      try {
-        size_t used = 0;
-        const double v = std::stod(text, &used);
-        if (used == text.size() && std::isfinite(v) && v >= 0) return {};
-      } catch (const std::exception&) {
-      }
-      return "expected a colour difference of 0 or more (linear, 1 = white), got '" + text + "'";
-    },
-    "0 or more", "T");
-
-// An output file: the extension is one of `exts` and its directory exists and is writable.
-CLI::Validator output_check(std::vector<std::string> exts) {
-  std::string desc;
-  for (const std::string& e : exts) desc += (desc.empty() ? "FILE" : " | FILE") + e;
-  return CLI::Validator(
-      [exts](std::string& path) -> std::string {
-        try {
-          host::check_output_path(path, exts);
-          return {};
-        } catch (const host::InputError& e) {
-          return e.what();
-        }
-      },
-      desc, "OUTPUT");
-}
-
-// --aov KIND=FILE.exr: the AOVs are float images, so EXR only.
-const CLI::Validator kAovCheck(
-    [](std::string& aov) -> std::string {
-      const auto eq = aov.find('=');
-      const std::string kind = aov.substr(0, eq);
-      if (eq == std::string::npos || eq + 1 == aov.size())
-        return "expected depth=FILE.exr or hit=FILE.exr, got '" + aov + "'";
-      if (kind != "depth" && kind != "hit")
-        return "unknown AOV '" + kind + "' in '" + aov + "' (known: depth, hit)";
-      try {
-        host::check_output_path(aov.substr(eq + 1), {".exr"});
-        return {};
-      } catch (const host::InputError& e) {
-        return e.what();
-      }
-    },
-    "depth=FILE.exr | hit=FILE.exr", "AOV");
-
-std::vector<std::string> profile_names() {
-  std::vector<std::string> names;
-  for (const vgpu::Profile& p : vgpu::profiles()) names.push_back(p.name);
-  return names;
-}
-
-void add_render_options(CLI::App& render, RenderArgs& a) {
-  const std::vector<std::string> on_off{"on", "off"};
-  render.add_option("scene", a.scene, "glTF file (.gltf/.glb) or a scene name from scenes/")
-      ->capture_default_str();
-  render.add_option("--size", a.size, "Image size")->check(kSizeCheck)->capture_default_str();
-  render.add_option("--out", a.out, "Write the image")->check(output_check({".png", ".exr"}));
-  render.add_option("--bounces", a.bounces, "Reflection iterations after the primary one")
-      ->check(CLI::Range(0, 64))
-      ->capture_default_str();
-  render.add_option("--shading", a.shading, "Shading model")
-      ->check(CLI::IsMember({"diffuse", "phong", "phong-atten"}))
-      ->capture_default_str();
-  render
-      .add_option("--texture-filter", a.texture_filter,
-                  "How the shader's texture unit filters base-colour textures: nearest (1 "
-                  "texel), bilinear (4), trilinear (8, mipmapped; level of detail from ray "
-                  "differentials)")
-      ->check(CLI::IsMember({"nearest", "bilinear", "trilinear"}))
-      ->capture_default_str();
-  render.add_option("--shadows", a.shadows, "Shadow rays")
-      ->check(CLI::IsMember(on_off))
-      ->capture_default_str();
-  render.add_option("--grid", a.grid, "Grid voxels per axis")
-      ->check(kGridCheck)
-      ->capture_default_str();
-  render
-      .add_option("--accel", a.accel,
-                  "Acceleration structure the rays walk: grid (the paper's uniform grid) | bvh "
-                  "(a SAH bounding volume hierarchy walked stackless) | kdtree (a SAH kd-tree "
-                  "walked by kd-restart) | auto (builds each, renders a probe at a quarter of the "
-                  "size with each and keeps the one the cost model predicts cheapest on "
-                  "--profile). bvh and kdtree are extensions; docs/structures.md")
-      ->check(CLI::IsMember({"grid", "bvh", "kdtree", "auto"}))
-      ->capture_default_str();
-  render
-      .add_option("--profile", a.profile,
-                  "Modeled card (the cpu engine uses only its texture limit, for --grid auto)")
-      ->check(CLI::IsMember(profile_names()))
-      ->capture_default_str();
-  render.add_option("--threads", a.threads, "Host threads (0: one per core)")
-      ->check(CLI::Range(0, kMaxThreads))
-      ->capture_default_str();
-  render
-      .add_option("--lanes", a.lanes,
-                  "SIMD lanes per batch, stream engine (1: scalar reference; fp24/fp16 run at 1 "
-                  "or 8)")
-      ->check(CLI::IsMember({1, 4, 8, 16}))
-      ->capture_default_str();
-  render
-      .add_option("--masks", a.masks,
-                  "Early-z masks for finished rays (paper's future work), stream engine")
-      ->check(CLI::IsMember(on_off))
-      ->capture_default_str();
-  render
-      .add_option("--mrt", a.mrt,
-                  "Multiple render targets (paper's future work): fused two-output passes for "
-                  "intersecciones + proximoTriangulo and traversal + actualizarVoxel; needs a "
-                  "profile with more than one output (not gf5700); off: the paper's pipeline")
-      ->check(CLI::IsMember(on_off))
-      ->capture_default_str();
-  render.add_option("--stats", a.stats, "Statistics on stdout")
-      ->check(CLI::IsMember({"table", "json", "none"}))
-      ->capture_default_str();
-  render.add_option("--stats-json", a.stats_json, "Also write the statistics as JSON")
-      ->check(output_check({".json"}));
-  render
-      .add_option("--aov", a.aovs,
-                  "Float AOV: depth (distance to the primary hit) or hit (triangle id)")
-      ->check(kAovCheck);
-  render
-      .add_option("--trace-pixel", a.trace_pixel,
-                  "Print every pass this pixel took part in and its state (stream engine)")
-      ->check(kPixelCheck);
-  render.add_flag("--quiet,-q", a.quiet, "No progress on stderr");
-  render
-      .add_option("--stats-csv", a.stats_csv,
-                  "Also write one row per pass (kernel, fragments, fetches, query) as CSV")
-      ->check(output_check({".csv"}));
-  render
-      .add_option("--report", a.report,
-                  "Write an HTML report of the frame (timeline, cost maps, pixel history), "
-                  "stream engine")
-      ->check(output_check({".html"}));
-  render
-      .add_option("--precision", a.precision,
-                  "Ray-state textures and kernel arithmetic, every group, stream engine (auto: "
-                  "per group, the fewest bits this scene needs; the stats say why)")
-      ->check(CLI::IsMember({"fp32", "fp24", "fp16", "auto"}))
-      ->capture_default_str();
-  render.add_option("--formats", a.formats,
-                    "Per group, over --precision: GROUP=FORMAT[/ARITH],... with GROUP rays, "
-                    "traversal, voxel, hits, colour, queries (e.g. colour=fp16/fp32)");
-  render
-      .add_option("--engine", a.engine,
-                  "stream (the vgpu pipeline) | gl (the same passes on an OpenGL driver) | cpu "
-                  "(double-precision reference)")
-      ->check(CLI::IsMember({"stream", "gl", "cpu"}))
-      ->capture_default_str();
-  render
-      .add_option("--gl-device", a.gl_device,
-                  "With --engine gl: auto, or an EGL device index (see vgpu-rt gl-devices)")
-      ->capture_default_str();
-  render
-      .add_option("--gl-readback", a.gl_readback,
-                  "With --engine gl: how the host waits for an occlusion query: block (the "
-                  "driver's GL_QUERY_RESULT wait), poll (spin on GL_QUERY_RESULT_AVAILABLE), "
-                  "auto (poll on a hardware driver, block on a software one)")
-      ->check(CLI::IsMember({"auto", "block", "poll"}))
-      ->capture_default_str();
-  render
-      .add_option("--kernels", a.kernels,
-                  "How rays walk the grid: multipass (the paper's kernels, one pass per step) | "
-                  "looping (one data-dependent loop, Purcell's branching variant; needs dynamic "
-                  "branching, e.g. --profile gf6600), stream engine")
-      ->check(CLI::IsMember({"multipass", "looping"}))
-      ->capture_default_str();
-  render
-      .add_option("--walk", a.walk,
-                  "How the emulator runs the multipass grid walk on the host: batches (8 pixels "
-                  "through every pass at a time, their state in registers, then the pass "
-                  "sequence replayed for the statistics) | passes (pass by pass over the "
-                  "target); same images and statistics, stream engine")
-      ->check(CLI::IsMember({"batches", "passes"}))
-      ->each([&a](const std::string&) { a.walk_given = true; })
-      ->capture_default_str();
-  render
-      .add_option("--spp", a.spp,
-                  "Rays per pixel, a square: a stratified, jittered n x n grid in each pixel "
-                  "(seeded: the same image every run), one sample frame each, resolved by a box "
-                  "filter; 1 is one ray through each pixel's centre")
-      ->check(kSppCheck)
-      ->capture_default_str();
-  render
-      .add_option("--aa", a.aa,
-                  "Anti-aliasing: none (--spp rays in every pixel), adaptive (one ray per "
-                  "pixel, then levels of 4, 16, ... up to --spp only where neighbours hit another "
-                  "surface or differ in colour by more than --aa-threshold) or undersample[:K] "
-                  "(one ray through every K-th pixel in x and y, default 2, then through the "
-                  "pixels between those that hit different surfaces; the rest blended)")
-      ->check(kAaCheck)
-      ->capture_default_str();
-  render
-      .add_option("--aa-threshold", a.aa_threshold,
-                  "With --aa adaptive: the colour difference (linear, per channel) to a "
-                  "neighbour that marks a pixel for more samples")
-      ->check(kThresholdCheck)
-      ->capture_default_str();
-  render
-      .add_option("--steps-per-pass", a.steps_per_pass,
-                  "With --kernels looping: loop iterations per pass before the host's occlusion "
-                  "query (the profile's loop limit applies: gf6600 255)")
-      ->check(CLI::Range(1, 4096))
-      ->each([&a](const std::string&) { a.steps_given = true; })
-      ->capture_default_str();
-  render.add_flag("--predict", a.predict,
-                  "Print the cost model's predicted time for --profile, with its breakdown");
-}
+using cli::parse_aa;
+using cli::parse_pixel;
+using cli::parse_size;
+using cli::RenderArgs;
+using cli::UsageError;
 
 int run_render(const RenderArgs& a, bool lanes_given) {
   // CLI11 checked each value; what is left are combinations of options.
@@ -444,6 +120,35 @@ int run_render(const RenderArgs& a, bool lanes_given) {
                        "without passes, lanes or masks)");
   }
   if (a.steps_given && !opt.looping) throw UsageError("--steps-per-pass needs --kernels looping");
+  // Animation (issue 23): the frames' times, and what several frames need.
+  const bool animating = !a.time.empty() || !a.frames.empty();
+  if (!a.time.empty() && !a.frames.empty())
+    throw UsageError("--time and --frames: give one (--frames A:A:1 is --time A)");
+  if (!animating && (!a.animation.empty() || a.update_given))
+    throw UsageError(std::string(a.animation.empty() ? "--update" : "--animation") +
+                     " needs --time or --frames");
+  std::vector<double> times = {0.0};
+  if (!a.time.empty()) times = {cli::parse_time(a.time)};
+  if (!a.frames.empty()) {
+    cli::FrameRange range;
+    cli::frames_problem(a.frames, range);  // CLI11 checked it
+    times = cli::frame_times(range);
+  }
+  if (times.size() > 1) {
+    for (const auto& [option, file] : {std::pair<std::string, std::string>{"--out", a.out},
+                                       {"--aov", aov_depth},
+                                       {"--aov", aov_hit}})
+      if (!file.empty() && !cli::has_frame_number(file))
+        throw UsageError(option + " " + file + ": " + std::to_string(times.size()) +
+                         " frames need '#' in the file name for the frame number (e.g. "
+                         "frame_####.png)");
+    const char* one_frame = !a.report.empty()      ? "--report"
+                            : !a.stats_csv.empty() ? "--stats-csv"
+                            : opt.trace_pixel      ? "--trace-pixel"
+                                                   : nullptr;
+    if (one_frame)
+      throw UsageError(std::string(one_frame) + " follows one frame: render it with --time T");
+  }
   if (a.walk_given && a.engine != "stream")
     throw UsageError("--walk needs --engine stream (it says how the emulator runs the walk)");
   // Reduced precision runs at 1 or 8 lanes (vgpu/gpu.cpp): refuse another width.
@@ -491,17 +196,50 @@ int run_render(const RenderArgs& a, bool lanes_given) {
     opt.observer = &*recorder;
   }
 
+  // The scene: as the file has it, or posed at each frame's time (--time, --frames).
   const std::string path = host::resolve_scene(a.scene);
-  const host::Scene scene = host::load_scene(path, host::with_images());
+  std::optional<host::AnimatedScene> animated;
+  std::optional<size_t> animation;
+  if (animating) {
+    animated.emplace(path, host::with_images());
+    const std::vector<host::Animation>& list = animated->animations();
+    if (!a.animation.empty()) {
+      animation = animated->find(a.animation);
+      if (!animation) {
+        std::string known;
+        for (size_t i = 0; i < list.size(); ++i)
+          known += (i ? ", " : "") + std::to_string(i) + " '" + list[i].name + "'";
+        throw UsageError("--animation " + a.animation + ": " + path +
+                         " has no animation named or numbered '" + a.animation + "' (" +
+                         (known.empty() ? "it has none" : "it has " + known) + ")");
+      }
+    } else if (!list.empty()) {
+      animation = 0;  // the first, as --help says
+    }
+    animated->check(animation);  // skinned meshes, morph-target weights: one line, exit 2
+  }
+  nlohmann::ordered_json animation_json = nullptr;
+  if (animation) {
+    const host::Animation& an = animated->animations()[*animation];
+    animation_json = {
+        {"name", an.name}, {"index", *animation}, {"start", an.start}, {"end", an.end}};
+  }
+  auto pose_start = std::chrono::steady_clock::now();
+  host::Scene scene =
+      animated ? animated->at(animation, times[0]) : host::load_scene(path, host::with_images());
+  double pose_ms = animated ? host::ms_since(pose_start) : 0.0;
+  const host::Scene& rest = animated ? animated->rest() : scene;  // frames a camera-less file
   const auto t0 = std::chrono::steady_clock::now();
   // With a structure other than the grid, the grid is one voxel: it gives the scene box only.
   const bool auto_accel = a.accel == "auto";
   host::AccelKind accel_kind = auto_accel ? host::AccelKind::grid : host::parse_accel_kind(a.accel);
   const bool want_grid = auto_accel || accel_kind == host::AccelKind::grid;
-  const host::Grid grid =
+  host::Grid grid =
       want_grid ? host::build_grid(
                       scene, host::grid_spec_for(grid_spec, scene, vgpu::profile(opt.profile)))
                 : host::Grid{};
+  // Later frames keep the first frame's resolution (so the voxel pointers keep their texture).
+  const host::GridSpec frame_grid{grid.res};
   std::optional<host::Grid> box;
   std::optional<host::Bvh> bvh;
   std::optional<host::KdTree> kd;
@@ -527,9 +265,13 @@ int run_render(const RenderArgs& a, bool lanes_given) {
     if (!why.empty()) throw UsageError(why);
   }
   const float aspect = float(opt.width) / float(opt.height);
-  const host::Camera cam = host::scene_camera(scene, aspect);
-  const bool tty = ::isatty(2) && !a.quiet;
-  if (!a.quiet)
+  // A frame's camera: the file's (moving with its node), else the rest scene's framing.
+  auto camera_for = [&](const host::Scene& s) {
+    return host::scene_camera(s.camera ? s : rest, aspect);
+  };
+  const bool several = times.size() > 1;
+  const bool tty = ::isatty(2) && !a.quiet && !several;
+  if (!a.quiet && !several)  // several frames: one line per frame instead
     opt.progress = [&](int it, int n) {
       std::fprintf(stderr, tty ? "\rvgpu-rt: iteration %d/%d" : "vgpu-rt: iteration %d/%d\n", it,
                    n);
@@ -539,172 +281,260 @@ int run_render(const RenderArgs& a, bool lanes_given) {
   if (auto_accel) {
     std::vector<host::AccelCandidate> candidates;
     for (host::AccelKind k : host::kAccelKinds) candidates.push_back({accel_of(k), formats_for(k)});
-    choice = host::choose_accel(scene, candidates, opt, cam);
+    choice = host::choose_accel(scene, candidates, opt, camera_for(scene));
     accel_kind = choice->kind;
     opt.formats = formats_for(accel_kind);
   }
   const host::Accel accel = accel_of(accel_kind);
   const host::Grid& walk_grid = *accel.grid;
+  // The host's build of the structure walked (and of its box), ms.
+  auto build_ms = [&] {
+    return accel_kind == host::AccelKind::grid  ? grid.build_ms
+           : accel_kind == host::AccelKind::bvh ? box->build_ms + bvh->build_ms
+                                                : box->build_ms + kd->build_ms;
+  };
   std::optional<host::StreamTracer> tracer;
   if (!cpu) tracer.emplace(scene, accel, opt);
   const double init_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   host::CpuStats cpu_stats;
-  const host::RenderResult r =
-      cpu ? host::render_cpu(scene, accel, cam, opt, &cpu_stats) : tracer->render(cam);
-  if (tty) std::fprintf(stderr, "\n");
-  if (recorder) recorder->finish(r.stats);
-
-  if (!a.out.empty()) host::write_image(a.out, r.width, r.height, 3, r.rgb);
-  if (!aov_depth.empty()) host::write_image(aov_depth, r.width, r.height, 1, r.depth);
-  if (!aov_hit.empty()) host::write_image(aov_hit, r.width, r.height, 1, r.hit_id);
-
-  nlohmann::ordered_json j;
-  j["scene"] = scene.name;
-  j["scene_path"] = path;
-  j["engine"] = a.engine;
-  if (tracer) j["device"] = tracer->device().description();
-  j["triangles"] = scene.triangle_count();
-  j["input_triangles"] = scene.input_triangles;
-  j["dropped_degenerate"] = scene.dropped_degenerate;
-  j["grid"] = {walk_grid.res.x, walk_grid.res.y, walk_grid.res.z};
-  j["grid_references"] = walk_grid.references();
-  {
-    nlohmann::ordered_json acc;
-    acc["structure"] = host::accel_name(accel_kind);
-    if (accel_kind == host::AccelKind::bvh) {
-      acc["nodes"] = bvh->nodes.size();
-      acc["leaves"] = bvh->leaves;
-      acc["depth"] = bvh->depth;
-      acc["max_leaf"] = bvh->max_leaf;
-      acc["references"] = bvh->references();
-      acc["sah_cost"] = bvh->sah_cost;
-      acc["build_ms"] = bvh->build_ms;
-    } else if (accel_kind == host::AccelKind::kdtree) {
-      acc["nodes"] = kd->nodes.size();
-      acc["leaves"] = kd->leaves;
-      acc["empty_leaves"] = kd->empty_leaves;
-      acc["depth"] = kd->depth;
-      acc["max_leaf"] = kd->max_leaf;
-      acc["references"] = kd->references();
-      acc["sah_cost"] = kd->sah_cost;
-      acc["build_ms"] = kd->build_ms;
-    } else {
-      acc["voxels"] = {walk_grid.res.x, walk_grid.res.y, walk_grid.res.z};
-      acc["references"] = walk_grid.references();
-      acc["build_ms"] = walk_grid.build_ms;
-    }
-    if (!cpu) {
-      const host::WalkWork w = host::walk_work(r.stats);
-      acc["work"] = {{"voxel_steps", w.voxel_steps},
-                     {"nodes_visited", w.nodes_visited},
-                     {"triangle_tests", w.triangle_tests},
-                     {"loop_iterations", w.loop_iterations}};
-    }
-    if (choice) {
-      nlohmann::ordered_json au;
-      au["probe_size"] = {choice->probe_width, choice->probe_height};
-      au["profile"] = opt.profile;
-      au["predicted_ms"] = choice->predicted_ms;
-      au["probe_passes"] = choice->probe_passes;
-      au["probe_ms"] = choice->probe_ms;
-      au["why"] = choice->why;
-      acc["auto"] = au;
-    }
-    j["accel"] = acc;
-  }
-  j["profile"] = opt.profile;
-  j["size"] = {r.width, r.height};
-  j["bounces"] = opt.bounces;
-  j["iterations"] = r.iterations;
-  j["shading"] = a.shading;
-  j["shadows"] = opt.shadows;
-  if (!scene.textures.empty()) {  // base-colour textures (kernels/base_color.h)
-    j["textures"] = scene.textures.size();
-    j["texture_filter"] = a.texture_filter;
-  }
-  j["masks"] = opt.masks;
-  j["mrt"] = opt.mrt;  // fused two-output passes (kernels/fused.h)
-  j["fused_programs"] = opt.mrt ? host::mrt_programs() : std::vector<std::string>{};
-  j["kernel_variant"] = a.kernels;  // multipass | looping ("kernels" lists the programs)
-  if (opt.looping) j["steps_per_pass"] = opt.steps_per_pass;
-  j["threads"] = opt.threads;
-  j["lanes"] = opt.lanes;
-  // How the emulator ran the grid walks: in batches or pass by pass (same statistics).
-  if (!cpu && !gl) j["walk"] = r.batch_walk ? "batches" : "passes";
-  j["precision"] = a.precision;
-  if (!cpu) j["formats"] = host::to_json(opt.formats);
-  j["init_ms"] = init_ms;
-  j["grid_build_ms"] = walk_grid.build_ms;
-  j["render_ms"] = r.render_ms;
-  if (tracer) j["texture_bytes"] = tracer->texture_bytes();
-  if (cpu)
-    j["cpu"] = {{"rays", cpu_stats.rays},
-                {"voxel_steps", cpu_stats.voxel_steps},
-                {"triangle_tests", cpu_stats.triangle_tests},
-                {"nodes_visited", cpu_stats.nodes_visited},
-                {"restarts", cpu_stats.restarts}};
-  j["rays_traced"] = r.rays_traced;
-  j["rays_unfinished"] = r.rays_unfinished;
-  // Supersampling (--spp): samples per pixel and the passes it added to the first sample frame.
-  {
-    double mean = double(r.samples);
-    uint64_t most = uint64_t(r.samples);
-    if (!r.rays_per_pixel.empty()) {
-      uint64_t total = 0;
-      most = 0;
-      for (const uint32_t n : r.rays_per_pixel) total += n, most = std::max<uint64_t>(most, n);
-      mean = double(total) / double(r.rays_per_pixel.size());
-    }
-    j["sampling"] = {{"mode", opt.undersample > 0           ? "undersample"
-                              : opt.adaptive && opt.spp > 1 ? "adaptive"
-                                                            : "uniform"},
-                     {"spp", opt.spp},
-                     {"samples_per_pixel_mean", mean},
-                     {"samples_per_pixel_max", most},
-                     {"passes_added", cpu ? 0 : r.stats.totals.passes - r.first_frame_passes}};
-    if (opt.adaptive) j["sampling"]["threshold"] = opt.aa_threshold;
-    if (opt.undersample > 0) j["sampling"]["k"] = opt.undersample;
-  }
-  {
-    nlohmann::ordered_json stats = r.stats.json();
-    if (gl)  // the emulator's SIMD model: a driver does not show its lanes
-      for (const char* key :
-           {"lanes_idle", "idle_in_batch32", "idle_in_batch1024", "loop_iterations",
-            "loop_lane_slots", "loop_lanes_idle", "loop_batch_iterations", "loop_idle_instructions",
-            "loop_idle_fetches"}) {
-        stats["totals"][key] = nullptr;
-        for (auto& k : stats["programs"]) k[key] = nullptr;
+  host::RenderResult r;
+  // One frame's statistics object (the whole --stats-json of a render that is not animated).
+  auto record = [&](double frame_init_ms) {
+    nlohmann::ordered_json j;
+    j["scene"] = scene.name;
+    j["scene_path"] = path;
+    j["engine"] = a.engine;
+    if (tracer) j["device"] = tracer->device().description();
+    j["triangles"] = scene.triangle_count();
+    j["input_triangles"] = scene.input_triangles;
+    j["dropped_degenerate"] = scene.dropped_degenerate;
+    j["grid"] = {walk_grid.res.x, walk_grid.res.y, walk_grid.res.z};
+    j["grid_references"] = walk_grid.references();
+    {
+      nlohmann::ordered_json acc;
+      acc["structure"] = host::accel_name(accel_kind);
+      if (accel_kind == host::AccelKind::bvh) {
+        acc["nodes"] = bvh->nodes.size();
+        acc["leaves"] = bvh->leaves;
+        acc["depth"] = bvh->depth;
+        acc["max_leaf"] = bvh->max_leaf;
+        acc["references"] = bvh->references();
+        acc["sah_cost"] = bvh->sah_cost;
+        acc["build_ms"] = bvh->build_ms;
+      } else if (accel_kind == host::AccelKind::kdtree) {
+        acc["nodes"] = kd->nodes.size();
+        acc["leaves"] = kd->leaves;
+        acc["empty_leaves"] = kd->empty_leaves;
+        acc["depth"] = kd->depth;
+        acc["max_leaf"] = kd->max_leaf;
+        acc["references"] = kd->references();
+        acc["sah_cost"] = kd->sah_cost;
+        acc["build_ms"] = kd->build_ms;
+      } else {
+        acc["voxels"] = {walk_grid.res.x, walk_grid.res.y, walk_grid.res.z};
+        acc["references"] = walk_grid.references();
+        acc["build_ms"] = walk_grid.build_ms;
       }
-    j["totals"] = std::move(stats["totals"]);
-    j["downloads"] = stats["downloads"];
-    j["download_bytes"] = stats["download_bytes"];
-    j["kernels"] = std::move(stats["programs"]);
-  }
-  // The cost model's prediction for every built-in profile (the counters do not depend on it).
-  nlohmann::ordered_json predicted_ms, predicted_breakdown;
-  for (const vgpu::Profile& p : vgpu::profiles()) {
-    if (cpu || gl) break;  // no passes, or no SIMD counters to predict from
-    if (opt.looping && p.max_loop_iterations < opt.steps_per_pass) {
-      predicted_ms[p.name] = nullptr;  // the looping program cannot run there
-      continue;
+      if (!cpu) {
+        const host::WalkWork w = host::walk_work(r.stats);
+        acc["work"] = {{"voxel_steps", w.voxel_steps},
+                       {"nodes_visited", w.nodes_visited},
+                       {"triangle_tests", w.triangle_tests},
+                       {"loop_iterations", w.loop_iterations}};
+      }
+      if (choice) {
+        nlohmann::ordered_json au;
+        au["probe_size"] = {choice->probe_width, choice->probe_height};
+        au["profile"] = opt.profile;
+        au["predicted_ms"] = choice->predicted_ms;
+        au["probe_passes"] = choice->probe_passes;
+        au["probe_ms"] = choice->probe_ms;
+        au["why"] = choice->why;
+        acc["auto"] = au;
+      }
+      j["accel"] = acc;
     }
-    const host::CostBreakdown c = host::predict(r.stats, p);
-    predicted_ms[p.name] = c.total_ms;
-    for (const auto& [key, v] : c.items()) predicted_breakdown[p.name][key] = v;
+    j["profile"] = opt.profile;
+    j["size"] = {r.width, r.height};
+    j["bounces"] = opt.bounces;
+    j["iterations"] = r.iterations;
+    j["shading"] = a.shading;
+    j["shadows"] = opt.shadows;
+    if (!scene.textures.empty()) {  // base-colour textures (kernels/base_color.h)
+      j["textures"] = scene.textures.size();
+      j["texture_filter"] = a.texture_filter;
+    }
+    j["masks"] = opt.masks;
+    j["mrt"] = opt.mrt;  // fused two-output passes (kernels/fused.h)
+    j["fused_programs"] = opt.mrt ? host::mrt_programs() : std::vector<std::string>{};
+    j["kernel_variant"] = a.kernels;  // multipass | looping ("kernels" lists the programs)
+    if (opt.looping) j["steps_per_pass"] = opt.steps_per_pass;
+    j["threads"] = opt.threads;
+    j["lanes"] = opt.lanes;
+    // How the emulator ran the grid walks: in batches or pass by pass (same statistics).
+    if (!cpu && !gl) j["walk"] = r.batch_walk ? "batches" : "passes";
+    j["precision"] = a.precision;
+    if (!cpu) j["formats"] = host::to_json(opt.formats);
+    j["init_ms"] = frame_init_ms;
+    j["grid_build_ms"] = walk_grid.build_ms;
+    j["render_ms"] = r.render_ms;
+    if (tracer) j["texture_bytes"] = tracer->texture_bytes();
+    if (cpu)
+      j["cpu"] = {{"rays", cpu_stats.rays},
+                  {"voxel_steps", cpu_stats.voxel_steps},
+                  {"triangle_tests", cpu_stats.triangle_tests},
+                  {"nodes_visited", cpu_stats.nodes_visited},
+                  {"restarts", cpu_stats.restarts}};
+    j["rays_traced"] = r.rays_traced;
+    j["rays_unfinished"] = r.rays_unfinished;
+    // Supersampling (--spp): samples per pixel and the passes it added to the first sample frame.
+    {
+      double mean = double(r.samples);
+      uint64_t most = uint64_t(r.samples);
+      if (!r.rays_per_pixel.empty()) {
+        uint64_t total = 0;
+        most = 0;
+        for (const uint32_t n : r.rays_per_pixel) total += n, most = std::max<uint64_t>(most, n);
+        mean = double(total) / double(r.rays_per_pixel.size());
+      }
+      j["sampling"] = {{"mode", opt.undersample > 0           ? "undersample"
+                                : opt.adaptive && opt.spp > 1 ? "adaptive"
+                                                              : "uniform"},
+                       {"spp", opt.spp},
+                       {"samples_per_pixel_mean", mean},
+                       {"samples_per_pixel_max", most},
+                       {"passes_added", cpu ? 0 : r.stats.totals.passes - r.first_frame_passes}};
+      if (opt.adaptive) j["sampling"]["threshold"] = opt.aa_threshold;
+      if (opt.undersample > 0) j["sampling"]["k"] = opt.undersample;
+    }
+    {
+      nlohmann::ordered_json stats = r.stats.json();
+      if (gl)  // the emulator's SIMD model: a driver does not show its lanes
+        for (const char* key :
+             {"lanes_idle", "idle_in_batch32", "idle_in_batch1024", "loop_iterations",
+              "loop_lane_slots", "loop_lanes_idle", "loop_batch_iterations",
+              "loop_idle_instructions", "loop_idle_fetches"}) {
+          stats["totals"][key] = nullptr;
+          for (auto& k : stats["programs"]) k[key] = nullptr;
+        }
+      j["totals"] = std::move(stats["totals"]);
+      j["downloads"] = stats["downloads"];
+      j["download_bytes"] = stats["download_bytes"];
+      j["kernels"] = std::move(stats["programs"]);
+    }
+    // The cost model's prediction for every built-in profile (the counters do not depend on it).
+    nlohmann::ordered_json predicted_ms, predicted_breakdown;
+    for (const vgpu::Profile& p : vgpu::profiles()) {
+      if (cpu || gl) break;  // no passes, or no SIMD counters to predict from
+      if (opt.looping && p.max_loop_iterations < opt.steps_per_pass) {
+        predicted_ms[p.name] = nullptr;  // the looping program cannot run there
+        continue;
+      }
+      const host::CostBreakdown c = host::predict(r.stats, p);
+      predicted_ms[p.name] = c.total_ms;
+      for (const auto& [key, v] : c.items()) predicted_breakdown[p.name][key] = v;
+    }
+    j["predicted_ms"] = predicted_ms;
+    j["predicted_breakdown"] = predicted_breakdown;
+    auto what_if = nlohmann::ordered_json::array();  // MRT and resident programs (docs/table1.md)
+    for (const auto& [name, s] :
+         cpu || gl ? decltype(host::what_ifs(r.stats)){} : host::what_ifs(r.stats)) {
+      nlohmann::ordered_json w = {{"name", name}, {"totals", vgpu::to_json(s.totals)}};
+      for (const vgpu::Profile& p : vgpu::profiles())
+        for (const auto& [key, v] : host::predict(s, p).items())
+          w["predicted_breakdown"][p.name][key] = v;
+      what_if.push_back(w);
+    }
+    j["predicted_what_if"] = what_if;
+    return j;
+  };
+
+  // Frame by frame: the scene posed, the structure rebuilt, the static textures that changed
+  // uploaded again (--update rebuild), the frame rendered and its files written.
+  nlohmann::ordered_json j, frames_json = nlohmann::ordered_json::array();
+  struct FrameLine {
+    double time, pose_ms, build_ms, write_ms, render_ms;
+    uint64_t uploaded, passes;
+    double predicted_ms;
+  };
+  std::vector<FrameLine> lines;
+  for (size_t f = 0; f < times.size(); ++f) {
+    const int number = int(f) + 1;
+    host::StreamTracer::Upload up;
+    double write_ms = 0;
+    if (f > 0) {
+      pose_start = std::chrono::steady_clock::now();
+      scene = animated->at(animation, times[f]);
+      pose_ms = host::ms_since(pose_start);
+      if (accel_kind == host::AccelKind::grid) {
+        grid = host::build_grid(scene, frame_grid);
+      } else {  // the structure walked, in the scene's new box
+        box = host::build_grid(scene, host::GridSpec{glm::ivec3(1)});
+        if (accel_kind == host::AccelKind::bvh) bvh = host::build_bvh(scene);
+        if (accel_kind == host::AccelKind::kdtree) kd = host::build_kdtree(scene, box->lo, box->hi);
+      }
+      const auto tu = std::chrono::steady_clock::now();
+      if (tracer) up = tracer->update(scene, accel);
+      write_ms = host::ms_since(tu);
+    } else if (tracer) {
+      up.bytes = tracer->static_bytes();  // the first frame's: initialization uploads them all
+    }
+    const host::Camera cam = camera_for(scene);
+    cpu_stats = {};
+    r = cpu ? host::render_cpu(scene, accel, cam, opt, &cpu_stats) : tracer->render(cam);
+    if (tty) std::fprintf(stderr, "\n");
+    if (recorder) recorder->finish(r.stats);
+
+    auto numbered = [&](const std::string& file) {
+      return animating ? cli::frame_path(file, number) : file;
+    };
+    if (!a.out.empty()) host::write_image(numbered(a.out), r.width, r.height, 3, r.rgb);
+    if (!aov_depth.empty()) host::write_image(numbered(aov_depth), r.width, r.height, 1, r.depth);
+    if (!aov_hit.empty()) host::write_image(numbered(aov_hit), r.width, r.height, 1, r.hit_id);
+
+    j = record(f == 0 ? init_ms : 0.0);
+    double predicted = 0;
+    if (!cpu && !gl) predicted = host::predict(r.stats, vgpu::profile(opt.profile)).total_ms;
+    if (animating) {
+      // What the frame's update cost: the host's work, the bytes sent to the device, and the
+      // cost model's charge for them on each profile (host/model/cost_model.h, predict_update).
+      nlohmann::ordered_json update = {
+          {"mode", f == 0 ? std::string("initial") : a.update},
+          {"pose_ms", pose_ms},
+          {"structure", host::accel_name(accel_kind)},
+          {"build_ms", build_ms()},
+          {"write_ms", write_ms},
+          {"uploaded_bytes", tracer ? nlohmann::ordered_json(up.bytes) : nullptr},
+          {"uploaded_textures", up.textures}};
+      nlohmann::ordered_json charged;
+      for (const vgpu::Profile& p : vgpu::profiles()) {
+        if (!tracer) break;
+        const host::UpdateCost c = host::predict_update(up.bytes, build_ms(), p);
+        charged[p.name] = {
+            {"upload_ms", c.upload_ms}, {"build_ms", c.build_ms}, {"total_ms", c.total_ms}};
+      }
+      update["predicted"] = charged;
+      j["frame"] = number;
+      j["time"] = times[f];
+      j["animation"] = animation_json;
+      j["update"] = update;
+      if (several) frames_json.push_back(j);
+      if (!a.quiet)
+        std::fprintf(stderr,
+                     "vgpu-rt: frame %d/%zu (t = %g s): update %.1f ms (pose %.1f, %s %.1f, "
+                     "textures %.1f), %llu bytes uploaded; render %.1f ms, %llu passes\n",
+                     number, times.size(), times[f], pose_ms + build_ms() + write_ms, pose_ms,
+                     std::string(host::accel_name(accel_kind)).c_str(), build_ms(), write_ms,
+                     static_cast<unsigned long long>(up.bytes), r.render_ms,
+                     static_cast<unsigned long long>(r.stats.totals.passes));
+    }
+    lines.push_back({times[f], pose_ms, build_ms(), write_ms, r.render_ms, up.bytes,
+                     r.stats.totals.passes, predicted});
   }
-  j["predicted_ms"] = predicted_ms;
-  j["predicted_breakdown"] = predicted_breakdown;
-  auto what_if = nlohmann::ordered_json::array();  // MRT and resident programs (docs/table1.md)
-  for (const auto& [name, s] :
-       cpu || gl ? decltype(host::what_ifs(r.stats)){} : host::what_ifs(r.stats)) {
-    nlohmann::ordered_json w = {{"name", name}, {"totals", vgpu::to_json(s.totals)}};
-    for (const vgpu::Profile& p : vgpu::profiles())
-      for (const auto& [key, v] : host::predict(s, p).items())
-        w["predicted_breakdown"][p.name][key] = v;
-    what_if.push_back(w);
-  }
-  j["predicted_what_if"] = what_if;
+  if (several)
+    j = {{"scene", scene.name}, {"scene_path", path},          {"animation", animation_json},
+         {"update", a.update},  {"frame_count", times.size()}, {"frames", frames_json}};
   if (!a.stats_json.empty()) {
     const std::string tmp = a.stats_json + ".tmp";
     std::ofstream f(tmp);
@@ -719,6 +549,25 @@ int run_render(const RenderArgs& a, bool lanes_given) {
   if (!a.report.empty()) host::write_report(a.report, *recorder, r, j);
   if (a.stats == "json") {
     std::cout << j.dump(2) << "\n";
+  } else if (a.stats == "table" && several) {
+    std::printf("scene %s, animation %s, %zu frames, %s, --update %s, %dx%d, %s %s\n",
+                scene.name.c_str(),
+                animation ? ("'" + animated->animations()[*animation].name + "'").c_str()
+                          : "none (the scene is static)",
+                times.size(), std::string(host::accel_name(accel_kind)).c_str(), a.update.c_str(),
+                r.width, r.height, cpu ? "engine" : "profile", cpu ? "cpu" : opt.profile.c_str());
+    std::printf("%6s %9s %9s %9s %11s %12s %10s %8s%s\n", "frame", "time s", "pose ms", "build ms",
+                "textures ms", "uploaded B", "render ms", "passes",
+                a.predict ? "  predicted ms" : "");
+    for (size_t f = 0; f < lines.size(); ++f) {
+      const FrameLine& l = lines[f];
+      std::printf("%6zu %9.4g %9.2f %9.2f %11.2f %12llu %10.1f %8llu", f + 1, l.time, l.pose_ms,
+                  l.build_ms, l.write_ms, static_cast<unsigned long long>(l.uploaded), l.render_ms,
+                  static_cast<unsigned long long>(l.passes));
+      if (a.predict) std::printf("  %12.3f", l.predicted_ms);
+      std::printf("\n");
+    }
+    std::printf("initialization %.1f ms (the first frame's grid and uploads)\n", init_ms);
   } else if (a.stats == "table") {
     if (cpu)
       std::printf(
@@ -753,8 +602,13 @@ int run_render(const RenderArgs& a, bool lanes_given) {
     if (gl)
       std::printf("device %s: passes %.2f ms of GPU time (timer queries)\n",
                   tracer->device().description().c_str(), r.stats.totals.device_ms);
+    if (animating)
+      std::printf("time %g s of %s\n", times[0],
+                  animation
+                      ? ("animation '" + animated->animations()[*animation].name + "'").c_str()
+                      : "no animation (the scene is static)");
   }
-  if (a.predict) {
+  if (a.predict && !several) {
     const vgpu::Profile& p = vgpu::profile(opt.profile);
     std::cout << host::describe(host::predict(r.stats, p), p);
   }
@@ -832,7 +686,7 @@ int main(int argc, char** argv) {
   RenderArgs a;
   auto* render = app.add_subcommand(
       "render", "Render a scene on the virtual GPU and print the pass statistics");
-  add_render_options(*render, a);
+  cli::add_render_options(*render, a);
   auto* scenes = app.add_subcommand("scenes", "List the scenes in scenes/");
   std::string kernel_name;
   bool kernel_glsl = false;
@@ -879,8 +733,15 @@ int main(int argc, char** argv) {
           listing.read_image = [](const std::vector<unsigned char>&) {
             return host::ImagePixels{1, 1, 3, {1.0f, 1.0f, 1.0f}};
           };
-          const host::Scene s = host::load_scene(path, listing);
-          std::printf("%-14s %7zu triangles  %s\n", name.c_str(), s.triangle_count(), path.c_str());
+          const host::AnimatedScene s(path, listing);
+          std::string animations;
+          for (const host::Animation& an : s.animations()) {
+            char range[64];
+            std::snprintf(range, sizeof range, " %g-%g s", an.start, an.end);
+            animations += (animations.empty() ? "  animations: '" : ", '") + an.name + "'" + range;
+          }
+          std::printf("%-14s %7zu triangles  %s%s\n", name.c_str(), s.rest().triangle_count(),
+                      path.c_str(), animations.c_str());
         } catch (const std::exception& e) {
           std::printf("%-14s (unreadable: %s)\n", name.c_str(), e.what());
         }
@@ -903,6 +764,9 @@ int main(int argc, char** argv) {
       return 0;
     }
   } catch (const UsageError& e) {
+    std::fprintf(stderr, "vgpu-rt: %s\n", e.what());
+    return 2;
+  } catch (const host::UnsupportedFeature& e) {  // a feature a frame at a time cannot honour
     std::fprintf(stderr, "vgpu-rt: %s\n", e.what());
     return 2;
   } catch (const std::exception& e) {

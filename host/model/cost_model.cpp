@@ -159,6 +159,14 @@ CostBreakdown predict(const vgpu::FrameStats& stats, const vgpu::Profile& hw, co
   return b;
 }
 
+UpdateCost predict_update(uint64_t uploaded_bytes, double build_ms, const vgpu::Profile& profile) {
+  UpdateCost c;
+  c.upload_ms = 1e3 * double(uploaded_bytes) / (profile.bus_mbps * 1e6);
+  c.build_ms = build_ms;
+  c.total_ms = c.upload_ms + c.build_ms;
+  return c;
+}
+
 std::string describe(const CostBreakdown& c, const vgpu::Profile& profile) {
   char buf[1024];
   auto pct = [&](double v) { return c.total_ms > 0 ? 100.0 * v / c.total_ms : 0.0; };

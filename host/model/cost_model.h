@@ -19,6 +19,7 @@
 //             + clears (bytes / bandwidth, counted with memory)
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <utility>
 #include <vector>
@@ -87,6 +88,17 @@ struct CostBreakdown {
 CostBreakdown predict(const vgpu::FrameStats& stats, const vgpu::Profile& profile);
 CostBreakdown predict(const vgpu::FrameStats& stats, const vgpu::Profile& profile,
                       const CostParams& params);
+
+// A moving scene's update between two frames (issue 23, --frames): the static textures uploaded
+// again cross the profile's host-to-GPU bus at Profile::bus_mbps, the figure program uploads use
+// (AGP 8x, 2112 MB/s, for gf5700 and r300; PCI Express for gf6600, rtx4090 and h200); the
+// structure's build is host work, charged as the host measured it (no 2004 CPU is modeled).
+struct UpdateCost {
+  double upload_ms = 0;  // uploaded bytes / bus_mbps
+  double build_ms = 0;   // host, as measured
+  double total_ms = 0;   // upload_ms + build_ms (the host builds, then uploads)
+};
+UpdateCost predict_update(uint64_t uploaded_bytes, double build_ms, const vgpu::Profile& profile);
 
 // A few lines: the predicted total and its breakdown, for the CLI.
 std::string describe(const CostBreakdown& cost, const vgpu::Profile& profile);

@@ -366,7 +366,8 @@ std::string first_line(const std::string& text) {
 namespace gltf_detail {
 
 std::vector<uint64_t> parse_file(const std::string& path, tinygltf::Model& model,
-                                 std::vector<std::string>& warnings, std::string& textures) {
+                                 std::vector<std::string>& warnings, std::string& textures,
+                                 bool keep_animations) {
   const std::vector<unsigned char> bytes = read_bytes(path);  // freed once parsed
   if (bytes.empty()) fail(path, "the file is empty");
   GlbParts glb;
@@ -387,7 +388,7 @@ std::vector<uint64_t> parse_file(const std::string& path, tinygltf::Model& model
   json doc;
   std::vector<uint64_t> lengths = precheck_json(path, text, is_glb ? &glb : nullptr, doc);
   // Textures are read by the loader (gltf_loader.cpp), not by tinygltf, which reads image buffer
-  // views without checking their range; animations and skins are never needed.
+  // views without checking their range.
   json tex = json::object();
   for (const char* key : {"images", "textures", "samplers"})
     tex[key] = doc.contains(key) && doc[key].is_array() ? doc[key] : json::array();
@@ -402,7 +403,21 @@ std::vector<uint64_t> parse_file(const std::string& path, tinygltf::Model& model
       tex["base_color"].push_back(info ? *info : json());
     }
   textures = tex.dump();
-  for (const char* key : {"images", "textures", "samplers", "animations", "skins"}) doc.erase(key);
+  // Skins are never needed (images, textures and samplers were read above). Animations only
+  // where asked for (host/scene/animation.cpp reads and checks them).
+  for (const char* key : {"images", "textures", "samplers", "skins"}) doc.erase(key);
+  if (!keep_animations) doc.erase("animations");
+  // tinygltf drops a channel whose target has no node (KHR_animation_pointer's): give it node
+  // -1, so that the channel is kept and animation.cpp refuses its path instead of a frame
+  // silently missing it.
+  if (auto anims = doc.find("animations"); anims != doc.end() && anims->is_array())
+    for (json& anim : *anims) {
+      if (!anim.is_object() || !anim.contains("channels") || !anim["channels"].is_array()) continue;
+      for (json& channel : anim["channels"])
+        if (channel.is_object() && channel.contains("target") && channel["target"].is_object() &&
+            !channel["target"].contains("node"))
+          channel["target"]["node"] = -1;
+    }
   const std::string clean = doc.dump();
   if (clean.size() > kMaxFileBytes - 64) fail(path, "the JSON is larger than 4 GiB");
 

@@ -1,12 +1,17 @@
-// What the glTF loader's two files share (gltf_file.cpp reads and parses, gltf_loader.cpp builds
-// the Scene): the one-line error messages, little-endian reads and the parse step itself.
+// What the glTF loader's files share (gltf_file.cpp reads and parses, gltf_loader.cpp builds
+// the Scene, animation.cpp poses it): the one-line error messages, little-endian reads, the parse
+// step itself and the loader kept open.
 #pragma once
 
 #include <cstdint>
 #include <glm/glm.hpp>
+#include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
+
+#include "host/scene/gltf_loader.h"
 
 namespace tinygltf {
 class Model;
@@ -34,8 +39,10 @@ inline uint32_t le32(const unsigned char* p) {
 // byteLength. Any problem throws InputError. tinygltf never sees the images, textures and samplers
 // (it reads image buffer views unchecked): `textures` gets them as JSON text, an object with
 // "images", "textures", "samplers" and "base_color" (each material's baseColorTexture or null).
+// The file's animations are parsed only with `keep_animations`.
 std::vector<uint64_t> parse_file(const std::string& path, tinygltf::Model& model,
-                                 std::vector<std::string>& warnings, std::string& textures);
+                                 std::vector<std::string>& warnings, std::string& textures,
+                                 bool keep_animations);
 
 // A material's baseColorTexture as the loader applies it: which Scene::textures entry, which
 // TEXCOORD_n set, and KHR_texture_transform's matrix (identity without it).
@@ -51,5 +58,32 @@ struct BaseColorTexture {
 std::vector<BaseColorTexture> read_textures(const std::string& path, const std::string& textures,
                                             const tinygltf::Model& model,
                                             const LoadOptions& options, Scene& scene);
+
+class Loader;
+
+// The loader kept open, so that one file's scene can be flattened again for other node
+// transforms (host/scene/animation.cpp, once per frame): the file is parsed and checked once,
+// each primitive decoded once.
+class OpenScene {
+ public:
+  // Parses and checks the file (throws InputError as load_scene does).
+  OpenScene(const std::string& path, const LoadOptions& options);
+  ~OpenScene();
+  // The default scene flattened as load_scene() does (gltf_loader.h's rules), with local[n],
+  // where set, as node n's local transform instead of the file's.
+  Scene flatten(const std::vector<std::optional<glm::dmat4>>& local = {});
+  const tinygltf::Model& model() const;
+  const std::string& path() const;
+  // The nodes the last flatten() walked, in walk order.
+  const std::vector<int>& walked() const;
+  // Accessor `accessor` read for `use` as doubles, `components` per element (1: SCALAR, 3:
+  // VEC3, 4: VEC4): float components, with `integers` also normalized byte and short ones.
+  // Checked like every accessor (in range, not sparse); a non-finite value throws InputError.
+  std::vector<double> read_doubles(int accessor, const std::string& use, int components,
+                                   bool integers) const;
+
+ private:
+  std::unique_ptr<Loader> loader_;
+};
 
 }  // namespace host::gltf_detail

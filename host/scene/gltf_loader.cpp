@@ -121,23 +121,81 @@ uint64_t element_stride(const tinygltf::BufferView& view, uint64_t element) {
   return view.byteStride ? view.byteStride : element;
 }
 
+}  // namespace
+
+namespace gltf_detail {
+
 class Loader {
  public:
+  // Parses and checks the file; flatten() walks its default scene.
   Loader(std::string path, const LoadOptions& options)
       : path_(std::move(path)),
         max_triangles_(std::min<uint64_t>(options.max_triangles, 0xFFFFFFFFull)),
-        options_(options) {}
-
-  Scene load() {
+        options_(options) {
     std::string textures;
-    declared_lengths_ = parse_file(path_, model_, scene_.warnings, textures);  // gltf_file.cpp
+    declared_lengths_ =
+        parse_file(path_, model_, warnings_, textures, options.animations);  // gltf_file.cpp
     check_buffers_and_views();
     check_accessors();
-    base_color_ = gltf_detail::read_textures(path_, textures, model_, options_, scene_);
+    // Decoded once; every flatten() hands the same textures to its scene.
+    Scene decoded;
+    base_color_ = gltf_detail::read_textures(path_, textures, model_, options_, decoded);
+    textures_ = std::move(decoded.textures);
     convert_materials();
-    walk(root_nodes());
+    roots_ = root_nodes();
+  }
+
+  // One walk of the default scene into a new Scene; `local[n]`, where set, replaces node n's
+  // own local transform. Primitives are decoded once, at their first walk.
+  Scene flatten(const std::vector<std::optional<glm::dmat4>>& local) {
+    scene_ = Scene{};
+    scene_.textures = textures_;
+    lights_.clear();
+    walked_.clear();
+    invalid_file_normals_ = 0;
+    local_ = &local;
+    walk(roots_);
+    local_ = nullptr;
     finish();
     return std::move(scene_);
+  }
+
+  const tinygltf::Model& model() const { return model_; }
+  const std::string& path() const { return path_; }
+  const std::vector<int>& walked() const { return walked_; }
+
+  // Accessor `index` for `use` as doubles, `components` per element (1: SCALAR, 3: VEC3,
+  // 4: VEC4): float components, or with `integers` also (normalized) byte and short ones.
+  std::vector<double> read_doubles(int index, const std::string& use, int components,
+                                   bool integers) const {
+    const tinygltf::Accessor& acc = accessor_for(index, use);
+    const int ct = acc.componentType;
+    const int type = components == 1   ? TINYGLTF_TYPE_SCALAR
+                     : components == 3 ? TINYGLTF_TYPE_VEC3
+                                       : TINYGLTF_TYPE_VEC4;
+    const bool normalized_int =
+        integers && acc.normalized &&
+        (ct == TINYGLTF_COMPONENT_TYPE_BYTE || ct == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE ||
+         ct == TINYGLTF_COMPONENT_TYPE_SHORT || ct == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT);
+    if (acc.type != type || (ct != TINYGLTF_COMPONENT_TYPE_FLOAT && !normalized_int))
+      fail(path_, use + ": accessor " + std::to_string(index) + " must be " +
+                      (components == 1   ? "SCALAR"
+                       : components == 3 ? "VEC3"
+                                         : "VEC4") +
+                      " of float" + (integers ? " or normalized byte or short" : "") +
+                      " components");
+    const int comp = tinygltf::GetComponentSizeInBytes(uint32_t(ct));
+    std::vector<double> out(size_t(acc.count) * size_t(components));
+    const Elements element = elements(acc);
+    for (size_t i = 0; i < acc.count; ++i)
+      for (int c = 0; c < components; ++c) {
+        const double v = read_component(element[i] + c * comp, ct, acc.normalized);
+        if (!std::isfinite(v))
+          fail(path_, use + ": accessor " + std::to_string(index) + " element " +
+                          std::to_string(i) + " is not finite");
+        out[i * size_t(components) + size_t(c)] = v;
+      }
+    return out;
   }
 
  private:
@@ -333,24 +391,24 @@ class Loader {
       if (src.extras.IsObject() && src.extras.Has("reflect")) {
         const tinygltf::Value& r = src.extras.Get("reflect");
         if (!r.IsNumber()) {
-          scene_.warnings.push_back(name + ": extras.reflect is not a number; ignored");
+          warnings_.push_back(name + ": extras.reflect is not a number; ignored");
         } else {
           const double value = r.GetNumberAsDouble();
           if (value < 0.0 || value > 1.0)
-            scene_.warnings.push_back(name + ": extras.reflect " + std::to_string(value) +
-                                      " is outside [0, 1]; clamped");
+            warnings_.push_back(name + ": extras.reflect " + std::to_string(value) +
+                                " is outside [0, 1]; clamped");
           out.reflect = float(std::clamp(value, 0.0, 1.0));
         }
       }
       if (m < base_color_.size()) out.texture = base_color_[m].texture;
-      scene_.materials.push_back(out);
+      materials_.push_back(out);
     }
   }
 
   uint32_t default_material() {
     if (!default_material_) {
-      default_material_ = uint32_t(scene_.materials.size());
-      scene_.materials.push_back(Material{});
+      default_material_ = uint32_t(materials_.size());
+      materials_.push_back(Material{});
     }
     return *default_material_;
   }
@@ -391,6 +449,7 @@ class Loader {
     check_size(node.translation, 3, "translation");
     check_size(node.rotation, 4, "rotation");
     check_size(node.scale, 3, "scale");
+    if (local_ && index < local_->size() && (*local_)[index]) return *(*local_)[index];
     if (!node.matrix.empty()) return glm::make_mat4(node.matrix.data());  // column-major
     glm::dmat4 t(1.0), r(1.0), s(1.0);
     if (!node.translation.empty())
@@ -428,6 +487,7 @@ class Loader {
         fail(path_, "node " + std::to_string(item.node) +
                         " is reached twice; the node hierarchy must be a tree");
       seen[n] = 1;
+      walked_.push_back(item.node);
       const tinygltf::Node& node = model_.nodes[n];
       const glm::dmat4 world = item.parent * local_matrix(node, n);
       visit(node, n, world);
@@ -508,7 +568,7 @@ class Loader {
   }
 
   void warn_once(const std::string& message) {
-    if (warned_.insert(message).second) scene_.warnings.push_back(message);
+    if (warned_.insert(message).second) warnings_.push_back(message);
   }
 
   // -- primitives ------------------------------------------------------------------------------
@@ -703,6 +763,8 @@ class Loader {
   // -- after the walk --------------------------------------------------------------------------
 
   void finish() {
+    scene_.materials = materials_;
+    scene_.warnings = warnings_;
     std::string skipped;
     for (const auto& [what, count] : skipped_modes_) {
       const std::string item =
@@ -739,12 +801,18 @@ class Loader {
   std::string path_;
   uint64_t max_triangles_;
   tinygltf::Model model_;
+  std::vector<int> roots_;
+  std::vector<Material> materials_;
+  std::vector<std::string> warnings_;  // the file's and the walks' so far, each once
+  const std::vector<std::optional<glm::dmat4>>* local_ = nullptr;  // during flatten()
+  std::vector<int> walked_;
   Scene scene_;
   std::vector<uint64_t> declared_lengths_;
   std::map<int, std::shared_ptr<const std::vector<glm::vec3>>> position_cache_, normal_cache_;
   std::map<int, std::shared_ptr<const std::vector<uint32_t>>> index_cache_;
   std::map<int, std::shared_ptr<const std::vector<glm::vec2>>> uv_cache_;
-  const LoadOptions& options_;
+  const LoadOptions options_;  // a copy: an AnimatedScene outlives the options it was given
+  std::vector<SceneTexture> textures_;  // the file's base-colour textures, decoded once
   std::vector<gltf_detail::BaseColorTexture> base_color_;  // per file material
   std::map<std::pair<size_t, size_t>, PrimitiveGeometry> primitives_;
   std::optional<uint32_t> default_material_;
@@ -754,10 +822,30 @@ class Loader {
   uint64_t invalid_file_normals_ = 0;
 };
 
-}  // namespace
+OpenScene::OpenScene(const std::string& path, const LoadOptions& options)
+    : loader_(std::make_unique<Loader>(path, options)) {}
+OpenScene::~OpenScene() = default;
+Scene OpenScene::flatten(const std::vector<std::optional<glm::dmat4>>& local) {
+  return loader_->flatten(local);
+}
+const tinygltf::Model& OpenScene::model() const {
+  return loader_->model();
+}
+const std::string& OpenScene::path() const {
+  return loader_->path();
+}
+const std::vector<int>& OpenScene::walked() const {
+  return loader_->walked();
+}
+std::vector<double> OpenScene::read_doubles(int accessor, const std::string& use, int components,
+                                            bool integers) const {
+  return loader_->read_doubles(accessor, use, components, integers);
+}
+
+}  // namespace gltf_detail
 
 Scene load_scene(const std::string& path, const LoadOptions& options) {
-  return Loader(path, options).load();
+  return gltf_detail::OpenScene(path, options).flatten();
 }
 
 }  // namespace host

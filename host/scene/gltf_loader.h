@@ -28,6 +28,8 @@ struct LoadOptions {
   // Unset: a file whose materials use a texture is refused (the scene room cannot decode images;
   // host/image, above it, can).
   std::function<ImagePixels(const std::vector<unsigned char>&)> read_image{};
+  // Parse the file's animations too (host/scene/animation.h); load_scene never uses them.
+  bool animations = false;
 };
 
 // Loads the default scene (or scene 0, or every root node when the file has no scenes).

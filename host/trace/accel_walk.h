@@ -8,7 +8,9 @@
 #include <glm/glm.hpp>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
+#include "host/accel/accel.h"
 #include "host/trace/passes.h"
 #include "vgpu/vgpu.h"
 
@@ -29,9 +31,17 @@ class AccelWalk {
   virtual ~AccelWalk() = default;
   // The per-pixel state textures, made after the tracer's own.
   virtual void make_state(vgpu::Device& gpu, const WalkShared& shared) = 0;
-  // Video memory gets the static textures once, at initialization.
+  // Video memory gets the static textures at initialization.
   virtual void upload(vgpu::Device& gpu) const = 0;
-  virtual uint64_t texture_bytes() const = 0;
+  // Between frames of a moving scene (StreamTracer::update): the structure `accel` (of the
+  // kind the walk was made for, rebuilt for the scene posed anew) replaces the old one. Its
+  // static textures are rewritten in place where the new structure fits them (else made anew),
+  // each one whose texels changed is uploaded again and named in `uploaded`, and the uniforms
+  // are set. Returns the bytes uploaded. Throws vgpu::Error past the profile's limits.
+  virtual uint64_t rebuild(vgpu::Device& gpu, const Accel& accel, float scene_width,
+                           std::vector<std::string>& uploaded) = 0;
+  virtual uint64_t static_bytes() const = 0;   // the structure's textures, as upload() sends
+  virtual uint64_t texture_bytes() const = 0;  // those and the per-pixel state
   // One stream of rays: enter the structure, then walk it until no ray is walking. Leaves the
   // nearest hits in the current intersection texture.
   virtual void trace(PassRunner& r, vgpu::Texture& origins, vgpu::Texture& rays, bool primary,

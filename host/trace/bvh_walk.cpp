@@ -37,7 +37,7 @@ Texture entry_texture(vgpu::Device& gpu, const std::string& name, size_t count, 
 }  // namespace
 
 BvhWalk::BvhWalk(vgpu::Device& gpu, const Bvh& bvh, const RenderOptions& options, float scene_width)
-    : opt_(options), nodes_(int(bvh.nodes.size())), max_leaf_(bvh.max_leaf) {
+    : opt_(options) {
   const Formats& fm = opt_.formats;
   for (auto [prog, g] :
        std::initializer_list<std::pair<vgpu::Program*, Group>>{{&enter_, Group::traversal},
@@ -56,8 +56,15 @@ BvhWalk::BvhWalk(vgpu::Device& gpu, const Bvh& bvh, const RenderOptions& options
     if (vgpu::significand_bits(fm.arithmetic(g)) > vgpu::significand_bits(loop_arith))
       loop_arith = fm.arithmetic(g);
   looping_.set_precision(loop_arith);
+  set_bvh(gpu, bvh, scene_width, nullptr);
+}
+
+uint64_t BvhWalk::set_bvh(vgpu::Device& gpu, const Bvh& bvh, float scene_width,
+                          std::vector<std::string>* uploaded) {
+  const Formats& fm = opt_.formats;
   // Node indices and list positions are texel addresses: refuse a format that cannot hold them
-  // (a walk would stall at an index that no longer counts up, as the grid's does past its cap).
+  // (a walk would stall at an index that no longer counts up, as the grid's does past its cap),
+  // at construction and for each frame's rebuilt structure.
   for (const auto& [count, g, kind] :
        {std::tuple{uint64_t(bvh.nodes.size()), Group::traversal, "node indices"},
         std::tuple{uint64_t(bvh.lists.size()), Group::voxel, "list positions"}})
@@ -68,21 +75,39 @@ BvhWalk::BvhWalk(vgpu::Device& gpu, const Bvh& bvh, const RenderOptions& options
             std::string(group_name(g)) + " group's " + std::string(vgpu::format_name(f)) +
             " addresses texels exactly only to " + std::to_string(exact_addresses(f)) +
             " (give it fp24 or fp32: --formats " + std::string(group_name(g)) + "=fp32)");
-
-  nodes_lo_ = entry_texture(gpu, "bvh nodes lo", bvh.nodes.size(), 4, "nodes");
-  nodes_hi_ = entry_texture(gpu, "bvh nodes hi", bvh.nodes.size(), 4, "nodes");
-  lists_ = entry_texture(gpu, "bvh lists", bvh.lists.size(), 1, "lists");
+  nodes_ = int(bvh.nodes.size());
+  max_leaf_ = bvh.max_leaf;
+  // Between frames the textures are kept where the new hierarchy fits them (entries past its
+  // nodes and lists are never reached: escapes end the walk, lists are closed by -1).
+  const bool fresh = uploaded == nullptr;
+  auto fits = [](const Texture& t, size_t count) {
+    return uint64_t(t.width()) * uint64_t(t.height()) >= count;
+  };
+  if (fresh || !fits(nodes_lo_, bvh.nodes.size())) {
+    nodes_lo_ = entry_texture(gpu, "bvh nodes lo", bvh.nodes.size(), 4, "nodes");
+    nodes_hi_ = entry_texture(gpu, "bvh nodes hi", bvh.nodes.size(), 4, "nodes");
+  }
+  if (fresh || !fits(lists_, bvh.lists.size()))
+    lists_ = entry_texture(gpu, "bvh lists", bvh.lists.size(), 1, "lists");
   const int nw = nodes_lo_.width(), lw = lists_.width();
+  std::vector<float> lo(nodes_lo_.data().begin(), nodes_lo_.data().end());
+  std::vector<float> hi(nodes_hi_.data().begin(), nodes_hi_.data().end());
+  std::vector<float> entries(lists_.data().begin(), lists_.data().end());
   for (size_t i = 0; i < bvh.nodes.size(); ++i) {
     const BvhNode& n = bvh.nodes[i];
-    float* lo = nodes_lo_.texel_mut(int(i % size_t(nw)), int(i / size_t(nw)));
-    float* hi = nodes_hi_.texel_mut(int(i % size_t(nw)), int(i / size_t(nw)));
-    for (int a = 0; a < 3; ++a) lo[a] = n.lo[a], hi[a] = n.hi[a];
-    lo[3] = float(n.escape);
-    hi[3] = n.count > 0 ? float(n.leaf) : kNone;
+    for (int a = 0; a < 3; ++a) lo[4 * i + size_t(a)] = n.lo[a], hi[4 * i + size_t(a)] = n.hi[a];
+    lo[4 * i + 3] = float(n.escape);
+    hi[4 * i + 3] = n.count > 0 ? float(n.leaf) : kNone;
   }
-  for (size_t k = 0; k < bvh.lists.size(); ++k)
-    lists_.texel_mut(int(k % size_t(lw)), int(k / size_t(lw)))[0] = float(bvh.lists[k]);
+  for (size_t k = 0; k < bvh.lists.size(); ++k) entries[k] = float(bvh.lists[k]);
+  uint64_t bytes = 0;
+  for (auto [t, texels] :
+       {std::pair{&nodes_lo_, &lo}, std::pair{&nodes_hi_, &hi}, std::pair{&lists_, &entries}})
+    if (t->replace(*texels) && uploaded) {
+      gpu.upload(*t);
+      bytes += t->bytes();
+      uploaded->push_back(t->name());
+    }
 
   BvhUniforms u;
   u.node_width = float(nw);
@@ -101,6 +126,16 @@ BvhWalk::BvhWalk(vgpu::Device& gpu, const Bvh& bvh, const RenderOptions& options
   looping_.kernel.bvh = u;
   looping_.kernel.scene = su;
   looping_.kernel.steps = opt_.steps_per_pass;
+  return bytes;
+}
+
+uint64_t BvhWalk::rebuild(vgpu::Device& gpu, const Accel& accel, float scene_width,
+                          std::vector<std::string>& uploaded) {
+  return set_bvh(gpu, *accel.bvh, scene_width, &uploaded);
+}
+
+uint64_t BvhWalk::static_bytes() const {
+  return nodes_lo_.bytes() + nodes_hi_.bytes() + lists_.bytes();
 }
 
 void BvhWalk::make_state(vgpu::Device& gpu, const WalkShared& shared) {

@@ -4,6 +4,8 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
+#include <vector>
 
 #include "host/accel/bvh.h"
 #include "host/trace/accel_walk.h"
@@ -36,6 +38,14 @@ class BvhWalk : public AccelWalk {
   BvhWalk(vgpu::Device& gpu, const Bvh& bvh, const RenderOptions& options, float scene_width);
   void make_state(vgpu::Device& gpu, const WalkShared& shared) override;
   void upload(vgpu::Device& gpu) const override;
+  // The hierarchy's textures and the uniforms that depend on them; with `uploaded` (between
+  // frames, AccelWalk::rebuild), the textures are kept where the new hierarchy fits them and
+  // each one whose texels changed is uploaded again and named there. Returns those bytes.
+  uint64_t set_bvh(vgpu::Device& gpu, const Bvh& bvh, float scene_width,
+                   std::vector<std::string>* uploaded);
+  uint64_t rebuild(vgpu::Device& gpu, const Accel& accel, float scene_width,
+                   std::vector<std::string>& uploaded) override;
+  uint64_t static_bytes() const override;
   uint64_t texture_bytes() const override;
   void trace(PassRunner& r, vgpu::Texture& origins, vgpu::Texture& rays, bool primary,
              glm::vec3 eye) override;

@@ -70,7 +70,7 @@ std::vector<std::string> mrt_programs() {
 
 GridWalk::GridWalk(vgpu::Device& gpu, const Grid& grid, const RenderOptions& options,
                    float scene_width)
-    : opt_(options), res_(grid.res) {
+    : opt_(options) {
   // Each program computes in its group's arithmetic format (formats.h: which kernel is where).
   const Formats& fm = opt_.formats;
   for (auto [prog, g] :
@@ -95,11 +95,16 @@ GridWalk::GridWalk(vgpu::Device& gpu, const Grid& grid, const RenderOptions& opt
     if (vgpu::significand_bits(fm.arithmetic(g)) > vgpu::significand_bits(loop_arith))
       loop_arith = fm.arithmetic(g);
   looping_.set_precision(loop_arith);
+  set_grid(gpu, grid, scene_width, nullptr);
+}
 
+uint64_t GridWalk::set_grid(vgpu::Device& gpu, const Grid& grid, float scene_width,
+                            std::vector<std::string>* uploaded) {
   // The lists, each closed by -1 (entry 0 is the -1 every empty voxel shares), and the voxel
   // pointers at (X*sizeY + Y, Z).
   const int maxs = gpu.profile().max_texture_size;
   const glm::ivec3 r = grid.res;
+  res_ = r;
   if (size_t(r.x) * r.y > size_t(maxs) || r.z > maxs)
     throw vgpu::Error("grid " + std::to_string(r.x) + "x" + std::to_string(r.y) + "x" +
                       std::to_string(r.z) + " needs a " + std::to_string(r.x * r.y) + "x" +
@@ -107,6 +112,7 @@ GridWalk::GridWalk(vgpu::Device& gpu, const Grid& grid, const RenderOptions& opt
                       gpu.profile().name + " allows " + std::to_string(maxs) + "x" +
                       std::to_string(maxs));
   size_t nonempty = 0;
+  max_list_ = 0;
   for (size_t vox = 0; vox < grid.voxels(); ++vox) {
     const uint32_t n = grid.start[vox + 1] - grid.start[vox];
     nonempty += n > 0;
@@ -122,13 +128,18 @@ GridWalk::GridWalk(vgpu::Device& gpu, const Grid& grid, const RenderOptions& opt
     throw vgpu::Error("grid lists hold " + std::to_string(list_len) + " entries; profile " +
                       gpu.profile().name + " holds at most " + std::to_string(size_t(maxs) * maxs) +
                       " (use a coarser grid)");
-  lists_ = gpu.make_texture("triangle lists", lw, int(lh), 1);
-  pointers_ = gpu.make_texture("voxel pointers", r.x * r.y, r.z, 1);
+  // Between frames the textures are kept where the new grid fits them (the lists' texels past
+  // the last list are never read), so a moving scene's frames reuse the device's textures.
+  const bool fresh = uploaded == nullptr;
+  if (fresh || uint64_t(lists_.width()) * uint64_t(lists_.height()) < list_len)
+    lists_ = gpu.make_texture("triangle lists", lw, int(lh), 1);
+  if (fresh || pointers_.width() != r.x * r.y || pointers_.height() != r.z)
+    pointers_ = gpu.make_texture("voxel pointers", r.x * r.y, r.z, 1);
+  const int width = lists_.width();
+  std::vector<float> lists(lists_.data().begin(), lists_.data().end());
+  std::vector<float> pointers(pointers_.data().size(), 0.0f);
   size_t k = 0;
-  auto put = [&](float value) {
-    lists_.texel_mut(int(k % lw), int(k / lw))[0] = value;
-    ++k;
-  };
+  auto put = [&](float value) { lists[k++] = value; };
   put(kNone);
   for (int z = 0; z < r.z; ++z)
     for (int y = 0; y < r.y; ++y)
@@ -140,15 +151,22 @@ GridWalk::GridWalk(vgpu::Device& gpu, const Grid& grid, const RenderOptions& opt
           for (uint32_t t : tris) put(float(t));
           put(kNone);
         }
-        pointers_.texel_mut(x * r.y + y, z)[0] = start;
+        pointers[size_t(z) * size_t(r.x * r.y) + size_t(x * r.y + y)] = start;
       }
+  uint64_t bytes = 0;
+  for (auto [t, texels] : {std::pair{&lists_, &lists}, std::pair{&pointers_, &pointers}})
+    if (t->replace(*texels) && uploaded) {
+      gpu.upload(*t);
+      bytes += t->bytes();
+      uploaded->push_back(t->name());
+    }
 
   // Uniforms that do not change during a frame.
   GridUniforms g;
   g.lo = grid.lo;
   g.cell = grid.cell;
   g.res = glm::vec3(r);
-  g.list_width = float(lw);
+  g.list_width = float(width);
   const float diag = glm::length(grid.hi - grid.lo);
   g.t_slack = float(kSlackOfDiagonal) * diag;
   const SceneUniforms su{scene_width};
@@ -165,6 +183,7 @@ GridWalk::GridWalk(vgpu::Device& gpu, const Grid& grid, const RenderOptions& opt
   looping_.kernel.grid = g;
   looping_.kernel.scene = su;
   looping_.kernel.steps = opt_.steps_per_pass;
+  return bytes;
 }
 
 void GridWalk::make_state(vgpu::Device& gpu, const Shared& shared) {
@@ -181,6 +200,10 @@ void GridWalk::make_state(vgpu::Device& gpu, const Shared& shared) {
 void GridWalk::upload(vgpu::Device& gpu) const {
   gpu.upload(lists_);
   gpu.upload(pointers_);
+}
+
+uint64_t GridWalk::static_bytes() const {
+  return lists_.bytes() + pointers_.bytes();
 }
 
 uint64_t GridWalk::texture_bytes() const {

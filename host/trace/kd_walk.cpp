@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <tuple>
 
+#include "host/trace/grid_walk.h"  // kSlackOfDiagonal
 #include "host/trace/walk.h"
 
 namespace host {
@@ -38,11 +39,7 @@ Texture entry_texture(vgpu::Device& gpu, const std::string& name, size_t count, 
 
 KdWalk::KdWalk(vgpu::Device& gpu, const KdTree& kd, const RenderOptions& options, float scene_width,
                float t_slack)
-    : opt_(options),
-      nodes_(int(kd.nodes.size())),
-      max_leaf_(kd.max_leaf),
-      depth_(kd.depth),
-      leaves_(kd.leaves) {
+    : opt_(options) {
   const Formats& fm = opt_.formats;
   for (auto [prog, g] :
        std::initializer_list<std::pair<vgpu::Program*, Group>>{{&enter_, Group::traversal},
@@ -60,8 +57,15 @@ KdWalk::KdWalk(vgpu::Device& gpu, const KdTree& kd, const RenderOptions& options
     if (vgpu::significand_bits(fm.arithmetic(g)) > vgpu::significand_bits(loop_arith))
       loop_arith = fm.arithmetic(g);
   looping_.set_precision(loop_arith);
+  set_tree(gpu, kd, scene_width, t_slack, nullptr);
+}
+
+uint64_t KdWalk::set_tree(vgpu::Device& gpu, const KdTree& kd, float scene_width, float t_slack,
+                          std::vector<std::string>* uploaded) {
+  const Formats& fm = opt_.formats;
   // Node indices and list positions are texel addresses: refuse a format that cannot hold them
-  // (a walk would stall at an index that no longer counts up, as the grid's does past its cap).
+  // (a walk would stall at an index that no longer counts up, as the grid's does past its cap),
+  // at construction and for each frame's rebuilt structure.
   for (const auto& [count, g, kind] :
        {std::tuple{uint64_t(kd.nodes.size()), Group::traversal, "node indices"},
         std::tuple{uint64_t(kd.lists.size()), Group::voxel, "list positions"}})
@@ -72,21 +76,40 @@ KdWalk::KdWalk(vgpu::Device& gpu, const KdTree& kd, const RenderOptions& options
             std::string(group_name(g)) + " group's " + std::string(vgpu::format_name(f)) +
             " addresses texels exactly only to " + std::to_string(exact_addresses(f)) +
             " (give it fp24 or fp32: --formats " + std::string(group_name(g)) + "=fp32)");
-
+  nodes_ = int(kd.nodes.size());
+  max_leaf_ = kd.max_leaf;
+  depth_ = kd.depth;
+  leaves_ = kd.leaves;
+  // Between frames the textures are kept where the new tree fits them (entries past its nodes
+  // and lists are never reached: children and list starts point inside, lists end with -1).
+  const bool fresh = uploaded == nullptr;
+  auto fits = [](const Texture& t, size_t count) {
+    return uint64_t(t.width()) * uint64_t(t.height()) >= count;
+  };
   // Node i: (split, axis or 3 for a leaf, right child, leaf list start).
-  tree_ = entry_texture(gpu, "kd nodes", kd.nodes.size(), 4, "nodes");
-  lists_ = entry_texture(gpu, "kd lists", kd.lists.size(), 1, "lists");
+  if (fresh || !fits(tree_, kd.nodes.size()))
+    tree_ = entry_texture(gpu, "kd nodes", kd.nodes.size(), 4, "nodes");
+  if (fresh || !fits(lists_, kd.lists.size()))
+    lists_ = entry_texture(gpu, "kd lists", kd.lists.size(), 1, "lists");
   const int nw = tree_.width(), lw = lists_.width();
+  std::vector<float> nodes(tree_.data().begin(), tree_.data().end());
+  std::vector<float> entries(lists_.data().begin(), lists_.data().end());
   for (size_t i = 0; i < kd.nodes.size(); ++i) {
     const KdNode& n = kd.nodes[i];
-    float* t = tree_.texel_mut(int(i % size_t(nw)), int(i / size_t(nw)));
+    float* t = nodes.data() + 4 * i;
     t[0] = n.split;
     t[1] = float(n.axis);
     t[2] = float(n.right);
     t[3] = n.axis == 3 ? float(n.leaf) : kNone;
   }
-  for (size_t k = 0; k < kd.lists.size(); ++k)
-    lists_.texel_mut(int(k % size_t(lw)), int(k / size_t(lw)))[0] = float(kd.lists[k]);
+  for (size_t k = 0; k < kd.lists.size(); ++k) entries[k] = float(kd.lists[k]);
+  uint64_t bytes = 0;
+  for (auto [t, texels] : {std::pair{&tree_, &nodes}, std::pair{&lists_, &entries}})
+    if (t->replace(*texels) && uploaded) {
+      gpu.upload(*t);
+      bytes += t->bytes();
+      uploaded->push_back(t->name());
+    }
 
   KdUniforms u;
   u.lo = kd.lo;
@@ -111,6 +134,17 @@ KdWalk::KdWalk(vgpu::Device& gpu, const KdTree& kd, const RenderOptions& options
   looping_.kernel.kd = u;
   looping_.kernel.scene = su;
   looping_.kernel.steps = opt_.steps_per_pass;
+  return bytes;
+}
+
+uint64_t KdWalk::rebuild(vgpu::Device& gpu, const Accel& accel, float scene_width,
+                         std::vector<std::string>& uploaded) {
+  const float t_slack = float(kSlackOfDiagonal) * glm::length(accel.grid->hi - accel.grid->lo);
+  return set_tree(gpu, *accel.kd, scene_width, t_slack, &uploaded);
+}
+
+uint64_t KdWalk::static_bytes() const {
+  return tree_.bytes() + lists_.bytes();
 }
 
 void KdWalk::make_state(vgpu::Device& gpu, const WalkShared& shared) {

@@ -80,8 +80,8 @@ StreamTracer::StreamTracer(const Scene& scene, const Grid& grid, const RenderOpt
     : StreamTracer(scene, Accel{AccelKind::grid, &grid, nullptr}, options) {}
 
 StreamTracer::StreamTracer(const Scene& scene, const Accel& accel, const RenderOptions& options)
-    : scene_(scene), grid_(*accel.grid), opt_(options) {
-  const Grid& grid = grid_;
+    : scene_(&scene), grid_(accel.grid), accel_kind_(accel.kind), opt_(options) {
+  const Grid& grid = *grid_;
   const auto t0 = std::chrono::steady_clock::now();
   gpu_ = make_device(opt_);
   s_ = std::make_unique<State>();
@@ -115,35 +115,16 @@ StreamTracer::StreamTracer(const Scene& scene, const Accel& accel, const RenderO
         "undersample: K must be 1 or more, with one ray per traced pixel (spp 1, not adaptive)");
   const bool sums = opt_.spp > 1 || opt_.undersample > 0;
   const bool marking = (opt_.adaptive && opt_.spp > 1) || opt_.undersample > 0;
-  const int maxs = gpu.profile().max_texture_size;
 
   // Scene textures: triangle i at texel (i mod width, i div width).
-  const size_t ntri = scene.triangle_count();
-  const int sw = int(std::min<size_t>(std::max<size_t>(ntri, 1), size_t(maxs)));
-  const size_t sh = (ntri + sw - 1) / sw;
-  if (sh > size_t(maxs))
-    throw vgpu::Error("scene has " + std::to_string(ntri) + " triangles; profile " +
-                      gpu.profile().name + " holds at most " + std::to_string(size_t(maxs) * maxs) +
-                      " in one " + std::to_string(maxs) + "x" + std::to_string(maxs) + " texture");
-  const std::vector<glm::vec3>* P[3] = {&scene.p0, &scene.p1, &scene.p2};
-  const std::vector<glm::vec3>* N[3] = {&scene.n0, &scene.n1, &scene.n2};
-  for (int c = 0; c < 3; ++c) {
-    s.v[c] = gpu.make_texture("vertices" + std::to_string(c), sw, int(sh), 3);
-    s.n[c] = gpu.make_texture("normals" + std::to_string(c), sw, int(sh), 3);
-    for (size_t i = 0; i < ntri; ++i) {
-      float* tv = s.v[c].texel_mut(int(i % sw), int(i / sw));
-      float* tn = s.n[c].texel_mut(int(i % sw), int(i / sw));
-      for (int k = 0; k < 3; ++k) tv[k] = (*P[c])[i][k], tn[k] = (*N[c])[i][k];
-    }
-  }
-  s.colors = gpu.make_texture("colors", sw, int(sh), 4);
-  for (size_t i = 0; i < ntri; ++i) {
-    const Material& m = scene.materials[scene.material[i]];
-    float* t = s.colors.texel_mut(int(i % sw), int(i / sw));
-    t[0] = m.color.r, t[1] = m.color.g, t[2] = m.color.b, t[3] = m.reflect;
-  }
+  write_scene(nullptr);
 
+  // Base-colour textures (kernels/base_color.h): the atlas, its table and the corners' UVs.
+  // Static: a moving scene's frames change positions, not UVs.
   if (!scene.textures.empty()) {
+    const int maxs = gpu.profile().max_texture_size;
+    const int sw = s.v[0].width(), sh = s.v[0].height();
+    const size_t ntri = scene.triangle_count();
     std::vector<MipChain> chains;
     size_t levels = 0;
     for (const SceneTexture& t : scene.textures) {
@@ -184,18 +165,21 @@ StreamTracer::StreamTracer(const Scene& scene, const Accel& accel, const RenderO
     for (const Texture* t : {&s.uvs01, &s.uvs2, &s.texture_table, &s.atlas}) gpu.upload(*t);
   }
 
-  // The acceleration structure's textures and walk (host/trace/grid_walk.h, bvh_walk.h).
+  // The acceleration structure's textures and walk (host/trace/grid_walk.h, bvh_walk.h,
+  // kd_walk.h).
   if (accel.kind == AccelKind::bvh)
-    s.walk = std::make_unique<BvhWalk>(gpu, *accel.bvh, opt_, float(sw));
+    s.walk = std::make_unique<BvhWalk>(gpu, *accel.bvh, opt_, float(s.v[0].width()));
   else if (accel.kind == AccelKind::kdtree)
-    s.walk = std::make_unique<KdWalk>(gpu, *accel.kd, opt_, float(sw),
+    s.walk = std::make_unique<KdWalk>(gpu, *accel.kd, opt_, float(s.v[0].width()),
                                       float(kSlackOfDiagonal) * glm::length(grid.hi - grid.lo));
   else
-    s.walk = std::make_unique<GridWalk>(gpu, grid, opt_, float(sw));
+    s.walk = std::make_unique<GridWalk>(gpu, grid, opt_, float(s.v[0].width()));
 
-  // Video memory gets the static textures once, at initialization.
+  // Video memory gets the static textures at initialization (and again, where they change,
+  // between frames of a moving scene: update()).
   for (const Texture* t : {&s.v[0], &s.v[1], &s.v[2], &s.n[0], &s.n[1], &s.n[2], &s.colors})
     gpu.upload(*t);
+  if (marking) gpu.upload(s.materials);
   s.walk->upload(gpu);
 
   // Dynamic textures: one texel per pixel.
@@ -217,11 +201,6 @@ StreamTracer::StreamTracer(const Scene& scene, const Accel& accel, const RenderO
   if (marking) {
     for (int i = 0; i < 2; ++i)
       s.marks[i] = gpu.make_texture(std::string("marks ") + (i ? "B" : "A"), W, H, 4, Format::fp32);
-    s.materials = gpu.make_texture("triangle materials", sw, int(sh), 1);
-    for (size_t i = 0; i < ntri; ++i)
-      s.materials.texel_mut(int(i % sw), int(i / sw))[0] = float(scene.material[i]);
-    gpu.upload(s.materials);
-    s.keep.kernel.scene = SceneUniforms{float(sw)};
     s.mark.kernel.threshold = opt_.aa_threshold;
     const LatticeUniforms lattice{float(std::max(opt_.undersample, 1)), float(W), float(H)};
     s.mark_lattice.kernel.lattice = lattice;
@@ -238,23 +217,108 @@ StreamTracer::StreamTracer(const Scene& scene, const Accel& accel, const RenderO
                            &s.isect_mask});
   s.runner = std::make_unique<PassRunner>(gpu, opt_, s.counter);
 
-  // Uniforms that do not change during a frame.
-  const float diag = glm::length(grid.hi - grid.lo);
-  const SceneUniforms su{float(sw)};
-  s.shader.kernel.scene = su;
   s.shader.kernel.model = opt_.shading;
   s.shader.kernel.shadows = opt_.shadows;
-  s.shader.kernel.atten_dist = float(kAttenOfDiagonal) * diag;
-  s.shader.kernel.texture.on = s.textured;
-  s.shader.kernel.texture.filter = opt_.texture_filter;
-  s.origin.kernel.scene = su;
-  s.origin.kernel.offset = float(kOffsetOfDiagonal) * diag;
-  s.direction.kernel.scene = su;
+  set_uniforms();
   gpu.stats().keep_pass_records = opt_.keep_pass_records;
   init_ms_ = ms_since(t0);
 }
 
 StreamTracer::~StreamTracer() = default;
+
+uint64_t StreamTracer::write_scene(std::vector<std::string>* uploaded) {
+  State& s = *s_;
+  vgpu::Device& gpu = *gpu_;
+  const Scene& scene = *scene_;
+  const bool marking = (opt_.adaptive && opt_.spp > 1) || opt_.undersample > 0;
+  const size_t ntri = scene.triangle_count();
+  if (!uploaded || uint64_t(s.v[0].width()) * uint64_t(s.v[0].height()) < ntri) {
+    const int maxs = gpu.profile().max_texture_size;
+    const int sw = int(std::min<size_t>(std::max<size_t>(ntri, 1), size_t(maxs)));
+    const size_t sh = (ntri + sw - 1) / sw;
+    if (sh > size_t(maxs))
+      throw vgpu::Error("scene has " + std::to_string(ntri) + " triangles; profile " +
+                        gpu.profile().name + " holds at most " +
+                        std::to_string(size_t(maxs) * maxs) + " in one " + std::to_string(maxs) +
+                        "x" + std::to_string(maxs) + " texture");
+    for (int c = 0; c < 3; ++c) {
+      s.v[c] = gpu.make_texture("vertices" + std::to_string(c), sw, int(sh), 3);
+      s.n[c] = gpu.make_texture("normals" + std::to_string(c), sw, int(sh), 3);
+    }
+    s.colors = gpu.make_texture("colors", sw, int(sh), 4);
+    if (marking) s.materials = gpu.make_texture("triangle materials", sw, int(sh), 1);
+  }
+  // Texel i is triangle i (row-major, rows of the texture's width); texels past the last
+  // triangle keep what they held (never read).
+  uint64_t bytes = 0;
+  auto write = [&](Texture& t, auto&& texel) {
+    std::vector<float> texels(t.data().begin(), t.data().end());
+    const size_t channels = size_t(t.channels());
+    for (size_t i = 0; i < ntri; ++i) texel(i, texels.data() + i * channels);
+    if (t.replace(texels) && uploaded) {
+      gpu.upload(t);
+      bytes += t.bytes();
+      uploaded->push_back(t.name());
+    }
+  };
+  const std::vector<glm::vec3>* P[3] = {&scene.p0, &scene.p1, &scene.p2};
+  const std::vector<glm::vec3>* N[3] = {&scene.n0, &scene.n1, &scene.n2};
+  for (int c = 0; c < 3; ++c) {
+    write(s.v[c], [&](size_t i, float* t) {
+      for (int k = 0; k < 3; ++k) t[k] = (*P[c])[i][k];
+    });
+    write(s.n[c], [&](size_t i, float* t) {
+      for (int k = 0; k < 3; ++k) t[k] = (*N[c])[i][k];
+    });
+  }
+  write(s.colors, [&](size_t i, float* t) {
+    const Material& m = scene.materials[scene.material[i]];
+    t[0] = m.color.r, t[1] = m.color.g, t[2] = m.color.b, t[3] = m.reflect;
+  });
+  if (marking) write(s.materials, [&](size_t i, float* t) { t[0] = float(scene.material[i]); });
+  return bytes;
+}
+
+void StreamTracer::set_uniforms() {
+  State& s = *s_;
+  const float diag = glm::length(grid_->hi - grid_->lo);
+  const SceneUniforms su{float(s.v[0].width())};
+  s.shader.kernel.scene = su;
+  s.shader.kernel.atten_dist = float(kAttenOfDiagonal) * diag;
+  s.origin.kernel.scene = su;
+  s.origin.kernel.offset = float(kOffsetOfDiagonal) * diag;
+  s.direction.kernel.scene = su;
+  s.keep.kernel.scene = su;
+  s.shader.kernel.texture.on = s.textured;
+  s.shader.kernel.texture.filter = opt_.texture_filter;
+}
+
+StreamTracer::Upload StreamTracer::update(const Scene& scene, const Grid& grid) {
+  return update(scene, Accel{AccelKind::grid, &grid, nullptr});
+}
+
+StreamTracer::Upload StreamTracer::update(const Scene& scene, const Accel& accel) {
+  if (accel.kind != accel_kind_)
+    throw std::invalid_argument("StreamTracer::update: the tracer walks a " +
+                                std::string(accel_name(accel_kind_)) + ", not a " +
+                                std::string(accel_name(accel.kind)));
+  scene_ = &scene;
+  grid_ = accel.grid;
+  Upload up;
+  up.bytes += write_scene(&up.textures);
+  up.bytes += s_->walk->rebuild(*gpu_, accel, float(s_->v[0].width()), up.textures);
+  set_uniforms();
+  return up;
+}
+
+uint64_t StreamTracer::static_bytes() const {
+  uint64_t b = s_->walk->static_bytes();
+  for (const Texture* t :
+       {&s_->v[0], &s_->v[1], &s_->v[2], &s_->n[0], &s_->n[1], &s_->n[2], &s_->colors})
+    b += t->bytes();
+  if ((opt_.adaptive && opt_.spp > 1) || opt_.undersample > 0) b += s_->materials.bytes();
+  return b;
+}
 
 uint64_t StreamTracer::texture_bytes() const {
   uint64_t b = s_->walk->texture_bytes();
@@ -503,7 +567,7 @@ void StreamTracer::frame(const Camera& cam, const vgpu::Program& generate, Rende
           const float* t = hits.texel(x, y);
           if (t[3] >= 0) {
             res.depth[size_t(y) * W + x] = t[0];
-            res.hit_id[size_t(y) * W + x] = float(scene_.id[size_t(t[3])]);
+            res.hit_id[size_t(y) * W + x] = float(scene_->id[size_t(t[3])]);
           }
         }
     }
@@ -511,7 +575,7 @@ void StreamTracer::frame(const Camera& cam, const vgpu::Program& generate, Rende
     Texture& surface = s.origins[ro ^ 1];
     r.pass(s.origin, {&s.origins[ro], &rays, &hits, &s.v[0], &s.v[1], &s.v[2]}, surface);
     // shader: one pass per light, after that light's shadow rays are traced.
-    const auto& lights = scene_.lights;
+    const auto& lights = scene_->lights;
     for (size_t li = 0; li < lights.size(); ++li) {
       Shader& sh = s.shader.kernel;
       sh.light = lights[li].position;

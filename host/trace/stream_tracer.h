@@ -28,6 +28,24 @@ class StreamTracer {
   StreamTracer(const Scene& scene, const Accel& accel, const RenderOptions& options);
   ~StreamTracer();
   RenderResult render(const Camera& camera);
+
+  // What a scene update sent to video memory.
+  struct Upload {
+    uint64_t bytes = 0;
+    std::vector<std::string> textures;  // names of the textures uploaded again
+  };
+  // Between frames of a moving scene (--frames, issue 23): `scene` (the same file posed at
+  // another time) and its rebuilt `grid` replace those the tracer was made with, on the same
+  // device. The static textures are rewritten in place where the new scene and grid fit them,
+  // and each one whose texels changed is uploaded again, whole; the uniforms that depend on
+  // them are set. Both must outlive the next render, as at construction. Throws vgpu::Error
+  // past the profile's limits, as the constructor does.
+  Upload update(const Scene& scene, const Grid& grid);
+  // The same with the structure `accel` names, of the kind the tracer was made with (its grid,
+  // the scene box for another structure, rebuilt too).
+  Upload update(const Scene& scene, const Accel& accel);
+  // Bytes of the static textures (the scene's and the grid's), all uploaded at initialization.
+  uint64_t static_bytes() const;
   double init_ms() const { return init_ms_; }
   vgpu::Device& device() { return *gpu_; }
   uint64_t texture_bytes() const;  // static + dynamic textures, as the modeled card holds them
@@ -51,8 +69,15 @@ class StreamTracer {
   // --aa undersample:K (RenderOptions::undersample): the lattice frame, the gaps' frame, the fill.
   void render_undersampled(const Camera& cam, RenderResult& res, int& iteration_number);
 
-  const Scene& scene_;
-  const Grid& grid_;
+  // The scene's textures: triangle i at texel (i mod width, i div width); new textures when the
+  // triangles outgrow them. With `uploaded`, changed textures are uploaded and named there.
+  uint64_t write_scene(std::vector<std::string>* uploaded);
+  // The uniforms that depend on the scene's texture width and the grid's size.
+  void set_uniforms();
+
+  const Scene* scene_;
+  const Grid* grid_;  // the grid walked, or the scene box another structure is walked in
+  AccelKind accel_kind_;
   RenderOptions opt_;
   std::unique_ptr<vgpu::Device> gpu_;
   std::unique_ptr<State> s_;

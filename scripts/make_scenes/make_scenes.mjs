@@ -436,6 +436,37 @@ class Gltf {
     return this.json.textures.length - 1;
   }
 
+  // Float SCALAR, VEC3 or VEC4 elements for an animation sampler (inputs carry min and max, as
+  // glTF requires of them).
+  addAnimationAccessor(elements, type, name) {
+    const n = { SCALAR: 1, VEC3: 3, VEC4: 4 }[type];
+    const f = new Float32Array(elements.flat());
+    if (f.length !== elements.length * n) throw new Error(`${name}: elements are not ${type}`);
+    const view = this.addBytes(f);
+    const acc = { name, bufferView: view, byteOffset: 0, componentType: 5126, count: elements.length, type };
+    if (type === 'SCALAR') Object.assign(acc, { min: [Math.min(...f)], max: [Math.max(...f)] });
+    this.json.accessors.push(acc);
+    return this.json.accessors.length - 1;
+  }
+
+  // An animation: channels [{ node, path, interpolation, times, values }], one sampler each;
+  // values per key (CUBICSPLINE: in-tangent, value, out-tangent per key), as glTF lays them out.
+  animation(name, channels, what) {
+    const samplers = [], out = [];
+    for (const [k, c] of channels.entries()) {
+      const tag = `${name} ${this.json.nodes[c.node].name} ${c.path}`;
+      samplers.push({
+        input: this.addAnimationAccessor(c.times, 'SCALAR', `${tag} times`),
+        interpolation: c.interpolation,
+        output: this.addAnimationAccessor(c.values, c.path === 'rotation' ? 'VEC4' : 'VEC3', `${tag} values`),
+      });
+      out.push({ sampler: k, target: { node: c.node, path: c.path } });
+    }
+    (this.json.animations ??= []).push({ name, channels: out, samplers });
+    const end = Math.max(...channels.map((c) => c.times[c.times.length - 1]));
+    (this.animationInfo ??= []).push({ name, end, what });
+  }
+
   addIndexAccessor(tris, vertexCount, name) {
     const flat = tris.flat();
     const u16 = vertexCount <= 65535;
@@ -533,6 +564,7 @@ class Gltf {
     writeFileSync(join(OUT_DIR, file), JSON.stringify(this.json, null, 1) + '\n');
     const b = bboxOf(this.worldPoints);
     const info = { file, description: this.description, source: this.source, faces: this.faces, bounds: { lo: roundv(b.lo, 3), hi: roundv(b.hi, 3) }, camera: this.cameraInfo, lights: this.lightInfo, materials: this.materialInfo };
+    if (this.animationInfo) info.animations = this.animationInfo;
     console.log(JSON.stringify(info));
     return info;
   }
@@ -743,6 +775,62 @@ for (const [file, mesh, what, src] of [
 }
 
 // ---------------------------------------------------------------------------------------------
+// 8. hop.gltf — issue 23: a moving scene of the paper's kind (Fig. 1's checkerboard)
+// ---------------------------------------------------------------------------------------------
+{
+  const g = new Gltf('hop', "Issue 23 (dynamic scenes): the simplified bunny of bunny-low.gltf hops three times across the classic scene's checkerboard while its mirror sphere turns once about a tilted axis; the bounds are the rest pose's (time 0)", `${SRC_BUNNY_LOW.replace('scaled by 0.3', 'scaled by 0.22')}; checkerboard and sphere procedural, as classic.gltf`);
+  const mRed = g.material('checker-red', [0.8, 0.1, 0.08], 0.0, 0.7);
+  const mYellow = g.material('checker-yellow', [0.9, 0.8, 0.15], 0.0, 0.7);
+  const mMirror = g.material('mirror-sphere', [0.9, 0.9, 0.92], 0.7, 0.05);
+  const mBunny = g.material('bunny', [0.85, 0.72, 0.55], 0.0, 0.6);
+  const [even, odd] = checker(8, 2.0); // 16 x 16 floor, 128 faces
+  g.instance('checker', g.mesh('checker', [{ mesh: even, material: mRed }, { mesh: odd, material: mYellow }]));
+  const big = uvSphere(1.5, 20, 10); // 360 faces
+  const cBig = [0, 1.55, -1.0];
+  const axis = norm([Math.sin(deg(30)), Math.cos(deg(30)), 0]); // 30 degrees off +Y
+  g.instance('mirror-sphere', g.mesh('mirror-sphere', [{ mesh: big, material: mMirror }]), { t: cBig });
+  const sphereNode = g.json.nodes.length - 1;
+  // The bunny faces its way (+X: its head, at -X in the model, turned half round about +Y) and
+  // leans back on the way up, forward on the way down.
+  const S = 0.22, T = 2.0, hops = 3, height = 1.0, x0 = -4.2, x1 = 4.2, z = 1.9;
+  const lean = (a) => {
+    const yaw = quatAxisAngle([0, 1, 0], Math.PI), pitch = quatAxisAngle([0, 0, 1], deg(a));
+    // yaw * pitch: pitch about the model's own Z first.
+    const [x1_, y1, z1, w1] = yaw, [x2, y2, z2, w2] = pitch;
+    return [w1 * x2 + x1_ * w2 + y1 * z2 - z1 * y2, w1 * y2 - x1_ * z2 + y1 * w2 + z1 * x2, w1 * z2 + x1_ * y2 - y1 * x2 + z1 * w2, w1 * w2 - x1_ * x2 - y1 * y2 - z1 * z2];
+  };
+  // The lowest point of the scaled bunny in either lean, so that it lands on the floor.
+  const lower = Math.min(...[-12, 12].flatMap((a) => placed(bunnyLowMesh, S, [0, 0, 0], lean(a)).map((p) => p[1])));
+  g.instance('bunny', g.mesh('bunny', [{ mesh: bunnyLowMesh, material: mBunny }]), { s: S, t: [x0, -lower, z], r: lean(-12) });
+  const bunnyNode = g.json.nodes.length - 1;
+  // Translation: CUBICSPLINE keys at each take-off, apex and landing. x moves at a constant
+  // speed (tangent dx/dt); y follows an exact parabola per half hop (Hermite with end slopes
+  // 2h/d and 0 is h(2u - u^2)); a landing's in- and out-tangents differ (the bounce).
+  const half = T / hops / 2, vx = (x1 - x0) / T, vy = (2 * height) / half;
+  const times = [], values = [];
+  for (let k = 0; k <= 2 * hops; k++) {
+    const t = k * half, apex = k % 2 === 1;
+    const p = [x0 + vx * t, (apex ? height : 0) - lower, z];
+    times.push(round(t, 6));
+    values.push([vx, apex ? 0 : -vy, 0].map((v) => round(v, 6)), roundv(p), [vx, apex ? 0 : vy, 0].map((v) => round(v, 6)));
+  }
+  // Rotation: LINEAR (slerp) between leaning back at take-off and forward at landing.
+  const rot = times.map((t, k) => roundv(lean(k % 2 === 0 ? -12 : 12), 7));
+  // The sphere: a full turn in five keys (slerp between quarter turns).
+  const turnTimes = [0, 0.5, 1.0, 1.5, 2.0];
+  const turn = turnTimes.map((t) => roundv(quatAxisAngle(axis, (2 * Math.PI * t) / T), 7));
+  g.animation('hop', [
+    { node: bunnyNode, path: 'translation', interpolation: 'CUBICSPLINE', times, values },
+    { node: bunnyNode, path: 'rotation', interpolation: 'LINEAR', times, values: rot },
+    { node: sphereNode, path: 'rotation', interpolation: 'LINEAR', times: turnTimes, values: turn },
+  ], `${hops} hops of the bunny (translation CUBICSPLINE, rotation LINEAR) and one turn of the mirror sphere (rotation LINEAR) in ${T} s`);
+  const ends = [x0, x1].flatMap((x) => placed(bunnyLowMesh, S, [x, height - lower, z]));
+  g.camera([0, 3.6, 10.5], [0, 1.0, 0], placed(big, 1, cBig).concat(ends), 0.9);
+  g.light('light', [-5, 9, 6], WHITE);
+  summary.push(g.write('hop.gltf'));
+}
+
+// ---------------------------------------------------------------------------------------------
 // scenes/README.md (generated, so its numbers always match the files)
 // ---------------------------------------------------------------------------------------------
 const fmtv = (v) => `(${v.join(', ')})`;
@@ -773,7 +861,8 @@ for (const s of summary) {
   lines.push(
     `- \`${s.file}\`: ${s.description}; data: ${s.source}; ${s.faces} faces; ` +
       `bounds ${fmtv(s.bounds.lo)} to ${fmtv(s.bounds.hi)}; camera at ${fmtv(cam.eye)} looking at ${fmtv(cam.target)}, ` +
-      `yfov ${cam.yfov} rad (${cam.yfovDeg} deg); point light at ${L}; materials: ${mats}.`
+      `yfov ${cam.yfov} rad (${cam.yfovDeg} deg); point light at ${L}; materials: ${mats}` +
+      (s.animations ?? []).map((a) => `; animation '${a.name}', 0 to ${a.end} s: ${a.what}`).join('') + '.'
   );
 }
 lines.push('');

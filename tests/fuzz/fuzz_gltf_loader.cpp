@@ -1,4 +1,5 @@
-// libFuzzer target: every input is written to a file and loaded with host::load_scene. InputError
+// libFuzzer target: every input is written to a file and loaded with host::load_scene, then as a
+// host::AnimatedScene posed at two times of each of its first animations. InputError
 // is the only acceptable failure; any other exception, crash, sanitizer report, hang or runaway
 // allocation is a loader bug. Build and run with scripts/fuzz.sh.
 #include <unistd.h>
@@ -9,6 +10,7 @@
 #include <cstdlib>
 #include <string>
 
+#include "host/scene/animation.h"
 #include "host/scene/gltf_loader.h"
 
 namespace {
@@ -36,6 +38,16 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   try {
     // A lower triangle cap than the default keeps legal-but-huge instancing within -rss_limit_mb.
     host::load_scene(path, host::LoadOptions{1'000'000});
+  } catch (const host::InputError&) {
+  }
+  try {
+    // The same file with its animations read and each posed mid-way and past its end
+    // (UnsupportedFeature is an InputError).
+    const host::AnimatedScene a(path, host::LoadOptions{1'000'000});
+    for (size_t i = 0; i < a.animations().size() && i < 4; ++i) {
+      a.at(i, 0.5 * (a.animations()[i].start + a.animations()[i].end));
+      a.at(i, a.animations()[i].end + 1.0);
+    }
   } catch (const host::InputError&) {
   }
   std::remove(path.c_str());

@@ -419,6 +419,104 @@ def textured_cases():
     b, d = textured_quad({"uri": png_uri}, uv_type="VEC3")
     write_gltf("texcoord_vec3.gltf", d, b.bin)
 
+def floats(b, values, type_):
+    """A float accessor of SCALAR, VEC3 or VEC4 elements (animation inputs and outputs)."""
+    n = {"SCALAR": 1, "VEC3": 3, "VEC4": 4}[type_]
+    flat = [c for v in values for c in ((v,) if n == 1 else v)]
+    data = struct.pack("<%df" % len(flat), *flat)
+    extra = {"min": [min(values)], "max": [max(values)]} if n == 1 else None
+    return b.accessor(b.view(data), FLOAT, type_, len(values), extra=extra)
+
+
+def cube_points(half):
+    """A non-indexed axis-aligned cube, 12 triangles counter-clockwise seen from outside."""
+    corners = [(x, y, z) for x in (-half, half) for y in (-half, half) for z in (-half, half)]
+    faces = [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4), (1, 5, 7, 3)]
+    pts = []
+    for a, b_, c, d in faces:
+        pts += [corners[a], corners[b_], corners[c], corners[a], corners[c], corners[d]]
+    return pts
+
+
+def animated_case():
+    # A floor (triangles 0-1), a body cube (2-13) and a head cube (14-25, the body's child), a
+    # camera and a light. Animation 0 "move": the body slides (LINEAR, keys at 1 s and 3 s) and
+    # turns a quarter about +Y (LINEAR, slerp), the head halves its scale at 2 s (STEP);
+    # animation 1 "bounce": the head's translation as a CUBICSPLINE over [0, 1] s.
+    b = Builder()
+    floor = {"attributes": {"POSITION": b.vec3([(-5, 0, -5), (-5, 0, 5), (5, 0, 5), (5, 0, -5)])},
+             "indices": b.indices([0, 1, 2, 0, 2, 3])}
+    cube = {"attributes": {"POSITION": b.vec3(cube_points(0.5))}}
+    s = math.sqrt(0.5)
+    move = {"name": "move", "samplers": [
+        {"input": floats(b, [1, 3], "SCALAR"),
+         "output": floats(b, [(0, 0.5, 0), (2, 0.5, 0)], "VEC3")},
+        {"input": floats(b, [1, 3], "SCALAR"),
+         "output": floats(b, [(0, 0, 0, 1), (0, s, 0, s)], "VEC4")},
+        {"input": floats(b, [0, 2], "SCALAR"), "interpolation": "STEP",
+         "output": floats(b, [(0.5, 0.5, 0.5), (0.25, 0.25, 0.25)], "VEC3")}],
+        "channels": [{"sampler": 0, "target": {"node": 1, "path": "translation"}},
+                     {"sampler": 1, "target": {"node": 1, "path": "rotation"}},
+                     {"sampler": 2, "target": {"node": 2, "path": "scale"}}]}
+    bounce = {"name": "bounce", "samplers": [
+        {"input": floats(b, [0, 1], "SCALAR"), "interpolation": "CUBICSPLINE",
+         "output": floats(b, [(0, 0, 0), (0, 1, 0), (0, 2, 0), (0, -2, 0), (0, 1, 0), (0, 0, 0)],
+                          "VEC3")}],
+        "channels": [{"sampler": 0, "target": {"node": 2, "path": "translation"}}]}
+    nodes = [
+        {"name": "floor", "mesh": 0},
+        {"name": "body", "mesh": 1, "translation": [0, 0.5, 0], "children": [2]},
+        {"name": "head", "mesh": 1, "translation": [0, 1, 0], "scale": [0.5, 0.5, 0.5]},
+        {"name": "camera", "camera": 0, "translation": [0, 1.5, 7]},
+        {"name": "light", "translation": [2, 6, 4], "extensions": {"KHR_lights_punctual": {"light": 0}}},
+    ]
+    d = b.doc(scene=0, scenes=[{"nodes": [0, 1, 3, 4]}], nodes=nodes,
+              meshes=[{"primitives": [floor]}, {"primitives": [cube]}],
+              cameras=[{"type": "perspective", "perspective": {"yfov": 0.7, "znear": 0.1}}],
+              extensionsUsed=["KHR_lights_punctual"],
+              extensions={"KHR_lights_punctual": {"lights": [{"type": "point", "intensity": 1}]}},
+              animations=[move, bounce])
+    write_gltf("animated.gltf", d, b.bin)
+
+    # Features a frame at time T cannot honour: a skinned mesh, morph-target weights.
+    b, d = simple(TRI, idx=[0, 1, 2])
+    d["nodes"] = [{"mesh": 0, "skin": 0}, {"name": "joint", "translation": [0, 1, 0]}]
+    d["scenes"] = [{"nodes": [0, 1]}]
+    d["skins"] = [{"joints": [1]}]
+    d["animations"] = [{"samplers": [{"input": floats(b, [0, 1], "SCALAR"),
+                                      "output": floats(b, [(0, 1, 0), (1, 1, 0)], "VEC3")}],
+                        "channels": [{"sampler": 0, "target": {"node": 1, "path": "translation"}}]}]
+    write_gltf("skinned.gltf", b.doc(**{k: v for k, v in d.items() if k not in (
+        "asset", "buffers", "bufferViews", "accessors")}), b.bin)
+    b, d = simple(TRI, idx=[0, 1, 2])
+    d["meshes"][0]["primitives"][0]["targets"] = [{"POSITION": b.vec3([(0, 0, 1)] * 3)}]
+    d["meshes"][0]["weights"] = [0]
+    d["animations"] = [{"name": "breathe",
+                        "samplers": [{"input": floats(b, [0, 1], "SCALAR"),
+                                      "output": floats(b, [0, 1], "SCALAR")}],
+                        "channels": [{"sampler": 0, "target": {"node": 0, "path": "weights"}}]}]
+    write_gltf("morph_weights.gltf", b.doc(**{k: v for k, v in d.items() if k not in (
+        "asset", "buffers", "bufferViews", "accessors")}), b.bin)
+
+    # A channel of another path without a node (KHR_animation_pointer): refused, not ignored.
+    b, d = simple(TRI, idx=[0, 1, 2])
+    d["extensionsUsed"] = ["KHR_animation_pointer"]
+    d["animations"] = [{"samplers": [{"input": floats(b, [0, 1], "SCALAR"),
+                                      "output": floats(b, [(0, 0, 0), (1, 0, 0)], "VEC3")}],
+                        "channels": [{"sampler": 0, "target": {
+                            "path": "pointer", "extensions": {"KHR_animation_pointer": {
+                                "pointer": "/nodes/0/translation"}}}}]}]
+    write_gltf("animation_pointer.gltf", b.doc(**{k: v for k, v in d.items() if k not in (
+        "asset", "buffers", "bufferViews", "accessors")}), b.bin)
+
+    # Broken: key times that go back.
+    b, d = simple(TRI, idx=[0, 1, 2])
+    d["animations"] = [{"samplers": [{"input": floats(b, [0, 2, 1], "SCALAR"),
+                                      "output": floats(b, [(0, 0, 0)] * 3, "VEC3")}],
+                        "channels": [{"sampler": 0, "target": {"node": 0, "path": "translation"}}]}]
+    write_gltf("animation_times_back.gltf", b.doc(**{k: v for k, v in d.items() if k not in (
+        "asset", "buffers", "bufferViews", "accessors")}), b.bin)
+
 
 if __name__ == "__main__":
     textured_cases()
@@ -437,3 +535,4 @@ if __name__ == "__main__":
     materials_case()
     modes_case()
     bad_cases()
+    animated_case()

@@ -1,0 +1,359 @@
+// The render subcommand's options and validators (see options.h).
+#include "host/cli/options.h"
+
+#include <regex>
+
+#include "host/accel/grid.h"
+#include "host/cli/frames.h"
+#include "host/image/image_io.h"
+#include "host/scene/scene.h"
+#include "host/trace/sampling.h"
+#include "vgpu/profile.h"
+
+namespace cli {
+namespace {
+
+// Largest image side: the render target limit of the largest profile (vgpu/profile.cpp).
+constexpr int kMaxImageSide = 16384;
+// Host threads: 0 (one per core) or 1..kMaxThreads; more than this only queues context switches.
+constexpr int kMaxThreads = 256;
+
+}  // namespace
+
+std::optional<glm::ivec2> parse_size(const std::string& text) {
+  std::smatch m;
+  if (!std::regex_match(text, m, std::regex(R"((\d{1,9})[xX](\d{1,9}))"))) return std::nullopt;
+  return glm::ivec2(std::stoi(m[1]), std::stoi(m[2]));
+}
+
+std::optional<glm::ivec2> parse_pixel(const std::string& text) {
+  std::smatch m;
+  if (!std::regex_match(text, m, std::regex(R"((\d{1,9}),(\d{1,9}))"))) return std::nullopt;
+  return glm::ivec2(std::stoi(m[1]), std::stoi(m[2]));
+}
+
+namespace {
+
+// CLI11 validators: each returns an empty string for a good value, else the problem (CLI11
+// prefixes the option name; main() prints it on one line and exits with 2).
+const CLI::Validator kSizeCheck(
+    [](std::string& text) -> std::string {
+      const std::optional<glm::ivec2> s = parse_size(text);
+      if (!s) return "expected WxH (e.g. 256x256), got '" + text + "'";
+      if (s->x < 1 || s->y < 1 || s->x > kMaxImageSide || s->y > kMaxImageSide)
+        return text + " is outside the limit 1x1.." + std::to_string(kMaxImageSide) + "x" +
+               std::to_string(kMaxImageSide);
+      return {};
+    },
+    "WxH in 1x1..16384x16384", "SIZE");
+
+const CLI::Validator kPixelCheck(
+    [](std::string& text) -> std::string {
+      return parse_pixel(text) ? "" : "expected X,Y (e.g. 128,128), got '" + text + "'";
+    },
+    "X,Y", "PIXEL");
+
+const CLI::Validator kGridCheck(
+    [](std::string& text) -> std::string {
+      try {
+        host::parse_grid_spec(text);
+        return {};
+      } catch (const std::invalid_argument& e) {
+        return e.what();
+      }
+    },
+    "auto | N | AxBxC, each 1.." + std::to_string(host::kMaxGridRes), "GRID");
+
+const CLI::Validator kSppCheck(
+    [](std::string& text) -> std::string {
+      try {
+        size_t used = 0;
+        const int n = std::stoi(text, &used);
+        if (used == text.size()) return host::spp_refusal(n);
+      } catch (const std::exception&) {
+      }
+      return "expected a square from 1 to " + std::to_string(host::kMaxSpp) + ", got '" + text +
+             "'";
+    },
+    "1, 4, 9, ..., 256", "N");
+
+}  // namespace
+
+std::optional<int> parse_aa(const std::string& text) {
+  if (text == "none" || text == "adaptive") return 0;
+  std::smatch m;
+  if (!std::regex_match(text, m, std::regex(R"(undersample(:(\d{1,4}))?)"))) return std::nullopt;
+  const int k = m[2].matched ? std::stoi(m[2]) : 2;
+  if (k < 1 || k > 64) return std::nullopt;
+  return k;
+}
+
+namespace {
+
+const CLI::Validator kAaCheck(
+    [](std::string& text) -> std::string {
+      return parse_aa(text) ? ""
+                            : "expected none, adaptive, undersample or undersample:K (K 1 to 64), "
+                              "got '" +
+                                  text + "'";
+    },
+    "none | adaptive | undersample[:K]", "MODE");
+
+const CLI::Validator kThresholdCheck(
+    [](std::string& text) -> std::string {
+      try {
+        size_t used = 0;
+        const double v = std::stod(text, &used);
+        if (used == text.size() && std::isfinite(v) && v >= 0) return {};
+      } catch (const std::exception&) {
+      }
+      return "expected a colour difference of 0 or more (linear, 1 = white), got '" + text + "'";
+    },
+    "0 or more", "T");
+
+const CLI::Validator kTimeCheck([](std::string& text) { return cli::time_problem(text); },
+                                "seconds, 0 or more", "T");
+
+const CLI::Validator kFramesCheck(
+    [](std::string& text) {
+      cli::FrameRange range;
+      return cli::frames_problem(text, range);
+    },
+    "A:B:N, N frames from A to B seconds", "A:B:N");
+
+// --update: how the structure follows a moving scene. Only a rebuild exists so far.
+const CLI::Validator kUpdateCheck(
+    [](std::string& text) -> std::string {
+      if (text == "rebuild") return {};
+      if (text == "refit" || text == "auto")
+        return text +
+               ": refitting a BVH's boxes between frames is not implemented yet; every frame "
+               "rebuilds the structure (--update rebuild)";
+      return "expected rebuild, got '" + text + "'";
+    },
+    "rebuild", "MODE");
+
+// An output file: the extension is one of `exts` and its directory exists and is writable.
+CLI::Validator output_check(std::vector<std::string> exts) {
+  std::string desc;
+  for (const std::string& e : exts) desc += (desc.empty() ? "FILE" : " | FILE") + e;
+  return CLI::Validator(
+      [exts](std::string& path) -> std::string {
+        try {
+          host::check_output_path(path, exts);
+          return {};
+        } catch (const host::InputError& e) {
+          return e.what();
+        }
+      },
+      desc, "OUTPUT");
+}
+
+// --aov KIND=FILE.exr: the AOVs are float images, so EXR only.
+const CLI::Validator kAovCheck(
+    [](std::string& aov) -> std::string {
+      const auto eq = aov.find('=');
+      const std::string kind = aov.substr(0, eq);
+      if (eq == std::string::npos || eq + 1 == aov.size())
+        return "expected depth=FILE.exr or hit=FILE.exr, got '" + aov + "'";
+      if (kind != "depth" && kind != "hit")
+        return "unknown AOV '" + kind + "' in '" + aov + "' (known: depth, hit)";
+      try {
+        host::check_output_path(aov.substr(eq + 1), {".exr"});
+        return {};
+      } catch (const host::InputError& e) {
+        return e.what();
+      }
+    },
+    "depth=FILE.exr | hit=FILE.exr", "AOV");
+
+std::vector<std::string> profile_names() {
+  std::vector<std::string> names;
+  for (const vgpu::Profile& p : vgpu::profiles()) names.push_back(p.name);
+  return names;
+}
+
+}  // namespace
+
+void add_render_options(CLI::App& render, RenderArgs& a) {
+  const std::vector<std::string> on_off{"on", "off"};
+  render.add_option("scene", a.scene, "glTF file (.gltf/.glb) or a scene name from scenes/")
+      ->capture_default_str();
+  render.add_option("--size", a.size, "Image size")->check(kSizeCheck)->capture_default_str();
+  render.add_option("--out", a.out, "Write the image")->check(output_check({".png", ".exr"}));
+  render.add_option("--bounces", a.bounces, "Reflection iterations after the primary one")
+      ->check(CLI::Range(0, 64))
+      ->capture_default_str();
+  render.add_option("--shading", a.shading, "Shading model")
+      ->check(CLI::IsMember({"diffuse", "phong", "phong-atten"}))
+      ->capture_default_str();
+  render
+      .add_option("--texture-filter", a.texture_filter,
+                  "How the shader's texture unit filters base-colour textures: nearest (1 "
+                  "texel), bilinear (4), trilinear (8, mipmapped; level of detail from ray "
+                  "differentials)")
+      ->check(CLI::IsMember({"nearest", "bilinear", "trilinear"}))
+      ->capture_default_str();
+  render.add_option("--shadows", a.shadows, "Shadow rays")
+      ->check(CLI::IsMember(on_off))
+      ->capture_default_str();
+  render.add_option("--grid", a.grid, "Grid voxels per axis")
+      ->check(kGridCheck)
+      ->capture_default_str();
+  render
+      .add_option("--accel", a.accel,
+                  "Acceleration structure the rays walk: grid (the paper's uniform grid) | bvh "
+                  "(a SAH bounding volume hierarchy walked stackless) | kdtree (a SAH kd-tree "
+                  "walked by kd-restart) | auto (builds each, renders a probe at a quarter of the "
+                  "size with each and keeps the one the cost model predicts cheapest on "
+                  "--profile). bvh and kdtree are extensions; docs/structures.md")
+      ->check(CLI::IsMember({"grid", "bvh", "kdtree", "auto"}))
+      ->capture_default_str();
+  render
+      .add_option("--profile", a.profile,
+                  "Modeled card (the cpu engine uses only its texture limit, for --grid auto)")
+      ->check(CLI::IsMember(profile_names()))
+      ->capture_default_str();
+  render.add_option("--threads", a.threads, "Host threads (0: one per core)")
+      ->check(CLI::Range(0, kMaxThreads))
+      ->capture_default_str();
+  render
+      .add_option("--lanes", a.lanes,
+                  "SIMD lanes per batch, stream engine (1: scalar reference; fp24/fp16 run at 1 "
+                  "or 8)")
+      ->check(CLI::IsMember({1, 4, 8, 16}))
+      ->capture_default_str();
+  render
+      .add_option("--masks", a.masks,
+                  "Early-z masks for finished rays (paper's future work), stream engine")
+      ->check(CLI::IsMember(on_off))
+      ->capture_default_str();
+  render
+      .add_option("--mrt", a.mrt,
+                  "Multiple render targets (paper's future work): fused two-output passes for "
+                  "intersecciones + proximoTriangulo and traversal + actualizarVoxel; needs a "
+                  "profile with more than one output (not gf5700); off: the paper's pipeline")
+      ->check(CLI::IsMember(on_off))
+      ->capture_default_str();
+  render.add_option("--stats", a.stats, "Statistics on stdout")
+      ->check(CLI::IsMember({"table", "json", "none"}))
+      ->capture_default_str();
+  render.add_option("--stats-json", a.stats_json, "Also write the statistics as JSON")
+      ->check(output_check({".json"}));
+  render
+      .add_option("--aov", a.aovs,
+                  "Float AOV: depth (distance to the primary hit) or hit (triangle id)")
+      ->check(kAovCheck);
+  render
+      .add_option("--trace-pixel", a.trace_pixel,
+                  "Print every pass this pixel took part in and its state (stream engine)")
+      ->check(kPixelCheck);
+  render.add_flag("--quiet,-q", a.quiet, "No progress on stderr");
+  render
+      .add_option("--stats-csv", a.stats_csv,
+                  "Also write one row per pass (kernel, fragments, fetches, query) as CSV")
+      ->check(output_check({".csv"}));
+  render
+      .add_option("--report", a.report,
+                  "Write an HTML report of the frame (timeline, cost maps, pixel history), "
+                  "stream engine")
+      ->check(output_check({".html"}));
+  render
+      .add_option("--precision", a.precision,
+                  "Ray-state textures and kernel arithmetic, every group, stream engine (auto: "
+                  "per group, the fewest bits this scene needs; the stats say why)")
+      ->check(CLI::IsMember({"fp32", "fp24", "fp16", "auto"}))
+      ->capture_default_str();
+  render.add_option("--formats", a.formats,
+                    "Per group, over --precision: GROUP=FORMAT[/ARITH],... with GROUP rays, "
+                    "traversal, voxel, hits, colour, queries (e.g. colour=fp16/fp32)");
+  render
+      .add_option("--engine", a.engine,
+                  "stream (the vgpu pipeline) | gl (the same passes on an OpenGL driver) | cpu "
+                  "(double-precision reference)")
+      ->check(CLI::IsMember({"stream", "gl", "cpu"}))
+      ->capture_default_str();
+  render
+      .add_option("--gl-device", a.gl_device,
+                  "With --engine gl: auto, or an EGL device index (see vgpu-rt gl-devices)")
+      ->capture_default_str();
+  render
+      .add_option("--gl-readback", a.gl_readback,
+                  "With --engine gl: how the host waits for an occlusion query: block (the "
+                  "driver's GL_QUERY_RESULT wait), poll (spin on GL_QUERY_RESULT_AVAILABLE), "
+                  "auto (poll on a hardware driver, block on a software one)")
+      ->check(CLI::IsMember({"auto", "block", "poll"}))
+      ->capture_default_str();
+  render
+      .add_option("--kernels", a.kernels,
+                  "How rays walk the grid: multipass (the paper's kernels, one pass per step) | "
+                  "looping (one data-dependent loop, Purcell's branching variant; needs dynamic "
+                  "branching, e.g. --profile gf6600), stream engine")
+      ->check(CLI::IsMember({"multipass", "looping"}))
+      ->capture_default_str();
+  render
+      .add_option("--walk", a.walk,
+                  "How the emulator runs the multipass grid walk on the host: batches (8 pixels "
+                  "through every pass at a time, their state in registers, then the pass "
+                  "sequence replayed for the statistics) | passes (pass by pass over the "
+                  "target); same images and statistics, stream engine")
+      ->check(CLI::IsMember({"batches", "passes"}))
+      ->each([&a](const std::string&) { a.walk_given = true; })
+      ->capture_default_str();
+  render
+      .add_option("--spp", a.spp,
+                  "Rays per pixel, a square: a stratified, jittered n x n grid in each pixel "
+                  "(seeded: the same image every run), one sample frame each, resolved by a box "
+                  "filter; 1 is one ray through each pixel's centre")
+      ->check(kSppCheck)
+      ->capture_default_str();
+  render
+      .add_option("--aa", a.aa,
+                  "Anti-aliasing: none (--spp rays in every pixel), adaptive (one ray per "
+                  "pixel, then levels of 4, 16, ... up to --spp only where neighbours hit another "
+                  "surface or differ in colour by more than --aa-threshold) or undersample[:K] "
+                  "(one ray through every K-th pixel in x and y, default 2, then through the "
+                  "pixels between those that hit different surfaces; the rest blended)")
+      ->check(kAaCheck)
+      ->capture_default_str();
+  render
+      .add_option("--aa-threshold", a.aa_threshold,
+                  "With --aa adaptive: the colour difference (linear, per channel) to a "
+                  "neighbour that marks a pixel for more samples")
+      ->check(kThresholdCheck)
+      ->capture_default_str();
+  render
+      .add_option("--steps-per-pass", a.steps_per_pass,
+                  "With --kernels looping: loop iterations per pass before the host's occlusion "
+                  "query (the profile's loop limit applies: gf6600 255)")
+      ->check(CLI::Range(1, 4096))
+      ->each([&a](const std::string&) { a.steps_given = true; })
+      ->capture_default_str();
+  render.add_flag("--predict", a.predict,
+                  "Print the cost model's predicted time for --profile, with its breakdown");
+  render
+      .add_option("--time", a.time,
+                  "Render the scene at T seconds of its animation (glTF; a static scene renders "
+                  "as it is; before the first key and after the last, the keys' values)")
+      ->check(kTimeCheck);
+  render
+      .add_option("--frames", a.frames,
+                  "Render N frames evenly from A to B seconds, both included (N = 1: A); --out "
+                  "and --aov need '#' in the file name for the frame number, zero-padded, "
+                  "numbered from 1 (frame_####.png: frame_0001.png, ...); --stats-json holds one "
+                  "record per frame")
+      ->check(kFramesCheck);
+  render.add_option("--animation", a.animation,
+                    "With --time or --frames: the animation to play, by name or index (default: "
+                    "the file's first)");
+  render
+      .add_option("--update", a.update,
+                  "With --time or --frames: how the acceleration structure follows the moving "
+                  "scene each frame: rebuild (the grid or BVH is built again; refit and auto are "
+                  "not implemented yet)")
+      ->check(kUpdateCheck)
+      ->each([&a](const std::string&) { a.update_given = true; })
+      ->capture_default_str();
+}
+
+}  // namespace cli

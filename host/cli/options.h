@@ -1,0 +1,74 @@
+// The render subcommand's options (RenderArgs) and their CLI11 validators: every value is
+// checked as it is parsed, before any work; main.cpp checks their combinations.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <glm/glm.hpp>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "vgpu/lanes.h"
+
+namespace cli {
+
+struct RenderArgs {
+  std::string scene = "bunny";
+  std::string size = "256x256";
+  std::string out;
+  int bounces = 2;
+  std::string shading = "phong";
+  std::string texture_filter = "trilinear";
+  std::string shadows = "on";
+  std::string grid = "auto";
+  std::string accel = "grid";
+  std::string profile = "gf5700";
+  int threads = 0;
+  int lanes = vgpu::kLanes;
+  std::string masks = "off";
+  std::string mrt = "off";
+  std::string stats = "table";
+  std::string stats_json;
+  std::string stats_csv;
+  std::string report;
+  std::vector<std::string> aovs;
+  std::string trace_pixel;
+  bool quiet = false;
+  bool predict = false;
+  std::string engine = "stream";
+  std::string gl_device = "auto";
+  std::string gl_readback = "auto";
+  std::string precision = "fp32";
+  std::string formats;
+  std::string kernels = "multipass";
+  std::string walk = "batches";
+  int steps_per_pass = 32;
+  int spp = 1;
+  std::string aa = "none";
+  float aa_threshold = 0.1f;
+  bool steps_given = false;
+  bool walk_given = false;
+  std::string time;       // --time T
+  std::string frames;     // --frames A:B:N
+  std::string animation;  // --animation NAME|INDEX
+  std::string update = "rebuild";
+  bool update_given = false;
+};
+
+struct UsageError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// "WxH" as two positive sides, or nullopt.
+std::optional<glm::ivec2> parse_size(const std::string& text);
+// "X,Y" pixel coordinates, or nullopt.
+std::optional<glm::ivec2> parse_pixel(const std::string& text);
+// --aa's value: none, adaptive, undersample or undersample:K; K (default 2) for undersample,
+// 0 otherwise, or nullopt.
+std::optional<int> parse_aa(const std::string& text);
+
+// Adds every `render` option to `render`, parsed into `a`.
+void add_render_options(CLI::App& render, RenderArgs& a);
+
+}  // namespace cli

@@ -1,0 +1,251 @@
+// Tests for host/scene/animation: the samplers' known answers on hand-made keys (LINEAR, STEP,
+// CUBICSPLINE, slerp the short way round, clamping outside the keys), and the scene of
+// tests/data/gltf/animated.gltf posed at a time against its transforms applied by hand.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <glm/gtc/epsilon.hpp>
+#include <glm/gtc/matrix_transform.hpp>
+#include <numbers>
+#include <sstream>
+#include <string>
+
+#include "host/scene/animation.h"
+
+namespace {
+
+using host::Interpolation;
+using host::Sampler;
+
+std::string data_path(const std::string& name) {
+  return std::string(VGPU_TEST_DATA) + "/gltf/" + name;
+}
+
+std::string str(glm::dvec3 v) {
+  std::ostringstream s;
+  s << "(" << v.x << ", " << v.y << ", " << v.z << ")";
+  return s.str();
+}
+
+#define CHECK_NEAR3(a, b) \
+  CHECK_MESSAGE(glm::all(glm::epsilonEqual((a), (b), 1e-12)), str(a) << " !~ " << str(b))
+
+Sampler vec3_sampler(Interpolation interpolation, std::vector<double> times,
+                     std::vector<glm::dvec3> values) {
+  Sampler s;
+  s.interpolation = interpolation;
+  s.times = std::move(times);
+  for (const glm::dvec3& v : values) s.values.emplace_back(v, 0.0);
+  return s;
+}
+
+// A unit quaternion in glTF order (x, y, z, w) for `angle` radians about unit `axis`.
+glm::dvec4 axis_angle(glm::dvec3 axis, double angle) {
+  return {axis * std::sin(angle / 2), std::cos(angle / 2)};
+}
+
+// Where a rotation sends +X.
+glm::dvec3 turn_x(const glm::dquat& q) {
+  return q * glm::dvec3(1, 0, 0);
+}
+
+}  // namespace
+
+TEST_CASE("linear keys interpolate between their neighbours and clamp outside them") {
+  const Sampler s =
+      vec3_sampler(Interpolation::linear, {1, 3, 4}, {{0, 0, 0}, {4, 2, -2}, {4, 3, 0}});
+  CHECK_NEAR3(host::sample_vec3(s, 2.0), glm::dvec3(2, 1, -1));
+  CHECK_NEAR3(host::sample_vec3(s, 1.5), glm::dvec3(1, 0.5, -0.5));
+  CHECK_NEAR3(host::sample_vec3(s, 3.5), glm::dvec3(4, 2.5, -1));
+  CHECK_NEAR3(host::sample_vec3(s, 3.0), glm::dvec3(4, 2, -2));  // on a key: its value
+  // Before the first key and after the last: those keys' values.
+  CHECK_NEAR3(host::sample_vec3(s, 0.0), glm::dvec3(0, 0, 0));
+  CHECK_NEAR3(host::sample_vec3(s, -7.0), glm::dvec3(0, 0, 0));
+  CHECK_NEAR3(host::sample_vec3(s, 4.0), glm::dvec3(4, 3, 0));
+  CHECK_NEAR3(host::sample_vec3(s, 100.0), glm::dvec3(4, 3, 0));
+}
+
+TEST_CASE("a step key holds its value until the next key's time") {
+  const Sampler s = vec3_sampler(Interpolation::step, {0, 1, 2}, {{1, 1, 1}, {2, 2, 2}, {3, 3, 3}});
+  CHECK_NEAR3(host::sample_vec3(s, -1.0), glm::dvec3(1));
+  CHECK_NEAR3(host::sample_vec3(s, 0.999), glm::dvec3(1));
+  CHECK_NEAR3(host::sample_vec3(s, 1.0), glm::dvec3(2));
+  CHECK_NEAR3(host::sample_vec3(s, 1.5), glm::dvec3(2));
+  CHECK_NEAR3(host::sample_vec3(s, 2.0), glm::dvec3(3));
+  CHECK_NEAR3(host::sample_vec3(s, 9.0), glm::dvec3(3));
+}
+
+TEST_CASE("a cubic spline follows the glTF Hermite form, its tangents scaled by the key interval") {
+  // Per key: in-tangent, value, out-tangent. Value 1 at both keys, leaving with slope 2 and
+  // arriving with slope -2: a bump.
+  const std::vector<glm::dvec3> keys = {{0, 0, 0},  {0, 1, 0}, {0, 2, 0},
+                                        {0, -2, 0}, {0, 1, 0}, {0, 0, 0}};
+  const Sampler one = vec3_sampler(Interpolation::cubic_spline, {0, 1}, keys);
+  // u = 1/2: h00 = 1/2, h10 = 1/8, h01 = 1/2, h11 = -1/8: 1/2 + 2/8 + 1/2 + 2/8 = 1.5.
+  CHECK_NEAR3(host::sample_vec3(one, 0.5), glm::dvec3(0, 1.5, 0));
+  // u = 1/4: h00 = 27/32, h10 = 9/64, h01 = 5/32, h11 = -3/64: 1.375.
+  CHECK_NEAR3(host::sample_vec3(one, 0.25), glm::dvec3(0, 1.375, 0));
+  // The same keys two seconds apart: the tangent terms double (27/32 + 2 (9/64) 2 + 5/32 +
+  // 2 (3/64) 2 = 1.75 at u = 1/4).
+  const Sampler two = vec3_sampler(Interpolation::cubic_spline, {0, 2}, keys);
+  CHECK_NEAR3(host::sample_vec3(two, 0.5), glm::dvec3(0, 1.75, 0));
+  // At and outside the keys: the values, never a tangent.
+  CHECK_NEAR3(host::sample_vec3(two, 0.0), glm::dvec3(0, 1, 0));
+  CHECK_NEAR3(host::sample_vec3(two, -1.0), glm::dvec3(0, 1, 0));
+  CHECK_NEAR3(host::sample_vec3(two, 2.0), glm::dvec3(0, 1, 0));
+  CHECK_NEAR3(host::sample_vec3(two, 5.0), glm::dvec3(0, 1, 0));
+}
+
+TEST_CASE("rotations are slerped the short way round and come out unit length") {
+  const double pi = std::numbers::pi;
+  const glm::dvec4 identity(0, 0, 0, 1);
+  const glm::dvec4 quarter = axis_angle({0, 1, 0}, pi / 2);  // +X -> -Z
+  Sampler s;
+  s.interpolation = Interpolation::linear;
+  s.times = {0, 1};
+  s.values = {identity, quarter};
+  // Halfway: an eighth of a turn about +Y, +X -> (cos 45, 0, -sin 45).
+  const glm::dvec3 half(std::sqrt(0.5), 0, -std::sqrt(0.5));
+  CHECK_NEAR3(turn_x(host::sample_rotation(s, 0.5)), half);
+  // A third of the way: 30 degrees, not the chord's angle.
+  CHECK_NEAR3(turn_x(host::sample_rotation(s, 1.0 / 3)),
+              glm::dvec3(std::cos(pi / 6), 0, -std::sin(pi / 6)));
+  // The same rotation stored as -q: the short way is still an eighth of a turn (the long way
+  // would pass through 135 degrees the other way round).
+  s.values = {identity, -quarter};
+  CHECK_NEAR3(turn_x(host::sample_rotation(s, 0.5)), half);
+  const glm::dquat q = host::slerp_short(host::to_quat(identity), host::to_quat(-quarter), 0.5);
+  CHECK(std::abs(glm::length(q) - 1.0) < 1e-12);
+  CHECK(std::abs(q.w) == doctest::Approx(std::cos(pi / 8)).epsilon(1e-12));
+  // STEP and clamping hand back unit keys; a cubic spline's result is normalised.
+  s.interpolation = Interpolation::step;
+  s.values = {identity * 2.0, quarter * 3.0};
+  CHECK(glm::length(host::sample_rotation(s, 0.5)) == doctest::Approx(1.0).epsilon(1e-12));
+  CHECK_NEAR3(turn_x(host::sample_rotation(s, 7.0)), glm::dvec3(0, 0, -1));
+  s.interpolation = Interpolation::cubic_spline;
+  s.values = {glm::dvec4(0), identity, glm::dvec4(0), glm::dvec4(0), quarter, glm::dvec4(0)};
+  const glm::dquat c = host::sample_rotation(s, 0.5);  // (identity + quarter) / 2, normalised
+  CHECK(glm::length(c) == doctest::Approx(1.0).epsilon(1e-12));
+  CHECK_NEAR3(turn_x(c), half);
+}
+
+TEST_CASE("a file's animations are listed by name and index with their time ranges") {
+  const host::AnimatedScene a(data_path("animated.gltf"));
+  REQUIRE(a.animations().size() == 2);
+  CHECK(a.animations()[0].name == "move");
+  CHECK(a.animations()[1].name == "bounce");
+  CHECK(a.animations()[0].channels.size() == 3);
+  CHECK(a.animations()[0].start == 0.0);
+  CHECK(a.animations()[0].end == 3.0);
+  CHECK(a.animations()[1].end == 1.0);
+  CHECK(a.find("bounce") == size_t(1));
+  CHECK(a.find("0") == size_t(0));
+  CHECK(a.find("1") == size_t(1));
+  CHECK_FALSE(a.find("2"));
+  CHECK_FALSE(a.find("walk"));
+  CHECK_FALSE(a.find(""));
+  CHECK(a.rest().triangle_count() == 26);
+}
+
+TEST_CASE("a posed scene is the rest scene with each node's animated transform applied by hand") {
+  const host::AnimatedScene a(data_path("animated.gltf"));
+  const host::Scene& rest = a.rest();
+  // The nodes' world matrices by hand: at rest the body sits at (0, 0.5, 0) and the head, its
+  // child, 1 above it at half size.
+  const glm::dmat4 I(1.0);
+  const glm::dmat4 body_rest = glm::translate(I, {0, 0.5, 0});
+  const glm::dmat4 head_local = glm::scale(glm::translate(I, {0, 1, 0}), glm::dvec3(0.5));
+  // Triangles 0-1 are the floor, 2-13 the body, 14-25 the head.
+  // Positions are stored in float: compare at float precision.
+  auto near = [](const host::Scene& s, const host::Scene& t) {
+    for (size_t i = 0; i < s.triangle_count(); ++i)
+      if (glm::any(glm::epsilonNotEqual(s.p0[i], t.p0[i], 1e-5f))) return false;
+    return true;
+  };
+  // t = 0: every channel before or on its first key, which the rest pose equals.
+  const host::Scene zero = a.at(0, 0.0);
+  CHECK(near(zero, rest));
+  // t = 2 of "move": the body halfway from (0, 0.5, 0) to (2, 0.5, 0) and an eighth of a turn
+  // about +Y; the head (STEP at 2 s) at a quarter size.
+  const double pi = std::numbers::pi;
+  const glm::dmat4 body2 = glm::rotate(glm::translate(I, {1, 0.5, 0}), pi / 4, {0, 1, 0});
+  const glm::dmat4 head2 = body2 * glm::scale(glm::translate(I, {0, 1, 0}), glm::dvec3(0.25));
+  const host::Scene two = a.at(0, 2.0);
+  for (size_t i = 0; i < rest.triangle_count(); ++i) {
+    CAPTURE(i);
+    const glm::dmat4 m = i < 2    ? I
+                         : i < 14 ? body2 * glm::inverse(body_rest)
+                                  : head2 * glm::inverse(body_rest * head_local);
+    CHECK(two.id[i] == rest.id[i]);
+    const glm::vec3 want(m * glm::dvec4(glm::dvec3(rest.p0[i]), 1.0));
+    CHECK_MESSAGE(glm::all(glm::epsilonEqual(two.p0[i], want, 1e-5f)),
+                  str(glm::dvec3(two.p0[i])) << " != " << str(glm::dvec3(want)));
+    const glm::vec3 want2(m * glm::dvec4(glm::dvec3(rest.p2[i]), 1.0));
+    CHECK(glm::all(glm::epsilonEqual(two.p2[i], want2, 1e-5f)));
+  }
+  // Normals turn with the body: the floor's stay +Y, the body's +X face now faces (1, 0, -1).
+  CHECK(glm::all(glm::epsilonEqual(two.n0[0], glm::vec3(0, 1, 0), 1e-6f)));
+  // Past the last key: clamped, the same as at the last key.
+  CHECK(near(a.at(0, 3.0), a.at(0, 50.0)));
+  CHECK_FALSE(near(a.at(0, 3.0), two));
+  // "bounce" moves the head only: up to 1.5 above the body at 0.5 s (the spline's bump).
+  const host::Scene bump = a.at(1, 0.5);
+  const glm::dmat4 head_bump =
+      body_rest * glm::scale(glm::translate(I, {0, 1.5, 0}), glm::dvec3(0.5));
+  for (size_t i = 14; i < 26; ++i) {
+    const glm::vec3 want(head_bump * glm::inverse(body_rest * head_local) *
+                         glm::dvec4(glm::dvec3(rest.p1[i]), 1.0));
+    CHECK(glm::all(glm::epsilonEqual(bump.p1[i], want, 1e-5f)));
+  }
+  for (size_t i = 0; i < 14; ++i) CHECK(bump.p1[i] == rest.p1[i]);
+  // The camera and the light are not animated; no animation at all is the rest scene.
+  REQUIRE(two.camera);
+  CHECK(two.camera->position == rest.camera->position);
+  CHECK(two.lights.size() == 1);
+  CHECK(two.lights[0].position == rest.lights[0].position);
+  CHECK(near(a.at(std::nullopt, 2.0), rest));
+}
+
+TEST_CASE("skinned meshes and morph-target weights are refused with one line naming the feature") {
+  const std::string skinned = data_path("skinned.gltf"), morph = data_path("morph_weights.gltf");
+  const host::AnimatedScene s(skinned);
+  auto message = [](auto&& f) -> std::string {
+    try {
+      f();
+    } catch (const host::UnsupportedFeature& e) {
+      return e.what();
+    }
+    return "";
+  };
+  const std::string skin_line = message([&] { s.at(0, 0.5); });
+  CHECK(skin_line == skinned + ": node 0 uses skin 0; skinned meshes are not supported");
+  CHECK(message([&] { s.check(std::nullopt); }) == skin_line);
+  const host::AnimatedScene m(morph);
+  CHECK(message([&] { m.at(0, 0.5); }) ==
+        morph +
+            ": animation 0 channel 0 animates morph-target weights (node 0); morph targets are "
+            "not supported");
+  CHECK(message([&] { m.check(std::nullopt); }).empty());  // the rest pose is the file's
+  // A channel of an extension's path, without a node, is refused too, not skipped.
+  const std::string pointer = data_path("animation_pointer.gltf");
+  const host::AnimatedScene ptr(pointer);
+  CHECK(message([&] { ptr.at(0, 0.5); }) ==
+        pointer + ": animation 0 channel 0 animates 'pointer', which is not supported");
+  // The static loader still reads both as before.
+  CHECK(host::load_scene(skinned).triangle_count() == 1);
+  CHECK(host::load_scene(morph).triangle_count() == 1);
+}
+
+TEST_CASE("key times that do not increase are refused, naming the sampler and the key") {
+  const std::string path = data_path("animation_times_back.gltf");
+  std::string message;
+  try {
+    host::AnimatedScene a(path);
+  } catch (const host::InputError& e) {
+    message = e.what();
+  }
+  CHECK(message == path +
+                       ": animation 0 sampler 0: key times must increase strictly (key 2 at "
+                       "1.000000 s follows 2.000000 s)");
+  CHECK(host::load_scene(path).triangle_count() == 1);  // a static load ignores animations
+}
