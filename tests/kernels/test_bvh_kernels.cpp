@@ -4,14 +4,18 @@
 // into test_gl (KTEST_GL), every pass is made again on the GL device from the same texels.
 //
 // The hand-made hierarchy (texture layouts of kernels/bvh.h and host/trace/bvh_walk.cpp), node
-// textures 2 texels wide (node 2 sits on the second row):
-//   node 0  root, inner  box [0, 4]^3                   escape -1
-//   node 1  leaf A       box [1, 2] x [0, 1] x [0, 1]   escape 2    list at 1: {0}
-//   node 2  leaf B       box [3, 4] x [0, 1] x [0, 1]   escape -1   list at 3: {2, 1}
+// textures 2 texels wide (nodes 2 to 4 sit on the second and third rows):
+//   node 0  root, inner  box [0, 4]^3                     escape -1
+//   node 1  inner L      box [1, 2] x [0, 1] x [0, 1]     escape 4 (past its subtree)
+//   node 2  leaf A       box [1, 1.6] x [0, 1] x [0, 1]   escape 3    list at 1: {0}
+//   node 3  leaf A2      box [1.6, 2] x [0, 1] x [0, 1]   escape 4    list at 6: {3}
+//   node 4  leaf B       box [3, 4] x [0, 1] x [0, 1]     escape -1   list at 3: {2, 1}
 // nodes lo = (box lo, escape), nodes hi = (box hi, list start; -1 for an inner node). Lists,
-// 4 entries per row (B's list wraps to the second row): {-1, 0, -1, 2 | 1, -1, 0, 0}.
-// Triangle k spans y, z in [0, 1] in the plane x = 1.5 (0), 3.5 (1) and 3.75 (2), corners
-// (x, 0, 0), (x, 1, 0), (x, 0, 1): a ray along +x through (y, z) meets it with u = y, v = z.
+// 4 entries per row (B's list wraps to the second row): {-1, 0, -1, 2 | 1, -1, 3, -1}.
+// Triangles 0, 1 and 2 span y, z in [0, 1] in the planes x = 1.5, 3.5 and 3.75, corners
+// (x, 0, 0), (x, 1, 0), (x, 0, 1): a ray along +x through (y, z) meets one with u = y, v = z.
+// Triangle 3, in x = 1.75, is the other half of that square: corners (x, 1, 1), (x, 0, 1),
+// (x, 1, 0), u = 1 - y, v = 1 - z.
 #include <doctest/doctest.h>
 
 #include <iterator>
@@ -29,18 +33,20 @@ using ktest::vec3s;
 namespace {
 
 struct Tree {
-  Texture lo = texels("nodes lo", 2, 2, {{0, 0, 0, -1}, {1, 0, 0, 2}, {3, 0, 0, -1}});
-  Texture hi = texels("nodes hi", 2, 2, {{4, 4, 4, -1}, {2, 1, 1, 1}, {4, 1, 1, 3}});
-  Texture lists = scalars("bvh lists", 4, 2, {kNone, 0, kNone, 2, 1, kNone, 0, 0});
-  Texture v0 = vec3s("vertices0", 2, 2, {{1.5f, 0, 0}, {3.5f, 0, 0}, {3.75f, 0, 0}});
-  Texture v1 = vec3s("vertices1", 2, 2, {{1.5f, 1, 0}, {3.5f, 1, 0}, {3.75f, 1, 0}});
-  Texture v2 = vec3s("vertices2", 2, 2, {{1.5f, 0, 1}, {3.5f, 0, 1}, {3.75f, 0, 1}});
+  Texture lo = texels("nodes lo", 2, 3,
+                      {{0, 0, 0, -1}, {1, 0, 0, 4}, {1, 0, 0, 3}, {1.6f, 0, 0, 4}, {3, 0, 0, -1}});
+  Texture hi = texels("nodes hi", 2, 3,
+                      {{4, 4, 4, -1}, {2, 1, 1, -1}, {1.6f, 1, 1, 1}, {2, 1, 1, 6}, {4, 1, 1, 3}});
+  Texture lists = scalars("bvh lists", 4, 2, {kNone, 0, kNone, 2, 1, kNone, 3, kNone});
+  Texture v0 = vec3s("vertices0", 2, 2, {{1.5f, 0, 0}, {3.5f, 0, 0}, {3.75f, 0, 0}, {1.75f, 1, 1}});
+  Texture v1 = vec3s("vertices1", 2, 2, {{1.5f, 1, 0}, {3.5f, 1, 0}, {3.75f, 1, 0}, {1.75f, 0, 1}});
+  Texture v2 = vec3s("vertices2", 2, 2, {{1.5f, 0, 1}, {3.5f, 0, 1}, {3.75f, 0, 1}, {1.75f, 1, 0}});
 };
 
 kernels::BvhUniforms uniforms() {
   kernels::BvhUniforms u;
   u.node_width = 2;
-  u.nodes = 3;
+  u.nodes = 5;
   u.list_width = 4;
   return u;
 }
@@ -66,36 +72,40 @@ const glm::vec4 kO(0.5f, 0.5f, 0.5f, 0);
 const std::vector<StepCase> kStepCases = {
     // 0: the root is met: an inner node sends the ray to node + 1 (its y is cleared)
     {kO, kPx, {0, 1, 9, 9}, kNoHit, {1, kNone, 0, 0}},
-    // 1: leaf A met: on to its escape, y = A's list start
-    {kO, kPx, {1, kNone, 0, 0}, kNoHit, {2, 1, 0, 0}},
-    // 2: leaf B met, escape -1: the node count (3), y = B's list start
-    {kO, kPx, {2, kNone, 0, 0}, kNoHit, {3, 3, 0, 0}},
-    // 3: leaf A missed (the ray runs -x from x = 0.5): its escape
-    {kO, kMx, {1, kNone, 0, 0}, kNoHit, {2, kNone, 0, 0}},
-    // 4: leaf B missed, escape -1: the node count
-    {kO, kMx, {2, kNone, 0, 0}, kNoHit, {3, kNone, 0, 0}},
-    // 5: at the node count: the walk is done
-    {kO, kPx, {3, kNone, 0, 0}, kNoHit, {kNone, kNone, 0, 0}},
-    // 6: a done ray: untouched, every channel
+    // 1: L met: on to its left child, node 2
+    {kO, kPx, {1, kNone, 0, 0}, kNoHit, {2, kNone, 0, 0}},
+    // 2: leaf A met: on to its escape (3), y = A's list start
+    {kO, kPx, {2, kNone, 0, 0}, kNoHit, {3, 1, 0, 0}},
+    // 3: leaf B met, escape -1: the node count (5), y = B's list start
+    {kO, kPx, {4, kNone, 0, 0}, kNoHit, {5, 3, 0, 0}},
+    // 4: L missed (the ray runs -x from x = 0.5): its escape, past its subtree
+    {kO, kMx, {1, kNone, 0, 0}, kNoHit, {4, kNone, 0, 0}},
+    // 5: leaf B missed, escape -1: the node count
+    {kO, kMx, {4, kNone, 0, 0}, kNoHit, {5, kNone, 0, 0}},
+    // 6: at the node count: the walk is done
+    {kO, kPx, {5, kNone, 0, 0}, kNoHit, {kNone, kNone, 0, 0}},
+    // 7: a done ray: untouched, every channel
     {kO, kPx, {kNone, kNone, 5, 6}, kNoHit, {kNone, kNone, 5, 6}},
-    // 7: B's box (entered at t = 2.5) lies beyond the nearest hit so far (t = 2): missed
-    {kO, kPx, {2, kNone, 0, 0}, {2, 0.25f, 0.25f, 0}, {3, kNone, 0, 0}},
-    // 8: the same with tmax 2 instead of a hit
-    {kO, {1, 0, 0, 2}, {2, kNone, 0, 0}, kNoHit, {3, kNone, 0, 0}},
-    // 9: a hit beyond the box (t = 3) does not stop the ray entering it
-    {kO, kPx, {2, kNone, 0, 0}, {3, 0.5f, 0.5f, 1}, {3, 3, 0, 0}},
-    // 10: oblique, into A through its x = 1 face before leaving its y slab at t = 1.125
-    {{0.5f, 0.1f, 0.5f, 0}, {0.6f, 0.8f, 0, kFar}, {1, kNone, 0, 0}, kNoHit, {2, 1, 0, 0}},
-    // 11: oblique, leaves A's y slab (t = 0.125) before its x slab begins (t = 0.83): missed
-    {{0.5f, 0.1f, 0.5f, 0}, {0.6f, -0.8f, 0, kFar}, {1, kNone, 0, 0}, kNoHit, {2, kNone, 0, 0}},
-    // 12: parallel to the y slab and outside it (y = 1.5): missed
-    {{0.5f, 1.5f, 0.5f, 0}, kPx, {1, kNone, 0, 0}, kNoHit, {2, kNone, 0, 0}},
-    // 13: parallel to the y slab, on its face y = 1: inside
-    {{0.5f, 1, 0.5f, 0}, kPx, {1, kNone, 0, 0}, kNoHit, {2, 1, 0, 0}},
-    // 14: starting inside A, going away (-x): met
-    {{1.5f, 0.5f, 0.5f, 0}, kMx, {1, kNone, 0, 0}, kNoHit, {2, 1, 0, 0}},
-    // 15: A behind the ray (+x from x = 2.5): missed
-    {{2.5f, 0.5f, 0.5f, 0}, kPx, {1, kNone, 0, 0}, kNoHit, {2, kNone, 0, 0}},
+    // 8: B's box (entered at t = 2.5) lies beyond the nearest hit so far (t = 2): missed
+    {kO, kPx, {4, kNone, 0, 0}, {2, 0.25f, 0.25f, 0}, {5, kNone, 0, 0}},
+    // 9: the same with tmax 2 instead of a hit
+    {kO, {1, 0, 0, 2}, {4, kNone, 0, 0}, kNoHit, {5, kNone, 0, 0}},
+    // 10: a hit beyond the box (t = 3) does not stop the ray entering it
+    {kO, kPx, {4, kNone, 0, 0}, {3, 0.5f, 0.5f, 1}, {5, 3, 0, 0}},
+    // 11: oblique, into A through its x = 1 face (t = 0.83) before leaving its y slab (1.125)
+    {{0.5f, 0.1f, 0.5f, 0}, {0.6f, 0.8f, 0, kFar}, {2, kNone, 0, 0}, kNoHit, {3, 1, 0, 0}},
+    // 12: oblique, leaves L's y slab (t = 0.125) before its x slab begins (t = 0.83): missed
+    {{0.5f, 0.1f, 0.5f, 0}, {0.6f, -0.8f, 0, kFar}, {1, kNone, 0, 0}, kNoHit, {4, kNone, 0, 0}},
+    // 13: parallel to the y slab and outside it (y = 1.5): A missed
+    {{0.5f, 1.5f, 0.5f, 0}, kPx, {2, kNone, 0, 0}, kNoHit, {3, kNone, 0, 0}},
+    // 14: parallel to the y slab, on its face y = 1: inside
+    {{0.5f, 1, 0.5f, 0}, kPx, {2, kNone, 0, 0}, kNoHit, {3, 1, 0, 0}},
+    // 15: starting inside A, going away (-x): met
+    {{1.5f, 0.5f, 0.5f, 0}, kMx, {2, kNone, 0, 0}, kNoHit, {3, 1, 0, 0}},
+    // 16: L behind the ray (+x from x = 2.5): missed
+    {{2.5f, 0.5f, 0.5f, 0}, kPx, {1, kNone, 0, 0}, kNoHit, {4, kNone, 0, 0}},
+    // 17: leaf A2 met: on to its escape (4), y = its list start (6, second row)
+    {kO, kPx, {3, kNone, 0, 0}, kNoHit, {4, 6, 0, 0}},
 };
 
 struct StepTextures {
@@ -232,10 +242,10 @@ TEST_CASE("bvh step + load leaf equals bvh step then bvh load leaf") {
   const Tree tree;
   const StepTextures s = step_textures();
   const int n = int(kStepCases.size());
-  // Nothing to test anywhere, but for case 13 (enters A while still testing triangle 2).
+  // Nothing to test anywhere, but for case 14 (enters A while still testing triangle 2).
   std::vector<glm::vec4> vsv(size_t(n), kEmpty);
-  vsv[13] = {4, 0, 0, 2};
-  vsv[6] = {7, 0, 0, kNone};
+  vsv[14] = {4, 0, 0, 2};
+  vsv[7] = {7, 0, 0, kNone};
   const Texture vs = texels("voxel state", n, 1, vsv);
   kernels::BvhStepLoad k;
   k.bvh = uniforms();
@@ -245,13 +255,14 @@ TEST_CASE("bvh step + load leaf equals bvh step then bvh load leaf") {
     CAPTURE(i);
     CHECK_TEXEL(out[0], i, 0, kStepCases[size_t(i)].expected);
   }
-  // Leaves entered: A (cases 1, 10, 14) loads triangle 0 at list entry 1; B (2, 9) triangle 2
-  // at entry 3; case 13 is still testing: kept.
+  // Leaves entered: A (cases 2, 11, 15) loads triangle 0 at list entry 1; B (3, 10) triangle 2
+  // at entry 3; A2 (17) triangle 3 at entry 6; case 14 is still testing: kept.
   for (int i = 0; i < n; ++i) {
     CAPTURE(i);
     glm::vec4 e = vsv[size_t(i)];
-    if (i == 1 || i == 10 || i == 14) e = {1, 0, 0, 0};
-    if (i == 2 || i == 9) e = {3, 0, 0, 2};
+    if (i == 2 || i == 11 || i == 15) e = {1, 0, 0, 0};
+    if (i == 3 || i == 10) e = {3, 0, 0, 2};
+    if (i == 17) e = {6, 0, 0, 3};
     CHECK_TEXEL(out[1], i, 0, e);
   }
   // The two single kernels, as the multipass walk runs them.
@@ -296,15 +307,16 @@ TEST_CASE("bvh intersections + next triangle equals bvh intersections then next 
 
 namespace {
 
-// The walk's rays: 0 hits triangle 0 in A, then misses B (beyond the hit); 1 misses A (behind
-// it), enters B, hits triangle 2 (t = 1.25), then triangle 1 nearer (t = 1); 2 runs -x and
-// misses both leaves; 3 is no ray; 4 has tmax 0.75: it enters A (at t = 0.5) but triangle 0
-// (t = 1) lies past tmax.
+// The walk's rays: 0 hits triangle 0 in A, then misses A2 and B (beyond the hit); 1 misses L
+// (behind it), enters B, hits triangle 2 (t = 1.25), then triangle 1 nearer (t = 1); 2 runs -x
+// and misses L and B; 3 is no ray; 4 has tmax 0.75: it enters A (at t = 0.5) but triangle 0
+// (t = 1) lies past tmax; 5 passes beside triangle 0 in A and hits triangle 3 in A2 (t = 1.25,
+// u = v = 0.25).
 struct Walk {
   Tree tree;
-  Texture origins = texels("origins", 5, 1, {kOa, kOb, kO, kO, kOa});
-  Texture rays = texels("rays", 5, 1, {kPx, kPx, kMx, {1, 0, 0, kNone}, {1, 0, 0, 0.75f}});
-  static constexpr int n = 5;
+  Texture origins = texels("origins", 6, 1, {kOa, kOb, kO, kO, kOa, {0.5f, 0.75f, 0.75f, 0}});
+  Texture rays = texels("rays", 6, 1, {kPx, kPx, kMx, {1, 0, 0, kNone}, {1, 0, 0, 0.75f}, kPx});
+  static constexpr int n = 6;
 };
 
 struct State {
@@ -379,33 +391,36 @@ void check_same_state(const State& a, const State& b) {
 
 TEST_CASE("the multipass bvh walk on hand-made texels finds each ray's nearest hit and ends") {
   const Walk w;
-  const State s = multipass(w, 4);  // at most 3 nodes, and one step to end
+  const State s = multipass(w, 6);  // at most 5 nodes, and one step to end
   for (int i = 0; i < Walk::n; ++i) CHECK_TEXEL(s.trav, i, 0, glm::vec4(kNone, kNone, 0, 0));
   CHECK_TEXEL(s.vs, 0, 0, glm::vec4(2, 0, 0, kNone));  // A's list read to its end
   CHECK_TEXEL(s.vs, 1, 0, glm::vec4(5, 0, 0, kNone));  // B's list read to its end
   CHECK_TEXEL(s.vs, 2, 0, kEmpty);
   CHECK_TEXEL(s.vs, 3, 0, kEmpty);
   CHECK_TEXEL(s.vs, 4, 0, glm::vec4(2, 0, 0, kNone));  // A's list read, its triangle refused
+  CHECK_TEXEL(s.vs, 5, 0, glm::vec4(7, 0, 0, kNone));  // A2's list read to its end
   CHECK_TEXEL(s.isect, 0, 0, glm::vec4(1, 0.25f, 0.25f, 0));
   CHECK_TEXEL(s.isect, 1, 0, glm::vec4(1, 0.25f, 0.5f, 1));
   CHECK_TEXEL(s.isect, 2, 0, kNoHit);
   CHECK_TEXEL(s.isect, 3, 0, kNoHit);
   CHECK_TEXEL(s.isect, 4, 0, kNoHit);
-  // Three rounds are one too few (the root, A, B, then the step that ends the walk): rays 0 to
-  // 2 and 4 wait at the node count with their hits found (ray 1 still names B's list, entered
-  // last); 3 was never walking.
-  const State short_walk = multipass(w, 3);
-  CHECK_TEXEL(short_walk.trav, 0, 0, glm::vec4(3, kNone, 0, 0));
-  CHECK_TEXEL(short_walk.trav, 1, 0, glm::vec4(3, 3, 0, 0));
-  CHECK_TEXEL(short_walk.trav, 2, 0, glm::vec4(3, kNone, 0, 0));
+  CHECK_TEXEL(s.isect, 5, 0, glm::vec4(1.25f, 0.25f, 0.25f, 3));
+  // Five rounds are one too few for rays 0 and 5 (the root, L, A, A2, B, then the step that
+  // ends the walk) and ray 4: they wait at the node count with their hits found; rays 1 and 2
+  // (root, L missed, B, end) are done, 3 was never walking.
+  const State short_walk = multipass(w, 5);
+  CHECK_TEXEL(short_walk.trav, 0, 0, glm::vec4(5, kNone, 0, 0));
+  CHECK_TEXEL(short_walk.trav, 1, 0, glm::vec4(kNone, kNone, 0, 0));
+  CHECK_TEXEL(short_walk.trav, 2, 0, glm::vec4(kNone, kNone, 0, 0));
   CHECK_TEXEL(short_walk.trav, 3, 0, glm::vec4(kNone, kNone, 0, 0));
-  CHECK_TEXEL(short_walk.trav, 4, 0, glm::vec4(3, kNone, 0, 0));
-  CHECK_TEXEL(short_walk.isect, 1, 0, glm::vec4(1, 0.25f, 0.5f, 1));
+  CHECK_TEXEL(short_walk.trav, 4, 0, glm::vec4(5, kNone, 0, 0));
+  CHECK_TEXEL(short_walk.trav, 5, 0, glm::vec4(5, kNone, 0, 0));
+  CHECK_TEXEL(short_walk.isect, 5, 0, glm::vec4(1.25f, 0.25f, 0.25f, 3));
 }
 
 TEST_CASE("bvh looping equals the multipass walk on hand-made texels, for any step budget") {
   const Walk w;
-  const State multi = multipass(w, 4);
+  const State multi = multipass(w, 6);
   vgpu::Gpu gpu(vgpu::profile("gf6600"), 1, 1);
   kernels::BvhLooping k;
   k.bvh = uniforms();
@@ -417,16 +432,17 @@ TEST_CASE("bvh looping equals the multipass walk on hand-made texels, for any st
   check_same_state(once, multi);
   // Another pass (more iterations) leaves finished rays as they are.
   check_same_state(looping_pass(gpu, p, w, once), multi);
-  // One iteration per pass, resumed where the last stopped: ray 1 needs 6 (the root, A missed,
-  // B entered and loaded, its two triangles, the end); 12 passes are more than enough.
+  // One iteration per pass, resumed where the last stopped: ray 5 needs 8 (the root, L, A
+  // entered and loaded, its triangle, A2 entered and loaded, its triangle, B missed, the end);
+  // 12 passes are more than enough.
   k.steps = 1;
   const vgpu::KernelProgram<kernels::BvhLooping> p1(k);
   State s = in;
   for (int i = 0; i < 12; ++i) s = looping_pass(gpu, p1, w, s);
   check_same_state(s, multi);
-  // After 2 iterations ray 1 has visited the root and missed A: it is at B, nothing loaded.
+  // After 2 iterations ray 1 has visited the root and missed L: it is at B, nothing loaded.
   State two = looping_pass(gpu, p1, w, looping_pass(gpu, p1, w, in));
-  CHECK_TEXEL(two.trav, 1, 0, glm::vec4(2, kNone, 0, 0));
+  CHECK_TEXEL(two.trav, 1, 0, glm::vec4(4, kNone, 0, 0));
   CHECK_TEXEL(two.vs, 1, 0, kEmpty);
   CHECK_TEXEL(two.isect, 1, 0, kNoHit);
 }
