@@ -263,14 +263,15 @@ TEST_CASE("describe names nodes, depth, leaves and the largest leaf") {
 TEST_CASE("acceleration structure names are parsed, and an unknown one is refused naming the set") {
   CHECK(host::parse_accel_kind("grid") == host::AccelKind::grid);
   CHECK(host::parse_accel_kind("bvh") == host::AccelKind::bvh);
+  CHECK(host::parse_accel_kind("kdtree") == host::AccelKind::kdtree);
   CHECK(host::accel_name(host::AccelKind::grid) == "grid");
   CHECK(host::accel_name(host::AccelKind::bvh) == "bvh");
-  // Only the names it accepts are offered.
+  // Only the names it accepts are offered ("auto" is the CLI's, which builds each structure).
   for (const std::string text : {"magic", "auto", "BVH", ""}) {
     CAPTURE(text);
     CHECK_THROWS_WITH_AS(
         host::parse_accel_kind(text),
-        ("unknown acceleration structure '" + text + "' (known: grid, bvh)").c_str(),
+        ("unknown acceleration structure '" + text + "' (known: grid, bvh, kdtree)").c_str(),
         std::invalid_argument);
   }
 }
