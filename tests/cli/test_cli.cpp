@@ -484,6 +484,10 @@ TEST_CASE("--accel bvh renders and its statistics name the structure and the hie
       CHECK(a["max_leaf"].get<int>() <= 4);
       CHECK(a["depth"].get<int>() > 1);
       CHECK(a["sah_cost"].get<double>() > 1);
+      // The walk's work: nodes visited and triangles tested, no voxel steps.
+      CHECK(a["work"]["nodes_visited"].get<uint64_t>() > 0);
+      CHECK(a["work"]["triangle_tests"].get<uint64_t>() > 0);
+      CHECK(a["work"]["voxel_steps"] == 0);
       // The one-voxel grid beside it gives the scene box only.
       CHECK(j["grid"] == nlohmann::json::array({1, 1, 1}));
       for (const char* kernel : {"bvh enter", "bvh step", "bvh load leaf", "bvh intersections"})
@@ -493,6 +497,8 @@ TEST_CASE("--accel bvh renders and its statistics name the structure and the hie
       CHECK(a["voxels"] == j["grid"]);
       CHECK(a.contains("references"));
       CHECK_FALSE(a.contains("nodes"));
+      CHECK(a["work"]["voxel_steps"].get<uint64_t>() > 0);
+      CHECK(a["work"]["nodes_visited"] == 0);
       CHECK(names.count("traversal") == 1);
       CHECK(names.count("bvh step") == 0);
     }
@@ -501,5 +507,5 @@ TEST_CASE("--accel bvh renders and its statistics name the structure and the hie
 }
 
 TEST_CASE("an unknown acceleration structure is refused, naming the option and the set") {
-  check_refused("--accel magic", "--accel", "magic not in {grid,bvh}");
+  check_refused("--accel magic", "--accel", "magic not in {grid,bvh,kdtree,auto}");
 }
