@@ -25,7 +25,7 @@ inline AccelKind parse_accel_kind(const std::string& text) {
   for (AccelKind k : kAccelKinds)
     if (text == accel_name(k)) return k;
   throw std::invalid_argument("unknown acceleration structure '" + text +
-                              "' (known: grid, bvh, kdtree, auto)");
+                              "' (known: grid, bvh, kdtree)");
 }
 
 // The structures of one scene, not owned: `grid` always; `bvh` or `kd` where kind names it.

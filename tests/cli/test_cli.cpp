@@ -783,3 +783,64 @@ TEST_CASE("an unknown acceleration structure is refused with one line, exit 2 an
       }
       fs::remove_all(dir);
     }
+
+TEST_CASE("--accel bvh renders and its statistics name the structure and the hierarchy") {
+  const fs::path dir = fs::temp_directory_path() / ("vgpu_cli_bvh_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  for (const char* accel : {"bvh", "grid"}) {
+    CAPTURE(accel);
+    const Outcome o =
+        run("render sphere --size 32x24 -q --stats none --accel " + std::string(accel) + " --out " +
+            (dir / "image.png").string() + " --stats-json " + (dir / "stats.json").string());
+    INFO("-> " << o.err);
+    REQUIRE(o.status == 0);
+    CHECK(o.err.empty());
+    CHECK(o.out.empty());
+    CHECK(read_png_header(dir / "image.png").width == 32);
+    nlohmann::json j;
+    REQUIRE_NOTHROW(j = nlohmann::json::parse(slurp(dir / "stats.json")));
+    REQUIRE(j.contains("accel"));
+    const nlohmann::json& a = j["accel"];
+    CHECK(a["structure"] == accel);
+    CHECK(j["rays_unfinished"] == 0);
+    CHECK(j["rays_traced"].get<uint64_t>() > 0);
+    std::set<std::string> names;
+    for (const auto& k : j["kernels"]) names.insert(k["name"].get<std::string>());
+    if (std::string(accel) == "bvh") {
+      for (const char* key :
+           {"nodes", "leaves", "depth", "max_leaf", "references", "sah_cost", "build_ms"})
+        CHECK_MESSAGE(a.contains(key), key);
+      const uint64_t nodes = a["nodes"].get<uint64_t>(), leaves = a["leaves"].get<uint64_t>();
+      CHECK(nodes == 2 * leaves - 1);
+      CHECK(leaves > 1);
+      CHECK(a["references"] == j["triangles"]);  // each triangle in one leaf
+      CHECK(a["max_leaf"].get<int>() >= 1);
+      CHECK(a["max_leaf"].get<int>() <= 4);
+      CHECK(a["depth"].get<int>() > 1);
+      CHECK(a["sah_cost"].get<double>() > 1);
+      // The walk's work: nodes visited and triangles tested, no voxel steps.
+      CHECK(a["work"]["nodes_visited"].get<uint64_t>() > 0);
+      CHECK(a["work"]["triangle_tests"].get<uint64_t>() > 0);
+      CHECK(a["work"]["voxel_steps"] == 0);
+      // The one-voxel grid beside it gives the scene box only.
+      CHECK(j["grid"] == nlohmann::json::array({1, 1, 1}));
+      for (const char* kernel : {"bvh enter", "bvh step", "bvh load leaf", "bvh intersections"})
+        CHECK_MESSAGE(names.count(kernel) == 1, kernel);
+      CHECK(names.count("traversal") == 0);
+    } else {
+      CHECK(a["voxels"] == j["grid"]);
+      CHECK(a.contains("references"));
+      CHECK_FALSE(a.contains("nodes"));
+      CHECK(a["work"]["voxel_steps"].get<uint64_t>() > 0);
+      CHECK(a["work"]["nodes_visited"] == 0);
+      CHECK(names.count("traversal") == 1);
+      CHECK(names.count("bvh step") == 0);
+    }
+  }
+  fs::remove_all(dir);
+}
+
+TEST_CASE("an unknown acceleration structure is refused, naming the option and the set") {
+  check_refused("--accel magic", "--accel", "magic not in {grid,bvh,kdtree,auto}");
+}

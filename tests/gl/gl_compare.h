@@ -54,6 +54,9 @@ inline int ulps_allowed(const std::string& kernel) {
       {"intersections + next triangle", 16},  // as intersections
       {"traversal + update voxel", 4},        // as traversal
       {"looping traversal", 16},              // intersections and traversal in one loop
+      {"bvh intersections", 16},              // as intersections
+      {"bvh intersections + next triangle", 16},
+      {"bvh looping traversal", 16},  // intersections and the box test in one loop
   };
   const auto it = allowed.find(kernel);
   return it == allowed.end() ? 0 : it->second;

@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 
+#include "host/accel/bvh.h"
 #include "host/accel/grid.h"
 #include "host/model/formats.h"
 #include "host/scene/gltf_loader.h"
@@ -90,4 +91,27 @@ TEST_CASE("auto gives the voxel state fp16 where every list position is an exact
   const host::Formats f = host::auto_formats(scene, grid, vgpu::profile("gf5700"));
   CHECK(f[Group::voxel] == Format::fp16);
   CHECK(f.why[size_t(Group::voxel)].find("within fp16's exact addresses") != std::string::npos);
+}
+
+TEST_CASE("auto counts the BVH's list positions, not the one-voxel grid's, with --accel bvh") {
+  // bunny-low with the one-voxel grid the CLI builds beside a BVH: the grid's single list fits
+  // fp16's exact addresses, but the voxel state walks the BVH's lists (a -1 after every leaf),
+  // whose positions pass 1023.
+  const host::Scene scene = host::load_scene(VGPU_SCENES_DIR "/bunny-low.gltf");
+  const host::Grid box = host::build_grid(scene, host::parse_grid_spec("1"));
+  const host::Bvh bvh = host::build_bvh(scene);
+  REQUIRE(host::integer_ranges(scene, box).list_entries - 1 <= 1023);
+  const host::IntegerRanges r = host::integer_ranges(scene, box, bvh.lists.size());
+  CHECK(r.list_entries == bvh.lists.size());
+  REQUIRE(r.list_entries - 1 > 1023);
+  const uint64_t entries = bvh.lists.size();
+  const host::Formats f = host::auto_formats(scene, box, vgpu::profile("gf5700"), entries);
+  CHECK(f[Group::voxel] == Format::fp32);
+  CHECK(f.why[size_t(Group::voxel)] == "list positions reach " + std::to_string(entries - 1) +
+                                           "; fp16 addresses texels exactly only to 1023");
+  // resolve passes the count on to auto, and leaves explicit formats alone.
+  CHECK(host::resolve(host::parse_format_request("auto", ""), scene, box, vgpu::profile("gf5700"),
+                      entries)[Group::voxel] == Format::fp32);
+  CHECK(host::resolve(host::parse_format_request("fp16", ""), scene, box, vgpu::profile("gf5700"),
+                      entries)[Group::voxel] == Format::fp16);
 }
