@@ -127,6 +127,10 @@ int run_render(const RenderArgs& a, bool lanes_given) {
   if (!animating && (!a.animation.empty() || a.update_given))
     throw UsageError(std::string(a.animation.empty() ? "--update" : "--animation") +
                      " needs --time or --frames");
+  if (a.update != "rebuild" && a.accel != "bvh")
+    throw UsageError("--update " + a.update +
+                     ": only a BVH's boxes can be refitted (--accel bvh); the grid and the "
+                     "kd-tree are rebuilt (--update rebuild)");
   std::vector<double> times = {0.0};
   if (!a.time.empty()) times = {cli::parse_time(a.time)};
   if (!a.frames.empty()) {
@@ -459,6 +463,11 @@ int run_render(const RenderArgs& a, bool lanes_given) {
     double predicted_ms;
   };
   std::vector<FrameLine> lines;
+  // --update auto rebuilds when the refitted BVH's SAH cost (expected node visits and triangle
+  // tests per ray) has grown past this factor of its last build's.
+  constexpr double kRefitLimit = 1.25;
+  double built_sah = bvh ? bvh->sah_cost : 0.0;
+  std::string action = "initial";
   for (size_t f = 0; f < times.size(); ++f) {
     const int number = int(f) + 1;
     host::StreamTracer::Upload up;
@@ -467,11 +476,29 @@ int run_render(const RenderArgs& a, bool lanes_given) {
       pose_start = std::chrono::steady_clock::now();
       scene = animated->at(animation, times[f]);
       pose_ms = host::ms_since(pose_start);
+      action = "rebuild";
       if (accel_kind == host::AccelKind::grid) {
         grid = host::build_grid(scene, frame_grid);
       } else {  // the structure walked, in the scene's new box
         box = host::build_grid(scene, host::GridSpec{glm::ivec3(1)});
-        if (accel_kind == host::AccelKind::bvh) bvh = host::build_bvh(scene);
+        if (accel_kind == host::AccelKind::bvh) {
+          // --update refit keeps the topology and moves the boxes; auto refits until the
+          // refitted tree's SAH cost passes kRefitLimit times the last build's, then rebuilds.
+          host::Bvh refitted = *bvh;
+          bool refit = a.update != "rebuild";
+          if (refit) {
+            host::refit_bvh(refitted, scene);
+            refit = a.update == "refit" || refitted.sah_cost <= kRefitLimit * built_sah;
+          }
+          if (refit) {
+            bvh = std::move(refitted);
+            action = "refit";
+          } else {
+            bvh = host::build_bvh(scene);
+            built_sah = bvh->sah_cost;
+            action = "rebuild";
+          }
+        }
         if (accel_kind == host::AccelKind::kdtree) kd = host::build_kdtree(scene, box->lo, box->hi);
       }
       const auto tu = std::chrono::steady_clock::now();
@@ -500,7 +527,7 @@ int run_render(const RenderArgs& a, bool lanes_given) {
       // What the frame's update cost: the host's work, the bytes sent to the device, and the
       // cost model's charge for them on each profile (host/model/cost_model.h, predict_update).
       nlohmann::ordered_json update = {
-          {"mode", f == 0 ? std::string("initial") : a.update},
+          {"mode", f == 0 ? std::string("initial") : action},
           {"pose_ms", pose_ms},
           {"structure", host::accel_name(accel_kind)},
           {"build_ms", build_ms()},

@@ -14,6 +14,7 @@
 
 #include "host/accel/accel.h"
 #include "host/accel/bvh.h"
+#include "host/image/image_io.h"
 #include "host/scene/gltf_loader.h"
 
 namespace {
@@ -159,7 +160,7 @@ TEST_CASE(
   REQUIRE(scenes.size() >= 8);
   for (const auto& [name, path] : scenes) {
     CAPTURE(name);
-    const Scene s = host::load_scene(path);
+    const Scene s = host::load_scene(path, host::with_images());
     const Bvh a = host::build_bvh(s), b = host::build_bvh(s);
     // Bundled meshes may hold triangles sharing a centroid: max_leaf checked where it must hold.
     check_invariants(s, a, {}, false);

@@ -13,6 +13,7 @@
 
 #include "host/accel/grid.h"
 #include "host/accel/kdtree.h"
+#include "host/image/image_io.h"
 #include "host/scene/gltf_loader.h"
 
 namespace {
@@ -191,7 +192,7 @@ TEST_CASE("every bundled scene's kd-tree lists each triangle in every leaf its b
   REQUIRE(scenes.size() >= 8);
   for (const auto& [name, path] : scenes) {
     CAPTURE(std::string(name));
-    const Scene s = host::load_scene(path);
+    const Scene s = host::load_scene(path, host::with_images());
     const host::Grid box = host::build_grid(s, host::GridSpec{glm::ivec3(1)});
     const KdTree kd = host::build_kdtree(s, box.lo, box.hi);
     CHECK(kd.leaves > 1);

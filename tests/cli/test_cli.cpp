@@ -519,270 +519,67 @@ TEST_CASE(
 
 TEST_CASE("an unknown acceleration structure is refused with one line, exit 2 and no image") {
   check_refused("--accel nonsense", "--accel", "nonsense");
+}
 
-  TEST_CASE("the texture filter is checked against its set and listed in --help") {
-    check_refused("--texture-filter anisotropic", "--texture-filter",
-                  "anisotropic not in {nearest,bilinear,trilinear}");
-    const Outcome o = run("render --help");
-    CHECK(o.out.find("--texture-filter") != std::string::npos);
-    CHECK(o.out.find("nearest,bilinear,trilinear") != std::string::npos);
-  }
+TEST_CASE("the texture filter is checked against its set and listed in --help") {
+  check_refused("--texture-filter anisotropic", "--texture-filter",
+                "anisotropic not in {nearest,bilinear,trilinear}");
+  const Outcome o = run("render --help");
+  CHECK(o.out.find("--texture-filter") != std::string::npos);
+  CHECK(o.out.find("nearest,bilinear,trilinear") != std::string::npos);
+}
 
-  TEST_CASE(
-      "a texture that cannot be read or a UV accessor of the wrong type: one line, no image") {
-    const std::string data = std::string(VGPU_TEST_DATA) + "/gltf/";
-    const fs::path out =
-        fs::temp_directory_path() / ("vgpu_cli_texture_" + std::to_string(::getpid()) + ".png");
-    struct Case {
-      const char* file;
-      const char* problem;
-    };
-    for (const Case& c :
-         {Case{"texture_missing.gltf", "image 0 (no_such_texture.png): cannot read"},
-          Case{"texture_not_an_image.gltf",
-               "image 0: cannot read the image: not a PNG or JPEG image"},
-          // libpng reports a PNG cut short on stderr too: still one line.
-          Case{"texture_truncated.gltf", "image 0: cannot read the image: "},
-          Case{"texcoord_vec3.gltf", "TEXCOORD_0: accessor 0 must be VEC2 of float"}}) {
-      CAPTURE(c.file);
-      for (const char* engine : {"stream", "cpu"}) {
-        CAPTURE(engine);
-        const Outcome o = run("render " + data + c.file + " -q --stats none --engine " + engine +
-                              " --out " + out.string());
-        CHECK(o.status != 0);
-        check_one_line(o, data + c.file, c.problem);
-        CHECK_FALSE(fs::exists(out));
-      }
+TEST_CASE("a texture that cannot be read or a UV accessor of the wrong type: one line, no image") {
+  const std::string data = std::string(VGPU_TEST_DATA) + "/gltf/";
+  const fs::path out =
+      fs::temp_directory_path() / ("vgpu_cli_texture_" + std::to_string(::getpid()) + ".png");
+  struct Case {
+    const char* file;
+    const char* problem;
+  };
+  for (const Case& c :
+       {Case{"texture_missing.gltf", "image 0 (no_such_texture.png): cannot read"},
+        Case{"texture_not_an_image.gltf",
+             "image 0: cannot read the image: not a PNG or JPEG image"},
+        // libpng reports a PNG cut short on stderr too: still one line.
+        Case{"texture_truncated.gltf", "image 0: cannot read the image: "},
+        Case{"texcoord_vec3.gltf", "TEXCOORD_0: accessor 0 must be VEC2 of float"}}) {
+    CAPTURE(c.file);
+    for (const char* engine : {"stream", "cpu"}) {
+      CAPTURE(engine);
+      const Outcome o = run("render " + data + c.file + " -q --stats none --engine " + engine +
+                            " --out " + out.string());
+      CHECK(o.status != 0);
+      check_one_line(o, data + c.file, c.problem);
+      CHECK_FALSE(fs::exists(out));
     }
   }
+}
 
-  TEST_CASE("a textured glb renders through the CLI, its JSON naming the textures and the filter") {
-    const std::string id = std::to_string(::getpid());
-    const fs::path out = fs::temp_directory_path() / ("vgpu_cli_duck_" + id + ".png"),
-                   js = fs::temp_directory_path() / ("vgpu_cli_duck_" + id + ".json");
-    const Outcome o =
-        run("render " + std::string(VGPU_TEST_DATA) +
-            "/gltf/textured.glb -q --stats none --size 32x32 --texture-filter bilinear "
-            "--out " +
-            out.string() + " --stats-json " + js.string());
-    INFO(o.err);
-    REQUIRE(o.status == 0);
-    CHECK(fs::exists(out));
-    const auto j = nlohmann::json::parse(slurp(js));
-    CHECK(j["textures"] == 1);
-    CHECK(j["texture_filter"] == "bilinear");
-    // An untextured scene's JSON has neither.
-    const Outcome plain =
-        run("render bunny-low -q --stats none --size 16x16 --stats-json " + js.string());
-    REQUIRE(plain.status == 0);
-    const auto p = nlohmann::json::parse(slurp(js));
-    CHECK_FALSE(p.contains("textures"));
-    CHECK_FALSE(p.contains("texture_filter"));
-    fs::remove(out);
-    fs::remove(js);
-
-    // ---- animation (issue 23): --time, --frames, --animation, --update
-
-    TEST_CASE("bad times and frame ranges are refused with one line naming the problem") {
-      check_refused("--time soon", "--time",
-                    "expected seconds, a number of 0 or more (e.g. 1.5), got 'soon'");
-      check_refused("--time nan", "--time", "got 'nan'");
-      check_refused("--time inf", "--time", "got 'inf'");
-      check_refused("--time=-1", "--time",
-                    "-1: times are seconds from the animation's start, 0 or more");
-      check_refused("--frames 2:1:3", "--frames",
-                    "2:1:3: the first time (2 s) is after the last (1 s)");
-      check_refused("--frames 0:1:0", "--frames",
-                    "0:1:0: the frame count must be 1 to 100000, got 0");
-      check_refused("--frames 0:1:200000", "--frames", "the frame count must be 1 to 100000");
-      check_refused("--frames=-1:1:3", "--frames",
-                    "-1:1:3: times are seconds from the animation's start, 0 or more");
-      for (const char* bad : {"0:1", "0:1:2:3", "a:1:2", "0:1:2.5", "0:nan:2", ":1:2"})
-        check_refused(std::string("--frames ") + bad, "--frames",
-                      "expected A:B:N (N frames evenly from A to B seconds, e.g. 0:2:25), got '" +
-                          std::string(bad) + "'");
-      check_refused("--time 1 --frames 0:1:2", "--time and --frames", "give one");
-      check_refused("--animation hop", "--animation", "needs --time or --frames");
-      check_refused("--update rebuild", "--update", "needs --time or --frames");
-      check_refused("--time 1 --update refit", "--update",
-                    "refit: refitting a BVH's boxes between frames is not implemented yet; every "
-                    "frame rebuilds the structure (--update rebuild)");
-      check_refused("--time 1 --update auto", "--update", "auto: refitting a BVH's boxes");
-      check_refused("--time 1 --update sometimes", "--update", "expected rebuild, got 'sometimes'");
-    }
-
-    TEST_CASE("several frames need a '#' frame number in every output file name") {
-      check_refused("--frames 0:1:3", "--out",
-                    "3 frames need '#' in the file name for the frame number");
-      // '#' in a directory name is not a frame number.
-      const fs::path dir = fs::temp_directory_path() / ("vgpu_cli_#_" + std::to_string(::getpid()));
-      fs::create_directories(dir);
-      const Outcome o =
-          run("render bunny-low -q --stats none --frames 0:1:2 --out " + (dir / "a.png").string());
-      CHECK(o.status == 2);
-      check_one_line(o, "--out", "2 frames need '#'");
-      const std::string hit = (fs::temp_directory_path() / "hit.exr").string();
-      check_refused("--frames 0:1:2 --aov hit=" + hit, "--out", "2 frames need '#'");
-      const Outcome aov = run("render bunny-low -q --stats none --frames 0:1:2 --aov hit=" + hit);
-      CHECK(aov.status == 2);
-      check_one_line(aov, "--aov " + hit, "2 frames need '#'");
-      const Outcome report = run("render bunny-low -q --stats none --frames 0:1:2 --report " +
-                                 (dir / "r.html").string());
-      CHECK(report.status == 2);
-      check_one_line(report, "--report", "follows one frame: render it with --time T");
-      CHECK(fs::is_empty(dir));
-      fs::remove_all(dir);
-    }
-
-    TEST_CASE("an unknown animation, a skinned mesh and morph-target weights are refused by name") {
-      check_refused("--time 1 --animation walk", "--animation walk",
-                    "has no animation named or numbered 'walk' (it has none)");
-      const fs::path out =
-          fs::temp_directory_path() / ("vgpu_cli_anim_" + std::to_string(::getpid()) + ".png");
-      const std::pair<std::string, std::string> cases[] = {
-          {"hop --time 1 --animation 1", "has no animation named or numbered '1' (it has 0 'hop')"},
-          {std::string(VGPU_TEST_DATA) + "/gltf/skinned.gltf --time 0.5",
-           "node 0 uses skin 0; skinned meshes are not supported"},
-          {std::string(VGPU_TEST_DATA) + "/gltf/morph_weights.gltf --time 0.5",
-           "animation 0 channel 0 animates morph-target weights (node 0); morph targets are not "
-           "supported"}};
-      for (const auto& [args, problem] : cases) {
-        const Outcome o = run("render " + args + " -q --stats none --out " + out.string());
-        INFO("vgpu-rt render " << args << " -> " << o.err);
-        CHECK(o.status == 2);
-        check_one_line(o, "", problem);
-        CHECK_FALSE(fs::exists(out));
-      }
-    }
-
-    TEST_CASE("a multi-frame render writes numbered files and one statistics record per frame") {
-      const fs::path dir =
-          fs::temp_directory_path() / ("vgpu_cli_frames_" + std::to_string(::getpid()));
-      fs::remove_all(dir);
-      fs::create_directories(dir);
-      const std::string size = " --size 40x32 --stats none";
-      const Outcome o =
-          run("render hop --frames 0:2:3" + size + " --out " + (dir / "frame_###.png").string() +
-              " --aov hit=" + (dir / "hit_#.exr").string() + " --stats-json " +
-              (dir / "frames.json").string());
-      INFO(o.err);
-      REQUIRE(o.status == 0);
-      std::set<std::string> written;
-      for (const auto& entry : fs::directory_iterator(dir)) written.insert(entry.path().filename());
-      CHECK(written == std::set<std::string>{"frame_001.png", "frame_002.png", "frame_003.png",
-                                             "hit_1.exr", "hit_2.exr", "hit_3.exr", "frames.json"});
-      CHECK(read_png_header(dir / "frame_003.png").width == 40);
-      // A progress line per frame on stderr.
-      for (int f = 1; f <= 3; ++f)
-        CHECK(o.err.find("vgpu-rt: frame " + std::to_string(f) +
-                         "/3 (t = " + std::to_string(f - 1) + " s): update ") != std::string::npos);
-      CHECK(std::count(o.err.begin(), o.err.end(), '\n') == 3);
-      nlohmann::json j;
-      REQUIRE_NOTHROW(j = nlohmann::json::parse(slurp(dir / "frames.json")));
-      CHECK(j["scene"] == "hop");
-      CHECK(j["animation"]["name"] == "hop");
-      CHECK(j["animation"]["end"] == 2.0);
-      CHECK(j["update"] == "rebuild");
-      REQUIRE(j["frames"].size() == 3);
-      for (int f = 0; f < 3; ++f) {
-        CAPTURE(f);
-        const nlohmann::json& r = j["frames"][size_t(f)];
-        CHECK(r["frame"] == f + 1);
-        CHECK(r["time"] == double(f));
-        CHECK(r["size"] == nlohmann::json::array({40, 32}));
-        CHECK(r["render_ms"].get<double>() > 0);
-        CHECK(r["totals"]["passes"].get<uint64_t>() > 0);
-        const nlohmann::json& u = r["update"];
-        CHECK(u["mode"] == (f == 0 ? "initial" : "rebuild"));
-        CHECK(u["build_ms"].get<double>() > 0);
-        // The moving bunny and sphere change the vertices, normals and grid every frame; the
-        // colours never change. The bus charge is the bytes over the profile's bus.
-        const uint64_t bytes = u["uploaded_bytes"].get<uint64_t>();
-        CHECK(bytes > 0);
-        if (f > 0) {
-          const auto& names = u["uploaded_textures"];
-          CHECK(std::find(names.begin(), names.end(), "vertices0") != names.end());
-          CHECK(std::find(names.begin(), names.end(), "triangle lists") != names.end());
-          CHECK(std::find(names.begin(), names.end(), "colors") == names.end());
-        }
-        CHECK(u["predicted"]["gf5700"]["upload_ms"].get<double>() ==
-              doctest::Approx(1e3 * double(bytes) / 2112e6));
-        CHECK(u["predicted"]["gf5700"]["build_ms"] == u["build_ms"]);
-      }
-      CHECK(j["frames"][0]["update"]["uploaded_bytes"].get<uint64_t>() >
-            j["frames"][1]["update"]["uploaded_bytes"].get<uint64_t>());
-      // The frames differ, and a frame rendered alone at its time (a new tracer) is the same image
-      // as the one the updated tracer rendered in the sequence.
-      CHECK(compare(dir / "hit_1.exr", dir / "hit_2.exr", 0.5).differing_percent > 1);
-      const Outcome one =
-          run("render hop --time 1" + size + " --out " + (dir / "one.png").string() +
-              " --stats-json " + (dir / "one.json").string() + " -q");
-      REQUIRE(one.status == 0);
-      CHECK(compare(dir / "one.png", dir / "frame_002.png", 0).differing_percent == 0);
-      // One frame keeps the single-frame statistics object, with its time and update added.
-      const nlohmann::json single = nlohmann::json::parse(slurp(dir / "one.json"));
-      CHECK_FALSE(single.contains("frames"));
-      CHECK(single["time"] == 1.0);
-      CHECK(single["update"]["mode"] == "initial");
-      CHECK(single["totals"]["passes"] == j["frames"][1]["totals"]["passes"]);
-      fs::remove_all(dir);
-    }
-
-    TEST_CASE(
-        "a static scene at any time renders as it is, and a render without a time is unchanged") {
-      const fs::path dir =
-          fs::temp_directory_path() / ("vgpu_cli_static_" + std::to_string(::getpid()));
-      fs::remove_all(dir);
-      fs::create_directories(dir);
-      const std::string common = "render classic --size 32x24 -q --stats none";
-      REQUIRE(run(common + " --out " + (dir / "plain.png").string() + " --stats-json " +
-                  (dir / "plain.json").string())
-                  .status == 0);
-      REQUIRE(run(common + " --time 7.5 --out " + (dir / "at.png").string()).status == 0);
-      CHECK(compare(dir / "plain.png", dir / "at.png", 0).differing_percent == 0);
-      const nlohmann::json plain = nlohmann::json::parse(slurp(dir / "plain.json"));
-      for (const char* key : {"frames", "frame", "time", "update", "animation"})
-        CHECK_MESSAGE(!plain.contains(key), key);
-      // hop without a time is its rest pose, the file's node transforms (its time 0).
-      REQUIRE(run("render hop --size 32x24 -q --stats none --out " + (dir / "rest.png").string())
-                  .status == 0);
-      REQUIRE(run("render hop --size 32x24 -q --stats none --time 0 --out " +
-                  (dir / "zero.png").string())
-                  .status == 0);
-      CHECK(compare(dir / "rest.png", dir / "zero.png", 0).differing_percent == 0);
-      fs::remove_all(dir);
-    }
-
-    TEST_CASE(
-        "with --accel bvh or kdtree every frame rebuilds the structure and uploads its changes") {
-      const fs::path dir =
-          fs::temp_directory_path() / ("vgpu_cli_tree_" + std::to_string(::getpid()));
-      for (const std::string structure : {"bvh", "kdtree"}) {
-        CAPTURE(structure);
-        fs::remove_all(dir);
-        fs::create_directories(dir);
-        const std::string common =
-            "render hop --accel " + structure + " --size 32x24 -q --stats none";
-        const Outcome o = run(common + " --frames 0:1:2 --out " + (dir / "f_#.png").string() +
-                              " --stats-json " + (dir / "f.json").string());
-        INFO(o.err);
-        REQUIRE(o.status == 0);
-        const nlohmann::json j = nlohmann::json::parse(slurp(dir / "f.json"));
-        REQUIRE(j["frames"].size() == 2);
-        const nlohmann::json& second = j["frames"][1];
-        CHECK(second["accel"]["structure"] == structure);
-        CHECK(second["update"]["structure"] == structure);
-        CHECK(second["update"]["build_ms"].get<double>() > 0);
-        const auto& names = second["update"]["uploaded_textures"];
-        const std::string nodes = structure == "bvh" ? "bvh nodes lo" : "kd nodes";
-        CHECK(std::find(names.begin(), names.end(), nodes) != names.end());
-        CHECK(std::find(names.begin(), names.end(), "vertices0") != names.end());
-        // The second frame, rendered by the updated tracer, is the frame rendered alone.
-        REQUIRE(run(common + " --time 1 --out " + (dir / "one.png").string()).status == 0);
-        CHECK(compare(dir / "one.png", dir / "f_2.png", 0).differing_percent == 0);
-      }
-      fs::remove_all(dir);
-    }
+TEST_CASE("a textured glb renders through the CLI, its JSON naming the textures and the filter") {
+  const std::string id = std::to_string(::getpid());
+  const fs::path out = fs::temp_directory_path() / ("vgpu_cli_duck_" + id + ".png"),
+                 js = fs::temp_directory_path() / ("vgpu_cli_duck_" + id + ".json");
+  const Outcome o = run("render " + std::string(VGPU_TEST_DATA) +
+                        "/gltf/textured.glb -q --stats none --size 32x32 --texture-filter bilinear "
+                        "--out " +
+                        out.string() + " --stats-json " + js.string());
+  INFO(o.err);
+  REQUIRE(o.status == 0);
+  CHECK(fs::exists(out));
+  const auto j = nlohmann::json::parse(slurp(js));
+  CHECK(j["textures"] == 1);
+  CHECK(j["texture_filter"] == "bilinear");
+  // An untextured scene's JSON has neither.
+  const Outcome plain =
+      run("render bunny-low -q --stats none --size 16x16 --stats-json " + js.string());
+  REQUIRE(plain.status == 0);
+  const auto p = nlohmann::json::parse(slurp(js));
+  CHECK_FALSE(p.contains("textures"));
+  CHECK_FALSE(p.contains("texture_filter"));
+  fs::remove(out);
+  fs::remove(js);
+}
 
 TEST_CASE("--accel bvh renders and its statistics name the structure and the hierarchy") {
   const fs::path dir = fs::temp_directory_path() / ("vgpu_cli_bvh_" + std::to_string(::getpid()));
@@ -843,4 +640,241 @@ TEST_CASE("--accel bvh renders and its statistics name the structure and the hie
 
 TEST_CASE("an unknown acceleration structure is refused, naming the option and the set") {
   check_refused("--accel magic", "--accel", "magic not in {grid,bvh,kdtree,auto}");
+}
+
+// ---- animation (issue 23): --time, --frames, --animation, --update
+
+TEST_CASE("bad times and frame ranges are refused with one line naming the problem") {
+  check_refused("--time soon", "--time",
+                "expected seconds, a number of 0 or more (e.g. 1.5), got 'soon'");
+  check_refused("--time nan", "--time", "got 'nan'");
+  check_refused("--time inf", "--time", "got 'inf'");
+  check_refused("--time=-1", "--time",
+                "-1: times are seconds from the animation's start, 0 or more");
+  check_refused("--frames 2:1:3", "--frames",
+                "2:1:3: the first time (2 s) is after the last (1 s)");
+  check_refused("--frames 0:1:0", "--frames", "0:1:0: the frame count must be 1 to 100000, got 0");
+  check_refused("--frames 0:1:200000", "--frames", "the frame count must be 1 to 100000");
+  check_refused("--frames=-1:1:3", "--frames",
+                "-1:1:3: times are seconds from the animation's start, 0 or more");
+  for (const char* bad : {"0:1", "0:1:2:3", "a:1:2", "0:1:2.5", "0:nan:2", ":1:2"})
+    check_refused(std::string("--frames ") + bad, "--frames",
+                  "expected A:B:N (N frames evenly from A to B seconds, e.g. 0:2:25), got '" +
+                      std::string(bad) + "'");
+  check_refused("--time 1 --frames 0:1:2", "--time and --frames", "give one");
+  check_refused("--animation hop", "--animation", "needs --time or --frames");
+  check_refused("--update rebuild", "--update", "needs --time or --frames");
+  check_refused("--time 1 --update refit", "--update",
+                "refit: only a BVH's boxes can be refitted (--accel bvh); the grid and the "
+                "kd-tree are rebuilt (--update rebuild)");
+  check_refused("--time 1 --update auto --accel kdtree", "--update",
+                "auto: only a BVH's boxes can be refitted");
+  check_refused("--time 1 --update sometimes", "--update",
+                "expected rebuild, refit or auto, got 'sometimes'");
+}
+
+TEST_CASE("several frames need a '#' frame number in every output file name") {
+  check_refused("--frames 0:1:3", "--out",
+                "3 frames need '#' in the file name for the frame number");
+  // '#' in a directory name is not a frame number.
+  const fs::path dir = fs::temp_directory_path() / ("vgpu_cli_#_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const Outcome o =
+      run("render bunny-low -q --stats none --frames 0:1:2 --out " + (dir / "a.png").string());
+  CHECK(o.status == 2);
+  check_one_line(o, "--out", "2 frames need '#'");
+  const std::string hit = (fs::temp_directory_path() / "hit.exr").string();
+  check_refused("--frames 0:1:2 --aov hit=" + hit, "--out", "2 frames need '#'");
+  const Outcome aov = run("render bunny-low -q --stats none --frames 0:1:2 --aov hit=" + hit);
+  CHECK(aov.status == 2);
+  check_one_line(aov, "--aov " + hit, "2 frames need '#'");
+  const Outcome report =
+      run("render bunny-low -q --stats none --frames 0:1:2 --report " + (dir / "r.html").string());
+  CHECK(report.status == 2);
+  check_one_line(report, "--report", "follows one frame: render it with --time T");
+  CHECK(fs::is_empty(dir));
+  fs::remove_all(dir);
+}
+
+TEST_CASE("an unknown animation, a skinned mesh and morph-target weights are refused by name") {
+  check_refused("--time 1 --animation walk", "--animation walk",
+                "has no animation named or numbered 'walk' (it has none)");
+  const fs::path out =
+      fs::temp_directory_path() / ("vgpu_cli_anim_" + std::to_string(::getpid()) + ".png");
+  const std::pair<std::string, std::string> cases[] = {
+      {"hop --time 1 --animation 1", "has no animation named or numbered '1' (it has 0 'hop')"},
+      {std::string(VGPU_TEST_DATA) + "/gltf/skinned.gltf --time 0.5",
+       "node 0 uses skin 0; skinned meshes are not supported"},
+      {std::string(VGPU_TEST_DATA) + "/gltf/morph_weights.gltf --time 0.5",
+       "animation 0 channel 0 animates morph-target weights (node 0); morph targets are not "
+       "supported"}};
+  for (const auto& [args, problem] : cases) {
+    const Outcome o = run("render " + args + " -q --stats none --out " + out.string());
+    INFO("vgpu-rt render " << args << " -> " << o.err);
+    CHECK(o.status == 2);
+    check_one_line(o, "", problem);
+    CHECK_FALSE(fs::exists(out));
+  }
+}
+
+TEST_CASE("a multi-frame render writes numbered files and one statistics record per frame") {
+  const fs::path dir =
+      fs::temp_directory_path() / ("vgpu_cli_frames_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string size = " --size 40x32 --stats none";
+  const Outcome o =
+      run("render hop --frames 0:2:3" + size + " --out " + (dir / "frame_###.png").string() +
+          " --aov hit=" + (dir / "hit_#.exr").string() + " --stats-json " +
+          (dir / "frames.json").string());
+  INFO(o.err);
+  REQUIRE(o.status == 0);
+  std::set<std::string> written;
+  for (const auto& entry : fs::directory_iterator(dir)) written.insert(entry.path().filename());
+  CHECK(written == std::set<std::string>{"frame_001.png", "frame_002.png", "frame_003.png",
+                                         "hit_1.exr", "hit_2.exr", "hit_3.exr", "frames.json"});
+  CHECK(read_png_header(dir / "frame_003.png").width == 40);
+  // A progress line per frame on stderr.
+  for (int f = 1; f <= 3; ++f)
+    CHECK(o.err.find("vgpu-rt: frame " + std::to_string(f) + "/3 (t = " + std::to_string(f - 1) +
+                     " s): update ") != std::string::npos);
+  CHECK(std::count(o.err.begin(), o.err.end(), '\n') == 3);
+  nlohmann::json j;
+  REQUIRE_NOTHROW(j = nlohmann::json::parse(slurp(dir / "frames.json")));
+  CHECK(j["scene"] == "hop");
+  CHECK(j["animation"]["name"] == "hop");
+  CHECK(j["animation"]["end"] == 2.0);
+  CHECK(j["update"] == "rebuild");
+  REQUIRE(j["frames"].size() == 3);
+  for (int f = 0; f < 3; ++f) {
+    CAPTURE(f);
+    const nlohmann::json& r = j["frames"][size_t(f)];
+    CHECK(r["frame"] == f + 1);
+    CHECK(r["time"] == double(f));
+    CHECK(r["size"] == nlohmann::json::array({40, 32}));
+    CHECK(r["render_ms"].get<double>() > 0);
+    CHECK(r["totals"]["passes"].get<uint64_t>() > 0);
+    const nlohmann::json& u = r["update"];
+    CHECK(u["mode"] == (f == 0 ? "initial" : "rebuild"));
+    CHECK(u["build_ms"].get<double>() > 0);
+    // The moving bunny and sphere change the vertices, normals and grid every frame; the
+    // colours never change. The bus charge is the bytes over the profile's bus.
+    const uint64_t bytes = u["uploaded_bytes"].get<uint64_t>();
+    CHECK(bytes > 0);
+    if (f > 0) {
+      const auto& names = u["uploaded_textures"];
+      CHECK(std::find(names.begin(), names.end(), "vertices0") != names.end());
+      CHECK(std::find(names.begin(), names.end(), "triangle lists") != names.end());
+      CHECK(std::find(names.begin(), names.end(), "colors") == names.end());
+    }
+    CHECK(u["predicted"]["gf5700"]["upload_ms"].get<double>() ==
+          doctest::Approx(1e3 * double(bytes) / 2112e6));
+    CHECK(u["predicted"]["gf5700"]["build_ms"] == u["build_ms"]);
+  }
+  CHECK(j["frames"][0]["update"]["uploaded_bytes"].get<uint64_t>() >
+        j["frames"][1]["update"]["uploaded_bytes"].get<uint64_t>());
+  // The frames differ, and a frame rendered alone at its time (a new tracer) is the same image
+  // as the one the updated tracer rendered in the sequence.
+  CHECK(compare(dir / "hit_1.exr", dir / "hit_2.exr", 0.5).differing_percent > 1);
+  const Outcome one = run("render hop --time 1" + size + " --out " + (dir / "one.png").string() +
+                          " --stats-json " + (dir / "one.json").string() + " -q");
+  REQUIRE(one.status == 0);
+  CHECK(compare(dir / "one.png", dir / "frame_002.png", 0).differing_percent == 0);
+  // One frame keeps the single-frame statistics object, with its time and update added.
+  const nlohmann::json single = nlohmann::json::parse(slurp(dir / "one.json"));
+  CHECK_FALSE(single.contains("frames"));
+  CHECK(single["time"] == 1.0);
+  CHECK(single["update"]["mode"] == "initial");
+  CHECK(single["totals"]["passes"] == j["frames"][1]["totals"]["passes"]);
+  fs::remove_all(dir);
+}
+
+TEST_CASE("a refitted BVH gives the rebuilt BVH's hit ids and depths on every frame of hop") {
+  const fs::path dir = fs::temp_directory_path() / ("vgpu_cli_refit_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string common = "render hop --accel bvh --frames 0:2:5 --size 48x40 -q --stats none";
+  for (const char* mode : {"rebuild", "refit", "auto"}) {
+    const std::string m(mode);
+    const Outcome o =
+        run(common + " --update " + m + " --aov hit=" + (dir / (m + "_hit_#.exr")).string() +
+            " --aov depth=" + (dir / (m + "_depth_#.exr")).string() + " --stats-json " +
+            (dir / (m + ".json")).string());
+    INFO(m << ": " << o.err);
+    REQUIRE(o.status == 0);
+  }
+  const nlohmann::json refit = nlohmann::json::parse(slurp(dir / "refit.json"));
+  const nlohmann::json rebuild = nlohmann::json::parse(slurp(dir / "rebuild.json"));
+  CHECK(refit["update"] == "refit");
+  REQUIRE(refit["frames"].size() == 5);
+  for (int f = 1; f <= 5; ++f) {
+    CAPTURE(f);
+    const std::string n = std::to_string(f);
+    for (const char* mode : {"refit", "auto"}) {
+      const std::string m(mode);
+      CHECK(compare(dir / ("rebuild_hit_" + n + ".exr"), dir / (m + "_hit_" + n + ".exr"), 0)
+                .differing_percent == 0);
+      CHECK(compare(dir / ("rebuild_depth_" + n + ".exr"), dir / (m + "_depth_" + n + ".exr"), 0)
+                .differing_percent == 0);
+    }
+    const nlohmann::json& u = refit["frames"][size_t(f - 1)]["update"];
+    CHECK(u["mode"] == (f == 1 ? "initial" : "refit"));
+    // A refit keeps the topology: the same node count as the first frame's build.
+    CHECK(refit["frames"][size_t(f - 1)]["accel"]["nodes"] ==
+          rebuild["frames"][0]["accel"]["nodes"]);
+  }
+  fs::remove_all(dir);
+}
+
+TEST_CASE("a static scene at any time renders as it is, and a render without a time is unchanged") {
+  const fs::path dir =
+      fs::temp_directory_path() / ("vgpu_cli_static_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string common = "render classic --size 32x24 -q --stats none";
+  REQUIRE(run(common + " --out " + (dir / "plain.png").string() + " --stats-json " +
+              (dir / "plain.json").string())
+              .status == 0);
+  REQUIRE(run(common + " --time 7.5 --out " + (dir / "at.png").string()).status == 0);
+  CHECK(compare(dir / "plain.png", dir / "at.png", 0).differing_percent == 0);
+  const nlohmann::json plain = nlohmann::json::parse(slurp(dir / "plain.json"));
+  for (const char* key : {"frames", "frame", "time", "update", "animation"})
+    CHECK_MESSAGE(!plain.contains(key), key);
+  // hop without a time is its rest pose, the file's node transforms (its time 0).
+  REQUIRE(
+      run("render hop --size 32x24 -q --stats none --out " + (dir / "rest.png").string()).status ==
+      0);
+  REQUIRE(
+      run("render hop --size 32x24 -q --stats none --time 0 --out " + (dir / "zero.png").string())
+          .status == 0);
+  CHECK(compare(dir / "rest.png", dir / "zero.png", 0).differing_percent == 0);
+  fs::remove_all(dir);
+}
+
+TEST_CASE("with --accel bvh or kdtree every frame rebuilds the structure and uploads its changes") {
+  const fs::path dir = fs::temp_directory_path() / ("vgpu_cli_tree_" + std::to_string(::getpid()));
+  for (const std::string structure : {"bvh", "kdtree"}) {
+    CAPTURE(structure);
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    const std::string common = "render hop --accel " + structure + " --size 32x24 -q --stats none";
+    const Outcome o = run(common + " --frames 0:1:2 --out " + (dir / "f_#.png").string() +
+                          " --stats-json " + (dir / "f.json").string());
+    INFO(o.err);
+    REQUIRE(o.status == 0);
+    const nlohmann::json j = nlohmann::json::parse(slurp(dir / "f.json"));
+    REQUIRE(j["frames"].size() == 2);
+    const nlohmann::json& second = j["frames"][1];
+    CHECK(second["accel"]["structure"] == structure);
+    CHECK(second["update"]["structure"] == structure);
+    CHECK(second["update"]["build_ms"].get<double>() > 0);
+    const auto& names = second["update"]["uploaded_textures"];
+    const std::string nodes = structure == "bvh" ? "bvh nodes lo" : "kd nodes";
+    CHECK(std::find(names.begin(), names.end(), nodes) != names.end());
+    CHECK(std::find(names.begin(), names.end(), "vertices0") != names.end());
+    // The second frame, rendered by the updated tracer, is the frame rendered alone.
+    REQUIRE(run(common + " --time 1 --out " + (dir / "one.png").string()).status == 0);
+    CHECK(compare(dir / "one.png", dir / "f_2.png", 0).differing_percent == 0);
+  }
+  fs::remove_all(dir);
 }

@@ -17,6 +17,7 @@
 #include "host/accel/accel.h"
 #include "host/accel/bvh.h"
 #include "host/accel/grid.h"
+#include "host/image/image_io.h"
 #include "host/scene/camera.h"
 #include "host/scene/gltf_loader.h"
 #include "host/trace/cpu_tracer.h"
@@ -42,7 +43,7 @@ struct Bundled {
   host::Bvh bvh;
   host::Camera camera;
   Bundled(const std::string& name, const std::string& profile = "gf5700")
-      : scene(host::load_scene(host::resolve_scene(name))),
+      : scene(host::load_scene(host::resolve_scene(name), host::with_images())),
         grid(host::build_grid(scene, host::grid_spec_for({}, scene, vgpu::profile(profile)))),
         box(host::build_grid(scene, host::GridSpec{glm::ivec3(1)})),
         bvh(host::build_bvh(scene)),

@@ -15,6 +15,7 @@
 
 #include "host/accel/accel.h"
 #include "host/accel/grid.h"
+#include "host/image/image_io.h"
 #include "host/model/formats.h"
 #include "host/scene/camera.h"
 #include "host/scene/gltf_loader.h"
@@ -70,7 +71,7 @@ struct Structures {
 };
 
 Structures bundled(const std::string& name, int w, int h, const std::string& profile = "gf5700") {
-  host::Scene s = host::load_scene(host::resolve_scene(name));
+  host::Scene s = host::load_scene(host::resolve_scene(name), host::with_images());
   const host::Camera cam = host::scene_camera(s, float(w) / float(h));
   return Structures(std::move(s), cam, profile);
 }
