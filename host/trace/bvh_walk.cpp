@@ -14,28 +14,6 @@ using vgpu::Format;
 using vgpu::Stencil;
 using vgpu::Texture;
 
-namespace {
-
-// A texture holding `count` entries of `channels`, entry k at (k mod width, k div width); throws
-// naming the limit when the profile's largest texture cannot hold them.
-Texture entry_texture(vgpu::Device& gpu, const std::string& name, size_t count, int channels,
-                      const char* what) {
-  const int maxs = gpu.profile().max_texture_size;
-  const int w = int(std::min<size_t>(std::max<size_t>(count, 1), size_t(maxs)));
-  const size_t h = (std::max<size_t>(count, 1) + size_t(w) - 1) / size_t(w);
-  if (h > size_t(maxs))
-    throw vgpu::Error("bvh " + std::string(what) + ": " + std::to_string(count) +
-                      " entries; profile " + gpu.profile().name + " holds at most " +
-                      std::to_string(size_t(maxs) * size_t(maxs)) + " in one " +
-                      std::to_string(maxs) + "x" + std::to_string(maxs) + " texture");
-  if (count >= (size_t(1) << 24))
-    throw vgpu::Error("bvh " + std::string(what) + ": " + std::to_string(count) +
-                      " entries; indices are exact floats only below 2^24");
-  return gpu.make_texture(name, w, int(h), channels);
-}
-
-}  // namespace
-
 BvhWalk::BvhWalk(vgpu::Device& gpu, const Bvh& bvh, const RenderOptions& options, float scene_width)
     : opt_(options) {
   const Formats& fm = opt_.formats;
@@ -84,11 +62,11 @@ uint64_t BvhWalk::set_bvh(vgpu::Device& gpu, const Bvh& bvh, float scene_width,
     return uint64_t(t.width()) * uint64_t(t.height()) >= count;
   };
   if (fresh || !fits(nodes_lo_, bvh.nodes.size())) {
-    nodes_lo_ = entry_texture(gpu, "bvh nodes lo", bvh.nodes.size(), 4, "nodes");
-    nodes_hi_ = entry_texture(gpu, "bvh nodes hi", bvh.nodes.size(), 4, "nodes");
+    nodes_lo_ = entry_texture(gpu, "bvh nodes lo", bvh.nodes.size(), 4, "bvh nodes");
+    nodes_hi_ = entry_texture(gpu, "bvh nodes hi", bvh.nodes.size(), 4, "bvh nodes");
   }
   if (fresh || !fits(lists_, bvh.lists.size()))
-    lists_ = entry_texture(gpu, "bvh lists", bvh.lists.size(), 1, "lists");
+    lists_ = entry_texture(gpu, "bvh lists", bvh.lists.size(), 1, "bvh lists");
   const int nw = nodes_lo_.width(), lw = lists_.width();
   std::vector<float> lo(nodes_lo_.data().begin(), nodes_lo_.data().end());
   std::vector<float> hi(nodes_hi_.data().begin(), nodes_hi_.data().end());

@@ -15,28 +15,6 @@ using vgpu::Format;
 using vgpu::Stencil;
 using vgpu::Texture;
 
-namespace {
-
-// A texture holding `count` entries of `channels`, entry k at (k mod width, k div width); throws
-// naming the limit when the profile's largest texture cannot hold them.
-Texture entry_texture(vgpu::Device& gpu, const std::string& name, size_t count, int channels,
-                      const char* what) {
-  const int maxs = gpu.profile().max_texture_size;
-  const int w = int(std::min<size_t>(std::max<size_t>(count, 1), size_t(maxs)));
-  const size_t h = (std::max<size_t>(count, 1) + size_t(w) - 1) / size_t(w);
-  if (h > size_t(maxs))
-    throw vgpu::Error("kd-tree " + std::string(what) + ": " + std::to_string(count) +
-                      " entries; profile " + gpu.profile().name + " holds at most " +
-                      std::to_string(size_t(maxs) * size_t(maxs)) + " in one " +
-                      std::to_string(maxs) + "x" + std::to_string(maxs) + " texture");
-  if (count >= (size_t(1) << 24))
-    throw vgpu::Error("kd-tree " + std::string(what) + ": " + std::to_string(count) +
-                      " entries; indices are exact floats only below 2^24");
-  return gpu.make_texture(name, w, int(h), channels);
-}
-
-}  // namespace
-
 KdWalk::KdWalk(vgpu::Device& gpu, const KdTree& kd, const RenderOptions& options, float scene_width,
                float t_slack)
     : opt_(options) {
@@ -88,9 +66,9 @@ uint64_t KdWalk::set_tree(vgpu::Device& gpu, const KdTree& kd, float scene_width
   };
   // Node i: (split, axis or 3 for a leaf, right child, leaf list start).
   if (fresh || !fits(tree_, kd.nodes.size()))
-    tree_ = entry_texture(gpu, "kd nodes", kd.nodes.size(), 4, "nodes");
+    tree_ = entry_texture(gpu, "kd nodes", kd.nodes.size(), 4, "kd-tree nodes");
   if (fresh || !fits(lists_, kd.lists.size()))
-    lists_ = entry_texture(gpu, "kd lists", kd.lists.size(), 1, "lists");
+    lists_ = entry_texture(gpu, "kd lists", kd.lists.size(), 1, "kd-tree lists");
   const int nw = tree_.width(), lw = lists_.width();
   std::vector<float> nodes(tree_.data().begin(), tree_.data().end());
   std::vector<float> entries(lists_.data().begin(), lists_.data().end());

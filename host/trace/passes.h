@@ -5,6 +5,7 @@
 #include <array>
 #include <cstdint>
 #include <initializer_list>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -30,6 +31,12 @@ struct WriteBack {
   std::array<vgpu::Stencil*, kMax> masks{};
   int nmasks = 0;
 };
+
+// A static texture of `count` entries of `channels`, entry k at (k mod width, k div width), for a
+// structure's nodes or lists; throws vgpu::Error, "WHAT: N entries; ...", when the profile's
+// largest texture cannot hold them or an index would pass 2^24 (no longer an exact float).
+vgpu::Texture entry_texture(vgpu::Device& gpu, const std::string& name, size_t count, int channels,
+                            const std::string& what);
 
 class PassRunner {
  public:
