@@ -22,6 +22,13 @@ struct Material {
   glm::vec3 color{0.8f};  // linear rgb, from baseColorFactor
   float reflect = 0.0f;   // reflection coefficient a_i of the paper's blend formula
   int texture = -1;       // index into Scene::textures (baseColorTexture), -1: none
+  // Glass (KHR_materials_transmission, KHR_materials_ior, KHR_materials_volume): the share of
+  // light transmitted through the surface, the index of refraction inside it, and the volume's
+  // absorption (Beer's law: colour reached after attenuation_distance world units inside).
+  float transmission = 0.0f;                // transmissionFactor, 0: opaque (the paper's model)
+  float ior = 1.5f;                         // KHR_materials_ior's default
+  glm::vec3 attenuation_color{1.0f};        // KHR_materials_volume, linear rgb
+  float attenuation_distance = 0.0f;        // world units; 0: no absorption (the spec's infinity)
 };
 
 // The sampler's wrap modes (glTF's REPEAT, CLAMP_TO_EDGE, MIRRORED_REPEAT), numbered as
