@@ -10,7 +10,7 @@ pkgs=(
   clang libclang-rt-14-dev clang-format
   python3-matplotlib
   libegl-dev libopengl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri
-  zlib1g-dev
+  zlib1g-dev ccache
   chromium
 )
 missing=()
