@@ -20,6 +20,7 @@ Usage: scripts/animation.py [--vgpu-rt build/host/vgpu-rt] [--scenes hop,scatter
          [--threads 0] [--runs build/animation_runs] [--reuse] [--doc docs/animation.md]
          [--png docs/animation.png]
   --reuse   read the runs' JSON already in --runs instead of rendering (a missing one is run)
+  --png ''  no chart (then matplotlib is not needed)
   --doc     the Markdown file whose block between the markers
             '<!-- animation.py: begin -->' and '<!-- animation.py: end -->' is replaced by the
             tables ('-' prints them instead)
@@ -30,11 +31,6 @@ import os
 import statistics
 import subprocess
 import sys
-
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 PROFILES = ["gf6600", "h200"]
@@ -204,6 +200,10 @@ def tables(a, runs, probes):
 
 
 def chart(a, runs):
+    import matplotlib  # here, so that --png '' runs where matplotlib is missing
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
     cols = (("update_ms", "multipass", "update, host ms (pose + build/refit + textures)"),
             ("render_ms", "multipass", "render, emulator host ms (multipass)"),
             ("gf6600", "multipass", "modeled GeForce 6600, multipass, ms"),
@@ -297,7 +297,8 @@ def main():
                 for v in a.kernels:
                     probes[(scene, size, s, v)] = run(a, scene, s, "rebuild", v, a.probe_time, size)
     text = tables(a, runs, probes)
-    chart(a, runs)
+    if a.png:
+        chart(a, runs)
     if a.doc == "-":
         print(text)
         return
