@@ -15,10 +15,13 @@ per-frame records it charts and tabulates, per frame:
   quality    a refitted BVH's SAH cost over the cost of a BVH built for the same frame (the
              rebuild run's), and its node visits over the rebuilt tree's
 
-Usage: scripts/animation.py [--vgpu-rt build/host/vgpu-rt] [--scenes hop,scatter]
-         [--structures grid,bvh,kdtree] [--refit bvh] [--frames 0:2:25] [--size 128]
-         [--threads 0] [--runs build/animation_runs] [--reuse] [--doc docs/animation.md]
+Usage: /usr/bin/python3 scripts/animation.py [--vgpu-rt build/host/vgpu-rt] [--scenes hop,scatter]
+         [--structures grid,bvh,kdtree] [--refit bvh] [--kernels multipass,looping]
+         [--frames 0:2:25] [--size 128] [--probe-sizes 256,512] [--probe-time 1] [--threads 0]
+         [--runs build/animation_runs] [--reuse] [--doc docs/animation.md]
          [--png docs/animation.png]
+  --kernels      multipass: the paper's kernels on gf5700; looping: the looping kernels on gf6600
+  --probe-sizes  one frame at --probe-time s at each size, per structure and kernels
   --reuse   read the runs' JSON already in --runs instead of rendering (a missing one is run)
   --png ''  no chart (then matplotlib is not needed)
   --doc     the Markdown file whose block between the markers
