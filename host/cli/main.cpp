@@ -48,6 +48,36 @@ using cli::parse_size;
 using cli::RenderArgs;
 using cli::UsageError;
 
+// Passes on what the tracer shows while `on`, and drops it otherwise: --report-frame K points the
+// report's recorder at frame K of a sequence (a refitted BVH's frame K depends on the frames
+// before it, so --time cannot render it alone).
+class OneFrame final : public host::PassObserver {
+ public:
+  explicit OneFrame(host::PassObserver& to) : to_(to) {}
+  bool on = false;
+  void iteration(int i) override {
+    if (on) to_.iteration(i);
+  }
+  void trace_begin(TraceKind k) override {
+    if (on) to_.trace_begin(k);
+  }
+  void trace_end() override {
+    if (on) to_.trace_end();
+  }
+  void pass_begin(const vgpu::Stencil* work) override {
+    if (on) to_.pass_begin(work);
+  }
+  void pass(const Pass& p) override {
+    if (on) to_.pass(p);
+  }
+  void query(uint64_t result, const vgpu::Stencil* written, const vgpu::FrameStats& s) override {
+    if (on) to_.query(result, written, s);
+  }
+
+ private:
+  host::PassObserver& to_;
+};
+
 int run_render(const RenderArgs& a, bool lanes_given) {
   // CLI11 checked each value; what is left are combinations of options.
   host::RenderOptions opt;
@@ -146,12 +176,25 @@ int run_render(const RenderArgs& a, bool lanes_given) {
         throw UsageError(option + " " + file + ": " + std::to_string(times.size()) +
                          " frames need '#' in the file name for the frame number (e.g. "
                          "frame_####.png)");
-    const char* one_frame = !a.report.empty()      ? "--report"
+    const char* one_frame = opt.trace_pixel        ? "--trace-pixel"
+                            : a.report_frame       ? nullptr
+                            : !a.report.empty()    ? "--report"
                             : !a.stats_csv.empty() ? "--stats-csv"
-                            : opt.trace_pixel      ? "--trace-pixel"
                                                    : nullptr;
     if (one_frame)
-      throw UsageError(std::string(one_frame) + " follows one frame: render it with --time T");
+      throw UsageError(
+          std::string(one_frame) + " follows one frame: render it with --time T" +
+          (opt.trace_pixel ? "" : ", or name one of the frames with --report-frame K"));
+  }
+  if (a.report_frame) {
+    if (a.frames.empty())
+      throw UsageError("--report-frame needs --frames (with --time the report is that frame's)");
+    if (a.report.empty() && a.stats_csv.empty())
+      throw UsageError("--report-frame needs --report or --stats-csv");
+    if (size_t(a.report_frame) > times.size())
+      throw UsageError("--report-frame " + std::to_string(a.report_frame) + ": --frames " +
+                       a.frames + " gives " + std::to_string(times.size()) + " frame" +
+                       (times.size() > 1 ? "s" : "") + ", numbered from 1");
   }
   if (a.walk_given && a.engine != "stream")
     throw UsageError("--walk needs --engine stream (it says how the emulator runs the walk)");
@@ -193,11 +236,13 @@ int run_render(const RenderArgs& a, bool lanes_given) {
   if (!a.report.empty()) host::check_output_path(a.report, {".html"});
   if (!a.stats_csv.empty()) host::check_output_path(a.stats_csv, {".csv"});
   std::optional<host::FrameRecorder> recorder;
+  std::optional<OneFrame> one_frame;  // --report-frame K: the recorder sees frame K alone
   if (!a.report.empty() || !a.stats_csv.empty()) {
     recorder.emplace(opt.width, opt.height, opt.masks, a.report.empty() ? 0 : host::kHistoryStride,
                      opt.trace_pixel ? std::vector{*opt.trace_pixel} : std::vector<glm::ivec2>{},
                      !a.report.empty());
     opt.observer = &*recorder;
+    if (a.report_frame) opt.observer = &one_frame.emplace(*recorder);
   }
 
   // The scene: as the file has it, or posed at each frame's time (--time, --frames).
@@ -461,8 +506,11 @@ int run_render(const RenderArgs& a, bool lanes_given) {
     double time, pose_ms, build_ms, write_ms, render_ms;
     uint64_t uploaded, passes;
     double predicted_ms;
+    std::string action;                   // initial, rebuild or refit
+    uint64_t nodes_visited, voxel_steps;  // the walk's work (a tree's nodes, the grid's voxels)
   };
   std::vector<FrameLine> lines;
+  std::optional<std::pair<host::RenderResult, nlohmann::ordered_json>> reported;  // --report-frame
   // --update auto rebuilds when the refitted BVH's SAH cost (expected node visits and triangle
   // tests per ray) has grown past this factor of its last build's.
   constexpr double kRefitLimit = 1.25;
@@ -509,9 +557,10 @@ int run_render(const RenderArgs& a, bool lanes_given) {
     }
     const host::Camera cam = camera_for(scene);
     cpu_stats = {};
+    if (one_frame) one_frame->on = number == a.report_frame;
     r = cpu ? host::render_cpu(scene, accel, cam, opt, &cpu_stats) : tracer->render(cam);
     if (tty) std::fprintf(stderr, "\n");
-    if (recorder) recorder->finish(r.stats);
+    if (recorder && (!one_frame || one_frame->on)) recorder->finish(r.stats);
 
     auto numbered = [&](const std::string& file) {
       return animating ? cli::frame_path(file, number) : file;
@@ -547,6 +596,7 @@ int run_render(const RenderArgs& a, bool lanes_given) {
       j["animation"] = animation_json;
       j["update"] = update;
       if (several) frames_json.push_back(j);
+      if (number == a.report_frame) reported.emplace(r, j);
       if (!a.quiet)
         std::fprintf(stderr,
                      "vgpu-rt: frame %d/%zu (t = %g s): update %.1f ms (pose %.1f, %s %.1f, "
@@ -556,8 +606,11 @@ int run_render(const RenderArgs& a, bool lanes_given) {
                      static_cast<unsigned long long>(up.bytes), r.render_ms,
                      static_cast<unsigned long long>(r.stats.totals.passes));
     }
+    const host::WalkWork work = cpu ? host::WalkWork{} : host::walk_work(r.stats);
     lines.push_back({times[f], pose_ms, build_ms(), write_ms, r.render_ms, up.bytes,
-                     r.stats.totals.passes, predicted});
+                     r.stats.totals.passes, predicted, f == 0 ? std::string("initial") : action,
+                     cpu ? cpu_stats.nodes_visited : work.nodes_visited,
+                     cpu ? cpu_stats.voxel_steps : work.voxel_steps});
   }
   if (several)
     j = {{"scene", scene.name}, {"scene_path", path},          {"animation", animation_json},
@@ -573,7 +626,9 @@ int run_render(const RenderArgs& a, bool lanes_given) {
     }
   }
   if (!a.stats_csv.empty()) host::write_stats_csv(a.stats_csv, *recorder);
-  if (!a.report.empty()) host::write_report(a.report, *recorder, r, j);
+  if (!a.report.empty())
+    host::write_report(a.report, *recorder, reported ? reported->first : r,
+                       reported ? reported->second : j);
   if (a.stats == "json") {
     std::cout << j.dump(2) << "\n";
   } else if (a.stats == "table" && several) {
@@ -583,14 +638,17 @@ int run_render(const RenderArgs& a, bool lanes_given) {
                           : "none (the scene is static)",
                 times.size(), std::string(host::accel_name(accel_kind)).c_str(), a.update.c_str(),
                 r.width, r.height, cpu ? "engine" : "profile", cpu ? "cpu" : opt.profile.c_str());
-    std::printf("%6s %9s %9s %9s %11s %12s %10s %8s%s\n", "frame", "time s", "pose ms", "build ms",
-                "textures ms", "uploaded B", "render ms", "passes",
-                a.predict ? "  predicted ms" : "");
+    std::printf("%6s %9s %8s %9s %9s %11s %12s %10s %8s %12s %12s%s\n", "frame", "time s", "update",
+                "pose ms", "build ms", "textures ms", "uploaded B", "render ms", "passes", "nodes",
+                "voxels", a.predict ? "  predicted ms" : "");
     for (size_t f = 0; f < lines.size(); ++f) {
       const FrameLine& l = lines[f];
-      std::printf("%6zu %9.4g %9.2f %9.2f %11.2f %12llu %10.1f %8llu", f + 1, l.time, l.pose_ms,
-                  l.build_ms, l.write_ms, static_cast<unsigned long long>(l.uploaded), l.render_ms,
-                  static_cast<unsigned long long>(l.passes));
+      std::printf("%6zu %9.4g %8s %9.2f %9.2f %11.2f %12llu %10.1f %8llu %12llu %12llu", f + 1,
+                  l.time, l.action.c_str(), l.pose_ms, l.build_ms, l.write_ms,
+                  static_cast<unsigned long long>(l.uploaded), l.render_ms,
+                  static_cast<unsigned long long>(l.passes),
+                  static_cast<unsigned long long>(l.nodes_visited),
+                  static_cast<unsigned long long>(l.voxel_steps));
       if (a.predict) std::printf("  %12.3f", l.predicted_ms);
       std::printf("\n");
     }

@@ -353,6 +353,11 @@ void add_render_options(CLI::App& render, RenderArgs& a) {
       ->check(kUpdateCheck)
       ->each([&a](const std::string&) { a.update_given = true; })
       ->capture_default_str();
+  render
+      .add_option("--report-frame", a.report_frame,
+                  "With --frames: the frame (1 to N) that --report and --stats-csv follow; a "
+                  "refitted BVH's frame depends on the frames before it, so --time cannot give it")
+      ->check(CLI::Range(1, kMaxFrames));
 }
 
 }  // namespace cli

@@ -54,6 +54,7 @@ struct RenderArgs {
   std::string animation;  // --animation NAME|INDEX
   std::string update = "rebuild";
   bool update_given = false;
+  int report_frame = 0;  // --report-frame K (1-based; 0: not given)
 };
 
 struct UsageError : std::runtime_error {

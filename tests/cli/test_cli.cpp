@@ -7,6 +7,8 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
+#include <cctype>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -823,6 +825,129 @@ TEST_CASE("a refitted BVH gives the rebuilt BVH's hit ids and depths on every fr
     CHECK(refit["frames"][size_t(f - 1)]["accel"]["nodes"] ==
           rebuild["frames"][0]["accel"]["nodes"]);
   }
+  fs::remove_all(dir);
+}
+
+TEST_CASE("--report-frame puts frame K of a refitted sequence in the report and the pass CSV") {
+  const fs::path dir =
+      fs::temp_directory_path() / ("vgpu_cli_report_frame_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const Outcome o =
+      run("render hop --accel bvh --update refit --frames 0:2:4 --size 32x24 -q "
+          "--stats none --report " +
+          (dir / "r.html").string() + " --report-frame 3 --stats-csv " + (dir / "p.csv").string() +
+          " --stats-json " + (dir / "f.json").string());
+  INFO(o.err);
+  REQUIRE(o.status == 0);
+  const nlohmann::json j = nlohmann::json::parse(slurp(dir / "f.json"));
+  REQUIRE(j["frames"].size() == 4);
+  // The CSV has a header and one row per pass of frame 3, none of the other frames'.
+  const std::string csv = slurp(dir / "p.csv");
+  const auto rows = uint64_t(std::count(csv.begin(), csv.end(), '\n'));
+  CHECK(rows == 1 + j["frames"][2]["totals"]["passes"].get<uint64_t>());
+  CHECK(j["frames"][2]["totals"]["passes"] != j["frames"][1]["totals"]["passes"]);
+  // The report carries frame 3's record: its time and its refit.
+  const std::string html = slurp(dir / "r.html");
+  const std::string time = nlohmann::json(j["frames"][2]["time"]).dump();
+  CHECK(html.find("\"frame\":3,\"time\":" + time) != std::string::npos);
+  CHECK(html.find("\"mode\":\"refit\"") != std::string::npos);
+  CHECK(html.find("\"frame\":4,") == std::string::npos);
+  fs::remove_all(dir);
+}
+
+TEST_CASE("--report-frame is refused without --frames, without a report, or past the last frame") {
+  const fs::path html =
+      fs::temp_directory_path() / ("vgpu_cli_rf_" + std::to_string(::getpid()) + ".html");
+  const std::string report = " --report " + html.string();
+  for (const auto& [args, option, problem] : std::vector<std::array<std::string, 3>>{
+           {"--time 1 --report-frame 1" + report, "--report-frame", "needs --frames"},
+           {"--frames 0:1:2 --report-frame 1", "--report-frame", "needs --report or --stats-csv"},
+           {"--frames 0:2:3 --report-frame 4" + report, "--report-frame 4",
+            "--frames 0:2:3 gives 3 frames, numbered from 1"},
+           {"--frames 0:2:3 --report-frame 0" + report, "--report-frame", "not in range"},
+           {"--frames 0:1:2" + report, "--report",
+            "follows one frame: render it with --time T, or name one of the frames with "
+            "--report-frame K"}}) {
+    const Outcome o = run("render bunny-low -q --stats none " + args);
+    INFO(args << " -> " << o.err);
+    CHECK(o.status == 2);
+    check_one_line(o, option, problem);
+    CHECK_FALSE(fs::exists(html));
+  }
+}
+
+TEST_CASE("the frame table lists each frame's update, its passes and the nodes its walk visited") {
+  const Outcome o = run("render hop --accel bvh --update auto --frames 0:2:3 --size 24x16 -q");
+  INFO(o.err);
+  REQUIRE(o.status == 0);
+  std::istringstream lines(o.out);
+  std::string line;
+  std::vector<std::vector<std::string>> rows;
+  std::vector<std::string> header;
+  while (std::getline(lines, line)) {
+    std::istringstream words(line);
+    std::vector<std::string> w;
+    for (std::string x; words >> x;) w.push_back(x);
+    if (!w.empty() && w[0] == "frame") header = w;
+    if (!header.empty() && w.size() >= 11 && std::isdigit(static_cast<unsigned char>(w[0][0])))
+      rows.push_back(w);
+  }
+  // frame, time s, update, pose ms, build ms, textures ms, uploaded B, render ms, passes, nodes,
+  // voxels ("time s" and the "ms"/"B" units are words of their own).
+  REQUIRE(header.size() >= 11);
+  CHECK(std::find(header.begin(), header.end(), "update") != header.end());
+  CHECK(std::find(header.begin(), header.end(), "nodes") != header.end());
+  REQUIRE(rows.size() == 3);
+  CHECK(rows[0][2] == "initial");
+  CHECK(rows[1][2] == "refit");
+  CHECK(rows[2][2] == "refit");
+  for (const auto& r : rows) {
+    CHECK(std::stoull(r[8]) > 0);    // passes
+    CHECK(std::stoull(r[9]) > 0);    // nodes visited by the BVH walk
+    CHECK(std::stoull(r[10]) == 0);  // no voxel steps: the grid is one voxel, never walked
+  }
+}
+
+TEST_CASE("the scatter scene's refitted BVH hits what a rebuild hits while its SAH cost grows") {
+  // scripts/scatter_scene.py writes the larger animation of docs/animation.md: ten full bunnies
+  // that start inside one another and hop apart.
+  const fs::path dir =
+      fs::temp_directory_path() / ("vgpu_cli_scatter_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string script = std::string(VGPU_TEST_DATA) + "/../../scripts/scatter_scene.py";
+  REQUIRE(std::system(("python3 " + script + " " + dir.string() + " >/dev/null").c_str()) == 0);
+  const std::string common = "render " + (dir / "scatter.gltf").string() +
+                             " --accel bvh --frames 0:0.5:3 --size 16x12 -q --stats none";
+  for (const char* mode : {"rebuild", "refit"}) {
+    const std::string m(mode);
+    const Outcome o =
+        run(common + " --update " + m + " --aov hit=" + (dir / (m + "_hit_#.exr")).string() +
+            " --aov depth=" + (dir / (m + "_depth_#.exr")).string() + " --stats-json " +
+            (dir / (m + ".json")).string());
+    INFO(m << ": " << o.err);
+    REQUIRE(o.status == 0);
+  }
+  const nlohmann::json refit = nlohmann::json::parse(slurp(dir / "refit.json"));
+  const nlohmann::json rebuild = nlohmann::json::parse(slurp(dir / "rebuild.json"));
+  REQUIRE(refit["frames"].size() == 3);
+  CHECK(refit["frames"][0]["triangles"].get<int>() >= 30000);
+  std::vector<double> ratio;
+  for (int f = 1; f <= 3; ++f) {
+    CAPTURE(f);
+    const std::string n = std::to_string(f);
+    CHECK(compare(dir / ("rebuild_hit_" + n + ".exr"), dir / ("refit_hit_" + n + ".exr"), 0)
+              .differing_percent == 0);
+    CHECK(compare(dir / ("rebuild_depth_" + n + ".exr"), dir / ("refit_depth_" + n + ".exr"), 0)
+              .differing_percent == 0);
+    ratio.push_back(refit["frames"][size_t(f - 1)]["accel"]["sah_cost"].get<double>() /
+                    rebuild["frames"][size_t(f - 1)]["accel"]["sah_cost"].get<double>());
+  }
+  // Frame 1 is the same build; as the bunnies move apart the refitted boxes grow and overlap.
+  CHECK(ratio[0] == doctest::Approx(1.0).epsilon(1e-12));
+  CHECK(ratio[1] > 1.5);
+  CHECK(ratio[2] > ratio[1]);
   fs::remove_all(dir);
 }
 
