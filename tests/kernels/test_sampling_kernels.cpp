@@ -9,25 +9,24 @@ using ktest::Texture;
 
 TEST_CASE(
     "mark pixels refines both sides of a colour step and a change of surface, not an even "
-    "shade") {
-  // A 7 x 1 row, threshold 0.1, every pixel a candidate on surface 5 but pixel 6 (surface 4):
-  //  red:   0, 0.1, 0.2, 0.3, 0.8, 0.8, 0.8
-  //  pixels 1-2 lie on an even ramp (neighbours differ by 0.1, the second difference is 0);
-  //  3 and 4 take the step of 0.5 (second differences 0.4 and -0.5); 5 and 6 change surface;
-  //  0 sees its clamped self and 0.1 (second difference 0.1, not above 0.1).
-  const float red[7] = {0, 0.1f, 0.2f, 0.3f, 0.8f, 0.8f, 0.8f};
+    "ramp") {
+  // A 7 x 1 row, threshold 0.1, on surface 5 but pixel 6 (surface 4); red:
+  //  0.3, 0.3, 0.45, 0.6, 0.75, 0.25, 0.25
+  //  0: flat (second difference 0); 1: the ramp starts (0.15); 2, 3: on the ramp (0: their
+  //  neighbours differ by 0.15, more than the threshold, yet they keep one ray); 4: the step
+  //  down (-0.65); 5: no candidate any more (x 0), so unmarked whatever its neighbours; 6: its
+  //  neighbour hit surface 5.
+  const float red[7] = {0.3f, 0.3f, 0.45f, 0.6f, 0.75f, 0.25f, 0.25f};
   std::vector<glm::vec4> marks, colour;
   for (int x = 0; x < 7; ++x) {
-    marks.push_back({1, x == 6 ? 4 : 5, 0, 0});
+    marks.push_back({x == 5 ? 0 : 1, x == 6 ? 4 : 5, 0, 0});
     colour.push_back({red[x], 0.25f, 0.5f, 1});
   }
-  // Pixel 2 is no candidate any more (x 0): it stays unmarked whatever its neighbours.
-  marks[2].x = 0;
   const Texture m = texels("marks", 7, 1, marks), c = texels("colour", 7, 1, colour);
   kernels::MarkPixels k;
   k.threshold = 0.1f;
   const Texture out = ktest::run(k, {&m, &c}, 7, 1, glm::vec4(9.0f));
-  const float marked[7] = {0, 0, 0, 1, 1, 1, 1};
+  const float marked[7] = {0, 1, 0, 0, 1, 0, 1};
   for (int x = 0; x < 7; ++x) CHECK_TEXEL(out, x, 0, glm::vec4(marked[x], x == 6 ? 4 : 5, 0, 0));
 
   // The same along y, in blue: a 1 x 4 column 0, 0, 0.5, 0.5 bends at rows 1 and 2.
