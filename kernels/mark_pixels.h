@@ -1,6 +1,9 @@
 // marcarPixeles (an extension, --aa adaptive): a pixel still a candidate gets more samples where
-// a 4-neighbour hit another surface (its key differs: another material, or a miss) or its
-// colour estimate differs from a neighbour's by more than the threshold in some channel.
+// a 4-neighbour hit another surface (its key differs: another material, or a miss) or the
+// colour estimate bends there: its second difference along x or y (left + right - 2 own, above
+// + below - 2 own) exceeds the threshold in some channel. A step between two pixels bends at
+// both (by the step's size); a shade or reflection that changes evenly does not, though its
+// neighbours differ, so its pixels keep their one ray (their centre ray is their mean).
 #pragma once
 
 #include "kernels/common.h"
@@ -21,15 +24,19 @@ struct MarkPixels {
     using F = typename L::F;
     const Vec4<F> own = f.fetch_own(kMarks);
     const Vec4<F> c = f.fetch_own(kColour);
-    // The neighbours left, right, above, below (the texture units clamp at the image's edge).
-    auto differs = [&](float dx, float dy) {
-      const F u = f.x + F(dx), v = f.y + F(dy);
-      const Vec4<F> m = f.fetch(kMarks, u, v);
-      const Vec4<F> n = f.fetch(kColour, u, v);
-      const F diff = max(max(abs(n.x - c.x), abs(n.y - c.y)), abs(n.z - c.z));
-      return (m.y != own.y) || (diff > F(threshold));
+    // The neighbours left, right, above, below (the texture units clamp at the image's edge):
+    // their surface keys, and the colour's second difference along each axis.
+    auto key = [&](float dx, float dy) { return f.fetch(kMarks, f.x + F(dx), f.y + F(dy)).y; };
+    auto colour = [&](float dx, float dy) { return f.fetch(kColour, f.x + F(dx), f.y + F(dy)); };
+    auto bends = [&](const Vec4<F>& a, const Vec4<F>& b) {
+      const F two(2.0f);
+      const F d = max(max(abs(a.x + b.x - two * c.x), abs(a.y + b.y - two * c.y)),
+                      abs(a.z + b.z - two * c.z));
+      return d > F(threshold);
     };
-    const auto edge = differs(-1, 0) || differs(1, 0) || differs(0, -1) || differs(0, 1);
+    const auto edge = (key(-1, 0) != own.y) || (key(1, 0) != own.y) || (key(0, -1) != own.y) ||
+                      (key(0, 1) != own.y) || bends(colour(-1, 0), colour(1, 0)) ||
+                      bends(colour(0, -1), colour(0, 1));
     const auto marked = (own.x > F(0.0f)) && edge;
     f.out(0) = {select(marked, F(1.0f), F(0.0f)), own.y, F(0.0f), F(0.0f)};
   }

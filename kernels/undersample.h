@@ -58,7 +58,9 @@ struct MarkLattice {
 
 // marcarHuecos: x = 1 on a pixel between lattice pixels whose surface keys (guardarImpactos'
 // y) are not all the same, or whose colours differ by more than the threshold in some channel:
-// it is traced; 0 elsewhere (lattice pixels were traced already).
+// it is traced; 0 elsewhere (lattice pixels were traced already). Only the lattice pixels its
+// fill would blend count: a pixel on a lattice row (or column) lies between the two lattice
+// pixels of that row, and their cell's other corners have weight 0 in its blend.
 struct MarkGaps {
   static constexpr const char* name = "mark gaps";
   static constexpr const char* paper_name = "marcarHuecos (extension)";
@@ -73,9 +75,18 @@ struct MarkGaps {
   void operator()(Fragments<L>& f) const {
     using F = typename L::F;
     const LatticeCell<L> c(f, lattice);
-    const std::array<Vec4<F>, 4> k = c.fetch(f, kKeys);
+    std::array<Vec4<F>, 4> k = c.fetch(f, kKeys);
     // The lattice pixels' colours (one sample each in the sum).
-    const std::array<Vec4<F>, 4> s = c.fetch(f, kSum);
+    std::array<Vec4<F>, 4> s = c.fetch(f, kSum);
+    // Corners outside the blend (x1 on the cell's left column, y1 on its top row) stand in as
+    // corner (x0, y0), which then agrees with itself.
+    const auto use_x1 = c.xi != c.x0, use_y1 = c.yi != c.y0;
+    k[1] = select(use_x1, k[1], k[0]);
+    k[2] = select(use_y1, k[2], k[0]);
+    k[3] = select(use_x1 && use_y1, k[3], k[0]);
+    s[1] = select(use_x1, s[1], s[0]);
+    s[2] = select(use_y1, s[2], s[0]);
+    s[3] = select(use_x1 && use_y1, s[3], s[0]);
     auto spread = [](const F& a, const F& b, const F& c, const F& d) {
       return max(max(a, b), max(c, d)) - min(min(a, b), min(c, d));
     };

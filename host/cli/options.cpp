@@ -308,15 +308,17 @@ void add_render_options(CLI::App& render, RenderArgs& a) {
       .add_option("--aa", a.aa,
                   "Anti-aliasing: none (--spp rays in every pixel), adaptive (one ray per "
                   "pixel, then levels of 4, 16, ... up to --spp only where neighbours hit another "
-                  "surface or differ in colour by more than --aa-threshold) or undersample[:K] "
-                  "(one ray through every K-th pixel in x and y, default 2, then through the "
-                  "pixels between those that hit different surfaces; the rest blended)")
+                  "surface or the colour's second difference across the pixel exceeds "
+                  "--aa-threshold) or undersample[:K] (one ray through every K-th pixel in x and "
+                  "y, default 2, then through the pixels between those that hit different "
+                  "surfaces or differ in colour by more than --aa-threshold; the rest blended)")
       ->check(kAaCheck)
       ->capture_default_str();
   render
       .add_option("--aa-threshold", a.aa_threshold,
-                  "With --aa adaptive: the colour difference (linear, per channel) to a "
-                  "neighbour that marks a pixel for more samples")
+                  "With --aa adaptive: the colour's second difference (linear, per channel, "
+                  "along x or y) that marks a pixel for more samples; with --aa undersample: the "
+                  "colour difference between lattice pixels that has the pixels between traced")
       ->check(kThresholdCheck)
       ->capture_default_str();
   render

@@ -438,7 +438,8 @@ class Tracer {
 };
 
 // --aa adaptive as the stream tracer runs it (host/trace/stream_tracer.cpp, render_adaptive):
-// the centre ray, then levels of n x n samples where marcarPixeles' rule marks the pixel,
+// the centre ray, then levels of n x n samples where marcarPixeles' rule marks the pixel (a
+// neighbour's surface key differs, or the colour's second difference exceeds the threshold),
 // each level's samples replacing the pixel's earlier ones.
 void adaptive(const Tracer& tracer, const RenderOptions& opt, unsigned workers,
               std::vector<Counters>& counters, RenderResult& res) {
@@ -459,13 +460,18 @@ void adaptive(const Tracer& tracer, const RenderOptions& opt, unsigned workers,
     for (int y = 0; y < H; ++y)
       for (int x = 0; x < W; ++x) {
         const size_t i = size_t(y) * size_t(W) + size_t(x);
+        auto at = [&](int dx, int dy) {
+          return size_t(std::clamp(y + dy, 0, H - 1)) * size_t(W) +
+                 size_t(std::clamp(x + dx, 0, W - 1));
+        };
         bool edge = false;
-        for (const glm::ivec2 d : {glm::ivec2(-1, 0), {1, 0}, {0, -1}, {0, 1}}) {
-          const int nx = std::clamp(x + d.x, 0, W - 1), ny = std::clamp(y + d.y, 0, H - 1);
-          const size_t j = size_t(ny) * size_t(W) + size_t(nx);
-          const glm::dvec3 diff = glm::abs(estimate[j] - estimate[i]);
-          edge = edge || key[j] != key[i] ||
-                 std::max({diff.x, diff.y, diff.z}) > double(opt.aa_threshold);
+        for (const glm::ivec2 d : {glm::ivec2(-1, 0), {1, 0}, {0, -1}, {0, 1}})
+          edge = edge || key[at(d.x, d.y)] != key[i];
+        // The colour's second difference along x and along y.
+        for (const glm::ivec2 d : {glm::ivec2(1, 0), {0, 1}}) {
+          const glm::dvec3 bend =
+              glm::abs(estimate[at(-d.x, -d.y)] + estimate[at(d.x, d.y)] - 2.0 * estimate[i]);
+          edge = edge || std::max({bend.x, bend.y, bend.z}) > double(opt.aa_threshold);
         }
         marked[i] = candidate[i] && edge;
         count += marked[i];
@@ -497,7 +503,7 @@ void adaptive(const Tracer& tracer, const RenderOptions& opt, unsigned workers,
 }
 
 // --aa undersample:K as the stream tracer runs it (render_undersampled): the lattice pixels,
-// then the pixels of lattice cells whose corners' surface keys or colours disagree, the rest
+// then the pixels whose blended lattice pixels' surface keys or colours disagree, the rest
 // blended bilinearly from their cell's corners; AOVs of pixels never traced from the nearest
 // corner.
 void undersample(const Tracer& tracer, const RenderOptions& opt, unsigned workers,
@@ -523,9 +529,13 @@ void undersample(const Tracer& tracer, const RenderOptions& opt, unsigned worker
       const size_t corner[4] = {
           size_t(c.z) * size_t(W) + size_t(c.x), size_t(c.z) * size_t(W) + size_t(c.y),
           size_t(c.w) * size_t(W) + size_t(c.x), size_t(c.w) * size_t(W) + size_t(c.y)};
+      // Only the corners the fill blends: on a lattice row (column) that row's (column's) two.
+      const bool use[4] = {true, x != c.x, y != c.z, x != c.x && y != c.z};
       glm::dvec3 lo = colour[corner[0]], hi = lo;
       bool disagree = false;
-      for (const size_t j : corner) {
+      for (int q = 0; q < 4; ++q) {
+        if (!use[q]) continue;
+        const size_t j = corner[q];
         disagree = disagree || key[j] != key[corner[0]];
         lo = glm::min(lo, colour[j]);
         hi = glm::max(hi, colour[j]);

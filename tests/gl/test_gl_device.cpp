@@ -186,6 +186,30 @@ TEST_CASE("supersampling on the GL device gives the vgpu's passes, query counts 
   }
 }
 
+TEST_CASE("adaptive sampling's second level on the GL device marks the vgpu's pixels") {
+  // Up to 16 samples: marcarPixeles before the 2 x 2 level and again before the 4 x 4 level.
+  const Frame v = render("classic", "vgpu", 32, true, false, "auto", 16, true),
+              g = render("classic", "gl", 32, true, false, "auto", 16, true);
+  const auto& pv = v.result.stats.passes;
+  const auto& pg = g.result.stats.passes;
+  REQUIRE(pv.size() == pg.size());
+  int marks = 0;
+  for (size_t i = 0; i < pv.size(); ++i) {
+    CAPTURE(i);
+    REQUIRE(pv[i].program == pg[i].program);
+    REQUIRE(pv[i].query_result == pg[i].query_result);
+    marks += pv[i].program == "mark pixels";
+  }
+  CHECK(marks == 2);
+  // Some pixels stopped after the 2 x 2 level, some went on.
+  const auto& n = v.result.rays_per_pixel;
+  CHECK(std::count(n.begin(), n.end(), 1u + 4u) > 0);
+  CHECK(std::count(n.begin(), n.end(), 1u + 4u + 16u) > 0);
+  CHECK(g.result.rays_per_pixel == v.result.rays_per_pixel);
+  gltest::check_same_frame(g.device, "intersections", v.result.hit_id, g.result.hit_id,
+                           v.result.depth, g.result.depth, v.result.rgb, g.result.rgb);
+}
+
 TEST_CASE("undersampling on the GL device traces the vgpu's pixels and gives its image") {
   const Frame v = render("classic", "vgpu", 48, true, false, "auto", 1, false, 2),
               g = render("classic", "gl", 48, true, false, "auto", 1, false, 2);

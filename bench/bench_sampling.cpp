@@ -1,0 +1,307 @@
+// Benchmark: the sampling modes (--spp, --aa adaptive, --aa undersample) on bundled scenes, in
+// one run: primary rays per pixel (mean, max), passes, the cost model's ms on gf5700 / gf6600 /
+// h200, the emulator's render ms (median of runs), and the error against the CPU tracer's
+// 256-sample image. scripts/sampling.py runs it (--json) to write docs/sampling.md.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "host/accel/grid.h"
+#include "host/image/image_io.h"
+#include "host/model/cost_model.h"
+#include "host/scene/camera.h"
+#include "host/scene/gltf_loader.h"
+#include "host/trace/cpu_tracer.h"
+#include "host/trace/sampling.h"
+#include "host/trace/stream_tracer.h"
+
+namespace {
+
+struct Mode {
+  std::string label;
+  int spp = 1;
+  bool adaptive = false;
+  float threshold = 0.1f;
+  int undersample = 0;
+};
+
+// The modes docs/sampling.md charts; the first is the one-ray image the others are compared with.
+std::vector<Mode> modes() {
+  return {{"spp 1", 1},
+          {"spp 4", 4},
+          {"spp 16", 16},
+          {"spp 64", 64},
+          {"adaptive 16, T 0.05", 16, true, 0.05f},
+          {"adaptive 16, T 0.1", 16, true, 0.1f},
+          {"adaptive 16, T 0.2", 16, true, 0.2f},
+          {"adaptive 64, T 0.1", 64, true, 0.1f},
+          {"undersample 2", 1, false, 0.1f, 2},
+          {"undersample 2, T 0.05", 1, false, 0.05f, 2},
+          {"undersample 2, T 0.02", 1, false, 0.02f, 2},
+          {"undersample 4", 1, false, 0.1f, 4}};
+}
+
+// An image as the PNG writer stores it: each channel clamped to [0, 1] and rounded to 8 bits,
+// read back in [0, 1] (the error is the one a viewer of the files would see).
+std::vector<double> as_8bit(const std::vector<float>& rgb) {
+  std::vector<double> out(rgb.size());
+  for (size_t i = 0; i < rgb.size(); ++i)
+    out[i] = std::round(double(std::clamp(rgb[i], 0.0f, 1.0f)) * 255.0) / 255.0;
+  return out;
+}
+
+double rms(const std::vector<double>& a, const std::vector<double>& b,
+           const std::vector<uint8_t>* only = nullptr) {
+  double sum = 0;
+  size_t n = 0;
+  for (size_t i = 0; i < a.size(); ++i) {
+    if (only && !(*only)[i / 3]) continue;
+    sum += (a[i] - b[i]) * (a[i] - b[i]);
+    ++n;
+  }
+  return n ? std::sqrt(sum / double(n)) : 0.0;
+}
+
+// The share of pixels whose largest channel difference exceeds `by`.
+double changed(const std::vector<double>& a, const std::vector<double>& b, double by) {
+  size_t n = 0;
+  for (size_t p = 0; p < a.size() / 3; ++p) {
+    double d = 0;
+    for (int c = 0; c < 3; ++c) d = std::max(d, std::fabs(a[p * 3 + c] - b[p * 3 + c]));
+    n += d > by;
+  }
+  return double(n) / double(a.size() / 3);
+}
+
+struct Row {
+  std::string scene, mode;
+  double rays_mean = 0, rays_max = 0, rms = 0, edge_rms = 0;
+  uint64_t passes = 0, rays_traced = 0;
+  double gf5700 = 0, gf6600 = 0, h200 = 0, emulator_ms = 0;
+  double changed_255 = 0, changed_005 = 0;  // against the one-ray image
+  size_t edge_pixels = 0;
+};
+
+std::vector<std::string> split(const std::string& s) {
+  std::vector<std::string> out;
+  size_t start = 0;
+  while (start <= s.size()) {
+    const size_t comma = s.find(',', start);
+    const size_t end = comma == std::string::npos ? s.size() : comma;
+    if (end > start) out.push_back(s.substr(start, end - start));
+    start = end + 1;
+  }
+  return out;
+}
+
+int usage(const char* why) {
+  std::fprintf(stderr,
+               "bench_sampling: %s\nusage: bench_sampling [--size N] [--reps N] [--scenes "
+               "a,b,...] [--modes prefix,...] [--ref-spp N] [--json FILE]\n",
+               why);
+  return 2;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int size = 128, reps = 3, ref_spp = 256;
+  std::string json_path;
+  std::vector<std::string> scenes = {"sphere", "bunny", "bunny-refl", "classic"};
+  std::vector<std::string> prefixes;  // --modes: only the modes whose label starts so
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (i + 1 >= argc) return usage(("option " + a + " needs a value").c_str());
+    const std::string v = argv[++i];
+    char* end = nullptr;
+    const long n = std::strtol(v.c_str(), &end, 10);
+    const bool number = !v.empty() && *end == '\0';
+    if (a == "--size" && number && n >= 4 && n <= 1024) {
+      size = int(n);
+    } else if (a == "--reps" && number && n >= 1 && n <= 100) {
+      reps = int(n);
+    } else if (a == "--ref-spp" && number && (n == 0 || host::spp_refusal(int(n)).empty())) {
+      ref_spp = int(n);
+    } else if (a == "--scenes" && !split(v).empty()) {
+      scenes = split(v);
+    } else if (a == "--modes" && !split(v).empty()) {
+      prefixes = split(v);
+    } else if (a == "--json") {
+      json_path = v;
+    } else {
+      return usage(("bad option or value: " + a + " " + v).c_str());
+    }
+  }
+
+  std::vector<Row> rows;
+  const vgpu::Profile& gf5700 = vgpu::profile("gf5700");
+  const vgpu::Profile& gf6600 = vgpu::profile("gf6600");
+  const vgpu::Profile& h200 = vgpu::profile("h200");
+  for (const std::string& name : scenes) {
+    host::Scene scene;
+    try {
+      scene = host::load_scene(host::resolve_scene(name), host::with_images());
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "bench_sampling: scene %s: %s\n", name.c_str(), e.what());
+      return 2;
+    }
+    // The CLI's defaults (2 bounces, Phong, shadows, grid auto), on gf6600.
+    const host::Grid grid =
+        host::build_grid(scene, host::grid_spec_for(host::GridSpec{}, scene, gf6600));
+    const host::Camera camera = host::scene_camera(scene, 1.0f);
+    host::RenderOptions base;
+    base.width = base.height = size;
+    base.profile = gf6600.name;
+    host::RenderOptions ref_opt = base;
+    ref_opt.spp = ref_spp;
+    // --ref-spp 0: no reference (the changed pixels alone); the error columns are then 0.
+    std::vector<double> ref(size_t(size) * size_t(size) * 3, 0.0);
+    if (ref_spp > 0) {
+      std::fprintf(stderr, "bench_sampling: %s: reference (CPU tracer, %d samples)\n", name.c_str(),
+                   ref_spp);
+      ref = as_8bit(host::render_cpu(scene, grid, camera, ref_opt).rgb);
+    }
+    std::vector<double> one;
+    std::vector<uint8_t> edges;
+    size_t edge_pixels = 0;
+    for (const Mode& m : modes()) {
+      // The one-ray image always runs: the others' changed pixels are counted against it.
+      const bool wanted = prefixes.empty() || m.label == "spp 1" ||
+                          std::any_of(prefixes.begin(), prefixes.end(), [&](const std::string& p) {
+                            return m.label.rfind(p, 0) == 0;
+                          });
+      if (!wanted) continue;
+      std::fprintf(stderr, "bench_sampling: %s: %s\n", name.c_str(), m.label.c_str());
+      host::RenderOptions opt = base;
+      opt.spp = m.spp;
+      opt.adaptive = m.adaptive;
+      opt.aa_threshold = m.threshold;
+      opt.undersample = m.undersample;
+      host::StreamTracer tracer(scene, grid, opt);
+      host::RenderResult r;
+      std::vector<double> ms;
+      for (int k = 0; k < reps; ++k) {
+        r = tracer.render(camera);
+        ms.push_back(r.render_ms);
+      }
+      std::sort(ms.begin(), ms.end());
+      const std::vector<double> img = as_8bit(r.rgb);
+      if (one.empty()) {
+        // Edge pixels: where the one-ray image differs from the reference by more than 0.05 in
+        // some channel (the pixels aliasing spoils).
+        one = img;
+        edges.assign(img.size() / 3, 0);
+        for (size_t p = 0; p < edges.size(); ++p)
+          for (int c = 0; c < 3; ++c)
+            if (ref_spp > 0 && std::fabs(one[p * 3 + c] - ref[p * 3 + c]) > 0.05) edges[p] = 1;
+        edge_pixels = size_t(std::count(edges.begin(), edges.end(), 1));
+      }
+      Row row;
+      row.scene = name;
+      row.mode = m.label;
+      if (r.rays_per_pixel.empty()) {
+        row.rays_mean = row.rays_max = r.samples;
+      } else {
+        double sum = 0;
+        for (const uint32_t n : r.rays_per_pixel) {
+          sum += n;
+          row.rays_max = std::max(row.rays_max, double(n));
+        }
+        row.rays_mean = sum / double(r.rays_per_pixel.size());
+      }
+      row.rms = rms(img, ref);
+      row.edge_rms = rms(img, ref, &edges);
+      row.edge_pixels = edge_pixels;
+      row.passes = r.stats.totals.passes;
+      row.rays_traced = r.rays_traced;
+      row.gf5700 = host::predict(r.stats, gf5700).total_ms;
+      row.gf6600 = host::predict(r.stats, gf6600).total_ms;
+      row.h200 = host::predict(r.stats, h200).total_ms;
+      row.emulator_ms = ms[ms.size() / 2];
+      row.changed_255 = changed(img, one, 1.0 / 255.0 + 1e-9);
+      row.changed_005 = changed(img, one, 0.05);
+      rows.push_back(row);
+    }
+  }
+
+  // One table per scene, then the targets.
+  for (const std::string& name : scenes) {
+    const Row* first = nullptr;
+    for (const Row& r : rows)
+      if (r.scene == name) {
+        if (!first) {
+          first = &r;
+          std::printf("\n%s, %dx%d, %zu edge pixels; reference: CPU tracer, %d samples\n",
+                      name.c_str(), size, size, r.edge_pixels, ref_spp);
+          std::printf("%-20s %9s %9s %8s %8s %10s %12s %12s %10s %10s %8s %8s\n", "mode", "rays/px",
+                      "max", "RMS", "edge RMS", "passes", "gf5700 ms", "gf6600 ms", "h200 ms",
+                      "emul. ms", ">1/255", ">0.05");
+        }
+        std::printf(
+            "%-20s %9.3f %9.0f %8.4f %8.4f %10llu %12.0f %12.0f %10.1f %10.1f %7.2f%% "
+            "%7.2f%%\n",
+            r.mode.c_str(), r.rays_mean, r.rays_max, r.rms, r.edge_rms,
+            (unsigned long long)r.passes, r.gf5700, r.gf6600, r.h200, r.emulator_ms,
+            100 * r.changed_255, 100 * r.changed_005);
+      }
+  }
+  std::printf(
+      "\n(>1/255, >0.05: pixels that differ from the spp 1 image by more than that in "
+      "some channel; emulator ms: median of %d runs)\n",
+      reps);
+  std::printf("\nTargets\n");
+  for (const std::string& name : scenes) {
+    const Row *u16 = nullptr, *best = nullptr;
+    for (const Row& r : rows)
+      if (r.scene == name && r.mode == "spp 16") u16 = &r;
+    for (const Row& r : rows)
+      if (r.scene == name && r.mode.rfind("adaptive 16", 0) == 0 && u16 &&
+          r.rms <= 1.5 * u16->rms && r.rays_mean <= 0.35 * 16 && (!best || r.rms < best->rms))
+        best = &r;
+    if (!u16 || ref_spp == 0)
+      ;  // no spp 16 image, or no reference to measure the error against
+    else if (best)
+      std::printf("%s: adaptive met (%s: RMS %.2fx spp 16's with %.0f%% of its rays)\n",
+                  name.c_str(), best->mode.c_str(), best->rms / u16->rms,
+                  100 * best->rays_mean / 16);
+    else
+      std::printf("%s: adaptive not met\n", name.c_str());
+    for (const Row& r : rows)
+      if (r.scene == name && r.mode.rfind("undersample 2", 0) == 0)
+        std::printf(
+            "%s: %s: %.3f rays per pixel, %.2f%% of pixels changed by > 1/255, "
+            "%.2f%% by > 0.05\n",
+            name.c_str(), r.mode.c_str(), r.rays_mean, 100 * r.changed_255, 100 * r.changed_005);
+  }
+
+  if (!json_path.empty()) {
+    std::ofstream f(json_path);
+    f << "{\"size\": " << size << ", \"reps\": " << reps << ", \"ref_spp\": " << ref_spp
+      << ", \"rows\": [\n";
+    for (size_t i = 0; i < rows.size(); ++i) {
+      const Row& r = rows[i];
+      char line[1024];
+      std::snprintf(line, sizeof line,
+                    "{\"scene\": \"%s\", \"mode\": \"%s\", \"rays_mean\": %.6g, \"rays_max\": "
+                    "%.6g, \"rms\": %.6g, \"edge_rms\": %.6g, \"edge_pixels\": %zu, \"passes\": "
+                    "%llu, \"rays_traced\": %llu, \"gf5700\": %.6g, \"gf6600\": %.6g, \"h200\": "
+                    "%.6g, \"emulator_ms\": %.6g, \"changed_255\": %.6g, \"changed_005\": %.6g}",
+                    r.scene.c_str(), r.mode.c_str(), r.rays_mean, r.rays_max, r.rms, r.edge_rms,
+                    r.edge_pixels, (unsigned long long)r.passes, (unsigned long long)r.rays_traced,
+                    r.gf5700, r.gf6600, r.h200, r.emulator_ms, r.changed_255, r.changed_005);
+      f << line << (i + 1 < rows.size() ? ",\n" : "\n");
+    }
+    f << "]}\n";
+    if (!f) {
+      std::fprintf(stderr, "bench_sampling: %s: could not be written\n", json_path.c_str());
+      return 1;
+    }
+  }
+  return 0;
+}
