@@ -11,7 +11,7 @@
 
 namespace host {
 
-WalkWork walk_work(const vgpu::FrameStats& stats) {
+WalkWork walk_work(const vgpu::FrameStats& stats, uint64_t rays_traced) {
   WalkWork w;
   auto useful = [&](const char* name) -> uint64_t {
     const vgpu::FrameStats::ProgramTotals* p = stats.find(name);
@@ -20,13 +20,20 @@ WalkWork walk_work(const vgpu::FrameStats& stats) {
     return c.fragments_shaded - std::min(c.lanes_idle, c.fragments_shaded);
   };
   using namespace kernels;
-  w.voxel_steps = useful(Traversal::name) + useful(TraverseUpdate::name);
+  w.voxel_steps = useful(Traversal::name) + useful(TraverseUpdate::name) + useful(Grid2Step::name) +
+                  useful(Grid2StepLoad::name);
   w.nodes_visited = useful(BvhStep::name) + useful(BvhStepLoad::name) + useful(KdStep::name) +
                     useful(KdStepLoad::name);
   w.triangle_tests = useful(Intersections::name) + useful(IntersectNext::name) +
                      useful(BvhIntersections::name) + useful(BvhIntersectNext::name) +
-                     useful(KdIntersections::name) + useful(KdIntersectNext::name);
-  for (const char* name : {LoopingTraversal::name, BvhLooping::name, KdLooping::name})
+                     useful(KdIntersections::name) + useful(KdIntersectNext::name) +
+                     useful(Grid2Intersections::name) + useful(Grid2IntersectNext::name);
+  if (stats.find(KdLoadLeaf::name)) {
+    const uint64_t leaves = useful(KdLoadLeaf::name);
+    w.restarts = leaves >= rays_traced ? int64_t(leaves - rays_traced) : 0;
+  }
+  for (const char* name :
+       {LoopingTraversal::name, BvhLooping::name, KdLooping::name, Grid2Looping::name})
     if (const vgpu::FrameStats::ProgramTotals* p = stats.find(name))
       w.loop_iterations += p->counters.loop_iterations;
   return w;
