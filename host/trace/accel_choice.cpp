@@ -82,6 +82,15 @@ AccelChoice choose_accel(const Scene& scene, const std::vector<AccelCandidate>& 
     }
   }
   if (!any) throw vgpu::Error("--accel auto: no structure fits: " + refused);
+  // The grid unless another is predicted clearly cheaper (kAutoGridMargin).
+  const auto grid = c.predicted_ms.find(std::string(accel_name(AccelKind::grid)));
+  bool kept = false;
+  if (c.kind != AccelKind::grid && grid != c.predicted_ms.end() &&
+      best > (1.0 - kAutoGridMargin) * grid->second) {
+    c.kind = AccelKind::grid;
+    best = grid->second;
+    kept = true;
+  }
   std::string others;
   for (const auto& [name, ms] : c.predicted_ms)
     if (name != accel_name(c.kind)) {
@@ -90,10 +99,11 @@ AccelChoice choose_accel(const Scene& scene, const std::vector<AccelCandidate>& 
                     name.c_str(), ms, ms / best);
       others += part;
     }
-  char line[512];
-  std::snprintf(line, sizeof line, "%s predicted %.1f ms on %s against %s, from %dx%d probes%s%s",
+  char line[640];
+  std::snprintf(line, sizeof line, "%s predicted %.1f ms on %s against %s, from %dx%d probes%s%s%s",
                 std::string(accel_name(c.kind)).c_str(), best, profile.name.c_str(),
                 others.empty() ? "nothing else" : others.c_str(), probe.width, probe.height,
+                kept ? " (the grid is kept unless another is predicted 10% cheaper)" : "",
                 refused.empty() ? "" : "; refused: ", refused.c_str());
   c.why = line;
   c.probe_ms =

@@ -538,7 +538,13 @@ TEST_CASE(
     CHECK(au["predicted_ms"][k].get<double>() > 0);
     best = std::min(best, au["predicted_ms"][k].get<double>());
   }
-  CHECK(au["predicted_ms"][chosen].get<double>() == best);  // the cheapest was taken
+  // The cheapest was taken, or the grid where nothing is predicted 10% cheaper than it.
+  const double grid_ms = au["predicted_ms"]["grid"].get<double>();
+  if (chosen == "grid")
+    CHECK(best >= (1.0 - 0.10) * grid_ms);
+  else
+    CHECK(au["predicted_ms"][chosen].get<double>() == best);
+  CHECK((best < (1.0 - 0.10) * grid_ms) == (chosen != "grid"));
   const std::string why = au["why"].get<std::string>();
   CHECK(why.rfind(chosen + " predicted ", 0) == 0);  // a sentence naming the choice first
   CHECK(why.find('\n') == std::string::npos);
