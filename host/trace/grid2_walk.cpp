@@ -51,12 +51,13 @@ uint64_t Grid2Walk::set_grid(vgpu::Device& gpu, const Grid2& g2, float scene_wid
         std::tuple{uint64_t(g2.lists.size()), Group::voxel, "list positions"}})
     for (const Format f : {fm[g], fm.arithmetic(g)})
       if (count - 1 > exact_addresses(f))
-        throw vgpu::Error(
-            "two-level grid: " + std::string(kind) + " reach " + std::to_string(count - 1) +
-            "; the " + std::string(group_name(g)) + " group's " +
-            std::string(vgpu::format_name(f)) + " addresses texels exactly only to " +
-            std::to_string(exact_addresses(f)) + " (give it fp24 or fp32: --formats " +
-            std::string(group_name(g)) + "=fp32)");
+        throw vgpu::Error("two-level grid: " + std::string(kind) + " reach " +
+                          std::to_string(count - 1) + "; the " + std::string(group_name(g)) +
+                          " group's " + std::string(vgpu::format_name(f)) +
+                          " addresses texels exactly only to " +
+                          std::to_string(exact_addresses(f)) + " (give it " +
+                          (count - 1 > exact_addresses(Format::fp24) ? "fp32" : "fp24 or fp32") +
+                          ": --formats " + std::string(group_name(g)) + "=fp32)");
   max_list_ = g2.max_list;
   // A ray crosses at most res.x + res.y + res.z coarse cells, and in each at most the sum of
   // its sub-grid's resolutions.

@@ -359,3 +359,30 @@ TEST_CASE("the two-level grid puts a small bunny on a huge floor in sub-grids of
   CHECK(host::walk_work(k.stats).triangle_tests * 4 < host::walk_work(g.stats).triangle_tests);
   CHECK(k.stats.totals.passes < g.stats.totals.passes);
 }
+
+TEST_CASE("a format that cannot address the two-level grid's sub-cells or lists is refused") {
+  // The bunny's two-level grid has more sub-cells than fp16 (1023) or fp24 (65535) address
+  // exactly: a sub-cell index that rounds would send the walk to another cell. Refused at
+  // initialization, naming the group, the count and the limit, and the format that holds it.
+  const Structures s = bundled("bunny", 32, 32);
+  REQUIRE(s.g2.sub_cells() > 65536);
+  host::RenderOptions opt = options(32, 32);
+  const std::string reach = "two-level grid: sub-cell indices reach " +
+                            std::to_string(s.g2.sub_cells() - 1) + "; the traversal group's ";
+  for (const vgpu::Format f : {vgpu::Format::fp16, vgpu::Format::fp24}) {
+    CAPTURE(vgpu::format_name(f));
+    opt.formats = host::Formats::all(vgpu::Format::fp32);
+    opt.formats.set(host::Group::traversal, f, vgpu::Format::fp32);
+    const std::string what = reach + std::string(vgpu::format_name(f)) +
+                             " addresses texels exactly only to " +
+                             std::to_string(host::exact_addresses(f)) + " (give it fp32";
+    CHECK_THROWS_WITH_AS(host::StreamTracer(s.scene, s.g2_accel(), opt),
+                         doctest::Contains(what.c_str()), vgpu::Error);
+  }
+  opt.formats = host::Formats::all(vgpu::Format::fp32);
+  opt.formats.set(host::Group::voxel, vgpu::Format::fp16, vgpu::Format::fp16);
+  const std::string lists = "two-level grid: list positions reach " +
+                            std::to_string(s.g2.lists.size() - 1) + "; the voxel group's fp16";
+  CHECK_THROWS_WITH_AS(host::StreamTracer(s.scene, s.g2_accel(), opt),
+                       doctest::Contains(lists.c_str()), vgpu::Error);
+}
