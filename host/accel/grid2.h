@@ -22,8 +22,8 @@ inline constexpr uint32_t kGrid2Crowded = 8;
 // A sub-grid has at most kGrid2SubBudget sub-cells per triangle of its cell.
 inline constexpr double kGrid2SubBudget = 64.0;
 
-// The sub-grid resolution of a crowded cell `cell` whose `triangles` occupy `occupied` (their
-// bounding boxes' union clipped to the cell): the grid's automatic resolution for the occupied
+// The sub-grid resolution of a crowded cell `cell` whose `triangles` occupy `occupied`
+// (grid2_occupied, below): the grid's automatic resolution for the occupied
 // part (auto_resolution, kGridDensity), its voxel size carried over the whole cell (so a small
 // object in a large cell, the teapot in a stadium, is cut as finely as if it filled the cell),
 // each axis at most kMaxAutoGridRes, scaled down evenly to at most kGrid2SubBudget sub-cells
