@@ -6,6 +6,7 @@
 #include "kernels/bvh.h"
 #include "kernels/fused.h"
 #include "kernels/generate_rays.h"
+#include "kernels/grid2.h"
 #include "kernels/init_traversal.h"
 #include "kernels/intersections.h"
 #include "kernels/kdtree.h"
@@ -70,3 +71,10 @@ extern template class vgpu::KernelProgram<kernels::KdIntersections>;
 extern template class vgpu::KernelProgram<kernels::KdStepLoad>;
 extern template class vgpu::KernelProgram<kernels::KdIntersectNext>;
 extern template class vgpu::KernelProgram<kernels::KdLooping>;
+extern template class vgpu::KernelProgram<kernels::Grid2Enter>;
+extern template class vgpu::KernelProgram<kernels::Grid2Step>;
+extern template class vgpu::KernelProgram<kernels::Grid2LoadCell>;
+extern template class vgpu::KernelProgram<kernels::Grid2Intersections>;
+extern template class vgpu::KernelProgram<kernels::Grid2StepLoad>;
+extern template class vgpu::KernelProgram<kernels::Grid2IntersectNext>;
+extern template class vgpu::KernelProgram<kernels::Grid2Looping>;

@@ -32,6 +32,12 @@
 //                   left child is node i + 1), w = the leaf's first list entry, -1 for an inner
 //                   node
 //   kd lists        x      triangle ids of each leaf, closed by -1 (entry 0: a -1)
+// Static (two-level grid, --accel grid2; kernels/grid2.h), entry k at (k mod width, k div width):
+//   grid2 cells     coarse cell c = (Z*resY + Y)*resX + X: xyz = its sub-grid's resolution
+//                   (1, 1, 1 for a cell that is not crowded), w = its first sub-cell; the
+//                   sub-cells of c follow one another, x fastest
+//   grid2 sub-cells x = the sub-cell's first list entry (0: empty), y = its coarse cell
+//   grid2 lists     x      triangle ids of each sub-cell, closed by -1 (entry 0: a -1)
 //
 // Dynamic (per pixel):
 //   origins         xyz = ray origin, world space; w unused    (paper: texturaInicioRayos)
@@ -46,7 +52,9 @@
 //                   y = list position of the leaf just entered (-1: none)   (--accel bvh)
 //   kd traversal    x = node (-1: done), y = list position of the leaf being tested (-1: none),
 //                   z, w = tmin, tmax of the ray's segment        (--accel kdtree)
-//   leaf state      as the voxel state, over the tree's lists; the kd-tree's looping kernel
+//   grid2 traversal x = sub-cell (-1: done), y = its first list entry, z, w = t where the ray
+//                   enters and leaves the sub-cell                 (--accel grid2)
+//   leaf state      as the voxel state, over the tree's (or the two-level grid's) lists; the kd-tree's looping kernel
 //                   keeps its push-down node in y and a "segment cut" flag in z
 //   intersection    x = t of the nearest valid hit so far, w = its triangle, -1 for none;
 //                   yz = barycentrics (u, v) of that hit      (paper: texturaEstadoInterseccion)

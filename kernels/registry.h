@@ -56,6 +56,13 @@ inline std::vector<std::unique_ptr<vgpu::Program>> all_programs() {
   v.push_back(std::make_unique<vgpu::KernelProgram<KdIntersections>>());
   v.push_back(std::make_unique<vgpu::KernelProgram<KdStepLoad>>());
   v.push_back(std::make_unique<vgpu::KernelProgram<KdIntersectNext>>());
+  // The two-level grid walk (an extension, kernels/grid2.h): --accel grid2; its fused forms.
+  v.push_back(std::make_unique<vgpu::KernelProgram<Grid2Enter>>());
+  v.push_back(std::make_unique<vgpu::KernelProgram<Grid2Step>>());
+  v.push_back(std::make_unique<vgpu::KernelProgram<Grid2LoadCell>>());
+  v.push_back(std::make_unique<vgpu::KernelProgram<Grid2Intersections>>());
+  v.push_back(std::make_unique<vgpu::KernelProgram<Grid2StepLoad>>());
+  v.push_back(std::make_unique<vgpu::KernelProgram<Grid2IntersectNext>>());
   return v;
 }
 

@@ -1,10 +1,11 @@
 #!/usr/bin/env python3
-"""Writes docs/structures.md and docs/structures.png: the uniform grid (the paper's), the BVH
-and --accel auto on the bundled scenes and on uneven scenes (scripts/uneven_scenes.py), side by
-side in one run.
+"""Writes docs/structures.md and docs/structures.png: the uniform grid (the paper's), the
+two-level grid, the BVH, the kd-tree and --accel auto on the bundled scenes and on uneven scenes
+(scripts/uneven_scenes.py), side by side in one run.
 
 Usage: /usr/bin/python3 scripts/structures.py [--vgpu-rt build/host/vgpu-rt] [--size 256]
                                               [--runs 3] [--h200 DIR]
+                                              [--reuse [--only ACCEL ...]]
 
 Per scene and structure, primary rays only (--bounces 0 --shadows off, as the issue's table) and
 the full frame (2 bounces, shadows): build ms, passes, query read-backs, fragments, voxel steps
@@ -14,7 +15,8 @@ statistics do not change between runs), emulator ms and CPU tracer ms (medians o
 --profile h200. --h200 FILE... adds frames measured on an H200 through the GL device: bench_gl JSON files
 (bench/bench_gl.cpp with --accel, warm frames after one warm-up, polled read-backs; made by
 scripts/structures_h200.sh), each GL frame set beside the cost model's prediction from the
-same frame's emulator statistics in the same file.
+same frame's emulator statistics in the same file. --reuse --only grid2 "auto gf6600" "auto h200"
+renders only those rows again and keeps the others from OUT/structures.json (rows of one size).
 """
 import argparse
 import glob
@@ -34,6 +36,7 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 BUNDLED = ["sphere", "bunny", "bunny-refl", "classic", "teapot"]
 UNEVEN = ["stadium", "scales"]
 MODES = {"primary": ["--bounces", "0", "--shadows", "off"], "full": []}
+COLOURS = {"grid": "C0", "grid2": "C1", "bvh": "C2", "kdtree": "C3"}  # the same in every panel
 
 
 def run(exe, scene, opts, js):
@@ -53,6 +56,10 @@ def main():
     ap.add_argument("--reuse", action="store_true",
                     help="take the emulator and CPU rows from OUT/structures.json instead of "
                     "rendering them again (the H200 files are read again)")
+    ap.add_argument("--only", nargs="*", default=[],
+                    help="with --reuse: render these rows (grid, grid2, bvh, kdtree, 'auto "
+                    "gf6600', 'auto h200', or SCENE:STRUCTURE for one scene's) again, "
+                    "replacing the stored ones")
     a = ap.parse_args()
     tmp = tempfile.mkdtemp(prefix="structures_")
     subprocess.run([sys.executable, os.path.join(ROOT, "scripts", "uneven_scenes.py"), tmp],
@@ -62,13 +69,16 @@ def main():
     rows = []
     js = os.path.join(tmp, "r.json")
     if a.reuse:
-        rows = json.load(open(os.path.join(a.out, "structures.json")))["rows"]
-    for name, path in ([] if a.reuse else scenes):
+        rows = [r for r in json.load(open(os.path.join(a.out, "structures.json")))["rows"]
+                if not wanted(a.only, r["scene"], r["accel"])]
+    for name, path in ([] if a.reuse and not a.only else scenes):
         for mode, mopts in MODES.items():
-            for acc, extra in (("grid", ["--accel", "grid"]), ("bvh", ["--accel", "bvh"]),
-                               ("kdtree", ["--accel", "kdtree"]),
+            for acc, extra in (("grid", ["--accel", "grid"]), ("grid2", ["--accel", "grid2"]),
+                               ("bvh", ["--accel", "bvh"]), ("kdtree", ["--accel", "kdtree"]),
                                ("auto gf6600", ["--accel", "auto", "--profile", "gf6600"]),
                                ("auto h200", ["--accel", "auto", "--profile", "h200"])):
+                if a.reuse and not wanted(a.only, name, acc):
+                    continue
                 runs = [run(a.vgpu_rt, path, size + mopts + extra, js)
                         for _ in range(a.runs if not acc.startswith("auto") else 1)]
                 j = runs[0]
@@ -93,6 +103,9 @@ def main():
                            for _ in range(a.runs)]
                     row["cpu_ms"] = statistics.median(r["render_ms"] for r in cpu)
                 rows.append(row)
+                order = ["grid", "grid2", "bvh", "kdtree", "auto gf6600", "auto h200"]
+                rows.sort(key=lambda r: ([s for s, _ in scenes].index(r["scene"]),
+                                         list(MODES).index(r["mode"]), order.index(r["accel"])))
                 print(f"{name:10s} {mode:7s} {acc:11s} -> {row['chosen']:4s} passes "
                       f"{row['passes']:7d} gf6600 {row['gf6600']:10.1f} ms h200 {row['h200']:8.1f}"
                       f" ms emulator {row['emu_ms']:8.1f} ms", file=sys.stderr)
@@ -114,6 +127,12 @@ def main():
               indent=1)
     write_doc(a, rows, h200)
     chart(a, rows, h200)
+
+
+def wanted(only, scene, acc):
+    """Whether --only names this row: by structure ("grid2") or scene and structure
+    ("bunny:grid")."""
+    return acc in only or f"{scene}:{acc}" in only
 
 
 def get(rows, scene, mode, acc):
@@ -190,6 +209,20 @@ def h200_table(h200):
     return "\n".join(L)
 
 
+def grid2_sentence(rows):
+    """The two-level grid against the grid and the BVH, primary rays, modeled gf6600."""
+    parts = []
+    for sc in ("bunny", "teapot", "stadium", "scales"):
+        g, g2, b = (get(rows, sc, "primary", acc) for acc in ("grid", "grid2", "bvh"))
+        parts.append(f"{sc} {g2['gf6600'] / g['gf6600']:.2f}x the grid's and "
+                     f"{g2['gf6600'] / b['gf6600']:.2f}x the BVH's")
+    return ("The two-level grid keeps the paper's DDA and its in-voxel rule, and cuts finely only "
+            "where triangles crowd; its modeled gf6600 time with primary rays is " +
+            "; ".join(parts) + ". On an uneven scene it removes most of the grid's triangle tests, "
+            "but a ray still steps every empty coarse cell and every sub-cell of each crowded cell "
+            "it crosses, one pass each, where a tree skips empty space in a few nodes.")
+
+
 def write_doc(a, rows, h200):
     size = f"{a.size}x{a.size}"
     within = [r for r in h200 if abs(r["predicted_ms"] / r["wall_ms"] - 1) <= 0.35]
@@ -199,7 +232,7 @@ def write_doc(a, rows, h200):
     worse = [(sc, mode) for sc in BUNDLED for mode in MODES
              if get(rows, sc, mode, "auto gf6600")["gf6600"] >
              1.10 * get(rows, sc, mode, "grid")["gf6600"]]
-    doc = f"""# Acceleration structures: the grid, a BVH, a kd-tree, and `--accel auto`
+    doc = f"""# Acceleration structures: the grid, a two-level grid, a BVH, a kd-tree, and `--accel auto`
 
 Written by `scripts/structures.py` (run it again to refresh every figure here); the chart is
 `docs/structures.png`, the raw figures `docs/structures.json`.
@@ -209,7 +242,7 @@ scene is uneven: a small detailed object on a large floor puts the object in a f
 grid sized by the triangle count (the automatic 121x1x121 grid of the "stadium" scene below
 holds the whole bunny in one column of voxels), and objects at very different scales leave most
 voxels empty or crowded. The paper names other structures ("bounding volumes, adaptive
-subdivision") as future work. vgpu-rt has two beside the grid, each built on the host, stored in
+subdivision") as future work. vgpu-rt has three beside the grid, each built on the host, stored in
 textures (`kernels/layout.h`) and walked by fragment programs under the paper's constraints: no
 recursion, no stack, one output per pass on the GeForce FX (two with `--mrt on` elsewhere), and
 the host steering passes by occlusion queries.
@@ -217,26 +250,36 @@ the host steering passes by occlusion queries.
 | `--accel` | built on the host | walked by | state per ray |
 |---|---|---|---|
 | `grid` (default) | the paper's uniform grid | 3D-DDA, one voxel per pass (Amanatides & Woo) | voxel, entry t |
+| `grid2` | a coarse uniform grid (the automatic rule at 0.25 cells per triangle) whose crowded cells (more than 8 triangles) hold a grid of their own, at the automatic resolution of the part their triangles occupy carried over the cell, at most 64 sub-cells per triangle (Jevans & Wyvill 1989; Kalojanov et al. 2011) | 3D-DDA on two levels without a stack: one sub-cell per pass; leaving a sub-grid steps the coarse grid and descends into the next cell's sub-grid on the face crossed | sub-cell, its list, segment [t in, t out] |
 | `bvh` | binned SAH (16 bins), leaves of up to 4 triangles | stackless: nodes in depth-first order, each with the index to jump to when the ray misses it (Thrane & Simonsen 2005); one node per pass | next node, leaf to load |
 | `kdtree` | SAH over the triangles' clipped box faces, depth 8 + 1.3 log2 n | kd-restart (Foley & Sugerman 2005): descend to the first leaf the ray's segment reaches, test it (a hit counts only inside the leaf's segment), restart from the root past it; one node per pass | node, leaf to load, segment [tmin, tmax] |
-| `auto` | all three | the one the cost model predicts cheapest on `--profile`, from a probe frame at a quarter of the size in x and y (the fixed per-pass, program-load and read-back costs as measured, the fragment work scaled by the pixel ratio) | |
+| `auto` | all four | the one the cost model predicts cheapest on `--profile`, from a probe frame at a quarter of the size in x and y (the fixed per-pass, program-load and read-back costs as measured, the fragment work scaled by the pixel ratio) | |
 
 Each walk is the grid's pass sequence with its own kernels in the places of the paper's: a step
-pass (`recorridoBVH` / `recorridoKd` where the grid has `traversal`), a leaf load
-(`cargarHoja` / `cargarHojaKd` where it has `actualizarVoxel`), one triangle per pass
-(`interseccionesBVH` / `interseccionesKd`, then `proximoTriangulo`), and the same two queries
+pass (`recorridoGrilla2` / `recorridoBVH` / `recorridoKd` where the grid has `traversal`), a
+load (`cargarCelda` / `cargarHoja` / `cargarHojaKd` where it has `actualizarVoxel`), one
+triangle per pass (`interseccionesGrilla2` / `interseccionesBVH` / `interseccionesKd`, then
+`proximoTriangulo`), and the same two queries
 (`rayosIntersectando`, `rayosEnGrilla`). Each has fused two-output forms for `--mrt on` and a
 looping kernel for profiles with data-dependent loops (`--kernels looping`); the kd-tree's
 looping kernel restarts with push-down (Horn et al., I3D 2007: a restart begins at the deepest
 node whose subtree holds the whole remaining segment). All of them run on the emulator (pass
 by pass and in batches, bit-identical), on the GL device (GLSL generated from the same
-functors) and in the CPU tracer (double precision). On every bundled scene the three structures
-give the same hit ids, depths and colours, bit for bit, on the emulator and on llvmpipe.
+functors) and in the CPU tracer (double precision). On every bundled scene the BVH and the
+kd-tree give the grid's hit ids, depths and colours, bit for bit, on the emulator and on
+llvmpipe; the two-level grid gives the grid's primary hit ids on every bundled scene at 48x48
+and on every stability case but for 3 pixels of the triangle fan, exact ties on a shared spoke
+checked in double (`tests/trace/test_grid2_walk.cpp`), and llvmpipe gives the emulator's.
 
 ## The figures
 
 {size}, one run per row on this 2-core machine (2 host threads; emulator and CPU ms are medians
 of {a.runs} runs, and were taken while other builds ran: read them as ratios within a row group).
+The two-level grid's rows come from a later run (`--reuse --only grid2 ...`), and the `auto`
+rows and the bunny's grid row from a third (`--reuse --only "auto gf6600" "auto h200"
+bunny:grid`, once `auto` kept the grid by a margin, below), on the same machine under other
+loads: emulator and CPU ms compare only within one run (the modeled ms and the counts do not
+depend on the load).
 "primary" is primary rays only (`--bounces 0 --shadows off`, as the issue's table); "full" is the
 default frame (2 bounces, shadows). Steps: voxels stepped (grid) or nodes visited (BVH, kd-tree)
 by the step passes' working fragments; tests: triangle tests. The modeled ms come from the same
@@ -253,8 +296,12 @@ its width) and "scales" (25 bunnies from 5% to 15 times its size, 92k triangles)
 {auto_table(rows)}
 
 `auto` is never more than 10% worse than `grid` in modeled gf6600 time on a bundled scene: {"met" if not worse else "missed on " + ", ".join(f"{s} ({m})" for s, m in worse)}.
-The probes cost host time at initialization (the column "probes ms", builds of all three
+The probes cost host time at initialization (the column "probes ms", builds of all four
 structures included); the frame's own render time is the same as with the chosen structure.
+The grid is kept unless another structure is predicted at least 10% cheaper
+(`kAutoGridMargin`): the 64x64 probes misjudge the full frame by about that much. Without the
+margin, `auto` took the two-level grid for the bunny's primary rays (predicted 6% cheaper than
+the grid, 12% dearer at 256x256: its longest walks grow with the image).
 
 ### Uneven scenes against the object alone
 
@@ -266,6 +313,9 @@ times the bunny's fragment work however good the structure, which the emulator's
 follows more closely than a modeled GPU's pass-bound time does.
 
 ## Measured on an H200 through the GL device
+
+The two-level grid was not measured on the H200 (the rows below are the grid, the BVH and the
+kd-tree only; no device time was spent on grid2).
 
 The same frames on an NVIDIA H200 through the GL device (`bench/bench_gl.cpp --accel grid bvh
 kdtree`, driver 580.159.04, 256x256, polled read-backs, SM clock 1980 MHz while busy): the
@@ -288,6 +338,7 @@ are compared with the model, which has no compilation term.
   per voxel; an uneven scene makes one ray cross a hundred empty voxels (stadium) or sit in a
   voxel listing hundreds of triangles (scales). The BVH's and kd-tree's pass counts follow the
   tree depth and leaf size instead, so they barely move with the scene's spread.
+- **Two levels against a tree.** {grid2_sentence(rows)}
 - **Restarts against a stack.** The FX has no loops and no indexable registers: a stack is out
   of reach, so the BVH walks its escape indices and the kd-tree restarts from the root. Every
   restart costs a descent (about the tree's depth in passes): on the bundled scenes kd-restart
@@ -315,12 +366,14 @@ positions against the structure's own lists. Asked for a format that cannot coun
 count or the list length (`--precision fp16`, or fp24 past 65535), `--accel bvh` and `kdtree`
 are refused with one line naming the group, the count and the limit: a node index that stops
 counting up would stall the walk (the grid instead stops at its pass cap and reports the rays
-left unfinished).
+left unfinished). `--accel grid2` is refused alike where its sub-cell indices, coarse cell
+indices or list positions pass what the traversal or voxel group's format addresses (the bunny's
+two-level grid has 96,334 sub-cells: fp16 and fp24 traversal groups both refuse it, and
+`--precision auto` keeps that group at fp32).
 
 ## Left out
 
-- The two-level grid (crowded cells holding grids of their own): the BVH and the kd-tree cover
-  the uneven scenes it was meant for; it is not built.
+- The two-level grid on the H200: not measured there.
 - kd-backtrack and the short stack of Horn et al.: kd-restart (with push-down in the looping
   kernel) is the only kd walk.
 - Front-to-back BVH order: it needs a stack or parent links with a direction flag.
@@ -335,10 +388,11 @@ def chart(a, rows, h200):
     for ax, key, title in ((axes[0], "gf6600", "modeled GeForce 6600 (multipass)"),
                            (axes[1], "h200", "modeled H200 (multipass)"),
                            (axes[2], "emu_ms", "emulator host ms (2 threads)")):
-        w = 0.27
-        for k, acc in enumerate(("grid", "bvh", "kdtree")):
+        w = 0.21
+        for k, acc in enumerate(("grid", "grid2", "bvh", "kdtree")):
             vals = [get(rows, s, "primary", acc)[key] for s in scenes]
-            ax.bar([i + (k - 1) * w for i in range(len(scenes))], vals, w, label=acc)
+            ax.bar([i + (k - 1.5) * w for i in range(len(scenes))], vals, w, label=acc,
+                   color=COLOURS[acc])
         ch = [get(rows, s, "primary", "auto gf6600" if key != "h200" else "auto h200")["chosen"]
               for s in scenes]
         ax.set_xticks(range(len(scenes)))
@@ -352,7 +406,7 @@ def chart(a, rows, h200):
         for acc, m in (("grid", "o"), ("bvh", "s"), ("kdtree", "^")):
             pts = [r for r in h200 if r["accel"] == acc]
             ax.scatter([r["wall_ms"] for r in pts], [r["predicted_ms"] for r in pts], marker=m,
-                       label=acc, alpha=0.8)
+                       label=acc, alpha=0.8, color=COLOURS[acc])
         lo = min(min(r["wall_ms"], r["predicted_ms"]) for r in h200) * 0.7
         hi = max(max(r["wall_ms"], r["predicted_ms"]) for r in h200) * 1.4
         xs = [lo, hi]
@@ -365,7 +419,8 @@ def chart(a, rows, h200):
         ax.set_ylabel("predicted ms")
         ax.set_title("H200: measured against predicted, every frame", fontsize=10)
         ax.legend(fontsize=7)
-    fig.suptitle(f"Grid, BVH and kd-tree, {a.size}x{a.size}: where each structure wins")
+    fig.suptitle(f"Grid, two-level grid, BVH and kd-tree, {a.size}x{a.size}: where each "
+                 "structure wins (the H200 panel: grid2 not measured there)")
     fig.tight_layout()
     fig.savefig(os.path.join(a.out, "structures.png"), dpi=100)
     print(f"wrote {a.out}/structures.png", file=sys.stderr)

@@ -292,21 +292,27 @@ int run_render(const RenderArgs& a, bool lanes_given) {
   std::optional<host::Grid> box;
   std::optional<host::Bvh> bvh;
   std::optional<host::KdTree> kd;
+  std::optional<host::Grid2> grid2;
   if (auto_accel || accel_kind != host::AccelKind::grid)
     box = host::build_grid(scene, host::GridSpec{glm::ivec3(1)});
   if (auto_accel || accel_kind == host::AccelKind::bvh) bvh = host::build_bvh(scene);
   if (auto_accel || accel_kind == host::AccelKind::kdtree)
     kd = host::build_kdtree(scene, box->lo, box->hi);
+  if (auto_accel || accel_kind == host::AccelKind::grid2) grid2 = host::build_grid2(scene);
   auto accel_of = [&](host::AccelKind k) {
     return host::Accel{k, k == host::AccelKind::grid ? &grid : &*box,
                        k == host::AccelKind::bvh ? &*bvh : nullptr,
-                       k == host::AccelKind::kdtree ? &*kd : nullptr};
+                       k == host::AccelKind::kdtree ? &*kd : nullptr,
+                       k == host::AccelKind::grid2 ? &*grid2 : nullptr};
   };
   auto formats_for = [&](host::AccelKind k) {
     const vgpu::Profile& p = vgpu::profile(opt.profile);
     return k == host::AccelKind::grid  ? host::resolve(formats, scene, grid, p)
            : k == host::AccelKind::bvh ? host::resolve(formats, scene, *box, p, bvh->lists.size())
-                                       : host::resolve(formats, scene, *box, p, kd->lists.size());
+           : k == host::AccelKind::grid2
+               ? host::resolve(formats, scene, *box, p,
+                               std::max<uint64_t>(grid2->lists.size(), grid2->sub_cells()))
+               : host::resolve(formats, scene, *box, p, kd->lists.size());
   };
   opt.formats = formats_for(accel_kind);
   if (opt.mrt) {
@@ -338,9 +344,10 @@ int run_render(const RenderArgs& a, bool lanes_given) {
   const host::Grid& walk_grid = *accel.grid;
   // The host's build of the structure walked (and of its box), ms.
   auto build_ms = [&] {
-    return accel_kind == host::AccelKind::grid  ? grid.build_ms
-           : accel_kind == host::AccelKind::bvh ? box->build_ms + bvh->build_ms
-                                                : box->build_ms + kd->build_ms;
+    return accel_kind == host::AccelKind::grid    ? grid.build_ms
+           : accel_kind == host::AccelKind::bvh   ? box->build_ms + bvh->build_ms
+           : accel_kind == host::AccelKind::grid2 ? grid2->build_ms
+                                                  : box->build_ms + kd->build_ms;
   };
   std::optional<host::StreamTracer> tracer;
   if (!cpu) tracer.emplace(scene, accel, opt);
@@ -380,17 +387,29 @@ int run_render(const RenderArgs& a, bool lanes_given) {
         acc["references"] = kd->references();
         acc["sah_cost"] = kd->sah_cost;
         acc["build_ms"] = kd->build_ms;
+      } else if (accel_kind == host::AccelKind::grid2) {
+        const host::Grid& c = grid2->coarse;
+        acc["coarse"] = {c.res.x, c.res.y, c.res.z};
+        acc["crowded_cells"] = grid2->crowded;
+        acc["sub_cells"] = grid2->sub_cells();
+        acc["list_entries"] = grid2->lists.size();
+        acc["references"] = grid2->references;
+        acc["max_list"] = grid2->max_list;
+        acc["build_ms"] = grid2->build_ms;
       } else {
         acc["voxels"] = {walk_grid.res.x, walk_grid.res.y, walk_grid.res.z};
         acc["references"] = walk_grid.references();
         acc["build_ms"] = walk_grid.build_ms;
       }
       if (!cpu) {
-        const host::WalkWork w = host::walk_work(r.stats);
+        const host::WalkWork w = host::walk_work(r.stats, r.rays_traced);
         acc["work"] = {{"voxel_steps", w.voxel_steps},
                        {"nodes_visited", w.nodes_visited},
                        {"triangle_tests", w.triangle_tests},
                        {"loop_iterations", w.loop_iterations}};
+        // kd-restart's restarts, where the passes show them (WalkWork::restarts); else null.
+        acc["work"]["restarts"] =
+            w.restarts >= 0 ? nlohmann::ordered_json(w.restarts) : nlohmann::ordered_json();
       }
       if (choice) {
         nlohmann::ordered_json au;
@@ -548,6 +567,7 @@ int run_render(const RenderArgs& a, bool lanes_given) {
           }
         }
         if (accel_kind == host::AccelKind::kdtree) kd = host::build_kdtree(scene, box->lo, box->hi);
+        if (accel_kind == host::AccelKind::grid2) grid2 = host::build_grid2(scene);
       }
       const auto tu = std::chrono::steady_clock::now();
       if (tracer) up = tracer->update(scene, accel);
@@ -671,6 +691,12 @@ int run_render(const RenderArgs& a, bool lanes_given) {
       std::printf("%s (%.1f ms to build)\n", host::describe(*bvh).c_str(), bvh->build_ms);
     if (accel_kind == host::AccelKind::kdtree)
       std::printf("%s (%.1f ms to build)\n", host::describe(*kd).c_str(), kd->build_ms);
+    if (accel_kind == host::AccelKind::grid2)
+      std::printf(
+          "two-level grid: coarse %dx%dx%d, %d crowded cells, %zu sub-cells, %llu "
+          "references (%.1f ms to build)\n",
+          grid2->coarse.res.x, grid2->coarse.res.y, grid2->coarse.res.z, grid2->crowded,
+          grid2->sub_cells(), static_cast<unsigned long long>(grid2->references), grid2->build_ms);
     if (choice)
       std::printf("accel auto: %s (probes %.0f ms)\n", choice->why.c_str(), choice->probe_ms);
     std::printf("%s %s, %dx%d, %d iteration(s), %s shading, shadows %s, masks %s, mrt %s\n",
@@ -707,6 +733,7 @@ int run_kernels(const std::string& name, bool glsl) {
   programs.push_back(std::make_unique<vgpu::KernelProgram<kernels::LoopingTraversal>>());
   programs.push_back(std::make_unique<vgpu::KernelProgram<kernels::BvhLooping>>());
   programs.push_back(std::make_unique<vgpu::KernelProgram<kernels::KdLooping>>());
+  programs.push_back(std::make_unique<vgpu::KernelProgram<kernels::Grid2Looping>>());
   auto spelled = [](std::string n) {
     for (char& c : n)
       if (c == ' ') c = '-';

@@ -198,13 +198,15 @@ void add_render_options(CLI::App& render, RenderArgs& a) {
       ->check(kGridCheck)
       ->capture_default_str();
   render
-      .add_option("--accel", a.accel,
-                  "Acceleration structure the rays walk: grid (the paper's uniform grid) | bvh "
-                  "(a SAH bounding volume hierarchy walked stackless) | kdtree (a SAH kd-tree "
-                  "walked by kd-restart) | auto (builds each, renders a probe at a quarter of the "
-                  "size with each and keeps the one the cost model predicts cheapest on "
-                  "--profile). bvh and kdtree are extensions; docs/structures.md")
-      ->check(CLI::IsMember({"grid", "bvh", "kdtree", "auto"}))
+      .add_option(
+          "--accel", a.accel,
+          "Acceleration structure the rays walk: grid (the paper's uniform grid) | grid2 "
+          "(a two-level grid: crowded cells of a coarse grid hold a grid of their own) | bvh "
+          "(a SAH bounding volume hierarchy walked stackless) | kdtree (a SAH kd-tree "
+          "walked by kd-restart) | auto (builds each, renders a probe at a quarter of the "
+          "size with each and keeps the one the cost model predicts cheapest on "
+          "--profile). grid2, bvh and kdtree are extensions; docs/structures.md")
+      ->check(CLI::IsMember({"grid", "grid2", "bvh", "kdtree", "auto"}))
       ->capture_default_str();
   render
       .add_option("--profile", a.profile,

@@ -192,10 +192,15 @@ void FrameRecorder::pass(const PassObserver::Pass& p) {
   const bool trav =
       r.program == kernels::Traversal::name || r.program == kernels::TraverseUpdate::name ||
       r.program == kernels::BvhStep::name || r.program == kernels::BvhStepLoad::name ||
-      r.program == kernels::KdStep::name || r.program == kernels::KdStepLoad::name;
+      r.program == kernels::KdStep::name || r.program == kernels::KdStepLoad::name ||
+      r.program == kernels::Grid2Step::name || r.program == kernels::Grid2StepLoad::name;
   const bool isect =
       r.program == kernels::Intersections::name || r.program == kernels::IntersectNext::name ||
-      r.program == kernels::BvhIntersections::name || r.program == kernels::BvhIntersectNext::name;
+      r.program == kernels::BvhIntersections::name ||
+      r.program == kernels::BvhIntersectNext::name || r.program == kernels::KdIntersections::name ||
+      r.program == kernels::KdIntersectNext::name ||
+      r.program == kernels::Grid2Intersections::name ||
+      r.program == kernels::Grid2IntersectNext::name;
   if (work && W == w_ && H == h_) {
     r.work_mask = work_id_;
     // Plain loops over 0/1 bytes: they vectorize (this runs for every pass of the frame).

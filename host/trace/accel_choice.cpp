@@ -11,7 +11,7 @@
 
 namespace host {
 
-WalkWork walk_work(const vgpu::FrameStats& stats) {
+WalkWork walk_work(const vgpu::FrameStats& stats, uint64_t rays_traced) {
   WalkWork w;
   auto useful = [&](const char* name) -> uint64_t {
     const vgpu::FrameStats::ProgramTotals* p = stats.find(name);
@@ -20,13 +20,20 @@ WalkWork walk_work(const vgpu::FrameStats& stats) {
     return c.fragments_shaded - std::min(c.lanes_idle, c.fragments_shaded);
   };
   using namespace kernels;
-  w.voxel_steps = useful(Traversal::name) + useful(TraverseUpdate::name);
+  w.voxel_steps = useful(Traversal::name) + useful(TraverseUpdate::name) + useful(Grid2Step::name) +
+                  useful(Grid2StepLoad::name);
   w.nodes_visited = useful(BvhStep::name) + useful(BvhStepLoad::name) + useful(KdStep::name) +
                     useful(KdStepLoad::name);
   w.triangle_tests = useful(Intersections::name) + useful(IntersectNext::name) +
                      useful(BvhIntersections::name) + useful(BvhIntersectNext::name) +
-                     useful(KdIntersections::name) + useful(KdIntersectNext::name);
-  for (const char* name : {LoopingTraversal::name, BvhLooping::name, KdLooping::name})
+                     useful(KdIntersections::name) + useful(KdIntersectNext::name) +
+                     useful(Grid2Intersections::name) + useful(Grid2IntersectNext::name);
+  if (stats.find(KdLoadLeaf::name)) {
+    const uint64_t leaves = useful(KdLoadLeaf::name);
+    w.restarts = leaves >= rays_traced ? int64_t(leaves - rays_traced) : 0;
+  }
+  for (const char* name :
+       {LoopingTraversal::name, BvhLooping::name, KdLooping::name, Grid2Looping::name})
     if (const vgpu::FrameStats::ProgramTotals* p = stats.find(name))
       w.loop_iterations += p->counters.loop_iterations;
   return w;
@@ -75,6 +82,15 @@ AccelChoice choose_accel(const Scene& scene, const std::vector<AccelCandidate>& 
     }
   }
   if (!any) throw vgpu::Error("--accel auto: no structure fits: " + refused);
+  // The grid unless another is predicted clearly cheaper (kAutoGridMargin).
+  const auto grid = c.predicted_ms.find(std::string(accel_name(AccelKind::grid)));
+  bool kept = false;
+  if (c.kind != AccelKind::grid && grid != c.predicted_ms.end() &&
+      best > (1.0 - kAutoGridMargin) * grid->second) {
+    c.kind = AccelKind::grid;
+    best = grid->second;
+    kept = true;
+  }
   std::string others;
   for (const auto& [name, ms] : c.predicted_ms)
     if (name != accel_name(c.kind)) {
@@ -83,10 +99,11 @@ AccelChoice choose_accel(const Scene& scene, const std::vector<AccelCandidate>& 
                     name.c_str(), ms, ms / best);
       others += part;
     }
-  char line[512];
-  std::snprintf(line, sizeof line, "%s predicted %.1f ms on %s against %s, from %dx%d probes%s%s",
+  char line[640];
+  std::snprintf(line, sizeof line, "%s predicted %.1f ms on %s against %s, from %dx%d probes%s%s%s",
                 std::string(accel_name(c.kind)).c_str(), best, profile.name.c_str(),
                 others.empty() ? "nothing else" : others.c_str(), probe.width, probe.height,
+                kept ? " (the grid is kept unless another is predicted 10% cheaper)" : "",
                 refused.empty() ? "" : "; refused: ", refused.c_str());
   c.why = line;
   c.probe_ms =

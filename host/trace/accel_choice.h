@@ -17,6 +17,12 @@
 
 namespace host {
 
+// The grid (the paper's structure, and the default) is kept unless another is predicted at least
+// this share cheaper: the probe's extrapolation errs by about that much (measured at 256x256
+// primary rays on the bunny: the two-level grid predicted 6% cheaper than the grid from 64x64
+// probes, 12% dearer in the full frame, its longest walk growing with the image).
+inline constexpr double kAutoGridMargin = 0.10;
+
 struct AccelChoice {
   AccelKind kind = AccelKind::grid;
   int probe_width = 0, probe_height = 0;
@@ -30,12 +36,18 @@ struct AccelChoice {
 // the branch) of the walk's step passes and intersection passes, alone or fused. A looping walk
 // does both in one program: its loop iterations instead.
 struct WalkWork {
-  uint64_t voxel_steps = 0;      // grid: traversal passes' walking fragments
+  uint64_t voxel_steps = 0;      // grid, grid2: traversal (cell step) passes' walking fragments
   uint64_t nodes_visited = 0;    // bvh: recorridoBVH passes' walking fragments (one node each)
   uint64_t triangle_tests = 0;   // either: intersection passes' testing fragments
   uint64_t loop_iterations = 0;  // looping kernels: iterations run (a node, voxel or triangle each)
+  // kd-restart: walks begun again from the root (the CPU tracer's CpuStats::restarts). Every
+  // ray entering the tree reaches a leaf once, then once more per restart, and cargarHojaKd
+  // runs once per leaf reached; so restarts = its loading fragments - rays traced. Only where
+  // cargarHojaKd runs as a pass of its own (multipass, --mrt off); -1 elsewhere.
+  int64_t restarts = -1;
 };
-WalkWork walk_work(const vgpu::FrameStats& stats);
+// `rays_traced`: the frame's rays entering a walk (RenderResult::rays_traced), for restarts.
+WalkWork walk_work(const vgpu::FrameStats& stats, uint64_t rays_traced = 0);
 
 // The candidates (built by the caller), each with the formats it renders with. A candidate the
 // profile's limits refuse (vgpu::Error) drops out; throws vgpu::Error if none is left.

@@ -88,6 +88,7 @@ class Tracer {
         grid_(*accel.grid),
         bvh_(accel.kind == AccelKind::bvh ? accel.bvh : nullptr),
         kd_(accel.kind == AccelKind::kdtree ? accel.kd : nullptr),
+        grid2_(accel.kind == AccelKind::grid2 ? accel.grid2 : nullptr),
         cam_(camera),
         opt_(opt),
         primary_(camera, opt.width, opt.height) {
@@ -156,6 +157,7 @@ class Tracer {
     ++c.rays;
     if (bvh_) return trace_bvh(o, d, tmax, any_hit, c);
     if (kd_) return trace_kd(o, d, tmax, any_hit, c);
+    if (grid2_) return trace_grid2(o, d, tmax, any_hit, c);
     Hit best;
     // Slab test against the grid box.
     double tnear = 0.0, tfar = tmax;
@@ -417,11 +419,93 @@ class Tracer {
     }
   }
 
+  // The two-level grid (kernels/grid2.h) in double: the sub-cell of coarse cell c (Grid::index)
+  // holding coordinate x along `axis`, half-open slabs, clamped to the sub-grid.
+  int grid2_sub_of(size_t c, int axis, double x) const {
+    const int last = grid2_->sub_res[c][axis] - 1;
+    const double f =
+        std::floor((x - double(grid2_->sub_lo[c][axis])) / double(grid2_->sub_cell[c][axis]));
+    int i = std::isnan(f) ? 0 : int(std::clamp(f, 0.0, double(last)));
+    while (i > 0 && x < grid2_->sub_boundary(c, axis, i)) --i;
+    while (i < last && x >= grid2_->sub_boundary(c, axis, i + 1)) ++i;
+    return i;
+  }
+
+  // The walk of kernels/grid2.h: each sub-cell's triangles with the in-cell rule (its segment
+  // widened by the slack), then the next sub-cell; leaving the sub-grid steps the coarse grid
+  // and enters the next cell's sub-grid on the face crossed.
+  Hit trace_grid2(const glm::dvec3& o, const glm::dvec3& d, double tmax, bool any_hit,
+                  Counters& c) const {
+    Hit best;
+    const Grid& g = grid2_->coarse;
+    double tnear = 0.0, tfar = tmax;
+    for (int a = 0; a < 3; ++a) {
+      const double lo = g.boundary(a, 0), hi = g.boundary(a, g.res[a]);
+      if (d[a] == 0.0) {
+        if (o[a] < lo || o[a] > hi) return best;
+        continue;
+      }
+      double t0 = (lo - o[a]) / d[a], t1 = (hi - o[a]) / d[a];
+      if (t0 > t1) std::swap(t0, t1);
+      tnear = std::max(tnear, t0);
+      tfar = std::min(tfar, t1);
+    }
+    if (!(tnear <= tfar) || !(tmax >= 0.0)) return best;
+    ++c.entered;
+    glm::ivec3 cc = g.voxel_of(o + d * tnear);
+    size_t ci = g.index(cc);
+    glm::ivec3 s;
+    for (int a = 0; a < 3; ++a) s[a] = grid2_sub_of(ci, a, o[a] + d[a] * tnear);
+    double t_enter = tnear;
+    for (;;) {
+      ++c.voxel_steps;
+      const glm::ivec3 r = grid2_->sub_res[ci];
+      glm::dvec3 exits(kInf);
+      for (int a = 0; a < 3; ++a)
+        if (d[a] != 0.0)
+          exits[a] = (grid2_->sub_boundary(ci, a, s[a] + (d[a] > 0.0 ? 1 : 0)) - o[a]) / d[a];
+      const double t_exit = std::min({exits.x, exits.y, exits.z});
+      const size_t k = grid2_->first[ci] + size_t((s.z * r.y + s.y) * r.x + s.x);
+      for (int32_t e = grid2_->list_start[k]; grid2_->lists[size_t(e)] >= 0; ++e) {
+        const auto tri = size_t(grid2_->lists[size_t(e)]);
+        ++c.triangle_tests;
+        double t, u, v;
+        if (!intersect(o, d, tris_[tri], t, u, v)) continue;
+        if (t < t_enter - slack_ || t > t_exit + slack_ || !(t < tmax) || !(t < best.t)) continue;
+        best = Hit{int64_t(tri), t, u, v};
+        if (any_hit) return best;
+      }
+      if (best.tri >= 0) return best;
+      // Every axis tied at the exit steps; those leaving the sub-grid step the coarse grid.
+      glm::ivec3 st(0);
+      bool leaving[3] = {false, false, false}, any_leaving = false;
+      for (int a = 0; a < 3; ++a) {
+        if (exits[a] != t_exit) continue;
+        st[a] = d[a] > 0.0 ? 1 : -1;
+        s[a] += st[a];
+        if (s[a] < 0 || s[a] >= r[a]) {
+          leaving[a] = any_leaving = true;
+          cc[a] += st[a];
+          if (cc[a] < 0 || cc[a] >= g.res[a]) return best;
+        }
+      }
+      if (any_leaving) {
+        ci = g.index(cc);
+        for (int a = 0; a < 3; ++a)
+          s[a] = leaving[a] ? (st[a] > 0 ? 0 : grid2_->sub_res[ci][a] - 1)
+                            : grid2_sub_of(ci, a, o[a] + d[a] * t_exit);
+      }
+      t_enter = t_exit;
+      if (t_enter - slack_ >= tmax) return best;  // nothing left can pass t < tmax
+    }
+  }
+
  private:
   const Scene& scene_;
   const Grid& grid_;
   const Bvh* bvh_ = nullptr;
   const KdTree* kd_ = nullptr;
+  const Grid2* grid2_ = nullptr;
   const Camera& cam_;
   const RenderOptions& opt_;
   const PrimaryRays primary_;

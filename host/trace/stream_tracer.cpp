@@ -15,6 +15,7 @@
 #include "host/common/parallel.h"
 #include "host/trace/bvh_walk.h"
 #include "host/trace/devices.h"
+#include "host/trace/grid2_walk.h"
 #include "host/trace/kd_walk.h"
 #include "host/trace/passes.h"
 #include "host/trace/sampling.h"
@@ -172,6 +173,9 @@ StreamTracer::StreamTracer(const Scene& scene, const Accel& accel, const RenderO
   else if (accel.kind == AccelKind::kdtree)
     s.walk = std::make_unique<KdWalk>(gpu, *accel.kd, opt_, float(s.v[0].width()),
                                       float(kSlackOfDiagonal) * glm::length(grid.hi - grid.lo));
+  else if (accel.kind == AccelKind::grid2)  // the two-level grid (grid2_walk.h)
+    s.walk = std::make_unique<Grid2Walk>(gpu, *accel.grid2, opt_, float(s.v[0].width()),
+                                         float(kSlackOfDiagonal) * glm::length(grid.hi - grid.lo));
   else
     s.walk = std::make_unique<GridWalk>(gpu, grid, opt_, float(s.v[0].width()));
 

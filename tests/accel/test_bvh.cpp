@@ -272,7 +272,7 @@ TEST_CASE("acceleration structure names are parsed, and an unknown one is refuse
     CAPTURE(text);
     CHECK_THROWS_WITH_AS(
         host::parse_accel_kind(text),
-        ("unknown acceleration structure '" + text + "' (known: grid, bvh, kdtree)").c_str(),
+        ("unknown acceleration structure '" + text + "' (known: grid, grid2, bvh, kdtree)").c_str(),
         std::invalid_argument);
   }
 }

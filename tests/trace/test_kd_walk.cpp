@@ -218,6 +218,9 @@ TEST_CASE("the kd walk with mrt on gives the multipass images, depths and hit id
     CHECK(f.stats.find(kernels::KdStepLoad::name) != nullptr);
     CHECK(f.stats.find(kernels::KdIntersectNext::name) != nullptr);
     CHECK(f.stats.find(kernels::KdStep::name) == nullptr);
+    // The fused step loads leaves unseen: no restart count.
+    CHECK(host::walk_work(f.stats, f.rays_traced).restarts == -1);
+    CHECK(host::walk_work(m.stats, m.rays_traced).restarts >= 0);
     CHECK(f.stats.totals.passes < m.stats.totals.passes);
   }
 }
@@ -279,10 +282,13 @@ TEST_CASE("the kd walk's triangle tests and node steps match the CPU tracer's pr
     host::CpuStats cs;
     const host::RenderResult c = host::render_cpu(s.scene, s.kd_accel(), s.camera, opt, &cs);
     const host::RenderResult k = stream(s.scene, s.kd_accel(), s.camera, opt);
-    const host::WalkWork w = host::walk_work(k.stats);
+    const host::WalkWork w = host::walk_work(k.stats, k.rays_traced);
     REQUIRE(c.hit_id == k.hit_id);  // the same walks: no tie decided otherwise
     CHECK(w.triangle_tests == cs.triangle_tests);
     CHECK(w.nodes_visited == cs.nodes_visited + cs.restarts + c.rays_traced);
+    // The stream walk's restarts, from cargarHojaKd's loads, are the CPU walk's.
+    CHECK(cs.restarts > 0);
+    CHECK(w.restarts == int64_t(cs.restarts));
     CHECK(w.voxel_steps == 0);
     CHECK(w.loop_iterations == 0);
   }

@@ -1,0 +1,329 @@
+// The two-level grid walk's kernels (an extension; host/accel/grid2.h): the paper's 3D-DDA on
+// two levels, without a stack. The ray's state names one sub-cell; a step moves it to the next
+// sub-cell of its coarse cell's sub-grid (descending by DDA), and where it leaves the sub-grid
+// it steps the coarse grid and descends into the next coarse cell's sub-grid at the face it
+// crossed (climbing back costs nothing: the coarse cell is read from the sub-cell's texel).
+//   inicioGrilla2 (extension)          the coarse cell where the ray enters the box, then the
+//                                      sub-cell of its sub-grid holding the entry point
+//                                      (initTraversal's place)
+//   recorridoGrilla2 (extension)       one sub-cell per pass: done at a hit inside the sub-cell,
+//                                      else the next sub-cell (descend / step / climb)
+//                                      (traversal's place)
+//   cargarCelda (extension)            the first triangle of the sub-cell reached
+//                                      (actualizarVoxel's place; cargarHoja over these lists)
+//   interseccionesGrilla2 (extension)  one triangle per pass, a hit counting only inside the
+//                                      sub-cell's segment widened by t_slack (the in-voxel rule)
+// with proximoTriangulo, rayosIntersectando and rayosEnGrilla as the grid has them. Traversal
+// state (kernels/layout.h): x = sub-cell (-1: done), y = the sub-cell's list start, z, w = t
+// where the ray enters and leaves the sub-cell.
+#pragma once
+
+#include "kernels/bvh.h"
+#include "kernels/common.h"
+#include "kernels/init_traversal.h"
+#include "kernels/kdtree.h"
+
+namespace kernels {
+
+struct Grid2Uniforms {
+  glm::vec3 lo{0.0f};    // coarse grid box minimum, world space
+  glm::vec3 cell{1.0f};  // world size of one coarse cell
+  glm::vec3 res{1.0f};   // coarse cells per axis, as floats
+  float cell_width = 1;  // width of the coarse-cell texture, texels
+  float sub_width = 1;   // width of the sub-cell texture, texels
+  float list_width = 1;  // width of the two-level grid's triangle-list texture, texels
+  float t_slack = 0;     // the in-cell rule's tolerance, world units along a unit ray
+};
+
+// Index `id` of an x-fastest rx × ry × rz array as (x, y, z); ids below 2^24 decode exactly
+// (the + 1/2 keeps the quotient off the integer below).
+template <class F>
+inline Vec3<F> decode_index(const F& id, const F& rx, const F& ry) {
+  const F q = floor((id + F(0.5f)) / rx);
+  const F z = floor((q + F(0.5f)) / ry);
+  return {id - q * rx, q - z * ry, z};
+}
+
+// The sub-grid of coarse cell `cc`: its resolution (xyz) and first sub-cell (w) from the
+// coarse-cell texture, its box minimum and its sub-cell size (world space).
+template <class L>
+struct SubGrid {
+  using F = typename L::F;
+  Vec4<F> rec;
+  Vec3<F> lo, size;
+  SubGrid(const Fragments<L>& f, int unit_cells, const Vec3<F>& cc, const Grid2Uniforms& u) {
+    const F id = (cc.z * F(u.res.y) + cc.y) * F(u.res.x) + cc.x;
+    rec = fetch_id(f, unit_cells, id, u.cell_width);
+    lo = {F(u.lo.x) + cc.x * F(u.cell.x), F(u.lo.y) + cc.y * F(u.cell.y),
+          F(u.lo.z) + cc.z * F(u.cell.z)};
+    size = {F(u.cell.x) / rec.x, F(u.cell.y) / rec.y, F(u.cell.z) / rec.z};
+  }
+  // Per axis, the t where the ray leaves sub-cell s through that axis' next boundary (kFar
+  // for an axis the ray runs parallel to): voxel_exits over the sub-grid.
+  Vec3<F> exits(const Vec3<F>& o, const Vec3<F>& d, const Vec3<F>& s) const {
+    auto axis = [&](const F& oa, const F& da, const F& sa, const F& la, const F& ca) {
+      const F boundary = la + (sa + select(da > F(0.0f), F(1.0f), F(0.0f))) * ca;
+      return select(da == F(0.0f), F(kFar), (boundary - oa) / da);
+    };
+    return {axis(o.x, d.x, s.x, lo.x, size.x), axis(o.y, d.y, s.y, lo.y, size.y),
+            axis(o.z, d.z, s.z, lo.z, size.z)};
+  }
+};
+
+// The state of a ray entering coarse cell `cc` at parameter t: per axis, the sub-cell `given`
+// where from_point is 0 (clamped into the sub-grid: a huge value gives the last sub-cell), else
+// the sub-cell holding the point o + t d (clamped). Fetches the sub-cell's list start.
+template <class L>
+inline Vec4<typename L::F> grid2_cell(const Fragments<L>& f, int unit_cells, int unit_subs,
+                                      const Vec3<typename L::F>& o, const Vec3<typename L::F>& d,
+                                      const Vec3<typename L::F>& cc, const typename L::F& t,
+                                      const Vec3<typename L::F>& given,
+                                      const Vec3<typename L::F>& from_point,
+                                      const Grid2Uniforms& u) {
+  using F = typename L::F;
+  const SubGrid<L> sg(f, unit_cells, cc, u);
+  const Vec3<F> p = o + d * t;  // world space
+  auto sub = [&](const F& pa, const F& la, const F& ca, const F& ra, const F& ga, const F& fp) {
+    const F v = select(fp > F(0.5f), floor((pa - la) / ca), ga);
+    return min(max(v, F(0.0f)), ra - F(1.0f));
+  };
+  const Vec3<F> s{sub(p.x, sg.lo.x, sg.size.x, sg.rec.x, given.x, from_point.x),
+                  sub(p.y, sg.lo.y, sg.size.y, sg.rec.y, given.y, from_point.y),
+                  sub(p.z, sg.lo.z, sg.size.z, sg.rec.z, given.z, from_point.z)};
+  const F g = sg.rec.w + (s.z * sg.rec.y + s.y) * sg.rec.x + s.x;
+  const F list = fetch_id(f, unit_subs, g, u.sub_width).x;
+  return {g, list, t, min3(sg.exits(o, d, s))};
+}
+
+inline constexpr float kGrid2Far = 1e6f;  // a sub-cell index past any sub-grid's last
+
+// Entry of a ray with tmax ray_w: the coarse cell where it enters the box (initTraversal's
+// grid_entry over the coarse grid), then the sub-cell holding the entry point; or done.
+template <class L>
+inline Vec4<typename L::F> grid2_entry(const Fragments<L>& f, int unit_cells, int unit_subs,
+                                       const Vec3<typename L::F>& o, const Vec3<typename L::F>& d,
+                                       const typename L::F& ray_w, const Grid2Uniforms& u) {
+  using F = typename L::F;
+  const GridUniforms coarse{u.lo, u.cell, u.res, u.list_width, u.t_slack};
+  const Vec4<F> e = grid_entry<L>(o, d, ray_w, coarse);
+  const Vec3<F> zero{F(0.0f), F(0.0f), F(0.0f)}, one{F(1.0f), F(1.0f), F(1.0f)};
+  const Vec3<F> cc = select(e.x >= F(0.0f), e.xyz(), zero);  // a done ray reads cell 0
+  const Vec4<F> in = grid2_cell(f, unit_cells, unit_subs, o, d, cc, e.w, zero, one, u);
+  return select(e.x >= F(0.0f), in, Vec4<F>{F(kNone), F(kNone), F(0.0f), F(0.0f)});
+}
+
+// One step for the lanes where `walking` (others keep trav): done when a hit was found inside
+// the sub-cell trav.x or the ray leaves the box; else the next sub-cell along the ray. Every
+// axis tied at the exit steps at once, as the grid's DDA; an axis that leaves the sub-grid steps
+// the coarse grid, and the ray enters the next coarse cell's sub-grid on the face it crossed.
+template <class L>
+inline Vec4<typename L::F> grid2_step(const Fragments<L>& f, int unit_cells, int unit_subs,
+                                      const Vec4<typename L::F>& trav,
+                                      const Vec4<typename L::F>& best, const Vec3<typename L::F>& o,
+                                      const Vec3<typename L::F>& d, const typename L::M& walking,
+                                      const Grid2Uniforms& u) {
+  using F = typename L::F;
+  // Climb: the sub-cell's texel names its coarse cell.
+  const F c = fetch_id(f, unit_subs, trav.x, u.sub_width).y;
+  const Vec3<F> cc = decode_index(c, F(u.res.x), F(u.res.y));
+  const SubGrid<L> sg(f, unit_cells, cc, u);
+  const Vec3<F> s = decode_index(trav.x - sg.rec.w, sg.rec.x, sg.rec.y);
+  const Vec3<F> exits = sg.exits(o, d, s);
+  const F t_exit = min3(exits);
+  // Per axis: the step (+-1 where tied at the exit, else 0), the sub-cell after it, and
+  // whether that leaves the sub-grid.
+  auto stepped = [&](const F& da, const F& ea) {
+    return select(ea == t_exit, select(da > F(0.0f), F(1.0f), F(-1.0f)), F(0.0f));
+  };
+  const Vec3<F> st{stepped(d.x, exits.x), stepped(d.y, exits.y), stepped(d.z, exits.z)};
+  const Vec3<F> ns = s + st;
+  const auto lx = (ns.x < F(0.0f)) || (ns.x >= sg.rec.x);
+  const auto ly = (ns.y < F(0.0f)) || (ns.y >= sg.rec.y);
+  const auto lz = (ns.z < F(0.0f)) || (ns.z >= sg.rec.z);
+  const auto leaving = lx || ly || lz;
+  // The coarse cell after the step (moved along the axes that leave the sub-grid).
+  const Vec3<F> nc{cc.x + select(lx, st.x, F(0.0f)), cc.y + select(ly, st.y, F(0.0f)),
+                   cc.z + select(lz, st.z, F(0.0f))};
+  const auto outside = (nc.x < F(0.0f)) || (nc.y < F(0.0f)) || (nc.z < F(0.0f)) ||
+                       (nc.x >= F(u.res.x)) || (nc.y >= F(u.res.y)) || (nc.z >= F(u.res.z));
+  // Within the sub-grid: the stepped sub-cell. Into the next coarse cell: along a crossed axis
+  // its first (or last) sub-cell, along the others the sub-cell holding the crossing point.
+  auto given = [&](const typename L::M& leave, const F& sta, const F& nsa) {
+    return select(leave, select(sta > F(0.0f), F(0.0f), F(kGrid2Far)), nsa);
+  };
+  const F pt = select(leaving, F(1.0f), F(0.0f));
+  const Vec3<F> g{given(lx, st.x, ns.x), given(ly, st.y, ns.y), given(lz, st.z, ns.z)};
+  const Vec3<F> from_point{select(lx, F(0.0f), pt), select(ly, F(0.0f), pt),
+                           select(lz, F(0.0f), pt)};
+  const auto found = best.w >= F(0.0f);  // a hit inside this sub-cell ends the walk
+  const auto done = found || outside;
+  const Vec3<F> zero{F(0.0f), F(0.0f), F(0.0f)};
+  const Vec4<F> next = grid2_cell(f, unit_cells, unit_subs, o, d, select(outside, zero, nc), t_exit,
+                                  g, from_point, u);
+  const Vec4<F> finished{F(kNone), F(kNone), F(0.0f), F(0.0f)};
+  return select(walking, select(done, finished, next), trav);
+}
+
+struct Grid2Enter {
+  static constexpr const char* name = "grid2 enter";
+  static constexpr const char* paper_name = "inicioGrilla2 (extension)";
+  static constexpr int outputs = 1;  // -> traversal
+  enum Unit { kOrigins, kRays, kCells, kSubCells };
+  static constexpr std::array<const char*, 4> units{"origins", "rays", "grid2_cells",
+                                                    "grid2_subcells"};
+
+  Grid2Uniforms grid2;
+
+  template <class L>
+  void operator()(Fragments<L>& f) const {
+    using F = typename L::F;
+    const Vec4<F> ray = f.fetch_own(kRays);
+    f.out(0) =
+        grid2_entry(f, kCells, kSubCells, f.fetch_own(kOrigins).xyz(), ray.xyz(), ray.w, grid2);
+  }
+};
+
+struct Grid2Step {
+  static constexpr const char* name = "grid2 step";
+  static constexpr const char* paper_name = "recorridoGrilla2 (extension)";
+  static constexpr int outputs = 1;  // -> traversal
+  enum Unit { kOrigins, kRays, kTraversal, kIntersection, kCells, kSubCells };
+  static constexpr std::array<const char*, 6> units{
+      "origins", "rays", "traversal", "intersection", "grid2_cells", "grid2_subcells"};
+  static constexpr std::array<int, 1> passthrough{kTraversal};
+
+  Grid2Uniforms grid2;
+
+  template <class L>
+  void operator()(Fragments<L>& f) const {
+    using F = typename L::F;
+    const Vec4<F> trav = f.fetch_own(kTraversal);
+    const auto walking = trav.x >= F(0.0f);
+    Vec4<F> next = trav;
+    if (f.branch(walking)) {
+      const Vec4<F> best = f.fetch_own(kIntersection);
+      const Vec3<F> o = f.fetch_own(kOrigins).xyz(), d = f.fetch_own(kRays).xyz();
+      next = grid2_step(f, kCells, kSubCells, trav, best, o, d, walking, grid2);
+    }
+    f.out(0) = next;
+  }
+};
+
+// cargarCelda: cargarHoja (kernels/bvh.h) over the two-level grid's lists.
+struct Grid2LoadCell : BvhLoadLeaf {
+  static constexpr const char* name = "grid2 load cell";
+  static constexpr const char* paper_name = "cargarCelda (extension)";
+  static constexpr std::array<const char*, 3> units{"traversal", "voxel_state", "grid2_lists"};
+};
+
+// interseccionesGrilla2: interseccionesKd's test (the segment trav.zw is the sub-cell's); only
+// the uniforms' t_slack is read.
+struct Grid2Intersections : KdIntersections {
+  static constexpr const char* name = "grid2 intersections";
+  static constexpr const char* paper_name = "interseccionesGrilla2 (extension)";
+};
+
+// recorridoGrilla2 + cargarCelda (--mrt on): one step, and the first triangle of the sub-cell
+// reached.
+struct Grid2StepLoad {
+  static constexpr const char* name = "grid2 step + load cell";
+  static constexpr const char* paper_name = "recorridoGrilla2+cargarCelda (extension)";
+  static constexpr int outputs = 2;  // -> traversal, voxel state
+  enum Unit { kOrigins, kRays, kTraversal, kIntersection, kVoxelState, kCells, kSubCells, kLists };
+  static constexpr std::array<const char*, 8> units{"origins",        "rays",        "traversal",
+                                                    "intersection",   "voxel_state", "grid2_cells",
+                                                    "grid2_subcells", "grid2_lists"};
+  static constexpr std::array<int, 2> passthrough{kTraversal, kVoxelState};
+
+  Grid2Uniforms grid2;
+
+  template <class L>
+  void operator()(Fragments<L>& f) const {
+    using F = typename L::F;
+    const Vec4<F> trav = f.fetch_own(kTraversal);
+    const Vec4<F> vs = f.fetch_own(kVoxelState);
+    const auto walking = trav.x >= F(0.0f);
+    Vec4<F> next = trav, nvs = vs;
+    if (f.branch(walking)) {
+      const Vec4<F> best = f.fetch_own(kIntersection);
+      const Vec3<F> o = f.fetch_own(kOrigins).xyz(), d = f.fetch_own(kRays).xyz();
+      next = grid2_step(f, kCells, kSubCells, trav, best, o, d, walking, grid2);
+      const auto load = walking && (next.y >= F(0.0f)) && (vs.w < F(0.0f));
+      const F tri = fetch_id(f, kLists, next.y, grid2.list_width).x;
+      nvs = select(load, Vec4<F>{next.y, F(0.0f), F(0.0f), tri}, vs);
+    }
+    f.out(0) = next;
+    f.out(1) = nvs;
+  }
+};
+
+// interseccionesGrilla2 + proximoTriangulo (--mrt on): interseccionesKd + proximoTriangulo over
+// these lists (only the uniforms' list_width and t_slack are read).
+struct Grid2IntersectNext : KdIntersectNext {
+  static constexpr const char* name = "grid2 intersections + next triangle";
+  static constexpr const char* paper_name = "interseccionesGrilla2+proximoTriangulo (extension)";
+  static constexpr std::array<const char*, 9> units{"origins",     "rays",         "traversal",
+                                                    "voxel_state", "intersection", "vertices0",
+                                                    "vertices1",   "vertices2",    "grid2_lists"};
+};
+
+// recorridoGrilla2Iterativo (extension): the walk in one looping program. Each iteration tests
+// the sub-cell's next triangle if one is left, else takes one step (loading the first triangle
+// of the sub-cell reached). The host loads the entry sub-cell's first triangle before the loop.
+struct Grid2Looping {
+  static constexpr const char* name = "grid2 looping traversal";
+  static constexpr const char* paper_name = "recorridoGrilla2Iterativo (extension)";
+  static constexpr int outputs = 3;  // -> traversal, voxel state, intersection
+  enum Unit {
+    kOrigins,
+    kRays,
+    kTraversal,
+    kVoxelState,
+    kIntersection,
+    kV0,
+    kV1,
+    kV2,
+    kCells,
+    kSubCells,
+    kLists
+  };
+  static constexpr std::array<const char*, 11> units{
+      "origins",   "rays",      "traversal",   "voxel_state",    "intersection", "vertices0",
+      "vertices1", "vertices2", "grid2_cells", "grid2_subcells", "grid2_lists"};
+  static constexpr std::array<int, 3> passthrough{kTraversal, kVoxelState, kIntersection};
+
+  Grid2Uniforms grid2;
+  SceneUniforms scene;
+  int steps = 32;
+
+  template <class L>
+  void operator()(Fragments<L>& f) const {
+    using F = typename L::F;
+    using M = typename L::M;
+    Vec4<F> trav = f.fetch_own(kTraversal);
+    Vec4<F> vs = f.fetch_own(kVoxelState);
+    Vec4<F> best = f.fetch_own(kIntersection);
+    const Vec3<F> o = f.fetch_own(kOrigins).xyz();
+    const Vec4<F> ray = f.fetch_own(kRays);
+    f.loop(steps, trav.x >= F(0.0f), [&](const M& act) {
+      const M testing = act && (vs.w >= F(0.0f));
+      best = nearest_hit_in_leaf(f, kV0, o, ray, trav, vs, best, testing, scene, grid2.t_slack);
+      const F pos = vs.x + F(1.0f);
+      const F tri = fetch_id(f, kLists, pos, grid2.list_width).x;
+      const M stepping = act && !testing;
+      const Vec4<F> next =
+          grid2_step(f, kCells, kSubCells, trav, best, o, ray.xyz(), stepping, grid2);
+      const M load = stepping && (next.y >= F(0.0f));
+      const F first = fetch_id(f, kLists, next.y, grid2.list_width).x;
+      vs = select(testing, Vec4<F>{pos, F(0.0f), F(0.0f), tri},
+                  select(load, Vec4<F>{next.y, F(0.0f), F(0.0f), first}, vs));
+      trav = select(stepping, next, trav);
+      return trav.x >= F(0.0f);
+    });
+    f.out(0) = trav;
+    f.out(1) = vs;
+    f.out(2) = best;
+  }
+};
+
+}  // namespace kernels
