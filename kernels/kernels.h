@@ -1,10 +1,15 @@
 // The paper's fragment programs (and the shadow-ray extension), one functor per file, and the
-// fused two-output programs --mrt on runs (kernels/fused.h).
+// fused two-output programs --mrt on runs (kernels/fused.h), and the ray streams of glass
+// (dividirRayos, sumaPrefijos, contarRayos, compactarRayos, copiarFilas, reunirHijos, sombraVidrio).
 #pragma once
 
 #include "kernels/accumulate_samples.h"
 #include "kernels/bvh.h"
+#include "kernels/compact_stream.h"
+#include "kernels/copy_rows.h"
+#include "kernels/count_stream.h"
 #include "kernels/fused.h"
+#include "kernels/gather_children.h"
 #include "kernels/generate_rays.h"
 #include "kernels/init_traversal.h"
 #include "kernels/intersections.h"
@@ -20,8 +25,11 @@
 #include "kernels/reflection_origin.h"
 #include "kernels/reset_traversal.h"
 #include "kernels/resolve_samples.h"
+#include "kernels/scan_stream.h"
 #include "kernels/shader.h"
+#include "kernels/shadow_glass.h"
 #include "kernels/shadow_rays.h"
+#include "kernels/split_rays.h"
 #include "kernels/traversal.h"
 #include "kernels/undersample.h"
 #include "kernels/update_voxel.h"
@@ -70,3 +78,10 @@ extern template class vgpu::KernelProgram<kernels::KdIntersections>;
 extern template class vgpu::KernelProgram<kernels::KdStepLoad>;
 extern template class vgpu::KernelProgram<kernels::KdIntersectNext>;
 extern template class vgpu::KernelProgram<kernels::KdLooping>;
+extern template class vgpu::KernelProgram<kernels::SplitRays>;
+extern template class vgpu::KernelProgram<kernels::ScanStream>;
+extern template class vgpu::KernelProgram<kernels::CountStream>;
+extern template class vgpu::KernelProgram<kernels::CompactStream>;
+extern template class vgpu::KernelProgram<kernels::CopyRows>;
+extern template class vgpu::KernelProgram<kernels::GatherChildren>;
+extern template class vgpu::KernelProgram<kernels::ShadowGlass>;

@@ -62,6 +62,7 @@ int run_render(const RenderArgs& a, bool lanes_given) {
                                                         : vgpu::Filter::trilinear;
   opt.masks = a.masks == "on";
   opt.mrt = a.mrt == "on";
+  opt.ray_streams = a.ray_streams == "on";
   opt.looping = a.kernels == "looping";
   opt.steps_per_pass = a.steps_per_pass;
   opt.batch_walk = a.walk == "batches";
