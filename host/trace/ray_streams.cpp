@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <cstdio>
 
 namespace host {
 
@@ -19,6 +20,52 @@ bool scene_has_glass(const Scene& scene) {
 float unshaded_share(const Material& m) {
   if (m.transmission <= 0.0f) return m.reflect;
   return float(1.0 - (1.0 - double(m.transmission)) * (1.0 - double(m.reflect)));
+}
+
+nlohmann::ordered_json to_json(const StreamStats& s) {
+  nlohmann::ordered_json levels = nlohmann::ordered_json::array();
+  for (const StreamLevel& l : s.levels)
+    levels.push_back({{"rays", l.rays},
+                      {"chunks", l.chunks},
+                      {"reflected", l.reflected},
+                      {"refracted", l.refracted},
+                      {"total_internal", l.total_internal}});
+  auto job = [](uint64_t passes, uint64_t bytes) {
+    return nlohmann::ordered_json{{"passes", passes}, {"bytes", bytes}};
+  };
+  return {{"levels", levels},
+          {"split", job(s.split_passes, s.split_bytes)},
+          {"compaction", job(s.compaction_passes, s.compaction_bytes)},
+          {"copies", job(s.copy_passes, s.copy_bytes)},
+          {"gather", job(s.gather_passes, s.gather_bytes)},
+          {"shadow_glass", job(s.shadow_passes, s.shadow_bytes)},
+          {"shadow_rays_continued", s.shadow_continued}};
+}
+
+std::string describe(const StreamStats& s) {
+  std::string out = "ray streams: level rays (chunks) -> reflected + refracted (TIR):";
+  char line[200];
+  for (size_t k = 0; k < s.levels.size(); ++k) {
+    const StreamLevel& l = s.levels[k];
+    std::snprintf(
+        line, sizeof line, "%s %zu: %llu (%llu) -> %llu + %llu (%llu)", k ? ";" : "", k,
+        static_cast<unsigned long long>(l.rays), static_cast<unsigned long long>(l.chunks),
+        static_cast<unsigned long long>(l.reflected), static_cast<unsigned long long>(l.refracted),
+        static_cast<unsigned long long>(l.total_internal));
+    out += line;
+  }
+  auto mb = [](uint64_t b) { return double(b) / 1e6; };
+  std::snprintf(line, sizeof line,
+                "\nray streams: passes (MB) split %llu (%.1f), compaction %llu (%.1f), copies %llu "
+                "(%.1f), gather %llu (%.1f), shadows through glass %llu (%.1f), %llu shadow rays "
+                "continued\n",
+                static_cast<unsigned long long>(s.split_passes), mb(s.split_bytes),
+                static_cast<unsigned long long>(s.compaction_passes), mb(s.compaction_bytes),
+                static_cast<unsigned long long>(s.copy_passes), mb(s.copy_bytes),
+                static_cast<unsigned long long>(s.gather_passes), mb(s.gather_bytes),
+                static_cast<unsigned long long>(s.shadow_passes), mb(s.shadow_bytes),
+                static_cast<unsigned long long>(s.shadow_continued));
+  return out + line;
 }
 
 namespace {
@@ -87,6 +134,17 @@ RayStreams::Level& RayStreams::level(int k, uint64_t n) {
   }
   if (stats.levels.size() <= size_t(k)) stats.levels.resize(size_t(k) + 1);
   return L;
+}
+
+uint64_t RayStreams::texture_bytes() const {
+  uint64_t b = glass_.bytes() + counter_.bytes();
+  for (const Level& L : levels_)
+    for (const Texture* t : {&L.origins, &L.rays, &L.weight, &L.surface, &L.split, &L.colour,
+                             &L.gathered, &L.scan[0], &L.scan[1]})
+      b += t->bytes();
+  for (const Texture& t : work_) b += t.bytes();
+  for (int i = 0; i < 2; ++i) b += shadow_origins_[i].bytes() + shadow_rays_[i].bytes();
+  return b;
 }
 
 const vgpu::PassRecord& RayStreams::pass(PassRunner& r, const vgpu::Program& p,

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <deque>
 #include <initializer_list>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -25,6 +26,10 @@ bool scene_has_glass(const Scene& scene);
 // shade itself, 1 - (1 - t)(1 - a), so the paper's shader adds w (1 - t)(1 - a) C. Exactly a for
 // an opaque material.
 float unshaded_share(const Material& m);
+
+// The statistics as --stats-json writes them ("streams") and as the table's lines print them.
+nlohmann::ordered_json to_json(const StreamStats& s);
+std::string describe(const StreamStats& s);
 
 class RayStreams {
  public:
@@ -78,6 +83,8 @@ class RayStreams {
                                              const vgpu::Texture& shadow_rays,
                                              const vgpu::Texture* hits, Trace&& trace);
 
+  // Bytes of every texture the streams hold (the glass texture, the levels' and chunks' state).
+  uint64_t texture_bytes() const;
   vgpu::Texture& work(int i) { return work_[i]; }  // W x H chunk textures (multi-chunk levels)
   const vgpu::Texture& glass() const { return glass_; }
   vgpu::Texture& glass_mut() { return glass_; }

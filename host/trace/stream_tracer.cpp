@@ -361,7 +361,7 @@ uint64_t StreamTracer::texture_bytes() const {
   if (s_->textured)
     for (const Texture* t : {&s_->uvs01, &s_->uvs2, &s_->texture_table, &s_->atlas})
       b += t->bytes();
-  if (s_->streams) b += s_->streams->glass().bytes();
+  if (s_->streams) b += s_->streams->texture_bytes();  // grows with the frame's levels
   return b;
 }
 
