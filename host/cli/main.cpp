@@ -115,6 +115,7 @@ int run_render(const RenderArgs& a, bool lanes_given) {
                          : a.precision != "fp32"  ? "--precision"
                          : !a.formats.empty()     ? "--formats"
                          : opt.looping            ? "--kernels looping"
+                         : opt.ray_streams        ? "--ray-streams on"
                                                   : nullptr;
     if (unused)
       throw UsageError(std::string(unused) +

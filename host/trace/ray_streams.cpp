@@ -97,10 +97,16 @@ void RayStreams::set_scene(const kernels::SceneUniforms& scene, float offset) {
 
 RayStreams::Level& RayStreams::level(int k, uint64_t n) {
   const uint64_t wh = uint64_t(W_) * uint64_t(H_);
-  // Element indices are float texel addresses: exact below 2^24.
-  if (n >= (uint64_t(1) << 24))
-    throw vgpu::Error("ray streams: level " + std::to_string(k) + " has " + std::to_string(n) +
-                      " rays; stream indices are exact floats only below 2^24");
+  // Element indices are float texel addresses, computed in the passes' arithmetic: exact below
+  // 2^24 in fp32, 2^17 in fp24, 2^11 in fp16 (as NV3x's half could not address a long stream).
+  const vgpu::Format f = gpu_.profile().computes(opt_.formats.finest());
+  const int bits = f == vgpu::Format::fp16 ? 11 : f == vgpu::Format::fp24 ? 17 : 24;
+  if (std::max(n, wh) > (uint64_t(1) << bits))
+    throw vgpu::Error("ray streams: level " + std::to_string(k) + " has " +
+                      std::to_string(std::max(n, wh)) + " elements; " +
+                      std::string(vgpu::format_name(f)) +
+                      " arithmetic holds their indices exactly only up to " +
+                      std::to_string(uint64_t(1) << bits));
   while (levels_.size() <= size_t(k)) levels_.emplace_back();
   Level& L = levels_[size_t(k)];
   L.n = n;

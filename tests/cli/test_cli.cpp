@@ -917,6 +917,15 @@ TEST_CASE("ray streams write their levels and costs in the statistics, and refus
   const Outcome bad = run("render bunny-refl --size 16x16 -q --ray-streams sometimes --out " + png);
   CHECK(bad.status == 2);
   CHECK(bad.err.find("--ray-streams") != std::string::npos);
+  const Outcome cpu =
+      run("render bunny-refl --size 16x16 -q --ray-streams on --engine cpu --out " + png);
+  CHECK(cpu.status == 2);
+  CHECK(cpu.err.find("--ray-streams on needs --engine stream") != std::string::npos);
+  const Outcome half =
+      run("render bunny-refl --size 64x64 -q --ray-streams on --precision fp16 --out " + png);
+  CHECK(half.status != 0);
+  CHECK(half.err.find("fp16 arithmetic holds their indices exactly only up to 2048") !=
+        std::string::npos);
   const Outcome traced =
       run("render bunny-refl --size 16x16 -q --ray-streams on --trace-pixel 3,3 --out " + png);
   CHECK(traced.status != 0);
