@@ -1,10 +1,15 @@
 // The paper's fragment programs (and the shadow-ray extension), one functor per file, and the
-// fused two-output programs --mrt on runs (kernels/fused.h).
+// fused two-output programs --mrt on runs (kernels/fused.h), and the ray streams of glass
+// (dividirRayos, sumaPrefijos, contarRayos, compactarRayos, copiarFilas, reunirHijos, sombraVidrio).
 #pragma once
 
 #include "kernels/accumulate_samples.h"
 #include "kernels/bvh.h"
+#include "kernels/compact_stream.h"
+#include "kernels/copy_rows.h"
+#include "kernels/count_stream.h"
 #include "kernels/fused.h"
+#include "kernels/gather_children.h"
 #include "kernels/generate_rays.h"
 #include "kernels/grid2.h"
 #include "kernels/init_traversal.h"
@@ -21,8 +26,11 @@
 #include "kernels/reflection_origin.h"
 #include "kernels/reset_traversal.h"
 #include "kernels/resolve_samples.h"
+#include "kernels/scan_stream.h"
 #include "kernels/shader.h"
+#include "kernels/shadow_glass.h"
 #include "kernels/shadow_rays.h"
+#include "kernels/split_rays.h"
 #include "kernels/traversal.h"
 #include "kernels/undersample.h"
 #include "kernels/update_voxel.h"
@@ -78,3 +86,10 @@ extern template class vgpu::KernelProgram<kernels::Grid2Intersections>;
 extern template class vgpu::KernelProgram<kernels::Grid2StepLoad>;
 extern template class vgpu::KernelProgram<kernels::Grid2IntersectNext>;
 extern template class vgpu::KernelProgram<kernels::Grid2Looping>;
+extern template class vgpu::KernelProgram<kernels::SplitRays>;
+extern template class vgpu::KernelProgram<kernels::ScanStream>;
+extern template class vgpu::KernelProgram<kernels::CountStream>;
+extern template class vgpu::KernelProgram<kernels::CompactStream>;
+extern template class vgpu::KernelProgram<kernels::CopyRows>;
+extern template class vgpu::KernelProgram<kernels::GatherChildren>;
+extern template class vgpu::KernelProgram<kernels::ShadowGlass>;

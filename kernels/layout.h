@@ -65,6 +65,25 @@
 //                   texturaResultado)
 //   sample sum      rgb = sum of the sample frames' colours, a = samples added (--spp N > 1;
 //                   an extension, kernels/accumulate_samples.h)
+//
+// Ray streams (glass, or --ray-streams on; host/trace/ray_streams.h). Static, per triangle like
+// the colours:
+//   glass           x = mirror coefficient a, y = transmission t, z = index of refraction
+//   colors          under ray streams a = 1 - (1 - t)(1 - a): the share of a ray's weight its
+//                   surface does not shade itself (a itself when t = 0)
+// Per level k of the ray tree, element i at (i mod W, i div W), W the image's width (level 0:
+// the pixels), a chunk of W x H elements every H rows:
+//   origins, rays   as above (compactarRayos writes them for k >= 1; no ray past the level)
+//   weights         a = the ray's weight in its pixel (the shader's result before shading)
+//   surface         as above (inicioReflejo)
+//   split           x = reflected ray's weight, y = refracted ray's weight (0: not spawned),
+//                   z = rays spawned (0-2), w = 1 if the reflected one is a total internal
+//                   reflection (dividirRayos)
+//   scan            x = inclusive prefix sum of split z over elements 0..i (sumaPrefijos), fp32
+//   colour          rgb = the ray's own shaded contribution (weight x local colour)
+//   gathered        rgb = colour plus its children's gathered colours (reunirHijos)
+//   shadow origins  xyz = a shadow ray's origin past the glass met so far, w = the light's
+//                   transmittance so far (sombraVidrio; the shader's visibility)
 #pragma once
 
 #include <glm/glm.hpp>

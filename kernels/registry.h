@@ -63,6 +63,14 @@ inline std::vector<std::unique_ptr<vgpu::Program>> all_programs() {
   v.push_back(std::make_unique<vgpu::KernelProgram<Grid2Intersections>>());
   v.push_back(std::make_unique<vgpu::KernelProgram<Grid2StepLoad>>());
   v.push_back(std::make_unique<vgpu::KernelProgram<Grid2IntersectNext>>());
+  // Glass (an extension, issue 25): the ray streams, their compaction and the gather back.
+  v.push_back(std::make_unique<vgpu::KernelProgram<SplitRays>>());
+  v.push_back(std::make_unique<vgpu::KernelProgram<ScanStream>>());
+  v.push_back(std::make_unique<vgpu::KernelProgram<CountStream>>());
+  v.push_back(std::make_unique<vgpu::KernelProgram<CompactStream>>());
+  v.push_back(std::make_unique<vgpu::KernelProgram<CopyRows>>());
+  v.push_back(std::make_unique<vgpu::KernelProgram<ShadowGlass>>());
+  v.push_back(std::make_unique<vgpu::KernelProgram<GatherChildren>>());
   return v;
 }
 

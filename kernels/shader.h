@@ -49,6 +49,9 @@ struct Shader {
   glm::vec3 light{0.0f}, light_color{1.0f};  // world space; rgb x intensity
   bool first_light = true, last_light = true;
   bool shadows = false;  // kShadow holds this light's shadow-ray intersections
+  // Scenes with glass (sombraVidrio): kShadow holds instead the shadow origins whose w is the
+  // light's transmittance (0 blocked, 1 clear, the glass crossed's t multiplied).
+  bool shadow_transmittance = false;
   glm::vec3 ambient{0.1f};
   glm::vec3 background{0.0f};
   float specular = 0.5f;     // ks
@@ -90,7 +93,10 @@ struct Shader {
         lit = lit * (F(1.0f) / (F(1.0f) + q * q));
       }
       F vis = F(1.0f);
-      if (shadows) vis = select(f.fetch_own(kShadow).w >= F(0.0f), F(0.0f), F(1.0f));
+      if (shadows && shadow_transmittance)
+        vis = f.fetch_own(kShadow).w;
+      else if (shadows)
+        vis = select(f.fetch_own(kShadow).w >= F(0.0f), F(0.0f), F(1.0f));
       Vec3<F> c = lit * splat<F>(light_color) * vis;
       if (first_light) c = c + kd * splat<F>(ambient);
       const F a = mat.w;

@@ -31,6 +31,7 @@
 #include "host/trace/accel_choice.h"
 #include "host/trace/cpu_tracer.h"
 #include "host/trace/devices.h"
+#include "host/trace/ray_streams.h"
 #include "host/trace/sampling.h"
 #include "host/trace/stream_tracer.h"
 #include "kernels/registry.h"
@@ -92,6 +93,7 @@ int run_render(const RenderArgs& a, bool lanes_given) {
                                                         : vgpu::Filter::trilinear;
   opt.masks = a.masks == "on";
   opt.mrt = a.mrt == "on";
+  opt.ray_streams = a.ray_streams == "on";
   opt.looping = a.kernels == "looping";
   opt.steps_per_pass = a.steps_per_pass;
   opt.batch_walk = a.walk == "batches";
@@ -143,6 +145,7 @@ int run_render(const RenderArgs& a, bool lanes_given) {
                          : a.precision != "fp32"  ? "--precision"
                          : !a.formats.empty()     ? "--formats"
                          : opt.looping            ? "--kernels looping"
+                         : opt.ray_streams        ? "--ray-streams on"
                                                   : nullptr;
     if (unused)
       throw UsageError(std::string(unused) +
@@ -455,6 +458,7 @@ int run_render(const RenderArgs& a, bool lanes_given) {
                   {"nodes_visited", cpu_stats.nodes_visited},
                   {"restarts", cpu_stats.restarts}};
     j["rays_traced"] = r.rays_traced;
+    if (r.streams.on) j["streams"] = host::to_json(r.streams);  // glass's ray streams
     j["rays_unfinished"] = r.rays_unfinished;
     // Supersampling (--spp): samples per pixel and the passes it added to the first sample frame.
     {
@@ -704,6 +708,7 @@ int run_render(const RenderArgs& a, bool lanes_given) {
                 r.iterations, a.shading.c_str(), a.shadows.c_str(), a.masks.c_str(), a.mrt.c_str());
     if (!cpu)
       std::cout << "formats (texture and arithmetic, per group):\n" << describe(opt.formats);
+    if (r.streams.on) std::cout << host::describe(r.streams);
     std::printf("initialization %.1f ms (grid %.1f ms), render %.1f ms (%s)\n", init_ms,
                 walk_grid.build_ms, r.render_ms,
                 cpu            ? "host CPU"

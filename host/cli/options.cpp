@@ -234,6 +234,12 @@ void add_render_options(CLI::App& render, RenderArgs& a) {
                   "profile with more than one output (not gf5700); off: the paper's pipeline")
       ->check(CLI::IsMember(on_off))
       ->capture_default_str();
+  render
+      .add_option("--ray-streams", a.ray_streams,
+                  "Ray streams (glass, docs/materials.md): auto, only for a scene with a "
+                  "transmissive material; on, the paper's reflections through them too")
+      ->check(CLI::IsMember({"auto", "on"}))
+      ->capture_default_str();
   render.add_option("--stats", a.stats, "Statistics on stdout")
       ->check(CLI::IsMember({"table", "json", "none"}))
       ->capture_default_str();

@@ -28,6 +28,7 @@ struct RenderArgs {
   int lanes = vgpu::kLanes;
   std::string masks = "off";
   std::string mrt = "off";
+  std::string ray_streams = "auto";
   std::string stats = "table";
   std::string stats_json;
   std::string stats_csv;

@@ -105,12 +105,39 @@ struct RenderOptions {
   // pixels whose surfaces (host/trace/sampling.h) disagree; the rest are blended from the four
   // lattice pixels around them. One ray per traced pixel (spp 1).
   int undersample = 0;
+  // Ray streams (glass, host/trace/ray_streams.h) on a scene without glass: the paper's
+  // reflections through the same streams, compaction and gather back. A scene with a
+  // transmissive material always runs them.
+  bool ray_streams = false;
   std::optional<glm::ivec2> trace_pixel;  // print every pass this pixel took part in
   std::ostream* trace_out = nullptr;
   bool keep_pass_records = false;
   // Called at the start of each ray-tracing iteration (1-based) with the iteration count.
   std::function<void(int iteration, int iterations)> progress;
   PassObserver* observer = nullptr;  // not owned
+};
+
+// Glass's ray streams (host/trace/ray_streams.h): what one frame's streams held and cost,
+// summed over its sample frames.
+struct StreamLevel {
+  uint64_t rays = 0;            // rays traced at this level (level 0: every pixel's)
+  uint64_t chunks = 0;          // walks of W x H rays they took
+  uint64_t reflected = 0;       // rays this level spawned for the next: reflected,
+  uint64_t refracted = 0;       //   refracted,
+  uint64_t total_internal = 0;  //   and of the reflected, total internal reflections
+};
+struct StreamStats {
+  bool on = false;  // the frame ran as ray streams (a glass scene, or RenderOptions::ray_streams)
+  std::vector<StreamLevel> levels;
+  // Passes and bytes (read + written) by job: dividirRayos; the compaction (sumaPrefijos,
+  // contarRayos, compactarRayos); copiarFilas (levels past one chunk); reunirHijos; the shadow
+  // rays' continuation through glass (sombraVidrio and its counts).
+  uint64_t split_passes = 0, split_bytes = 0;
+  uint64_t compaction_passes = 0, compaction_bytes = 0;
+  uint64_t copy_passes = 0, copy_bytes = 0;
+  uint64_t gather_passes = 0, gather_bytes = 0;
+  uint64_t shadow_passes = 0, shadow_bytes = 0;
+  uint64_t shadow_continued = 0;  // shadow rays continued past a glass surface
 };
 
 struct RenderResult {
@@ -129,6 +156,7 @@ struct RenderResult {
   // Primary rays per pixel where they differ between pixels (--aa adaptive); empty: `samples`
   // in every pixel.
   std::vector<uint32_t> rays_per_pixel;
+  StreamStats streams;  // glass's ray streams; streams.on false: the paper's frame
 };
 
 }  // namespace host

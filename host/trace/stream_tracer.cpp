@@ -18,6 +18,7 @@
 #include "host/trace/grid2_walk.h"
 #include "host/trace/kd_walk.h"
 #include "host/trace/passes.h"
+#include "host/trace/ray_streams.h"
 #include "host/trace/sampling.h"
 #include "host/trace/textures.h"
 
@@ -67,6 +68,8 @@ struct StreamTracer::State {
   // The walk through the acceleration structure, and how passes are issued.
   std::unique_ptr<AccelWalk> walk;
   std::unique_ptr<PassRunner> runner;
+  // Glass (or --ray-streams on): the frame as ray streams (host/trace/ray_streams.h).
+  std::unique_ptr<RayStreams> streams;
 };
 
 kernels::ShadingModel parse_shading(const std::string& name) {
@@ -116,6 +119,17 @@ StreamTracer::StreamTracer(const Scene& scene, const Accel& accel, const RenderO
         "undersample: K must be 1 or more, with one ray per traced pixel (spp 1, not adaptive)");
   const bool sums = opt_.spp > 1 || opt_.undersample > 0;
   const bool marking = (opt_.adaptive && opt_.spp > 1) || opt_.undersample > 0;
+
+  // Ray streams: a scene with glass needs them; --ray-streams on runs the paper's reflections
+  // through them.
+  const bool glass = scene_has_glass(scene);
+  if (glass || opt_.ray_streams) {
+    if (opt_.trace_pixel)
+      throw vgpu::Error(
+          "--trace-pixel follows one pixel's ray, and ray streams (a glass scene or --ray-streams "
+          "on) move a pixel's rays to other texels");
+    s.streams = std::make_unique<RayStreams>(gpu, opt_, glass);
+  }
 
   // Scene textures: triangle i at texel (i mod width, i div width).
   write_scene(nullptr);
@@ -184,6 +198,7 @@ StreamTracer::StreamTracer(const Scene& scene, const Accel& accel, const RenderO
   for (const Texture* t : {&s.v[0], &s.v[1], &s.v[2], &s.n[0], &s.n[1], &s.n[2], &s.colors})
     gpu.upload(*t);
   if (marking) gpu.upload(s.materials);
+  if (s.streams) gpu.upload(s.streams->glass());
   s.walk->upload(gpu);
 
   // Dynamic textures: one texel per pixel.
@@ -250,6 +265,7 @@ uint64_t StreamTracer::write_scene(std::vector<std::string>* uploaded) {
       s.n[c] = gpu.make_texture("normals" + std::to_string(c), sw, int(sh), 3);
     }
     s.colors = gpu.make_texture("colors", sw, int(sh), 4);
+    if (s.streams) s.streams->glass_mut() = gpu.make_texture("glass", sw, int(sh), 4);
     if (marking) s.materials = gpu.make_texture("triangle materials", sw, int(sh), 1);
   }
   // Texel i is triangle i (row-major, rows of the texture's width); texels past the last
@@ -277,8 +293,14 @@ uint64_t StreamTracer::write_scene(std::vector<std::string>* uploaded) {
   }
   write(s.colors, [&](size_t i, float* t) {
     const Material& m = scene.materials[scene.material[i]];
-    t[0] = m.color.r, t[1] = m.color.g, t[2] = m.color.b, t[3] = m.reflect;
+    t[0] = m.color.r, t[1] = m.color.g, t[2] = m.color.b;
+    t[3] = s.streams ? unshaded_share(m) : m.reflect;
   });
+  if (s.streams)
+    write(s.streams->glass_mut(), [&](size_t i, float* t) {
+      const Material& m = scene.materials[scene.material[i]];
+      t[0] = m.reflect, t[1] = m.transmission, t[2] = m.ior, t[3] = 0.0f;
+    });
   if (marking) write(s.materials, [&](size_t i, float* t) { t[0] = float(scene.material[i]); });
   return bytes;
 }
@@ -295,6 +317,10 @@ void StreamTracer::set_uniforms() {
   s.keep.kernel.scene = su;
   s.shader.kernel.texture.on = s.textured;
   s.shader.kernel.texture.filter = opt_.texture_filter;
+  if (s.streams) {
+    s.streams->set_scene(su, float(kOffsetOfDiagonal) * diag);
+    s.shader.kernel.shadow_transmittance = s.streams->glass_scene() && opt_.shadows;
+  }
 }
 
 StreamTracer::Upload StreamTracer::update(const Scene& scene, const Grid& grid) {
@@ -321,6 +347,7 @@ uint64_t StreamTracer::static_bytes() const {
        {&s_->v[0], &s_->v[1], &s_->v[2], &s_->n[0], &s_->n[1], &s_->n[2], &s_->colors})
     b += t->bytes();
   if ((opt_.adaptive && opt_.spp > 1) || opt_.undersample > 0) b += s_->materials.bytes();
+  if (s_->streams) b += s_->streams->glass().bytes();
   return b;
 }
 
@@ -338,6 +365,7 @@ uint64_t StreamTracer::texture_bytes() const {
   if (s_->textured)
     for (const Texture* t : {&s_->uvs01, &s_->uvs2, &s_->texture_table, &s_->atlas})
       b += t->bytes();
+  if (s_->streams) b += s_->streams->texture_bytes();  // grows with the frame's levels
   return b;
 }
 
@@ -352,6 +380,7 @@ RenderResult StreamTracer::render(const Camera& cam) {
   gpu.stats().clear();
   PassRunner& r = *s.runner;
   r.counts = {};
+  if (s.streams) s.streams->stats = {};
   const int W = opt_.width, H = opt_.height;
   RenderResult res;
   res.width = W;
@@ -413,6 +442,7 @@ RenderResult StreamTracer::render(const Camera& cam) {
   res.rays_traced = r.counts.rays_traced;
   res.rays_unfinished = r.counts.rays_unfinished;
   res.batch_walk = r.counts.batch_walk;
+  if (s.streams) res.streams = s.streams->stats;
   res.render_ms = ms_since(t0);
   return res;
 }
@@ -533,10 +563,13 @@ void StreamTracer::render_undersampled(const Camera& cam, RenderResult& res,
 
 void StreamTracer::frame(const Camera& cam, const vgpu::Program& generate, RenderResult& res,
                          bool aovs, int& iteration_number, const Texture* marks, bool keep_hits) {
+  if (s_->streams) {
+    stream_frame(cam, generate, res, aovs, iteration_number, marks, keep_hits);
+    return;
+  }
   vgpu::Device& gpu = *gpu_;
   State& s = *s_;
   PassRunner& r = *s.runner;
-  const int W = opt_.width, H = opt_.height;
   int ro = 0;  // origins[ro]: this iteration's ray origins; origins[ro ^ 1]: its hit points
   gpu.clear(s.origins[ro], {cam.position.x, cam.position.y, cam.position.z, 0});
   if (marks)
@@ -562,19 +595,7 @@ void StreamTracer::frame(const Camera& cam, const vgpu::Program& generate, Rende
     // guardarImpactos: the primary hits' surface keys (--aa adaptive), before later traces
     // overwrite the intersections.
     if (it == 0 && keep_hits) r.pass(s.keep, {&hits, &s.materials}, s.marks[s.cur_mark]);
-    if (it == 0 && aovs) {
-      gpu.download(hits);
-      res.depth.assign(size_t(W) * H, 0.0f);
-      res.hit_id.assign(size_t(W) * H, -1.0f);
-      for (int y = 0; y < H; ++y)
-        for (int x = 0; x < W; ++x) {
-          const float* t = hits.texel(x, y);
-          if (t[3] >= 0) {
-            res.depth[size_t(y) * W + x] = t[0];
-            res.hit_id[size_t(y) * W + x] = float(scene_->id[size_t(t[3])]);
-          }
-        }
-    }
+    if (it == 0 && aovs) download_aovs(res);
     // inicioReflejo: hit points, the shader's record and the next rays' origins.
     Texture& surface = s.origins[ro ^ 1];
     r.pass(s.origin, {&s.origins[ro], &rays, &hits, &s.v[0], &s.v[1], &s.v[2]}, surface);
@@ -615,6 +636,148 @@ void StreamTracer::frame(const Camera& cam, const vgpu::Program& generate, Rende
            s.rays[s.cur_rays ^ 1]);
     s.cur_rays ^= 1;
     ro ^= 1;
+  }
+}
+
+void StreamTracer::download_aovs(RenderResult& res) {
+  Texture& hits = s_->isect[s_->cur_isect];
+  const int W = opt_.width, H = opt_.height;
+  gpu_->download(hits);
+  res.depth.assign(size_t(W) * H, 0.0f);
+  res.hit_id.assign(size_t(W) * H, -1.0f);
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      const float* t = hits.texel(x, y);
+      if (t[3] >= 0) {
+        res.depth[size_t(y) * W + x] = t[0];
+        res.hit_id[size_t(y) * W + x] = float(scene_->id[size_t(t[3])]);
+      }
+    }
+}
+
+void StreamTracer::stream_frame(const Camera& cam, const vgpu::Program& generate,
+                                RenderResult& res, bool aovs, int& iteration_number,
+                                const Texture* marks, bool keep_hits) {
+  vgpu::Device& gpu = *gpu_;
+  State& s = *s_;
+  PassRunner& r = *s.runner;
+  RayStreams& g = *s.streams;
+  const int W = opt_.width, H = opt_.height;
+  g.stats.on = true;
+  // Level 0 is the paper's primary frame: one ray per pixel from the eye, weight 1.
+  gpu.clear(s.origins[0], {cam.position.x, cam.position.y, cam.position.z, 0});
+  if (marks)
+    r.pass(generate, {marks}, s.rays[s.cur_rays]);
+  else
+    r.pass(generate, {}, s.rays[s.cur_rays]);
+  gpu.clear(s.result[s.cur_result], {0, 0, 0, 1});
+  const Texture* const statics[6] = {&s.v[0], &s.v[1], &s.v[2], &s.n[0], &s.n[1], &s.n[2]};
+  const int iterations = 1 + std::max(0, opt_.bounces);
+  uint64_t n = uint64_t(W) * uint64_t(H);
+  int deepest = 0;
+  for (int k = 0; k < iterations; ++k) {
+    const int number = ++iteration_number;
+    res.iterations = std::max(res.iterations, k + 1);
+    if (opt_.progress) opt_.progress(k + 1, iterations);
+    if (opt_.observer) opt_.observer->iteration(number);
+    RayStreams::Level& L = g.level(k, n);
+    g.stats.levels[size_t(k)].rays += n;
+    g.stats.levels[size_t(k)].chunks += uint64_t(L.chunks);
+    const bool spawns = k + 1 < iterations;
+    const bool chunked = L.chunks > 1;
+    for (int c = 0; c < L.chunks; ++c) {
+      // This chunk's rays, its surface record and spawn shares, and the pair the shader
+      // ping-pongs (the first holds the rays' weights): level 0 in the tracer's own textures,
+      // a one-chunk level in its own, a longer one through the chunk textures.
+      Texture *origins, *rays, *surface, *split, *col[2];
+      if (k == 0) {
+        origins = &s.origins[0], rays = &s.rays[s.cur_rays];
+        col[0] = &s.result[s.cur_result], col[1] = &s.result[s.cur_result ^ 1];
+        surface = &L.surface, split = &L.split;
+      } else if (!chunked) {
+        origins = &L.origins, rays = &L.rays, col[0] = &L.weight, col[1] = &L.colour;
+        surface = &L.surface, split = &L.split;
+      } else {
+        origins = &g.work(0), rays = &g.work(1), col[0] = &g.work(2), col[1] = &g.work(5);
+        surface = &g.work(3), split = &g.work(4);
+        g.copy_chunk(r, L.origins, *origins, c, false);
+        g.copy_chunk(r, L.rays, *rays, c, false);
+        g.copy_chunk(r, L.weight, *col[0], c, false);
+      }
+      if (opt_.observer)
+        opt_.observer->trace_begin(k ? PassObserver::TraceKind::reflected
+                                     : PassObserver::TraceKind::primary);
+      trace(*origins, *rays, k == 0, cam);
+      if (opt_.observer) opt_.observer->trace_end();
+      Texture& hits = s.isect[s.cur_isect];
+      if (k == 0 && keep_hits) r.pass(s.keep, {&hits, &s.materials}, s.marks[s.cur_mark]);
+      if (k == 0 && aovs) download_aovs(res);
+      // inicioReflejo: the hit points (the shader's record, the reflected rays' origins).
+      r.pass(s.origin, {origins, rays, &hits, &s.v[0], &s.v[1], &s.v[2]}, *surface);
+      // dividirRayos: the weights of the rays this one spawns, before the shader replaces the
+      // weight.
+      if (spawns)
+        g.pass(r, g.split,
+               {rays, surface, col[0], &g.glass(), &s.v[0], &s.v[1], &s.v[2], &s.n[0], &s.n[1],
+                &s.n[2]},
+               *split, nullptr, g.stats.split_passes, g.stats.split_bytes);
+      // shader: one pass per light after its shadow rays (continued through glass).
+      int cur = 0;
+      const auto& lights = scene_->lights;
+      for (size_t li = 0; li < lights.size(); ++li) {
+        Shader& sh = s.shader.kernel;
+        sh.light = lights[li].position;
+        sh.light_color = lights[li].color;
+        sh.first_light = li == 0;
+        sh.last_light = li + 1 == lights.size();
+        const Texture* shadow = &s.isect[s.cur_isect];
+        if (opt_.shadows) {
+          s.shadow.kernel.light = lights[li].position;
+          r.pass(s.shadow, {surface, col[cur]}, s.shadow_rays);
+          if (opt_.observer) opt_.observer->trace_begin(PassObserver::TraceKind::shadow);
+          trace(*surface, s.shadow_rays, false, cam);
+          shadow = &s.isect[s.cur_isect];
+          if (g.glass_scene())
+            shadow = &g.shadows_through_glass(r, *surface, s.shadow_rays, shadow,
+                                              [&](Texture& o, Texture& d) {
+                                                trace(o, d, false, cam);
+                                                return &s.isect[s.cur_isect];
+                                              });
+          if (opt_.observer) opt_.observer->trace_end();
+        }
+        if (s.textured)
+          r.pass(s.shader,
+                 {surface, rays, col[cur], shadow, &s.colors, &s.v[0], &s.v[1], &s.v[2], &s.n[0],
+                  &s.n[1], &s.n[2], origins, &s.uvs01, &s.uvs2, &s.texture_table, &s.atlas},
+                 *col[cur ^ 1]);
+        else
+          r.pass(s.shader,
+                 {surface, rays, col[cur], shadow, &s.colors, &s.v[0], &s.v[1], &s.v[2], &s.n[0],
+                  &s.n[1], &s.n[2]},
+                 *col[cur ^ 1]);
+        cur ^= 1;
+      }
+      if (k == 0) s.cur_result ^= cur;
+      if (!chunked) {
+        L.shaded = col[cur];
+      } else {
+        g.copy_chunk(r, *surface, L.surface, c, true);
+        if (spawns) g.copy_chunk(r, *split, L.split, c, true);
+        g.copy_chunk(r, *col[cur], L.colour, c, true);
+        L.shaded = &L.colour;
+      }
+    }
+    if (!spawns) break;
+    // The compaction: the next level holds only the rays spawned.
+    n = g.compact(r, k, k == 0 ? s.rays[s.cur_rays] : L.rays, statics);
+    if (n == 0) break;
+    deepest = k + 1;
+  }
+  // The colours return to the pixels, deepest level first (level 0's shaded colour is the
+  // current result).
+  if (deepest > 0) {
+    g.gather_back(r, deepest, s.result[s.cur_result ^ 1]);
+    s.cur_result ^= 1;
   }
 }
 

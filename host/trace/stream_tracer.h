@@ -63,6 +63,14 @@ class StreamTracer {
   // the primary hits' surface keys into the current marks texture.
   void frame(const Camera& cam, const vgpu::Program& generate, RenderResult& res, bool aovs,
              int& iteration_number, const vgpu::Texture* marks = nullptr, bool keep_hits = false);
+  // frame() as ray streams (a glass scene, or RenderOptions::ray_streams;
+  // host/trace/ray_streams.h): level 0 is the primary frame; each later level traces and
+  // shades, chunk by chunk, the rays the level before spawned (compacted), and the colours
+  // return to the pixels level by level. Same arguments and results as frame().
+  void stream_frame(const Camera& cam, const vgpu::Program& generate, RenderResult& res,
+                    bool aovs, int& iteration_number, const vgpu::Texture* marks, bool keep_hits);
+  // The primary hits' depths and input triangle ids into res, from the current intersections.
+  void download_aovs(RenderResult& res);
   // --aa adaptive (RenderOptions::adaptive): the centre frame, then levels of samples where the
   // marks say; leaves the resolved colour in the current result texture.
   void render_adaptive(const Camera& cam, RenderResult& res, int& iteration_number);

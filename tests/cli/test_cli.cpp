@@ -1037,3 +1037,59 @@ TEST_CASE("with --accel bvh or kdtree every frame rebuilds the structure and upl
   }
   fs::remove_all(dir);
 }
+
+TEST_CASE("ray streams write their levels and costs in the statistics, and refuse a traced pixel") {
+  const fs::path dir =
+      fs::temp_directory_path() / ("vgpu_cli_streams_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const std::string json = (dir / "s.json").string(), png = (dir / "s.png").string();
+  const Outcome o =
+      run("render bunny-refl --size 32x32 --ray-streams on --stats table -q "
+          "--stats-json " +
+          json + " --out " + png);
+  INFO(o.err);
+  REQUIRE(o.status == 0);
+  CHECK(o.out.find("ray streams: level rays") != std::string::npos);
+  const nlohmann::json j = nlohmann::json::parse(slurp(dir / "s.json"));
+  REQUIRE(j.contains("streams"));
+  const nlohmann::json& s = j["streams"];
+  REQUIRE(s["levels"].size() == 3);
+  CHECK(s["levels"][0]["rays"] == 32 * 32);
+  CHECK(s["levels"][1]["rays"] == s["levels"][0]["reflected"]);
+  CHECK(s["levels"][0]["refracted"] == 0);
+  CHECK(s["compaction"]["passes"].get<int>() > 0);
+  CHECK(s["gather"]["passes"] == 2);
+  // The frame report shows the levels (its summary reads the run's "streams").
+  const std::string html = (dir / "s.html").string();
+  const Outcome rep =
+      run("render bunny-refl --size 24x24 --ray-streams on -q --stats none --report " + html);
+  INFO(rep.err);
+  REQUIRE(rep.status == 0);
+  const std::string page = slurp(html);
+  CHECK(page.find("\"streams\":{\"levels\"") != std::string::npos);
+  CHECK(page.find("Ray streams: ${levels}") != std::string::npos);
+  // The paper's pipeline writes no streams.
+  REQUIRE(run("render bunny-refl --size 16x16 -q --stats none --stats-json " + json).status == 0);
+  CHECK_FALSE(nlohmann::json::parse(slurp(dir / "s.json")).contains("streams"));
+  // Bad values: one line, status 2, nothing written.
+  fs::remove(png);
+  const Outcome bad = run("render bunny-refl --size 16x16 -q --ray-streams sometimes --out " + png);
+  CHECK(bad.status == 2);
+  CHECK(bad.err.find("--ray-streams") != std::string::npos);
+  const Outcome cpu =
+      run("render bunny-refl --size 16x16 -q --ray-streams on --engine cpu --out " + png);
+  CHECK(cpu.status == 2);
+  CHECK(cpu.err.find("--ray-streams on needs --engine stream") != std::string::npos);
+  const Outcome half =
+      run("render bunny-refl --size 64x64 -q --ray-streams on --precision fp16 --out " + png);
+  CHECK(half.status != 0);
+  CHECK(half.err.find("fp16 arithmetic holds their indices exactly only up to 2048") !=
+        std::string::npos);
+  const Outcome traced =
+      run("render bunny-refl --size 16x16 -q --ray-streams on --trace-pixel 3,3 --out " + png);
+  CHECK(traced.status != 0);
+  CHECK(traced.err.find("--trace-pixel") != std::string::npos);
+  CHECK(std::count(traced.err.begin(), traced.err.end(), '\n') == 1);
+  CHECK_FALSE(fs::exists(png));
+  fs::remove_all(dir);
+}

@@ -1,0 +1,12 @@
+// The compiled programs of glass's ray streams (issue 25): dividirRayos, sumaPrefijos,
+// contarRayos, compactarRayos, copiarFilas, reunirHijos and sombraVidrio (kernels/kernels.h
+// declares them; every lane family of each is compiled here, once).
+#include "kernels/kernels.h"
+
+template class vgpu::KernelProgram<kernels::SplitRays>;
+template class vgpu::KernelProgram<kernels::ScanStream>;
+template class vgpu::KernelProgram<kernels::CountStream>;
+template class vgpu::KernelProgram<kernels::CompactStream>;
+template class vgpu::KernelProgram<kernels::CopyRows>;
+template class vgpu::KernelProgram<kernels::GatherChildren>;
+template class vgpu::KernelProgram<kernels::ShadowGlass>;
