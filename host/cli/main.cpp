@@ -699,7 +699,7 @@ int run_gl_devices() {
     std::printf("%d  %s%s\n", d.index, d.name.c_str(), d.software ? " (software)" : "");
   return 0;
 #else
-  throw host::InputError("gl-devices: this build has no GL device (EGL was not found)");
+  throw std::runtime_error("gl-devices: this build has no GL device (EGL was not found)");
 #endif
 }
 
@@ -794,6 +794,9 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "vgpu-rt: %s\n", e.what());
     return 2;
   } catch (const host::UnsupportedFeature& e) {  // a feature a frame at a time cannot honour
+    std::fprintf(stderr, "vgpu-rt: %s\n", e.what());
+    return 2;
+  } catch (const host::InputError& e) {  // a bad input file (or output path): the user's to fix
     std::fprintf(stderr, "vgpu-rt: %s\n", e.what());
     return 2;
   } catch (const std::exception& e) {

@@ -878,3 +878,30 @@ TEST_CASE("with --accel bvh or kdtree every frame rebuilds the structure and upl
   }
   fs::remove_all(dir);
 }
+
+TEST_CASE(
+    "a glass material with a bad ior or transmissionFactor: one line naming it, exit 2, no "
+    "image") {
+  const std::string data = std::string(VGPU_TEST_DATA) + "/gltf/";
+  const fs::path out =
+      fs::temp_directory_path() / ("vgpu_cli_glass_" + std::to_string(::getpid()) + ".png");
+  struct Case {
+    const char* file;
+    const char* problem;
+  };
+  for (const Case& c :
+       {Case{"glass_ior_below_one.gltf", "material 1: KHR_materials_ior.ior 0.5 is below 1"},
+        Case{"glass_ior_string.gltf", "material 1: KHR_materials_ior.ior is not a number"},
+        Case{"glass_transmission_above_one.gltf",
+             "material 1: KHR_materials_transmission.transmissionFactor 1.5 is outside [0, 1]"}}) {
+    CAPTURE(c.file);
+    for (const char* engine : {"stream", "cpu"}) {
+      CAPTURE(engine);
+      const Outcome o = run("render " + data + c.file + " -q --stats none --engine " + engine +
+                            " --out " + out.string());
+      CHECK(o.status == 2);
+      check_one_line(o, data + c.file, c.problem);
+      CHECK_FALSE(fs::exists(out));
+    }
+  }
+}
