@@ -389,7 +389,11 @@ int run_render(const RenderArgs& a, bool lanes_given) {
                   {"voxel_steps", cpu_stats.voxel_steps},
                   {"triangle_tests", cpu_stats.triangle_tests},
                   {"nodes_visited", cpu_stats.nodes_visited},
-                  {"restarts", cpu_stats.restarts}};
+                  {"restarts", cpu_stats.restarts},
+                  {"reflected", cpu_stats.reflected},
+                  {"refracted", cpu_stats.refracted},
+                  {"total_internal", cpu_stats.total_internal},
+                  {"glass_shadow_crossings", cpu_stats.glass_shadow_crossings}};
     j["rays_traced"] = r.rays_traced;
     j["rays_unfinished"] = r.rays_unfinished;
     // Supersampling (--spp): samples per pixel and the passes it added to the first sample frame.

@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <glm/glm.hpp>
+#include <vector>
 
 #include "host/accel/grid.h"
 #include "host/scene/scene.h"
@@ -22,6 +23,30 @@ struct CpuStats {
                                 // voxels may be tested once per voxel)
   uint64_t nodes_visited = 0;   // BVH nodes whose box was tested, kd-tree nodes descended
   uint64_t restarts = 0;        // kd-restart: walks begun again from the root (--accel kdtree)
+  // Glass: rays traced per iteration (index i: iteration i, 0 the primary rays', whose entry is
+  // 0; one entry per iteration the render ran, RenderResult::iterations) by kind: reflected (by a
+  // mirror, or by glass below its critical angle), refracted, and totally internally reflected (by
+  // glass past its critical angle). Their sum is every reflected-or-refracted ray cast.
+  std::vector<uint64_t> reflected, refracted, total_internal;
+  uint64_t glass_shadow_crossings = 0;  // glass surfaces shadow rays went through (each a ray)
+};
+
+// The kinds of ray in a pixel's ray tree.
+enum class CpuRayKind { primary, reflected, refracted, total_internal };
+
+// A shadow ray crosses at most this many glass surfaces; meeting one more blocks it
+// (docs/materials.md, "Shadow rays through glass").
+inline constexpr int kMaxGlassCrossings = 8;
+
+// One ray of a pixel's tree as the CPU tracer traces it (cpu_ray_tree).
+struct CpuRay {
+  int depth = 0;  // surfaces before it on its path: 0 for the primary ray
+  CpuRayKind kind = CpuRayKind::primary;
+  glm::dvec3 origin{0.0}, dir{0.0};  // world space; dir unit
+  double weight = 1;                 // its share of the pixel's colour
+  int64_t hit = -1;                  // internal triangle index it hits, -1: none
+  double t = 0;                      // hit distance (world units), infinite for none
+  double local_share = 1;  // of `weight`, the share its hit's own shading (or the background) has
 };
 
 // Renders with the options the stream tracer takes; the GPU-only ones (profile, lanes, masks,
@@ -53,6 +78,14 @@ RenderResult render_cpu(const Scene& scene, const Grid& grid, const Camera& came
 // triangle of a leaf tested; no voxel rule), counted in CpuStats::nodes_visited.
 RenderResult render_cpu(const Scene& scene, const Accel& accel, const Camera& camera,
                         const RenderOptions& options, CpuStats* stats = nullptr);
+
+// Every ray the CPU tracer traces for one camera ray from `origin` along the unit `dir` (shadow
+// rays aside), depth-first in the order traced: the tree of docs/materials.md's glass model, with
+// each ray's weight. A ray's weight is w times its parent's share; the weights of its hit's local
+// shading and of its children never sum above its own.
+std::vector<CpuRay> cpu_ray_tree(const Scene& scene, const Accel& accel,
+                                 const RenderOptions& options, const glm::dvec3& origin,
+                                 const glm::dvec3& dir);
 
 // host::primary_dir's contract (camera.h) evaluated in double from the camera's float fields:
 // the unit world-space direction through the centre of pixel (x, y), y = 0 the top row.
