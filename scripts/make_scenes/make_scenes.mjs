@@ -847,7 +847,7 @@ for (const [file, mesh, what, src] of [
 // 9. glass.gltf — issue 25: glass in the manner of Whitted's 1980 image
 // ---------------------------------------------------------------------------------------------
 {
-  const g = new Gltf('glass', "Issue 25 (glass): Whitted's 1980 image in spirit: a floating glass ball (ior 1.5) and a smaller water-clear one (ior 1.33) in front of a mirror sphere, and a glass bunny (the simplified bunny of bunny-low.gltf, ior 1.5), over the classic scene's red/yellow checkerboard (16 x 16 units), which they refract; the bunny mesh is open at its base, as the Stanford scan is", `${SRC_BUNNY_LOW.replace('scaled by 0.3', 'scaled by 0.25')}; checkerboard and spheres procedural, as classic.gltf`);
+  const g = new Gltf('glass', "Issue 25 (glass): Whitted's 1980 image in spirit: a floating glass ball (ior 1.5) and a smaller water-clear one (ior 1.33) in front of a mirror sphere, and a glass bunny (the simplified bunny of bunny-low.gltf, ior 1.5), over the classic scene's red/yellow checkerboard (16 x 16 units), which they refract; every glass mesh is closed (no boundary edges), so each ray that enters one can leave it", `${SRC_BUNNY_LOW.replace('scaled by 0.3', 'scaled by 0.25')}; checkerboard and spheres procedural, as classic.gltf`);
   const mRed = g.material('checker-red', [0.8, 0.1, 0.08], 0.0, 0.7);
   const mYellow = g.material('checker-yellow', [0.9, 0.8, 0.15], 0.0, 0.7);
   const mMirror = g.material('mirror-sphere', [0.9, 0.9, 0.92], 0.7, 0.05);
