@@ -14,6 +14,7 @@
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <numeric>
 #include <optional>
 
 #include "host/accel/accel.h"
@@ -600,14 +601,26 @@ int run_render(const RenderArgs& a, bool lanes_given) {
     }
     std::printf("initialization %.1f ms (the first frame's grid and uploads)\n", init_ms);
   } else if (a.stats == "table") {
-    if (cpu)
+    if (cpu) {
       std::printf(
           "CPU reference (double precision, recursive Whitted): %llu rays, %llu voxel steps, %llu "
           "triangle tests\n",
           static_cast<unsigned long long>(cpu_stats.rays),
           static_cast<unsigned long long>(cpu_stats.voxel_steps),
           static_cast<unsigned long long>(cpu_stats.triangle_tests));
-    else
+      // Glass (docs/materials.md): the rays of each kind, summed over the iterations.
+      auto sum = [](const std::vector<uint64_t>& v) {
+        return static_cast<unsigned long long>(std::accumulate(v.begin(), v.end(), uint64_t(0)));
+      };
+      if (sum(cpu_stats.refracted) + sum(cpu_stats.total_internal) +
+              cpu_stats.glass_shadow_crossings >
+          0)
+        std::printf(
+            "glass: %llu reflected, %llu refracted, %llu totally internally reflected rays; %llu "
+            "shadow-ray crossings\n",
+            sum(cpu_stats.reflected), sum(cpu_stats.refracted), sum(cpu_stats.total_internal),
+            static_cast<unsigned long long>(cpu_stats.glass_shadow_crossings));
+    } else
       std::cout << r.stats.to_table();
     std::printf(
         "scene %s: %zu triangles (%u dropped as degenerate), grid %dx%dx%d (%llu references)\n",

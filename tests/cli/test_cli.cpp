@@ -905,3 +905,38 @@ TEST_CASE(
     }
   }
 }
+
+TEST_CASE("the glass scene on the cpu engine counts its rays by kind per iteration in the JSON") {
+  const std::string id = std::to_string(::getpid());
+  const fs::path json = fs::temp_directory_path() / ("vgpu_cli_glass_" + id + ".json");
+  const Outcome o =
+      run("render glass --engine cpu --size 32x32 -q --stats table --stats-json " + json.string());
+  INFO(o.err);
+  REQUIRE(o.status == 0);
+  CHECK(o.out.find("glass: ") != std::string::npos);
+  const nlohmann::json j = nlohmann::json::parse(slurp(json));
+  fs::remove(json);
+  const nlohmann::json& cpu = j["cpu"];
+  const size_t iterations = j["iterations"].get<size_t>();
+  CHECK(iterations == 3);  // --bounces 2
+  uint64_t spawned = 0;
+  for (const char* kind : {"reflected", "refracted", "total_internal"}) {
+    CAPTURE(kind);
+    REQUIRE(cpu[kind].size() == iterations);
+    CHECK(cpu[kind][0] == 0);  // the primary rays are none of these
+    for (const auto& n : cpu[kind]) spawned += n.get<uint64_t>();
+  }
+  CHECK(cpu["refracted"][1].get<uint64_t>() > 0);  // the glass is seen, and refracts
+  CHECK(cpu["glass_shadow_crossings"].get<uint64_t>() > 0);
+  // Every ray cast is a primary, a spawned or a shadow ray.
+  CHECK(cpu["rays"].get<uint64_t>() > 32 * 32 + spawned);
+  // An opaque scene spawns reflected rays only.
+  const Outcome opaque = run("render classic --engine cpu --size 32x32 -q --stats json");
+  REQUIRE(opaque.status == 0);
+  const nlohmann::json c = nlohmann::json::parse(opaque.out)["cpu"];
+  CHECK(c["reflected"][1].get<uint64_t>() > 0);
+  CHECK(c["refracted"] == nlohmann::json::array({0, 0, 0}));
+  CHECK(c["total_internal"] == nlohmann::json::array({0, 0, 0}));
+  CHECK(c["glass_shadow_crossings"] == 0);
+  CHECK(opaque.out.find("glass: ") == std::string::npos);
+}
