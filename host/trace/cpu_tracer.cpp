@@ -274,9 +274,11 @@ class Tracer {
   }
 
   // Whitted's recursion: the colour seen along o + t d (d unit) by the surface `depth` (0-based)
-  // of the chain, whose weight in the final colour is w. Returns (1 - a) C + a L_reflected, so
-  // the primary call returns the paper's sum_i w_i (1 - a_i) C_i. The chain stops where the
-  // next weight w a falls under 1/512 or after 1 + bounces surfaces, as rayosReflejados does.
+  // of the tree, whose weight in the final colour is w. Opaque: returns (1 - a) C + a L_reflected,
+  // so the primary call returns the paper's sum_i w_i (1 - a_i) C_i. Glass (t > 0, the model of
+  // docs/materials.md): (1 - t)(1 - a) C + ((1 - t) a + t F) L_reflected + t (1 - F) L_refracted.
+  // A ray is spawned only if its weight is at least 1/512 and the path has fewer than 1 + bounces
+  // surfaces, as rayosReflejados does; `kind` is what spawned this one (cpu_ray_tree's log).
   glm::dvec3 radiance(const glm::dvec3& o, const glm::dvec3& d, int depth, double w, Hit* hit_out,
                       Counters& c, CpuRayKind kind = CpuRayKind::primary) const {
     c.iterations = std::max(c.iterations, depth + 1);
@@ -300,8 +302,8 @@ class Tracer {
     glm::dvec3 kd(mat.color);
     if (mat.texture >= 0) kd *= glm::dvec3(base_texel(h, d, mat.texture));
     glm::dvec3 local = kd * ambient_;
-    // Glass: t and its Fresnel term, read before the lights so that a surface with no local
-    // share casts no shadow rays (its (1 - t)(1 - a) is 0).
+    // The share of w the surface's own shading gets, known before the lights so that a clear
+    // glass (t = 1, share 0) casts no shadow rays.
     const double tr = mat.transmission;
     const double a = mat.reflect;
     const double local_share = tr > 0.0 ? (1.0 - tr) * (1.0 - a) : 1.0 - a;
@@ -327,13 +329,10 @@ class Tracer {
         const double q = dist / atten_dist_;
         lit /= 1.0 + q * q;
       }
-      if (through == 1.0)
-        local += lit * glm::dvec3(light.color);
-      else
-        local += lit * glm::dvec3(light.color) * through;
+      local += lit * glm::dvec3(light.color) * through;  // x 1 is exact: opaque scenes unchanged
     }
 
-    if (tr <= 0.0) {  // opaque: the paper's model, the arithmetic of the tracer before glass
+    if (tr <= 0.0) {  // opaque: the paper's model, in the paper's arithmetic
       glm::dvec3 colour = local * (1.0 - a);
       if (w * a >= min_weight_ && depth + 1 < iterations_) {
         const glm::dvec3 r = glm::normalize(glm::reflect(d, n));
@@ -377,7 +376,7 @@ class Tracer {
     const glm::dvec3 to_light = lp - from;
     double dist = glm::length(to_light);
     const glm::dvec3 ds = to_light / dist;
-    // Without glass any hit blocks, and any hit will do (the tracer before glass, unchanged).
+    // Without glass any hit blocks, so the first one found will do.
     if (!has_glass_) return trace(from, ds, dist, true, c).tri >= 0 ? 0.0 : 1.0;
     double through = 1.0;
     glm::dvec3 o = from;
@@ -651,7 +650,7 @@ glm::dvec3 cpu_primary_dir(const Camera& camera, int W, int H, int x, int y) {
 std::vector<CpuRay> cpu_ray_tree(const Scene& scene, const Accel& accel,
                                  const RenderOptions& options, const glm::dvec3& origin,
                                  const glm::dvec3& dir) {
-  const Camera camera;  // unused by radiance(); the tracer's texture footprints assume it
+  const Camera camera;  // only the trilinear texture footprint reads it (its pixel spread)
   Tracer tracer(scene, accel, camera, options);
   std::vector<CpuRay> rays;
   tracer.log_ = &rays;

@@ -62,11 +62,15 @@ struct CpuRay {
 //     normal interpolated by the hit's barycentrics; background black; with no lights, only the
 //     ambient term;
 //   - shadows: a ray from the offset hit point to each light, blocked by any hit with t below the
-//     light's distance;
+//     light's distance; with glass in the scene, dimmed by t at each glass surface it crosses
+//     (nearest first, at most kMaxGlassCrossings) and blocked by an opaque one;
 //   - offsets: reflection and shadow origin = hit point + geometric normal (towards the incoming
-//     side) * 1e-4 * grid diagonal;
+//     side) * 1e-4 * grid diagonal; a refracted ray's origin is on the other side;
 //   - blend: final = sum_i w_i (1 - a_i) C_i, w_{i+1} = w_i a_i; reflection stops when
-//     w < 1/512 or after 1 + bounces iterations.
+//     w < 1/512 or after 1 + bounces iterations;
+//   - glass (Material::transmission t > 0): docs/materials.md's model, the exact Fresnel term F
+//     of host/trace/optics.h splitting w into (1 - t)(1 - a) for the local shading, (1 - t) a + t F
+//     for the reflected ray and t (1 - F) for the refracted one, the same cut-off and limit.
 // Multi-threaded over rows (options.threads, 0 = every core); each pixel is computed alone, so
 // the output is bit-identical for any thread count. RenderResult::stats (vgpu::FrameStats) stays
 // empty; rays_traced counts the rays that enter the grid, as the stream tracer's queries do;
