@@ -34,9 +34,10 @@ struct CpuStats {
 // The kinds of ray in a pixel's ray tree.
 enum class CpuRayKind { primary, reflected, refracted, total_internal };
 
-// A shadow ray crosses at most this many glass surfaces; meeting one more blocks it
-// (docs/materials.md, "Shadow rays through glass").
-inline constexpr int kMaxGlassCrossings = 8;
+// A shadow ray crosses at most this many glass surfaces: the eighth glass surface it meets
+// blocks it (docs/materials.md, "Shadow rays through glass"; the stream tracer's 8 rounds of
+// sombraVidrio, the last of which blocks).
+inline constexpr int kMaxGlassCrossings = 7;
 
 // One ray of a pixel's tree as the CPU tracer traces it (cpu_ray_tree).
 struct CpuRay {
