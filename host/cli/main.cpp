@@ -616,9 +616,9 @@ int run_render(const RenderArgs& a, bool lanes_given) {
               cpu_stats.glass_shadow_crossings >
           0)
         std::printf(
-            "glass: %llu reflected, %llu refracted, %llu totally internally reflected rays; %llu "
+            "glass: %llu reflected rays (%llu of them totally internally), %llu refracted; %llu "
             "shadow-ray crossings\n",
-            sum(cpu_stats.reflected), sum(cpu_stats.refracted), sum(cpu_stats.total_internal),
+            sum(cpu_stats.reflected), sum(cpu_stats.total_internal), sum(cpu_stats.refracted),
             static_cast<unsigned long long>(cpu_stats.glass_shadow_crossings));
     } else
       std::cout << r.stats.to_table();

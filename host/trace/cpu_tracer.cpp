@@ -38,7 +38,7 @@ struct alignas(64) Counters {
   uint64_t rays = 0, entered = 0, voxel_steps = 0, triangle_tests = 0, nodes_visited = 0,
            restarts = 0, glass_shadow_crossings = 0;
   int iterations = 0;
-  // Rays traced per iteration (index 0: the primary rays' iteration, always 0) by kind.
+  // Rays spawned per iteration by kind (index i: spawned by iteration i, traced in i + 1).
   std::vector<uint64_t> reflected, refracted, total_internal;
   void count(std::vector<uint64_t>& kind, int iteration) {
     if (kind.size() <= size_t(iteration)) kind.resize(size_t(iteration) + 1, 0);
@@ -336,7 +336,7 @@ class Tracer {
       glm::dvec3 colour = local * (1.0 - a);
       if (w * a >= min_weight_ && depth + 1 < iterations_) {
         const glm::dvec3 r = glm::normalize(glm::reflect(d, n));
-        c.count(c.reflected, depth + 1);
+        c.count(c.reflected, depth);
         colour += a * radiance(lifted, r, depth + 1, w * a, nullptr, c, CpuRayKind::reflected);
       }
       return colour;
@@ -354,14 +354,15 @@ class Tracer {
         const glm::dvec3 r = glm::normalize(glm::reflect(d, n));
         // Past the critical angle the reflected ray is a totally internally reflected one.
         const bool tir = f.total;
-        c.count(tir ? c.total_internal : c.reflected, depth + 1);
+        c.count(c.reflected, depth);
+        if (tir) c.count(c.total_internal, depth);
         colour +=
             reflect_share * radiance(lifted, r, depth + 1, w * reflect_share, nullptr, c,
                                      tir ? CpuRayKind::total_internal : CpuRayKind::reflected);
       }
       if (refract_share > 0.0 && w * refract_share >= min_weight_) {
         const glm::dvec3 r = optics::refract(d, n, e, f);
-        c.count(c.refracted, depth + 1);
+        c.count(c.refracted, depth);
         colour += refract_share * radiance(p - ng * offset_, r, depth + 1, w * refract_share,
                                            nullptr, c, CpuRayKind::refracted);
       }

@@ -23,10 +23,11 @@ struct CpuStats {
                                 // voxels may be tested once per voxel)
   uint64_t nodes_visited = 0;   // BVH nodes whose box was tested, kd-tree nodes descended
   uint64_t restarts = 0;        // kd-restart: walks begun again from the root (--accel kdtree)
-  // Glass: rays traced per iteration (index i: iteration i, 0 the primary rays', whose entry is
-  // 0; one entry per iteration the render ran, RenderResult::iterations) by kind: reflected (by a
-  // mirror, or by glass below its critical angle), refracted, and totally internally reflected (by
-  // glass past its critical angle). Their sum is every reflected-or-refracted ray cast.
+  // Glass: rays spawned per iteration by kind, as the stream tracer's StreamLevel counts them
+  // (index i: spawned by iteration i, 0 the primary rays', and traced in iteration i + 1; one
+  // entry per iteration the render ran, RenderResult::iterations, so the last is 0): reflected
+  // (by a mirror or by glass), refracted, and total_internal, the reflected rays of glass past its
+  // critical angle (a part of `reflected`). reflected + refracted is every secondary ray cast.
   std::vector<uint64_t> reflected, refracted, total_internal;
   uint64_t glass_shadow_crossings = 0;  // glass surfaces shadow rays went through (each a ray)
 };
