@@ -14,6 +14,7 @@
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <numeric>
 #include <optional>
 
 #include "host/accel/accel.h"
@@ -456,7 +457,11 @@ int run_render(const RenderArgs& a, bool lanes_given) {
                   {"voxel_steps", cpu_stats.voxel_steps},
                   {"triangle_tests", cpu_stats.triangle_tests},
                   {"nodes_visited", cpu_stats.nodes_visited},
-                  {"restarts", cpu_stats.restarts}};
+                  {"restarts", cpu_stats.restarts},
+                  {"reflected", cpu_stats.reflected},
+                  {"refracted", cpu_stats.refracted},
+                  {"total_internal", cpu_stats.total_internal},
+                  {"glass_shadow_crossings", cpu_stats.glass_shadow_crossings}};
     j["rays_traced"] = r.rays_traced;
     if (r.streams.on) j["streams"] = host::to_json(r.streams);  // glass's ray streams
     j["rays_unfinished"] = r.rays_unfinished;
@@ -678,14 +683,26 @@ int run_render(const RenderArgs& a, bool lanes_given) {
     }
     std::printf("initialization %.1f ms (the first frame's grid and uploads)\n", init_ms);
   } else if (a.stats == "table") {
-    if (cpu)
+    if (cpu) {
       std::printf(
           "CPU reference (double precision, recursive Whitted): %llu rays, %llu voxel steps, %llu "
           "triangle tests\n",
           static_cast<unsigned long long>(cpu_stats.rays),
           static_cast<unsigned long long>(cpu_stats.voxel_steps),
           static_cast<unsigned long long>(cpu_stats.triangle_tests));
-    else
+      // Glass (docs/materials.md): the rays of each kind, summed over the iterations.
+      auto sum = [](const std::vector<uint64_t>& v) {
+        return static_cast<unsigned long long>(std::accumulate(v.begin(), v.end(), uint64_t(0)));
+      };
+      if (sum(cpu_stats.refracted) + sum(cpu_stats.total_internal) +
+              cpu_stats.glass_shadow_crossings >
+          0)
+        std::printf(
+            "glass: %llu reflected rays (%llu of them totally internally), %llu refracted; %llu "
+            "shadow-ray crossings\n",
+            sum(cpu_stats.reflected), sum(cpu_stats.total_internal), sum(cpu_stats.refracted),
+            static_cast<unsigned long long>(cpu_stats.glass_shadow_crossings));
+    } else
       std::cout << r.stats.to_table();
     std::printf(
         "scene %s: %zu triangles (%u dropped as degenerate), grid %dx%dx%d (%llu references)\n",
@@ -789,7 +806,7 @@ int run_gl_devices() {
     std::printf("%d  %s%s\n", d.index, d.name.c_str(), d.software ? " (software)" : "");
   return 0;
 #else
-  throw host::InputError("gl-devices: this build has no GL device (EGL was not found)");
+  throw std::runtime_error("gl-devices: this build has no GL device (EGL was not found)");
 #endif
 }
 
@@ -884,6 +901,9 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "vgpu-rt: %s\n", e.what());
     return 2;
   } catch (const host::UnsupportedFeature& e) {  // a feature a frame at a time cannot honour
+    std::fprintf(stderr, "vgpu-rt: %s\n", e.what());
+    return 2;
+  } catch (const host::InputError& e) {  // a bad input file (or output path): the user's to fix
     std::fprintf(stderr, "vgpu-rt: %s\n", e.what());
     return 2;
   } catch (const std::exception& e) {

@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <glm/gtc/quaternion.hpp>
@@ -113,6 +115,18 @@ glm::vec3 clamp01(const std::vector<double>& v) {
 // also when finite coordinates overflow the sum (the loader's checks have always meant this).
 bool all_finite(glm::vec3 v) {
   return std::isfinite(v.x + v.y + v.z);
+}
+
+// A number as a message shows it: as the file most likely wrote it (0.5, not 0.500000).
+std::string shortest(double x) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.17g", x);
+  for (int digits = 1; digits < 17; ++digits) {  // the fewest digits that read back the same
+    char shorter[32];
+    std::snprintf(shorter, sizeof shorter, "%.*g", digits, x);
+    if (std::strtod(shorter, nullptr) == x) return shorter;
+  }
+  return text;
 }
 
 // The distance between an accessor's elements: the view's byteStride, or `element` (the element
@@ -401,7 +415,52 @@ class Loader {
         }
       }
       if (m < base_color_.size()) out.texture = base_color_[m].texture;
+      read_glass(src, name, out);
       materials_.push_back(out);
+    }
+  }
+
+  // KHR_materials_transmission and KHR_materials_ior into out.transmission and out.ior (see
+  // gltf_loader.h for the rules). A number out of its valid range is refused: a typo in a glass
+  // would otherwise render as some other glass without a word.
+  void read_glass(const tinygltf::Material& src, const std::string& name, Material& out) {
+    // The number `key` of extension `ext` on this material, or nullopt when absent.
+    auto number = [&](const char* ext, const char* key) -> std::optional<double> {
+      const auto it = src.extensions.find(ext);
+      if (it == src.extensions.end()) return std::nullopt;
+      if (!it->second.IsObject()) fail(path_, name + ": " + ext + " is not an object");
+      if (!it->second.Has(key)) return std::nullopt;
+      const tinygltf::Value& v = it->second.Get(key);
+      if (!v.IsNumber()) fail(path_, name + ": " + ext + "." + key + " is not a number");
+      return v.GetNumberAsDouble();  // finite: the JSON check refuses overflowing numbers
+    };
+    if (const auto t = number("KHR_materials_transmission", "transmissionFactor")) {
+      if (!(*t >= 0.0 && *t <= 1.0))
+        fail(path_, name + ": KHR_materials_transmission.transmissionFactor " + shortest(*t) +
+                        " is outside [0, 1]");
+      out.transmission = float(*t);
+    }
+    if (src.extensions.count("KHR_materials_transmission")) {
+      const tinygltf::Value& v = src.extensions.at("KHR_materials_transmission");
+      if (v.Has("transmissionTexture"))
+        warnings_.push_back(name +
+                            ": KHR_materials_transmission.transmissionTexture is not supported; "
+                            "transmissionFactor alone is used");
+    }
+    if (const auto ior = number("KHR_materials_ior", "ior")) {
+      if (*ior == 0.0) {
+        // The extension's special value: the Fresnel term is 1 at every angle, so the surface
+        // transmits nothing. Under the glass model that is exactly the opaque mirror whose
+        // reflected share (1 - t) a + t is its reflection coefficient (its local share
+        // (1 - t)(1 - a) is then 1 - reflect), and shadow rays stop at it, as no light passes.
+        out.reflect = out.reflect + out.transmission * (1.0f - out.reflect);
+        out.transmission = 0.0f;
+      } else if (*ior < 1.0) {
+        fail(path_, name + ": KHR_materials_ior.ior " + shortest(*ior) +
+                        " is below 1 (only 0, the extension's special value, is allowed below 1)");
+      } else {
+        out.ior = float(*ior);
+      }
     }
   }
 

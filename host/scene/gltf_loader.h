@@ -59,6 +59,12 @@ struct LoadOptions {
 //   [0, 1], with the glTF defaults (white, metallicFactor 1) when absent; a number
 //   `extras.reflect` in [0, 1] on the material overrides reflect. A primitive without a material
 //   gets Material{} (0.8 grey, reflect 0), appended after the file's materials.
+// - Glass: KHR_materials_transmission.transmissionFactor (default 0) into transmission, and
+//   KHR_materials_ior.ior (default 1.5) into ior. A transmissionFactor outside [0, 1], an ior below
+//   1, or either not a number: InputError naming the material. ior 0, which the extension
+//   allows (a Fresnel term of 1 everywhere: nothing is transmitted), becomes the opaque mirror it
+//   is: transmission 0, reflect = a + t (1 - a). A transmissionTexture is not supported: a
+//   warning, and the factor alone is used. KHR_materials_volume is ignored (clear glass).
 // Textures
 // - pbrMetallicRoughness.baseColorTexture: its texture's image (a data: URI, a buffer view, or a
 //   file beside the .gltf; PNG or JPEG, decoded by LoadOptions::read_image) and its sampler's

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "host/common/parallel.h"
+#include "host/trace/optics.h"
 #include "host/trace/sampling.h"
 #include "host/trace/textures.h"
 #include "kernels/kernels.h"
@@ -35,9 +36,21 @@ struct Hit {
 // share one.
 struct alignas(64) Counters {
   uint64_t rays = 0, entered = 0, voxel_steps = 0, triangle_tests = 0, nodes_visited = 0,
-           restarts = 0;
+           restarts = 0, glass_shadow_crossings = 0;
   int iterations = 0;
+  // Rays spawned per iteration by kind (index i: spawned by iteration i, traced in i + 1).
+  std::vector<uint64_t> reflected, refracted, total_internal;
+  void count(std::vector<uint64_t>& kind, int iteration) {
+    if (kind.size() <= size_t(iteration)) kind.resize(size_t(iteration) + 1, 0);
+    ++kind[size_t(iteration)];
+  }
 };
+
+// Adds b into a, entry by entry, a growing to b's length.
+void add_into(std::vector<uint64_t>& a, const std::vector<uint64_t>& b) {
+  if (a.size() < b.size()) a.resize(b.size(), 0);
+  for (size_t i = 0; i < b.size(); ++i) a[i] += b[i];
+}
 
 // Moller-Trumbore, two-sided, closed triangle, t > 0: the kernels' intersect_triangle in double.
 bool intersect(const glm::dvec3& o, const glm::dvec3& d, const Tri& tri, double& t, double& u,
@@ -116,6 +129,7 @@ class Tracer {
     specular_ = shader.specular;
     min_weight_ = kernels::ReflectedRays{}.min_weight;
     for (const SceneTexture& t : scene.textures) chains_.push_back(build_mip_chain(t));
+    for (const Material& m : scene.materials) has_glass_ = has_glass_ || m.transmission > 0.0f;
     spread_ = 2.0 * primary_.t / double(opt.height);
   }
 
@@ -262,14 +276,18 @@ class Tracer {
   }
 
   // Whitted's recursion: the colour seen along o + t d (d unit) by the surface `depth` (0-based)
-  // of the chain, whose weight in the final colour is w. Returns (1 - a) C + a L_reflected, so
-  // the primary call returns the paper's sum_i w_i (1 - a_i) C_i. The chain stops where the
-  // next weight w a falls under 1/512 or after 1 + bounces surfaces, as rayosReflejados does.
+  // of the tree, whose weight in the final colour is w. Opaque: returns (1 - a) C + a L_reflected,
+  // so the primary call returns the paper's sum_i w_i (1 - a_i) C_i. Glass (t > 0, the model of
+  // docs/materials.md): (1 - t)(1 - a) C + ((1 - t) a + t F) L_reflected + t (1 - F) L_refracted.
+  // A ray is spawned only if its weight is at least 1/512 and the path has fewer than 1 + bounces
+  // surfaces, as rayosReflejados does; `kind` is what spawned this one (cpu_ray_tree's log).
   glm::dvec3 radiance(const glm::dvec3& o, const glm::dvec3& d, int depth, double w, Hit* hit_out,
-                      Counters& c) const {
+                      Counters& c, CpuRayKind kind = CpuRayKind::primary) const {
     c.iterations = std::max(c.iterations, depth + 1);
     const Hit h = trace(o, d, kInf, false, c);
     if (hit_out) *hit_out = h;
+    const size_t logged = log_ ? log_->size() : 0;
+    if (log_) log_->push_back(CpuRay{depth, kind, o, d, w, h.tri, h.t, 1.0});
     if (h.tri < 0) return background_;
     const size_t k = size_t(h.tri);
     const glm::dvec3 p = o + d * h.t;  // world space, on the surface
@@ -286,12 +304,19 @@ class Tracer {
     glm::dvec3 kd(mat.color);
     if (mat.texture >= 0) kd *= glm::dvec3(base_texel(h, d, mat.texture));
     glm::dvec3 local = kd * ambient_;
+    // The share of w the surface's own shading gets, known before the lights so that a clear
+    // glass (t = 1, share 0) casts no shadow rays.
+    const double tr = mat.transmission;
+    const double a = mat.reflect;
+    const double local_share = tr > 0.0 ? (1.0 - tr) * (1.0 - a) : 1.0 - a;
+    if (log_) (*log_)[logged].local_share = local_share;
     for (const PointLight& light : scene_.lights) {
+      if (tr > 0.0 && local_share == 0.0) break;
       const glm::dvec3 lp(light.position);
+      double through = 1.0;  // the share of the light that reaches p past glass
       if (opt_.shadows) {
-        const glm::dvec3 to_light = lp - lifted;
-        const double shadow_dist = glm::length(to_light);
-        if (trace(lifted, to_light / shadow_dist, shadow_dist, true, c).tri >= 0) continue;
+        through = light_through(lifted, lp, c);
+        if (through == 0.0) continue;
       }
       const glm::dvec3 to = lp - p;
       const double dist = glm::length(to);
@@ -306,17 +331,73 @@ class Tracer {
         const double q = dist / atten_dist_;
         lit /= 1.0 + q * q;
       }
-      local += lit * glm::dvec3(light.color);
+      local += lit * glm::dvec3(light.color) * through;  // x 1 is exact: opaque scenes unchanged
     }
 
-    const double a = mat.reflect;
-    glm::dvec3 colour = local * (1.0 - a);
-    if (w * a >= min_weight_ && depth + 1 < iterations_) {
-      const glm::dvec3 r = glm::normalize(glm::reflect(d, n));
-      colour += a * radiance(lifted, r, depth + 1, w * a, nullptr, c);
+    if (tr <= 0.0) {  // opaque: the paper's model, in the paper's arithmetic
+      glm::dvec3 colour = local * (1.0 - a);
+      if (w * a >= min_weight_ && depth + 1 < iterations_) {
+        const glm::dvec3 r = glm::normalize(glm::reflect(d, n));
+        c.count(c.reflected, depth);
+        colour += a * radiance(lifted, r, depth + 1, w * a, nullptr, c, CpuRayKind::reflected);
+      }
+      return colour;
+    }
+
+    // Glass (docs/materials.md): entering when d meets the front of the triangle's winding.
+    const bool entering = glm::dot(d, geo_normals_[k]) < 0.0;
+    const double e = entering ? 1.0 / double(mat.ior) : double(mat.ior);
+    const optics::Interface f = optics::meet(d, n, e);
+    const double reflect_share = (1.0 - tr) * a + tr * f.reflectance;
+    const double refract_share = tr * (1.0 - f.reflectance);
+    glm::dvec3 colour = local * local_share;
+    if (depth + 1 < iterations_) {
+      if (reflect_share > 0.0 && w * reflect_share >= min_weight_) {
+        const glm::dvec3 r = glm::normalize(glm::reflect(d, n));
+        // Past the critical angle the reflected ray is a totally internally reflected one.
+        const bool tir = f.total;
+        c.count(c.reflected, depth);
+        if (tir) c.count(c.total_internal, depth);
+        colour +=
+            reflect_share * radiance(lifted, r, depth + 1, w * reflect_share, nullptr, c,
+                                     tir ? CpuRayKind::total_internal : CpuRayKind::reflected);
+      }
+      if (refract_share > 0.0 && w * refract_share >= min_weight_) {
+        const glm::dvec3 r = optics::refract(d, n, e, f);
+        c.count(c.refracted, depth);
+        colour += refract_share * radiance(p - ng * offset_, r, depth + 1, w * refract_share,
+                                           nullptr, c, CpuRayKind::refracted);
+      }
     }
     return colour;
   }
+
+  // The share of a light at lp that reaches `from` (the lifted hit point): 0 behind an opaque
+  // surface, the product of the transmissions of the glass surfaces between (no caustics:
+  // refraction does not bend the shadow ray), 0 past more than kMaxGlassCrossings of them.
+  double light_through(const glm::dvec3& from, const glm::dvec3& lp, Counters& c) const {
+    const glm::dvec3 to_light = lp - from;
+    double dist = glm::length(to_light);
+    const glm::dvec3 ds = to_light / dist;
+    // Without glass any hit blocks, so the first one found will do.
+    if (!has_glass_) return trace(from, ds, dist, true, c).tri >= 0 ? 0.0 : 1.0;
+    double through = 1.0;
+    glm::dvec3 o = from;
+    for (int crossed = 0;; ++crossed) {
+      const Hit h = trace(o, ds, dist, false, c);  // the nearest: the crossings go in order
+      if (h.tri < 0) return through;
+      const double t = scene_.materials[scene_.material[size_t(h.tri)]].transmission;
+      if (t <= 0.0 || crossed == kMaxGlassCrossings) return 0.0;
+      ++c.glass_shadow_crossings;
+      through *= t;
+      o += ds * (h.t + offset_);  // p + d_s ε, on along the same line
+      dist -= h.t + offset_;
+      if (!(dist > 0.0)) return through;
+    }
+  }
+
+  // Where radiance() writes every ray it traces (cpu_ray_tree), or null.
+  std::vector<CpuRay>* log_ = nullptr;
 
   // The stackless BVH walk (kernels/bvh.h) in double: every node in depth-first order whose
   // padded box the ray meets before the nearest hit so far, its escape otherwise.
@@ -518,6 +599,7 @@ class Tracer {
   glm::dvec3 ambient_, background_;
   double specular_ = 0, min_weight_ = 0;
   std::vector<MipChain> chains_;  // per Scene::textures entry
+  bool has_glass_ = false;        // some material has transmission > 0
   double spread_ = 0;             // angle between neighbouring pixels' rays (base_texel)
 };
 
@@ -660,6 +742,18 @@ glm::dvec3 cpu_primary_dir(const Camera& camera, int W, int H, int x, int y) {
   return PrimaryRays(camera, W, H).dir(x, y);
 }
 
+std::vector<CpuRay> cpu_ray_tree(const Scene& scene, const Accel& accel,
+                                 const RenderOptions& options, const glm::dvec3& origin,
+                                 const glm::dvec3& dir) {
+  const Camera camera;  // only the trilinear texture footprint reads it (its pixel spread)
+  Tracer tracer(scene, accel, camera, options);
+  std::vector<CpuRay> rays;
+  tracer.log_ = &rays;
+  Counters counters;
+  tracer.radiance(origin, glm::normalize(dir), 0, 1.0, nullptr, counters);
+  return rays;
+}
+
 RenderResult render_cpu(const Scene& scene, const Grid& grid, const Camera& camera,
                         const RenderOptions& options, CpuStats* stats) {
   return render_cpu(scene, Accel{AccelKind::grid, &grid, nullptr}, camera, options, stats);
@@ -702,9 +796,15 @@ RenderResult render_cpu(const Scene& scene, const Accel& accel, const Camera& ca
     total.triangle_tests += c.triangle_tests;
     total.nodes_visited += c.nodes_visited;
     total.restarts += c.restarts;
+    total.glass_shadow_crossings += c.glass_shadow_crossings;
+    add_into(total.reflected, c.reflected);
+    add_into(total.refracted, c.refracted);
+    add_into(total.total_internal, c.total_internal);
     res.rays_traced += c.entered;
     res.iterations = std::max(res.iterations, c.iterations);
   }
+  for (auto* kind : {&total.reflected, &total.refracted, &total.total_internal})
+    kind->resize(size_t(std::max(res.iterations, 1)), 0);  // one entry per iteration run
   if (stats) *stats = total;
   if (res.rays_per_pixel.empty()) res.samples = std::max(options.spp, 1);
   res.render_ms = ms_since(t0);

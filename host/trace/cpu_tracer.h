@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <glm/glm.hpp>
+#include <vector>
 
 #include "host/accel/grid.h"
 #include "host/scene/scene.h"
@@ -22,6 +23,32 @@ struct CpuStats {
                                 // voxels may be tested once per voxel)
   uint64_t nodes_visited = 0;   // BVH nodes whose box was tested, kd-tree nodes descended
   uint64_t restarts = 0;        // kd-restart: walks begun again from the root (--accel kdtree)
+  // Glass: rays spawned per iteration by kind, as the stream tracer's StreamLevel counts them
+  // (index i: spawned by iteration i, 0 the primary rays', and traced in iteration i + 1; one
+  // entry per iteration the render ran, RenderResult::iterations, so the last is 0): reflected
+  // (by a mirror or by glass), refracted, and total_internal, the reflected rays of glass past its
+  // critical angle (a part of `reflected`). reflected + refracted is every secondary ray cast.
+  std::vector<uint64_t> reflected, refracted, total_internal;
+  uint64_t glass_shadow_crossings = 0;  // glass surfaces shadow rays went through (each a ray)
+};
+
+// The kinds of ray in a pixel's ray tree.
+enum class CpuRayKind { primary, reflected, refracted, total_internal };
+
+// A shadow ray crosses at most this many glass surfaces: the eighth glass surface it meets
+// blocks it (docs/materials.md, "Shadow rays through glass"; the stream tracer's 8 rounds of
+// sombraVidrio, the last of which blocks).
+inline constexpr int kMaxGlassCrossings = 7;
+
+// One ray of a pixel's tree as the CPU tracer traces it (cpu_ray_tree).
+struct CpuRay {
+  int depth = 0;  // surfaces before it on its path: 0 for the primary ray
+  CpuRayKind kind = CpuRayKind::primary;
+  glm::dvec3 origin{0.0}, dir{0.0};  // world space; dir unit
+  double weight = 1;                 // its share of the pixel's colour
+  int64_t hit = -1;                  // internal triangle index it hits, -1: none
+  double t = 0;                      // hit distance (world units), infinite for none
+  double local_share = 1;  // of `weight`, the share its hit's own shading (or the background) has
 };
 
 // Renders with the options the stream tracer takes; the GPU-only ones (profile, lanes, masks,
@@ -37,11 +64,15 @@ struct CpuStats {
 //     normal interpolated by the hit's barycentrics; background black; with no lights, only the
 //     ambient term;
 //   - shadows: a ray from the offset hit point to each light, blocked by any hit with t below the
-//     light's distance;
+//     light's distance; with glass in the scene, dimmed by t at each glass surface it crosses
+//     (nearest first, at most kMaxGlassCrossings) and blocked by an opaque one;
 //   - offsets: reflection and shadow origin = hit point + geometric normal (towards the incoming
-//     side) * 1e-4 * grid diagonal;
+//     side) * 1e-4 * grid diagonal; a refracted ray's origin is on the other side;
 //   - blend: final = sum_i w_i (1 - a_i) C_i, w_{i+1} = w_i a_i; reflection stops when
-//     w < 1/512 or after 1 + bounces iterations.
+//     w < 1/512 or after 1 + bounces iterations;
+//   - glass (Material::transmission t > 0): docs/materials.md's model, the exact Fresnel term F
+//     of host/trace/optics.h splitting w into (1 - t)(1 - a) for the local shading, (1 - t) a + t F
+//     for the reflected ray and t (1 - F) for the refracted one, the same cut-off and limit.
 // Multi-threaded over rows (options.threads, 0 = every core); each pixel is computed alone, so
 // the output is bit-identical for any thread count. RenderResult::stats (vgpu::FrameStats) stays
 // empty; rays_traced counts the rays that enter the grid, as the stream tracer's queries do;
@@ -53,6 +84,14 @@ RenderResult render_cpu(const Scene& scene, const Grid& grid, const Camera& came
 // triangle of a leaf tested; no voxel rule), counted in CpuStats::nodes_visited.
 RenderResult render_cpu(const Scene& scene, const Accel& accel, const Camera& camera,
                         const RenderOptions& options, CpuStats* stats = nullptr);
+
+// Every ray the CPU tracer traces for one camera ray from `origin` along the unit `dir` (shadow
+// rays aside), depth-first in the order traced: the tree of docs/materials.md's glass model, with
+// each ray's weight. A ray's weight is w times its parent's share; the weights of its hit's local
+// shading and of its children never sum above its own.
+std::vector<CpuRay> cpu_ray_tree(const Scene& scene, const Accel& accel,
+                                 const RenderOptions& options, const glm::dvec3& origin,
+                                 const glm::dvec3& dir);
 
 // host::primary_dir's contract (camera.h) evaluated in double from the camera's float fields:
 // the unit world-space direction through the centre of pixel (x, y), y = 0 the top row.

@@ -480,11 +480,24 @@ class Gltf {
 
   // reflect: reflection coefficient (0 = none); roughness only matters to other viewers.
   // texture: a texture index for baseColorTexture (multiplied by color), or undefined.
-  material(name, color, reflect, roughness = 0.5, texture = undefined) {
+  // glass: { transmission, ior } (KHR_materials_transmission's transmissionFactor and
+  // KHR_materials_ior's ior), or undefined for an opaque material.
+  material(name, color, reflect, roughness = 0.5, texture = undefined, glass = undefined) {
     const pbr = { baseColorFactor: [...roundv(color, 4), 1], metallicFactor: reflect, roughnessFactor: roughness };
     if (texture !== undefined) pbr.baseColorTexture = { index: texture };
-    this.json.materials.push({ name, pbrMetallicRoughness: pbr, extras: { reflect } });
-    this.materialInfo.push({ name, color: roundv(color, 4), reflect });
+    const m = { name, pbrMetallicRoughness: pbr, extras: { reflect } };
+    const info = { name, color: roundv(color, 4), reflect };
+    if (glass) {
+      m.extensions = {
+        KHR_materials_transmission: { transmissionFactor: glass.transmission },
+        KHR_materials_ior: { ior: glass.ior },
+      };
+      for (const e of ['KHR_materials_transmission', 'KHR_materials_ior'])
+        if (!this.json.extensionsUsed.includes(e)) this.json.extensionsUsed.push(e);
+      Object.assign(info, glass);
+    }
+    this.json.materials.push(m);
+    this.materialInfo.push(info);
     return this.json.materials.length - 1;
   }
 
@@ -831,6 +844,36 @@ for (const [file, mesh, what, src] of [
 }
 
 // ---------------------------------------------------------------------------------------------
+// 9. glass.gltf — issue 25: glass in the manner of Whitted's 1980 image
+// ---------------------------------------------------------------------------------------------
+{
+  const g = new Gltf('glass', "Issue 25 (glass): Whitted's 1980 image in spirit: a floating glass ball (ior 1.5) and a smaller water-clear one (ior 1.33) in front of a mirror sphere, and a glass bunny (the simplified bunny of bunny-low.gltf, ior 1.5), over the classic scene's red/yellow checkerboard (16 x 16 units), which they refract; every glass mesh is closed (no boundary edges), so each ray that enters one can leave it", `${SRC_BUNNY_LOW.replace('scaled by 0.3', 'scaled by 0.25')}; checkerboard and spheres procedural, as classic.gltf`);
+  const mRed = g.material('checker-red', [0.8, 0.1, 0.08], 0.0, 0.7);
+  const mYellow = g.material('checker-yellow', [0.9, 0.8, 0.15], 0.0, 0.7);
+  const mMirror = g.material('mirror-sphere', [0.9, 0.9, 0.92], 0.7, 0.05);
+  const mGlass = g.material('glass-ball', [0.95, 0.97, 1.0], 0.0, 0.0, undefined, { transmission: 0.9, ior: 1.5 });
+  const mWater = g.material('water-ball', [0.85, 0.95, 1.0], 0.0, 0.0, undefined, { transmission: 0.95, ior: 1.33 });
+  const mBunny = g.material('glass-bunny', [0.8, 0.95, 0.85], 0.0, 0.0, undefined, { transmission: 0.85, ior: 1.5 });
+  const [even, odd] = checker(8, 2.0); // 16 x 16 floor, 128 faces
+  g.instance('checker', g.mesh('checker', [{ mesh: even, material: mRed }, { mesh: odd, material: mYellow }]));
+  const big = uvSphere(1.3, 24, 12); // 528 faces
+  const small = uvSphere(0.8, 16, 8); // 224 faces
+  const mirror = uvSphere(1.2, 16, 8); // 224 faces
+  const cGlass = [-1.5, 2.0, 1.0], cWater = [0.5, 0.8, 3.1], cMirror = [0.2, 1.2, -2.6];
+  g.instance('glass-ball', g.mesh('glass-ball', [{ mesh: big, material: mGlass }]), { t: cGlass });
+  g.instance('water-ball', g.mesh('water-ball', [{ mesh: small, material: mWater }]), { t: cWater });
+  g.instance('mirror-sphere', g.mesh('mirror-sphere', [{ mesh: mirror, material: mMirror }]), { t: cMirror });
+  const S = 0.25;
+  const lowest = Math.min(...bunnyLowMesh.positions.map((p) => p[1])) * S;
+  const r = quatAxisAngle([0, 1, 0], deg(-25));
+  const tBunny = [2.7, Math.ceil(-lowest * 1e6) / 1e6, 0.9]; // rests on y = 0 (never below)
+  g.instance('glass-bunny', g.mesh('glass-bunny', [{ mesh: bunnyLowMesh, material: mBunny }]), { s: S, t: tBunny, r });
+  g.camera([0, 4.4, 9.0], [0.4, 1.0, 0], placed(big, 1, cGlass).concat(placed(small, 1, cWater), placed(mirror, 1, cMirror), placed(bunnyLowMesh, S, tBunny, r)), 0.85);
+  g.light('light', [-5, 9, 6], WHITE);
+  summary.push(g.write('glass.gltf'));
+}
+
+// ---------------------------------------------------------------------------------------------
 // scenes/README.md (generated, so its numbers always match the files)
 // ---------------------------------------------------------------------------------------------
 const fmtv = (v) => `(${v.join(', ')})`;
@@ -852,12 +895,15 @@ const lines = [
   'Material colour = `pbrMetallicRoughness.baseColorFactor`, reflection coefficient = `metallicFactor`,',
   'repeated as `extras.reflect`. Camera: one perspective node (looks down local -Z, +Y up, vertical',
   '`yfov`, `aspectRatio` 1 for the 256x256 frame). Lights: `KHR_lights_punctual` point lights, white,',
-  'intensity 1 (the renderer uses colour x intensity, no physical falloff).',
+  'intensity 1 (the renderer uses colour x intensity, no physical falloff). Glass: a material\'s',
+  '`KHR_materials_transmission.transmissionFactor` and `KHR_materials_ior.ior`, both declared in',
+  '`extensionsUsed` (docs/materials.md gives the model).',
   '',
 ];
 for (const s of summary) {
   const cam = s.camera, L = s.lights.map((l) => `${fmtv(l.position)}`).join(', ');
-  const mats = s.materials.map((m) => `${m.name} ${fmtv(m.color)} reflect ${m.reflect}`).join('; ');
+  const glass = (m) => (m.transmission !== undefined ? ` transmission ${m.transmission} ior ${m.ior}` : '');
+  const mats = s.materials.map((m) => `${m.name} ${fmtv(m.color)} reflect ${m.reflect}${glass(m)}`).join('; ');
   lines.push(
     `- \`${s.file}\`: ${s.description}; data: ${s.source}; ${s.faces} faces; ` +
       `bounds ${fmtv(s.bounds.lo)} to ${fmtv(s.bounds.hi)}; camera at ${fmtv(cam.eye)} looking at ${fmtv(cam.target)}, ` +

@@ -1093,3 +1093,68 @@ TEST_CASE("ray streams write their levels and costs in the statistics, and refus
   CHECK_FALSE(fs::exists(png));
   fs::remove_all(dir);
 }
+
+TEST_CASE(
+    "a glass material with a bad ior or transmissionFactor: one line naming it, exit 2, no "
+    "image") {
+  const std::string data = std::string(VGPU_TEST_DATA) + "/gltf/";
+  const fs::path out =
+      fs::temp_directory_path() / ("vgpu_cli_glass_" + std::to_string(::getpid()) + ".png");
+  struct Case {
+    const char* file;
+    const char* problem;
+  };
+  for (const Case& c :
+       {Case{"glass_ior_below_one.gltf", "material 1: KHR_materials_ior.ior 0.5 is below 1"},
+        Case{"glass_ior_string.gltf", "material 1: KHR_materials_ior.ior is not a number"},
+        Case{"glass_transmission_above_one.gltf",
+             "material 1: KHR_materials_transmission.transmissionFactor 1.5 is outside [0, 1]"}}) {
+    CAPTURE(c.file);
+    for (const char* engine : {"stream", "cpu"}) {
+      CAPTURE(engine);
+      const Outcome o = run("render " + data + c.file + " -q --stats none --engine " + engine +
+                            " --out " + out.string());
+      CHECK(o.status == 2);
+      check_one_line(o, data + c.file, c.problem);
+      CHECK_FALSE(fs::exists(out));
+    }
+  }
+}
+
+TEST_CASE("the glass scene on the cpu engine counts its rays by kind per iteration in the JSON") {
+  const std::string id = std::to_string(::getpid());
+  const fs::path json = fs::temp_directory_path() / ("vgpu_cli_glass_" + id + ".json");
+  const Outcome o =
+      run("render glass --engine cpu --size 32x32 -q --stats table --stats-json " + json.string());
+  INFO(o.err);
+  REQUIRE(o.status == 0);
+  CHECK(o.out.find("glass: ") != std::string::npos);
+  const nlohmann::json j = nlohmann::json::parse(slurp(json));
+  fs::remove(json);
+  const nlohmann::json& cpu = j["cpu"];
+  const size_t iterations = j["iterations"].get<size_t>();
+  CHECK(iterations == 3);  // --bounces 2
+  uint64_t spawned = 0;
+  for (const char* kind : {"reflected", "refracted", "total_internal"}) {
+    CAPTURE(kind);
+    REQUIRE(cpu[kind].size() == iterations);
+    CHECK(cpu[kind][iterations - 1] == 0);  // the last iteration spawns none
+  }
+  for (const char* kind : {"reflected", "refracted"})  // total_internal is part of reflected
+    for (const auto& n : cpu[kind]) spawned += n.get<uint64_t>();
+  CHECK(cpu["refracted"][0].get<uint64_t>() > 0);       // the glass is seen, and refracts
+  CHECK(cpu["total_internal"][1].get<uint64_t>() > 0);  // inside glass, past the critical angle
+  CHECK(cpu["total_internal"][1] <= cpu["reflected"][1]);
+  CHECK(cpu["glass_shadow_crossings"].get<uint64_t>() > 0);
+  // Every ray cast is a primary, a spawned or a shadow ray.
+  CHECK(cpu["rays"].get<uint64_t>() > 32 * 32 + spawned);
+  // An opaque scene spawns reflected rays only.
+  const Outcome opaque = run("render classic --engine cpu --size 32x32 -q --stats json");
+  REQUIRE(opaque.status == 0);
+  const nlohmann::json c = nlohmann::json::parse(opaque.out)["cpu"];
+  CHECK(c["reflected"][0].get<uint64_t>() > 0);
+  CHECK(c["refracted"] == nlohmann::json::array({0, 0, 0}));
+  CHECK(c["total_internal"] == nlohmann::json::array({0, 0, 0}));
+  CHECK(c["glass_shadow_crossings"] == 0);
+  CHECK(opaque.out.find("glass: ") == std::string::npos);
+}

@@ -303,6 +303,41 @@ TEST_CASE(
   CHECK(s.materials[4].reflect == 0.0f);
 }
 
+TEST_CASE(
+    "Glass materials take transmissionFactor and ior from their extensions, with the defaults 0 "
+    "and 1.5") {
+  const host::Scene s = load("glass.gltf");
+  REQUIRE(s.materials.size() == 6);
+  CHECK(s.materials[0].transmission == 0.75f);
+  CHECK(s.materials[0].ior == 1.33f);
+  CHECK(s.materials[1].transmission == 1.0f);
+  CHECK(s.materials[1].ior == 1.5f);  // KHR_materials_ior absent: its default
+  CHECK(s.materials[2].transmission == 0.0f);
+  CHECK(s.materials[2].ior == 2.42f);
+  CHECK(s.materials[5].ior == 1.0f);  // 1 is valid: an interface that does not bend light
+  // The materials of the other tests' files stay opaque.
+  for (const host::Material& m : load("materials.gltf").materials) CHECK(m.transmission == 0.0f);
+}
+
+TEST_CASE("An ior of 0 (a Fresnel term of 1) loads as the opaque mirror it is") {
+  const host::Scene s = load("glass.gltf");
+  // metallicFactor 0.5, transmissionFactor 0.5: reflect = a + t (1 - a) = 0.75, nothing passes.
+  CHECK(s.materials[3].transmission == 0.0f);
+  CHECK(s.materials[3].reflect == 0.75f);
+}
+
+TEST_CASE(
+    "A transmissionTexture is ignored with a warning and KHR_materials_volume is ignored "
+    "silently") {
+  const host::Scene s = load("glass.gltf");
+  CHECK(s.materials[4].transmission == 0.5f);
+  CHECK(has_warning(s,
+                    "material 4: KHR_materials_transmission.transmissionTexture is not "
+                    "supported"));
+  CHECK(s.materials[4].attenuation_distance == 0.0f);  // no absorption: volume is not modeled
+  CHECK(s.warnings.size() == 1);
+}
+
 TEST_CASE("Points and lines primitives are skipped with a warning") {
   const host::Scene s = load("modes.gltf");
   CHECK(s.triangle_count() == 1);
@@ -460,4 +495,22 @@ TEST_CASE("frame_bounds sees the whole bounding box with a margin, at any aspect
       CHECK(std::abs(glm::dot(v, cam.up) / depth) < t);
     }
   }
+}
+
+TEST_CASE("An ior below 1, negative, not a number or overflowing is refused, naming the material") {
+  check_rejected("glass_ior_below_one.gltf", "material 1: KHR_materials_ior.ior 0.5");
+  check_rejected("glass_ior_below_one.gltf", "is below 1");
+  check_rejected("glass_ior_negative.gltf", "material 1: KHR_materials_ior.ior -1.5");
+  check_rejected("glass_ior_string.gltf", "material 1: KHR_materials_ior.ior is not a number");
+  check_rejected("glass_ior_overflow.gltf", "number overflow parsing '1e999'");
+}
+
+TEST_CASE("A transmissionFactor outside [0, 1] or not a number is refused, naming the material") {
+  check_rejected("glass_transmission_above_one.gltf",
+                 "material 1: KHR_materials_transmission.transmissionFactor 1.5");
+  check_rejected("glass_transmission_above_one.gltf", "is outside [0, 1]");
+  check_rejected("glass_transmission_negative.gltf",
+                 "material 1: KHR_materials_transmission.transmissionFactor -0.25");
+  check_rejected("glass_transmission_bool.gltf",
+                 "material 1: KHR_materials_transmission.transmissionFactor is not a number");
 }

@@ -276,6 +276,59 @@ def materials_case():
     write_gltf("materials.gltf", d, b.bin)
 
 
+def glass_case():
+    """Glass materials: valid ones, then one file per refused value (a triangle each)."""
+    b = Builder()
+    pos = b.vec3(TRI)
+    materials = [
+        {"extensions": {"KHR_materials_transmission": {"transmissionFactor": 0.75},
+                        "KHR_materials_ior": {"ior": 1.33}}},
+        {"extensions": {"KHR_materials_transmission": {"transmissionFactor": 1}}},
+        {"extensions": {"KHR_materials_ior": {"ior": 2.42}}},
+        # ior 0: the extension's "Fresnel term 1": an opaque mirror, a + t (1 - a) = 0.5 + 0.25.
+        {"pbrMetallicRoughness": {"metallicFactor": 0.5},
+         "extensions": {"KHR_materials_transmission": {"transmissionFactor": 0.5},
+                        "KHR_materials_ior": {"ior": 0}}},
+        {"extensions": {"KHR_materials_transmission": {
+            "transmissionFactor": 0.5, "transmissionTexture": {"index": 0}},
+            "KHR_materials_volume": {"thicknessFactor": 1, "attenuationDistance": 2,
+                                     "attenuationColor": [1, 0.5, 0.5]}}},
+        {"extensions": {"KHR_materials_ior": {"ior": 1}}},
+    ]
+    prims = [{"attributes": {"POSITION": pos}, "material": m} for m in range(len(materials))]
+    used = ["KHR_materials_transmission", "KHR_materials_ior", "KHR_materials_volume"]
+    d = b.doc(scene=0, scenes=[{"nodes": [0]}], nodes=[{"mesh": 0}],
+              meshes=[{"primitives": prims}], materials=materials, extensionsUsed=used)
+    write_gltf("glass.gltf", d, b.bin)
+
+    bad = {
+        "glass_ior_below_one.gltf": {"KHR_materials_ior": {"ior": 0.5}},
+        "glass_ior_negative.gltf": {"KHR_materials_ior": {"ior": -1.5}},
+        "glass_ior_string.gltf": {"KHR_materials_ior": {"ior": "1.5"}},
+        "glass_transmission_above_one.gltf": {"KHR_materials_transmission": {"transmissionFactor": 1.5}},
+        "glass_transmission_negative.gltf": {"KHR_materials_transmission": {"transmissionFactor": -0.25}},
+        "glass_transmission_bool.gltf": {"KHR_materials_transmission": {"transmissionFactor": True}},
+    }
+    for name, ext in bad.items():
+        b = Builder()
+        pos = b.vec3(TRI)
+        # Material 1 is the bad one, so the message must name it (not the first material).
+        d = b.doc(scene=0, scenes=[{"nodes": [0]}], nodes=[{"mesh": 0}],
+                  meshes=[{"primitives": [{"attributes": {"POSITION": pos}, "material": 1}]}],
+                  materials=[{}, {"extensions": ext}], extensionsUsed=sorted(ext))
+        write_gltf(name, d, b.bin)
+    # An ior that overflows a double: JSON has no NaN or infinity, this is as close as it gets
+    # (the JSON parser refuses it before the material is read).
+    b = Builder()
+    pos = b.vec3(TRI)
+    d = b.doc(scene=0, scenes=[{"nodes": [0]}], nodes=[{"mesh": 0}],
+              meshes=[{"primitives": [{"attributes": {"POSITION": pos}, "material": 1}]}],
+              materials=[{}, {"extensions": {"KHR_materials_ior": {"ior": 7}}}])
+    d["buffers"][0]["uri"] = data_uri(b.bin)
+    write_text("glass_ior_overflow.gltf",
+               json.dumps(d, indent=1).replace('"ior": 7', '"ior": 1e999') + "\n")
+
+
 def modes_case():
     b = Builder()
     pos = b.vec3(TRI)
@@ -533,6 +586,7 @@ if __name__ == "__main__":
     ortho_case()
     lights_case()
     materials_case()
+    glass_case()
     modes_case()
     bad_cases()
     animated_case()

@@ -1,0 +1,286 @@
+// Known answers for the CPU reference tracer's glass (docs/materials.md, "Glass: the model"): a
+// slab shifts a ray by the analytic amount and returns it parallel, on every structure; a ray
+// tree's weights never sum above its ray's; shadow rays are dimmed by t per glass surface and
+// blocked past kMaxGlassCrossings; rays are counted by kind.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <numbers>
+#include <vector>
+
+#include "host/accel/accel.h"
+#include "host/accel/bvh.h"
+#include "host/accel/grid.h"
+#include "host/accel/kdtree.h"
+#include "host/trace/cpu_tracer.h"
+#include "host/trace/grid_walk.h"
+#include "host/trace/optics.h"
+#include "kernels/kernels.h"
+
+namespace {
+
+using host::CpuRay;
+using host::CpuRayKind;
+using host::Material;
+using host::Scene;
+
+// The square [x0, x1] x [y0, y1] in the plane z, its front (counter-clockwise) towards +z when
+// `up`, towards -z otherwise.
+void quad_z(Scene& s, float x0, float x1, float y0, float y1, float z, bool up, uint32_t mat) {
+  const glm::vec3 a(x0, y0, z), b(x1, y0, z), c(x1, y1, z), d(x0, y1, z);
+  const uint32_t id = uint32_t(s.id.size());
+  if (up) {
+    s.add_flat_triangle(a, b, c, mat, id);
+    s.add_flat_triangle(a, c, d, mat, id + 1);
+  } else {
+    s.add_flat_triangle(a, c, b, mat, id);
+    s.add_flat_triangle(a, d, c, mat, id + 1);
+  }
+}
+
+// The same in the plane x, spanning y and z, its front towards +x when `up`.
+void quad_x(Scene& s, float x, float y0, float y1, float z0, float z1, bool up, uint32_t mat) {
+  const glm::vec3 a(x, y0, z0), b(x, y1, z0), c(x, y1, z1), d(x, y0, z1);
+  const uint32_t id = uint32_t(s.id.size());
+  if (up) {
+    s.add_flat_triangle(a, b, c, mat, id);
+    s.add_flat_triangle(a, c, d, mat, id + 1);
+  } else {
+    s.add_flat_triangle(a, c, b, mat, id);
+    s.add_flat_triangle(a, d, c, mat, id + 1);
+  }
+}
+
+// A scene with its three structures: the grid, and the one-voxel box grid that a BVH or kd-tree
+// frame carries with it.
+struct Structures {
+  Scene scene;
+  host::Grid grid, box;
+  host::Bvh bvh;
+  host::KdTree kd;
+  explicit Structures(Scene s)
+      : scene(std::move(s)),
+        grid(host::build_grid(scene, host::GridSpec{glm::ivec3(4)})),
+        box(host::build_grid(scene, host::GridSpec{glm::ivec3(1)})),
+        bvh(host::build_bvh(scene)),
+        kd(host::build_kdtree(scene, box.lo, box.hi)) {}
+  std::vector<host::Accel> all() const {
+    return {{host::AccelKind::grid, &grid, nullptr, nullptr},
+            {host::AccelKind::bvh, &box, &bvh, nullptr},
+            {host::AccelKind::kdtree, &box, nullptr, &kd}};
+  }
+  // The tracers' ray offset ε for a structure: a fraction of its grid's diagonal.
+  static double offset(const host::Accel& a) {
+    return host::kOffsetOfDiagonal * glm::length(glm::dvec3(a.grid->hi) - glm::dvec3(a.grid->lo));
+  }
+};
+
+// A glass slab: the faces z = -2 (front up) and z = -2 - thickness (front down), clear glass of
+// index eta, over an opaque grey wall at z = -6.
+Scene slab_scene(double thickness, float eta) {
+  Scene s;
+  Material glass;
+  glass.transmission = 1.0f;
+  glass.ior = eta;
+  glass.reflect = 0.0f;
+  Material wall;
+  wall.reflect = 0.0f;
+  s.materials = {glass, wall};
+  const float back = float(-2.0 - thickness);
+  quad_z(s, -20, 20, -20, 20, -2.0f, true, 0);
+  quad_z(s, -20, 20, -20, 20, back, false, 0);
+  quad_z(s, -40, 40, -40, 40, -6.0f, true, 1);
+  s.lights = {{glm::vec3(0, 0, 5), glm::vec3(1)}};
+  s.input_triangles = uint32_t(s.id.size());
+  return s;
+}
+
+host::RenderOptions options(int bounces) {
+  host::RenderOptions o;
+  o.width = o.height = 1;
+  o.bounces = bounces;
+  o.shading = kernels::ShadingModel::diffuse;
+  return o;
+}
+
+}  // namespace
+
+TEST_CASE(
+    "A ray through a glass slab leaves parallel to how it entered, shifted by d sin(theta - "
+    "theta_t) / cos(theta_t), on every structure") {
+  const double thickness = 0.75;
+  const float eta = 1.5f;
+  const Structures st(slab_scene(thickness, eta));
+  for (const host::Accel& accel : st.all()) {
+    CAPTURE(host::accel_name(accel.kind));
+    for (const double theta : {0.0, 0.3, 0.7, 1.1}) {
+      CAPTURE(theta);
+      const glm::dvec3 o(0.1, 0.2, 0.0);
+      const glm::dvec3 d(std::sin(theta), 0.0, -std::cos(theta));
+      const std::vector<CpuRay> tree = host::cpu_ray_tree(st.scene, accel, options(4), o, d);
+      // The path straight through: primary, refracted in, refracted out to the wall.
+      const CpuRay* out = nullptr;
+      for (const CpuRay& r : tree)
+        if (r.depth == 2 && r.kind == CpuRayKind::refracted) out = &r;
+      REQUIRE(out != nullptr);
+      REQUIRE(out->hit >= 4);  // the wall's triangles
+      CHECK(glm::length(out->dir - d) < 1e-12);
+      // The light left by the slab is what Fresnel let through twice: t (1 - F) at each face.
+      const host::optics::Interface front = host::optics::meet(std::cos(theta), 1.0 / eta);
+      const host::optics::Interface back = host::optics::meet(front.cos_t, double(eta));
+      CHECK(out->weight ==
+            doctest::Approx((1.0 - front.reflectance) * (1.0 - back.reflectance)).epsilon(1e-12));
+      // Where it lands on the wall, against the line it came in on.
+      const glm::dvec3 landing = out->origin + out->dir * out->t;
+      const glm::dvec3 rel = landing - o;
+      const double shift = glm::length(rel - d * glm::dot(rel, d));
+      const double theta_t = std::asin(std::sin(theta) / double(eta));
+      const double analytic = thickness * std::sin(theta - theta_t) / std::cos(theta_t);
+      // Each face's offset ε along the normal moves the path by at most ε (tan θ + tan θt) cos θ.
+      const double eps = Structures::offset(accel);
+      CHECK(std::abs(shift - analytic) <= 2.0 * eps);
+      CHECK(shift == doctest::Approx(analytic +
+                                     eps * (std::sin(theta) + std::tan(theta_t) * std::cos(theta)))
+                         .epsilon(1e-9));
+    }
+  }
+}
+
+TEST_CASE("The weights of a ray's tree never sum above its own, and a child carries its share") {
+  // Half-mirror half-glass slab (a = 0.4, t = 0.5): all three shares are non-zero, and rays
+  // bounce between the faces until the 1/512 cut-off or the iteration limit ends them.
+  Scene s = slab_scene(0.5, 1.7f);
+  s.materials[0].transmission = 0.5f;
+  s.materials[0].reflect = 0.4f;
+  s.materials[1].reflect = 0.3f;  // the wall reflects too
+  const Structures st(std::move(s));
+  for (const int bounces : {0, 1, 3, 12}) {
+    CAPTURE(bounces);
+    for (const double theta : {0.0, 0.5, 1.3}) {
+      CAPTURE(theta);
+      const glm::dvec3 d(std::sin(theta), 0.0, -std::cos(theta));
+      const std::vector<CpuRay> tree =
+          host::cpu_ray_tree(st.scene, st.all()[0], options(bounces), glm::dvec3(0.0), d);
+      REQUIRE(!tree.empty());
+      CHECK(tree[0].weight == 1.0);
+      // The terminal weights: each hit's own shading share, each miss's background.
+      double sum = 0.0;
+      for (size_t i = 0; i < tree.size(); ++i) {
+        const CpuRay& r = tree[i];
+        CHECK(r.depth <= bounces);
+        sum += r.weight * r.local_share;
+        // Its children are the rays one deeper that follow it before anything else at its depth.
+        double children = 0.0;
+        for (size_t j = i + 1; j < tree.size() && tree[j].depth > r.depth; ++j)
+          if (tree[j].depth == r.depth + 1) children += tree[j].weight;
+        CHECK(children + r.weight * r.local_share <= r.weight * (1.0 + 1e-12));
+        if (r.depth > 0) CHECK(r.weight >= kernels::ReflectedRays{}.min_weight);
+      }
+      CHECK(sum <= 1.0 + 1e-12);
+      CHECK(sum > 0.0);
+    }
+  }
+}
+
+TEST_CASE("An opaque surface keeps the paper's shares: its reflection carries a of the weight") {
+  Scene s = slab_scene(0.5, 1.5f);
+  s.materials[0].transmission = 0.0f;
+  s.materials[0].reflect = 0.375f;
+  const Structures st(std::move(s));
+  const std::vector<CpuRay> tree =
+      host::cpu_ray_tree(st.scene, st.all()[0], options(2), glm::dvec3(0.0), glm::dvec3(0, 0, -1));
+  REQUIRE(tree.size() == 2);  // the primary ray and its mirror reflection (which misses)
+  CHECK(tree[0].local_share == 1.0 - 0.375);
+  CHECK(tree[1].kind == CpuRayKind::reflected);
+  CHECK(tree[1].weight == 0.375);
+  CHECK(tree[1].hit == -1);
+}
+
+TEST_CASE("Past the critical angle the light inside glass is totally reflected and counted so") {
+  // A ray inside a block of index 1.5 meeting its top face at 60 degrees (critical: 41.8).
+  Scene s;
+  Material glass;
+  glass.transmission = 1.0f;
+  glass.ior = 1.5f;
+  s.materials = {glass};
+  quad_z(s, -20, 20, -20, 20, 0.0f, true, 0);     // top face, front up (outside is above)
+  quad_z(s, -20, 20, -20, 20, -10.0f, false, 0);  // bottom face, front down
+  s.input_triangles = uint32_t(s.id.size());
+  const Structures st(std::move(s));
+  const double theta = 60.0 * std::numbers::pi / 180.0;
+  const glm::dvec3 d(std::sin(theta), 0.0, std::cos(theta));  // upwards, from inside
+  const std::vector<CpuRay> tree =
+      host::cpu_ray_tree(st.scene, st.all()[0], options(1), glm::dvec3(0, 0, -5), d);
+  REQUIRE(tree.size() == 2);
+  CHECK(tree[1].kind == CpuRayKind::total_internal);
+  CHECK(tree[1].weight == 1.0);  // F = 1: everything reflected, nothing refracted
+  CHECK(tree[1].dir.z == doctest::Approx(-d.z).epsilon(1e-14));
+  // The counters of a render agree: one frame of rays, counted per spawning iteration by kind.
+  host::RenderOptions o = options(1);
+  o.width = 3;
+  o.height = 2;
+  host::Camera cam;
+  cam.position = glm::vec3(0, 0, -5);
+  cam.forward = glm::vec3(glm::normalize(d));
+  cam.up = glm::vec3(0, 1, 0);
+  cam.yfov = 0.01f;
+  host::CpuStats stats;
+  const host::RenderResult r = host::render_cpu(st.scene, st.all()[0], cam, o, &stats);
+  CHECK(r.iterations == 2);
+  // Spawned by iteration 0 (the camera rays' hits), a part of the reflected rays.
+  CHECK(stats.total_internal == std::vector<uint64_t>{6, 0});
+  CHECK(stats.reflected == std::vector<uint64_t>{6, 0});
+  CHECK(stats.refracted == std::vector<uint64_t>{0, 0});
+}
+
+TEST_CASE(
+    "A shadow ray's light is multiplied by t for each glass surface it crosses and blocked by an "
+    "opaque one or by the eighth glass one") {
+  // A floor at z = -5 seen straight down the camera's centre ray, lit from (3, 0, -2); panes
+  // between them in the planes x = 0.3 ... , out of the camera ray's way.
+  auto floor_colour = [](const std::vector<float>& panes, const host::AccelKind kind) {
+    Scene s;
+    Material floor;
+    floor.reflect = 0.0f;
+    floor.color = glm::vec3(0.5f);
+    s.materials = {floor};
+    quad_z(s, -1, 1, -1, 1, -5.0f, true, 0);
+    for (size_t i = 0; i < panes.size(); ++i) {
+      Material pane;
+      pane.transmission = panes[i];
+      pane.reflect = 0.0f;
+      s.materials.push_back(pane);
+      quad_x(s, 0.3f + 0.25f * float(i), -1, 1, -4.99f, -2.5f, true, uint32_t(i + 1));
+    }
+    s.lights = {{glm::vec3(3, 0, -2), glm::vec3(1)}};
+    s.input_triangles = uint32_t(s.id.size());
+    const Structures st(std::move(s));
+    host::Camera cam;
+    cam.position = glm::vec3(0.0f);
+    cam.forward = glm::vec3(0, 0, -1);
+    cam.up = glm::vec3(0, 1, 0);
+    cam.yfov = 0.01f;
+    const host::Accel accel = st.all()[size_t(kind)];
+    host::CpuStats stats;
+    const host::RenderResult r = host::render_cpu(st.scene, accel, cam, options(0), &stats);
+    REQUIRE(r.hit_id[0] >= 0.0f);
+    REQUIRE(r.hit_id[0] <= 1.0f);  // the floor
+    return double(r.rgb[0]);
+  };
+  for (const host::AccelKind kind : host::kAccelKinds) {
+    CAPTURE(host::accel_name(kind));
+    const double clear = floor_colour({}, kind);
+    const double blocked = floor_colour({0.0f}, kind);
+    const double lit = clear - blocked;  // the light's own term (the rest is ambient)
+    REQUIRE(lit > 0.05);
+    auto through = [&](const std::vector<float>& panes) {
+      return (floor_colour(panes, kind) - blocked) / lit;
+    };
+    // Float output: the shares hold to its rounding.
+    CHECK(through({0.6f}) == doctest::Approx(0.6).epsilon(1e-6));
+    CHECK(through({0.6f, 0.5f}) == doctest::Approx(0.3).epsilon(1e-6));
+    CHECK(through({0.6f, 0.0f, 0.5f}) == 0.0);
+    CHECK(through(std::vector<float>(7, 0.9f)) == doctest::Approx(std::pow(0.9, 7)).epsilon(1e-6));
+    CHECK(through(std::vector<float>(8, 0.9f)) == 0.0);  // the eighth glass surface blocks
+  }
+}
