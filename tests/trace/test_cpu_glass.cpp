@@ -11,6 +11,7 @@
 #include "host/accel/accel.h"
 #include "host/accel/bvh.h"
 #include "host/accel/grid.h"
+#include "host/accel/grid2.h"
 #include "host/accel/kdtree.h"
 #include "host/trace/cpu_tracer.h"
 #include "host/trace/grid_walk.h"
@@ -58,16 +59,25 @@ struct Structures {
   host::Grid grid, box;
   host::Bvh bvh;
   host::KdTree kd;
+  host::Grid2 grid2;
   explicit Structures(Scene s)
       : scene(std::move(s)),
         grid(host::build_grid(scene, host::GridSpec{glm::ivec3(4)})),
         box(host::build_grid(scene, host::GridSpec{glm::ivec3(1)})),
         bvh(host::build_bvh(scene)),
-        kd(host::build_kdtree(scene, box.lo, box.hi)) {}
+        kd(host::build_kdtree(scene, box.lo, box.hi)),
+        grid2(host::build_grid2(scene)) {}
   std::vector<host::Accel> all() const {
     return {{host::AccelKind::grid, &grid, nullptr, nullptr},
             {host::AccelKind::bvh, &box, &bvh, nullptr},
-            {host::AccelKind::kdtree, &box, nullptr, &kd}};
+            {host::AccelKind::kdtree, &box, nullptr, &kd},
+            {host::AccelKind::grid2, &box, nullptr, nullptr, &grid2}};
+  }
+  host::Accel of(host::AccelKind kind) const {
+    for (const host::Accel& a : all())
+      if (a.kind == kind) return a;
+    FAIL("no structure of kind " << host::accel_name(kind));
+    return {};
   }
   // The tracers' ray offset ε for a structure: a fraction of its grid's diagonal.
   static double offset(const host::Accel& a) {
@@ -260,7 +270,7 @@ TEST_CASE(
     cam.forward = glm::vec3(0, 0, -1);
     cam.up = glm::vec3(0, 1, 0);
     cam.yfov = 0.01f;
-    const host::Accel accel = st.all()[size_t(kind)];
+    const host::Accel accel = st.of(kind);
     host::CpuStats stats;
     const host::RenderResult r = host::render_cpu(st.scene, accel, cam, options(0), &stats);
     REQUIRE(r.hit_id[0] >= 0.0f);
