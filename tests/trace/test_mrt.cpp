@@ -62,8 +62,12 @@ void check_fused_matches(const host::RenderResult& off, const host::RenderResult
     CHECK(passes_of(b, gone) == 0);
   const uint64_t saved = k + steps - traces;
   CHECK(b.totals.passes == a.totals.passes - saved);
-  // Every pass loads a program in both pipelines (no two passes in a row share one).
-  CHECK(a.totals.program_loads == a.totals.passes);
+  // Every pass loads a program in both pipelines (no two passes in a row share one), but for
+  // the ray streams' passes (glass): their prefix-sum passes run one program several times in
+  // a row, and the count of those repeats is the same in both pipelines.
+  const uint64_t repeats = a.totals.passes - a.totals.program_loads;
+  CHECK(repeats == b.totals.passes - b.totals.program_loads);
+  if (passes_of(a, "stream scan") == 0) CHECK(repeats == 0);
   CHECK(b.totals.program_loads == a.totals.program_loads - saved);
   // Every pass shades every pixel (no masks): the saved passes' fragments are saved.
   CHECK(b.totals.fragments_shaded == a.totals.fragments_shaded - saved * uint64_t(pixels));
