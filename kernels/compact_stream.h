@@ -54,14 +54,20 @@ struct CompactStream {
     }
     const Vec4<F> surf = fetch_id(f, kSurface, i, width);
     const Vec3<F> d = fetch_id(f, kRays, i, width).xyz();
-    const Surface<F> s = surface_at(f, surf.w, surf.xyz(), d, kV0, kN0, scene);
     if (part == 0) {
       // inicioReflejo lifted the point by `offset` to the ray's side; the refracted ray starts
-      // as far on the other side.
-      const Vec3<F> p = select(reflected, surf.xyz(), surf.xyz() - s.ng * F(2.0f * offset));
+      // as far on the other side. Only the geometric normal is needed (surface_at's, to the same
+      // rounding): the shading normals are not fetched, as a compiler would drop those fetches.
+      const Vec3<F> p0 = fetch_id(f, kV0, surf.w, scene.width).xyz();
+      const Vec3<F> p1 = fetch_id(f, kV1, surf.w, scene.width).xyz();
+      const Vec3<F> p2 = fetch_id(f, kV2, surf.w, scene.width).xyz();
+      Vec3<F> ng = normalize(cross(p1 - p0, p2 - p0));
+      ng = select(dot(ng, d) > F(0.0f), -ng, ng);
+      const Vec3<F> p = select(reflected, surf.xyz(), surf.xyz() - ng * F(2.0f * offset));
       f.out(0) = select(live, Vec4<F>{p.x, p.y, p.z, zero}, Vec4<F>{zero, zero, zero, zero});
       return;
     }
+    const Surface<F> s = surface_at(f, surf.w, surf.xyz(), d, kV0, kN0, scene);
     const F ior = fetch_id(f, kGlass, surf.w, scene.width).z;
     const Glass<L> g = glass_optics<L>(d, s, ior);
     // direccionReflejo's mirror direction, to the same rounding.

@@ -78,7 +78,8 @@ const int kReport = [] {
 TEST_CASE("every kernel's generated GLSL compiles on the GL device and declares its outputs") {
   for (const auto& p : kernels::all_programs()) {
     const vgpu::GlslProgram g = vgpu::to_glsl(*p);
-    CAPTURE(p->name());
+    const std::string name = p->name();
+    CAPTURE(name);
     CHECK(g.source.find("layout(location = 0) out vec4 out0;") != std::string::npos);
     // One sampler per unit the counting run says the kernel fetches from.
     const vgpu::Program::Analysis a = p->analyze();
