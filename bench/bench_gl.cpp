@@ -18,6 +18,7 @@
 #include "gl/gl_device.h"
 #include "host/accel/accel.h"
 #include "host/accel/grid.h"
+#include "host/accel/grid2.h"
 #include "host/image/image_io.h"
 #include "host/model/cost_model.h"
 #include "host/scene/camera.h"
@@ -192,9 +193,11 @@ int main(int argc, char** argv) {
                  "both, or none (no GL frames: the emulator's counts and predictions only)")
       ->check(CLI::IsMember({"block", "poll", "both", "none"}))
       ->capture_default_str();
-  app.add_option("--accel", accels,
-                 "Acceleration structures per frame: grid (the paper's, --grid), bvh, kdtree")
-      ->check(CLI::IsMember({"grid", "bvh", "kdtree"}))
+  app.add_option(
+         "--accel", accels,
+         "Acceleration structures per frame: grid (the paper's, --grid), grid2 (two-level), "
+         "bvh, kdtree")
+      ->check(CLI::IsMember({"grid", "grid2", "bvh", "kdtree"}))
       ->capture_default_str();
   app.add_option("--bounces", bounces,
                  "Reflection iterations after the primary one (0: primary "
@@ -303,16 +306,19 @@ int main(int argc, char** argv) {
           const host::Grid box = host::build_grid(scene, host::GridSpec{glm::ivec3(1)});
           std::optional<host::Bvh> bvh;
           std::optional<host::KdTree> kd;
+          std::optional<host::Grid2> grid2;
           for (const std::string& a : accels) {
             if (a == "bvh" && !bvh) bvh = host::build_bvh(scene);
             if (a == "kdtree" && !kd) kd = host::build_kdtree(scene, box.lo, box.hi);
+            if (a == "grid2" && !grid2) grid2 = host::build_grid2(scene);
           }
           const host::Camera cam = host::scene_camera(scene);
           for (const std::string& accel_name : accels)
             for (const std::string& variant : variants) {
               const host::AccelKind kind = host::parse_accel_kind(accel_name);
               const host::Accel accel{kind, kind == host::AccelKind::grid ? &grid : &box,
-                                      bvh ? &*bvh : nullptr, kd ? &*kd : nullptr};
+                                      bvh ? &*bvh : nullptr, kd ? &*kd : nullptr,
+                                      grid2 ? &*grid2 : nullptr};
               // The paper's pipeline at Table 1's profile; its future work (MRT fused passes, the
               // looping kernels) needs a profile with several outputs and loops: the h200's.
               opt.mrt = variant == "mrt";

@@ -5,11 +5,12 @@
 #   scripts/uneven_scenes.py .h200
 #   mkdir -p .gl && (cd .gl && apt-get download libegl1 libglvnd0 libopengl0 libgl1 libglx0)
 # copy the repository with .h200 and .gl to the GPU host and run there, from its root:
-#   OUT=DIR scripts/structures_h200.sh
+#   OUT=DIR scripts/structures_h200.sh              (ACCELS="grid2" measures only those structures)
 # then copy DIR's files to docs/structures_h200_{primary,full}.json and _clocks.csv, and run here:
 #   /usr/bin/python3 scripts/structures.py --h200 docs/structures_h200_primary.json \
 #     docs/structures_h200_full.json
 set -u
+accels="${ACCELS:-grid grid2 bvh kdtree}"
 out="${OUT:?set OUT to a folder}"
 if [ -d .gl ]; then
   for f in .gl/*.deb; do dpkg -x "$f" /; done
@@ -25,8 +26,8 @@ trap 'kill $sampler 2>/dev/null || true' EXIT
 S="scenes/sphere.gltf scenes/bunny.gltf scenes/bunny-refl.gltf scenes/classic.gltf"
 S="$S scenes/teapot.gltf .h200/stadium.gltf .h200/scales.gltf"
 .h200/bench_gl --runs 3 --sizes 256 --threads 16 --readback-wait poll --grid auto \
-  --accel grid bvh kdtree --variants multipass looping --bounces 0 --scenes $S \
+  --accel $accels --variants multipass looping --bounces 0 --scenes $S \
   --json "$out/structures_primary.json"
 .h200/bench_gl --runs 3 --sizes 256 --threads 16 --readback-wait poll --grid auto \
-  --accel grid bvh kdtree --variants multipass --bounces 2 --micro-passes 10 --scenes $S \
+  --accel $accels --variants multipass --bounces 2 --micro-passes 10 --scenes $S \
   --json "$out/structures_full.json"
