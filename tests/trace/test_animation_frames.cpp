@@ -13,6 +13,7 @@
 
 #include "host/accel/accel.h"
 #include "host/accel/grid.h"
+#include "host/accel/grid2.h"
 #include "host/scene/animation.h"
 #include "host/scene/camera.h"
 #include "host/trace/stream_tracer.h"
@@ -158,25 +159,29 @@ TEST_CASE("a tracer updated between frames renders what a tracer made for the fr
 }
 
 TEST_CASE(
-    "a tracer walking a BVH or a kd-tree, updated between frames, renders what a new one "
-    "renders") {
+    "a tracer walking a BVH, a kd-tree or a two-level grid, updated between frames, renders what "
+    "a new one renders") {
   const host::AnimatedScene a(data_path("animated.gltf"));
   const Scene first = a.at(0, 0.0), second = a.at(0, 2.0);
   const host::Camera cam = *first.camera;
-  for (const host::AccelKind kind : {host::AccelKind::bvh, host::AccelKind::kdtree}) {
+  for (const host::AccelKind kind :
+       {host::AccelKind::bvh, host::AccelKind::kdtree, host::AccelKind::grid2}) {
     CAPTURE(std::string(host::accel_name(kind)));
     // The structure in its scene box (a one-voxel grid), as the CLI builds them every frame.
     struct Built {
       host::Grid box;
       host::Bvh bvh;
       host::KdTree kd;
+      host::Grid2 grid2;
     };
     auto accel_of = [kind](const Scene& s, Built& b) {
       b.box = host::build_grid(s, host::GridSpec{glm::ivec3(1)});
       if (kind == host::AccelKind::bvh) b.bvh = host::build_bvh(s);
       if (kind == host::AccelKind::kdtree) b.kd = host::build_kdtree(s, b.box.lo, b.box.hi);
+      if (kind == host::AccelKind::grid2) b.grid2 = host::build_grid2(s);
       return host::Accel{kind, &b.box, kind == host::AccelKind::bvh ? &b.bvh : nullptr,
-                         kind == host::AccelKind::kdtree ? &b.kd : nullptr};
+                         kind == host::AccelKind::kdtree ? &b.kd : nullptr,
+                         kind == host::AccelKind::grid2 ? &b.grid2 : nullptr};
     };
     Built b1, b2;
     host::StreamTracer tracer(first, accel_of(first, b1), options());
@@ -190,7 +195,9 @@ TEST_CASE(
     CHECK(differing(updated.hit_id, fresh.hit_id) == 0);
     CHECK(differing(updated.depth, fresh.depth) == 0);
     CHECK(updated.stats.totals.passes == fresh.stats.totals.passes);
-    const char* nodes = kind == host::AccelKind::bvh ? "bvh nodes lo" : "kd nodes";
+    const char* nodes = kind == host::AccelKind::bvh      ? "bvh nodes lo"
+                        : kind == host::AccelKind::kdtree ? "kd nodes"
+                                                          : "grid2 lists";
     for (const char* name : {"vertices0", nodes})
       CHECK_MESSAGE(std::find(up.textures.begin(), up.textures.end(), name) != up.textures.end(),
                     name);
