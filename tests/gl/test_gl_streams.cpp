@@ -1,7 +1,7 @@
 // Glass's ray streams (issue 25) on the GL device against the vgpu: the stream passes' GLSL
 // (generated from the same functors), drawn over rectangles of tall textures, give the vgpu's
-// stream lengths, query counts and image; on a hand-made glass slab and on bunny-refl with
-// --ray-streams on.
+// stream lengths, query counts and image; on a hand-made glass slab, on the bundled glass scene
+// and on bunny-refl with --ray-streams on.
 #include <doctest/doctest.h>
 
 #include "host/accel/grid.h"
@@ -73,6 +73,12 @@ TEST_CASE("a glass slab's ray streams on the GL device give the vgpu's streams a
 
 TEST_CASE("bunny-refl's reflections as ray streams on the GL device give the vgpu's image") {
   const host::Scene scene = host::load_scene(host::resolve_scene("bunny-refl"));
+  REQUIRE(scene.camera.has_value());
+  check_streams_on_gl(scene);
+}
+
+TEST_CASE("the bundled glass scene's ray streams on the GL device give the vgpu's hits and image") {
+  const host::Scene scene = host::load_scene(host::resolve_scene("glass"));
   REQUIRE(scene.camera.has_value());
   check_streams_on_gl(scene);
 }
