@@ -100,8 +100,32 @@ struct MarkGaps {
   }
 };
 
+// The blend's error where the colour curves: between lattice pixels a and b, K apart, a
+// straight blend of a colour whose second derivative is c misses it by t(1 - t) K^2 c / 2 at the
+// fraction t from a. The lattice measures K^2 c as the second difference at a (the lattice
+// pixels a - K, a, b) and at b (a, b, b + K); the fill subtracts t(1 - t) / 2 of the smaller of
+// the two (minmod: 0 where they differ in sign), so that an edge beyond the cell, whose second
+// difference is large at one end only, changes nothing, where a smooth shade gets the
+// Catmull-Rom blend's midpoint back (the mean of the two ends' differences, which on a smooth
+// shade differ little).
+template <class F>
+F minmod(const F& a, const F& b) {
+  return select(a * b > F(0.0f), select(abs(a) < abs(b), a, b), F(0.0f));
+}
+// The correction's second difference: minmod of the two ends', and 0 unless both are within
+// the threshold (a shade that bends gently; a stripe two lattice steps wide bends as much at
+// both ends as a curve, and a step has a large second difference: those keep the straight
+// blend, which marcarHuecos' spread test already judged good enough).
+template <class F>
+F gentle_bend(const F& a, const F& b, const F& limit) {
+  return select(max(abs(a), abs(b)) <= limit, minmod(a, b), F(0.0f));
+}
+
 // rellenarHuecos: traced pixels (sample count a > 0) take their colour; the others the
-// bilinear blend of the four lattice pixels around them.
+// bilinear blend of the four lattice pixels around them, less the curvature correction above
+// along x (on the cell's two rows) and along y (on its two columns, blended by the pixel's x):
+// 13 fetches, where a lattice pixel one step beyond the cell is out of the image or the cell is
+// narrower than K (the last column or row), no correction along that axis.
 struct FillGaps {
   static constexpr const char* name = "fill gaps";
   static constexpr const char* paper_name = "rellenarHuecos (extension)";
@@ -110,6 +134,7 @@ struct FillGaps {
   static constexpr std::array<const char*, 1> units{"sample_sum"};
 
   LatticeUniforms lattice;
+  float threshold = 0.1f;  // --aa-threshold: the largest second difference corrected
 
   template <class L>
   void operator()(Fragments<L>& f) const {
@@ -123,9 +148,42 @@ struct FillGaps {
       const F n = max(v.w, F(1.0f));
       return Vec3<F>{v.x / n, v.y / n, v.z / n};
     };
-    const Vec3<F> top = mean(s[0]) + (mean(s[1]) - mean(s[0])) * tx;
-    const Vec3<F> bottom = mean(s[2]) + (mean(s[3]) - mean(s[2])) * tx;
-    const Vec3<F> blend = top + (bottom - top) * ty;
+    const Vec3<F> m00 = mean(s[0]), m10 = mean(s[1]), m01 = mean(s[2]), m11 = mean(s[3]);
+    // The lattice pixels one step beyond the cell (coordinates clamped into the image; where
+    // one is outside, `along_x` or `along_y` is false and its colour is not used).
+    const F k(lattice.k);
+    const F xm = max(c.x0 - k, F(0.0f)), xp = min(c.x1 + k, F(lattice.width - 1.0f));
+    const F ym = max(c.y0 - k, F(0.0f)), yp = min(c.y1 + k, F(lattice.height - 1.0f));
+    const auto along_x =
+        (c.x0 - k >= F(0.0f)) && (c.x1 + k <= F(lattice.width - 1.0f)) && (c.x1 - c.x0 == k);
+    const auto along_y =
+        (c.y0 - k >= F(0.0f)) && (c.y1 + k <= F(lattice.height - 1.0f)) && (c.y1 - c.y0 == k);
+    auto at = [&](const F& px, const F& py) {
+      return mean(f.fetch(kSum, px + F(0.5f), py + F(0.5f)));
+    };
+    const Vec3<F> w0 = at(xm, c.y0), e0 = at(xp, c.y0), w1 = at(xm, c.y1), e1 = at(xp, c.y1);
+    const Vec3<F> n0 = at(c.x0, ym), s0 = at(c.x0, yp), n1 = at(c.x1, ym), s1 = at(c.x1, yp);
+    const F two(2.0f);
+    // The correction, per channel, between lattice pixels a and b with outer neighbours o (before
+    // a) and p (after b).
+    auto bend = [&](const Vec3<F>& o, const Vec3<F>& a, const Vec3<F>& b, const Vec3<F>& p,
+                    const F& t) {
+      const F w = t * (F(1.0f) - t) * F(0.5f);
+      const F lim(threshold * 0.5f);
+      return Vec3<F>{w * gentle_bend(o.x - two * a.x + b.x, a.x - two * b.x + p.x, lim),
+                     w * gentle_bend(o.y - two * a.y + b.y, a.y - two * b.y + p.y, lim),
+                     w * gentle_bend(o.z - two * a.z + b.z, a.z - two * b.z + p.z, lim)};
+    };
+    const Vec3<F> zero{F(0.0f), F(0.0f), F(0.0f)};
+    auto only = [](const auto& m, const Vec3<F>& v, const Vec3<F>& otherwise) {
+      return Vec3<F>{select(m, v.x, otherwise.x), select(m, v.y, otherwise.y),
+                     select(m, v.z, otherwise.z)};
+    };
+    const Vec3<F> top = m00 + (m10 - m00) * tx - only(along_x, bend(w0, m00, m10, e0, tx), zero);
+    const Vec3<F> bottom = m01 + (m11 - m01) * tx - only(along_x, bend(w1, m01, m11, e1, tx), zero);
+    const Vec3<F> left = bend(n0, m00, m01, s0, ty), right = bend(n1, m10, m11, s1, ty);
+    const Vec3<F> down = only(along_y, left + (right - left) * tx, zero);
+    const Vec3<F> blend = top + (bottom - top) * ty - down;
     const Vec3<F> traced = mean(own);
     const auto was_traced = own.w > F(0.0f);
     f.out(0) = {select(was_traced, traced.x, blend.x), select(was_traced, traced.y, blend.y),

@@ -668,6 +668,15 @@ void adaptive(const Tracer& tracer, const RenderOptions& opt, unsigned workers,
   res.samples = most;
 }
 
+// The one of a and b of smaller magnitude, 0 where their signs differ (rellenarHuecos' limiter).
+double minmod(double a, double b) {
+  return a * b > 0.0 ? (std::fabs(a) < std::fabs(b) ? a : b) : 0.0;
+}
+// ... and 0 unless both are within the threshold (kernels/undersample.h: gentle_bend).
+double gentle_bend(double a, double b, double limit) {
+  return std::max(std::fabs(a), std::fabs(b)) <= limit ? minmod(a, b) : 0.0;
+}
+
 // --aa undersample:K as the stream tracer runs it (render_undersampled): the lattice pixels,
 // then the pixels whose blended lattice pixels' surface keys or colours disagree, the rest
 // blended bilinearly from their cell's corners; AOVs of pixels never traced from the nearest
@@ -723,9 +732,33 @@ void undersample(const Tracer& tracer, const RenderOptions& opt, unsigned worker
         auto at = [&](int px, int py) { return colour[size_t(py) * size_t(W) + size_t(px)]; };
         const double tx = q.y > q.x ? double(x - q.x) / double(q.y - q.x) : 0.0;
         const double ty = q.w > q.z ? double(y - q.z) / double(q.w - q.z) : 0.0;
-        const glm::dvec3 top = at(q.x, q.z) + (at(q.y, q.z) - at(q.x, q.z)) * tx;
-        const glm::dvec3 bottom = at(q.x, q.w) + (at(q.y, q.w) - at(q.x, q.w)) * tx;
+        // rellenarHuecos' blend: bilinear, less the minmod curvature correction along each
+        // axis where the lattice pixels one step beyond the cell are in the image.
+        const bool along_x = q.x - K >= 0 && q.y + K <= W - 1 && q.y - q.x == K;
+        const bool along_y = q.z - K >= 0 && q.w + K <= H - 1 && q.w - q.z == K;
+        const double limit = double(opt.aa_threshold * 0.5f);
+        auto bend = [limit](const glm::dvec3& o, const glm::dvec3& a, const glm::dvec3& b,
+                            const glm::dvec3& p, double t) {
+          glm::dvec3 r;
+          for (int ch = 0; ch < 3; ++ch)
+            r[ch] = t * (1.0 - t) * 0.5 *
+                    gentle_bend(o[ch] - 2.0 * a[ch] + b[ch], a[ch] - 2.0 * b[ch] + p[ch], limit);
+          return r;
+        };
+        glm::dvec3 top = at(q.x, q.z) + (at(q.y, q.z) - at(q.x, q.z)) * tx;
+        glm::dvec3 bottom = at(q.x, q.w) + (at(q.y, q.w) - at(q.x, q.w)) * tx;
+        if (along_x) {
+          top -= bend(at(q.x - K, q.z), at(q.x, q.z), at(q.y, q.z), at(q.y + K, q.z), tx);
+          bottom -= bend(at(q.x - K, q.w), at(q.x, q.w), at(q.y, q.w), at(q.y + K, q.w), tx);
+        }
         c = top + (bottom - top) * ty;
+        if (along_y) {
+          const glm::dvec3 left =
+              bend(at(q.x, q.z - K), at(q.x, q.z), at(q.x, q.w), at(q.x, q.w + K), ty);
+          const glm::dvec3 right =
+              bend(at(q.y, q.z - K), at(q.y, q.z), at(q.y, q.w), at(q.y, q.w + K), ty);
+          c -= left + (right - left) * tx;
+        }
         const int nx = x - q.x <= q.y - x ? q.x : q.y, ny = y - q.z <= q.w - y ? q.z : q.w;
         const size_t j = size_t(ny) * size_t(W) + size_t(nx);
         res.depth[i] = res.depth[j];

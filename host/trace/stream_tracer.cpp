@@ -226,6 +226,7 @@ StreamTracer::StreamTracer(const Scene& scene, const Accel& accel, const RenderO
     s.mark_gaps.kernel.lattice = lattice;
     s.mark_gaps.kernel.threshold = opt_.aa_threshold;
     s.fill.kernel.lattice = lattice;
+    s.fill.kernel.threshold = opt_.aa_threshold;
   }
   s.grid_mask = Stencil(W, H, 1);
   s.isect_mask = Stencil(W, H, 1);
@@ -655,9 +656,9 @@ void StreamTracer::download_aovs(RenderResult& res) {
     }
 }
 
-void StreamTracer::stream_frame(const Camera& cam, const vgpu::Program& generate,
-                                RenderResult& res, bool aovs, int& iteration_number,
-                                const Texture* marks, bool keep_hits) {
+void StreamTracer::stream_frame(const Camera& cam, const vgpu::Program& generate, RenderResult& res,
+                                bool aovs, int& iteration_number, const Texture* marks,
+                                bool keep_hits) {
   vgpu::Device& gpu = *gpu_;
   State& s = *s_;
   PassRunner& r = *s.runner;
