@@ -319,14 +319,16 @@ void add_render_options(CLI::App& render, RenderArgs& a) {
                   "surface or the colour's second difference across the pixel exceeds "
                   "--aa-threshold) or undersample[:K] (one ray through every K-th pixel in x and "
                   "y, default 2, then through the pixels between those that hit different "
-                  "surfaces or differ in colour by more than --aa-threshold; the rest blended)")
+                  "surfaces or differ in colour by more than --aa-threshold; the rest blended, "
+                  "corrected for the shade's curvature)")
       ->check(kAaCheck)
       ->capture_default_str();
   render
       .add_option("--aa-threshold", a.aa_threshold,
                   "With --aa adaptive: the colour's second difference (linear, per channel, "
                   "along x or y) that marks a pixel for more samples; with --aa undersample: the "
-                  "colour difference between lattice pixels that has the pixels between traced")
+                  "colour difference between lattice pixels that has the pixels between traced "
+                  "(and twice the largest second difference the blend corrects)")
       ->check(kThresholdCheck)
       ->capture_default_str();
   render
