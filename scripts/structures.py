@@ -297,7 +297,6 @@ def frame_cost(h200_files, sizes_files):
     over = {acc: med([c["gpu"] - c["work"] for c in loop if c["accel"] == acc])
             for acc in ("grid2", "bvh", "kdtree")}
     over_rel = med([(c["gpu"] - c["work"]) / c["work"] for c in loop if c["accel"] == "grid2"])
-    g2 = [c for c in loop if c["accel"] == "grid2"]
     size_rows = "; ".join(
         f"{s}x{s}: wall {med([c['wall'] for c in per[s]]):.2f} ms, remainder "
         f"{med([host(c) for c in per[s]]):.2f} ms" for s in sizes)
