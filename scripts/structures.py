@@ -378,7 +378,7 @@ def frame_cost(h200_files, sizes_files):
     # Numbers stay on one line with their units.
     text = re.sub(r" (ms|us|ns|MHz|GB/s|TB/s)\b", "\x00\\1", text)
     return textwrap.fill(text, width=98, initial_indent="- ", subsequent_indent="  ",
-                         break_on_hyphens=False, break_long_words=False).replace("\x00", " ")
+                         break_on_hyphens=False, break_long_words=False).replace("\x00", " ") + "\n"
 
 
 def write_doc(a, rows, h200):
@@ -531,8 +531,7 @@ two-level grid has 96,334 sub-cells: fp16 and fp24 traversal groups both refuse 
 - The cost model for the two-level grid's looping kernel: its H200 frames run 33-46% longer
   than predicted, where every other structure's looping frames stay within 35%. The model is
   not recalibrated for it.
-{frame_cost(a.h200, a.h200_sizes)}
-- kd-backtrack and the short stack of Horn et al.: kd-restart (with push-down in the looping
+{frame_cost(a.h200, a.h200_sizes)}- kd-backtrack and the short stack of Horn et al.: kd-restart (with push-down in the looping
   kernel) is the only kd walk.
 - Front-to-back BVH order: it needs a stack or parent links with a direction flag.
 """
