@@ -6,9 +6,13 @@
 #   mkdir -p .gl && (cd .gl && apt-get download libegl1 libglvnd0 libopengl0 libgl1 libglx0)
 # copy the repository with .h200 and .gl to the GPU host and run there, from its root:
 #   OUT=DIR scripts/structures_h200.sh              (ACCELS="grid2" measures only those structures)
+#   OUT=DIR SIZES=1 scripts/structures_h200.sh      (the same frames at 8x8 to 512x512 instead:
+#                                                    what grows with the image, docs/structures.md)
 # then copy DIR's files to docs/structures_h200_{primary,full}.json and _clocks.csv, and run here:
 #   /usr/bin/python3 scripts/structures.py --h200 docs/structures_h200_primary.json \
 #     docs/structures_h200_full.json
+# (with SIZES=1: docs/structures_h200_sizes_{looping,multipass}.json and _clocks.csv, read by
+# scripts/structures.py --h200-sizes)
 set -u
 accels="${ACCELS:-grid grid2 bvh kdtree}"
 out="${OUT:?set OUT to a folder}"
@@ -25,6 +29,18 @@ sampler=$!
 trap 'kill $sampler 2>/dev/null || true' EXIT
 S="scenes/sphere.gltf scenes/bunny.gltf scenes/bunny-refl.gltf scenes/classic.gltf"
 S="$S scenes/teapot.gltf .h200/stadium.gltf .h200/scales.gltf"
+if [ -n "${SIZES:-}" ]; then
+  # Looping walks from 8x8 (a frame of little more than its fixed costs) to 512x512, and
+  # multipass frames at 8x8 and 64x64: one constant per frame stays, a cost per pixel grows.
+  .h200/bench_gl --runs 5 --sizes 8 64 256 512 --threads 16 --readback-wait poll --grid auto \
+    --accel grid2 bvh kdtree --variants looping --bounces 0 --micro-passes 20 --scenes $S \
+    --json "$out/structures_sizes_looping.json"
+  .h200/bench_gl --runs 3 --sizes 8 64 --threads 16 --readback-wait poll --grid auto \
+    --accel grid2 bvh --variants multipass --bounces 0 --micro-passes 10 \
+    --scenes scenes/bunny.gltf scenes/classic.gltf scenes/teapot.gltf \
+    --json "$out/structures_sizes_multipass.json"
+  exit 0
+fi
 .h200/bench_gl --runs 3 --sizes 256 --threads 16 --readback-wait poll --grid auto \
   --accel $accels --variants multipass looping --bounces 0 --scenes $S \
   --json "$out/structures_primary.json"
