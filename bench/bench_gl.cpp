@@ -3,6 +3,8 @@
 // frame and of every kernel, passes and query read-backs, medians of several runs, with the
 // emulator's host ms and the cost model's predictions for the same counters; and the fixed
 // costs of one pass, one query read-back and one program switch, measured on tiny passes.
+// Frames can run glass's ray streams (--ray-streams) and the sampling modes (--sampling), each
+// priced beside its measurement like the paper's frame.
 // Needs no OpenImageIO and no display: it runs on any machine with EGL (llvmpipe, NVIDIA).
 #include <CLI/CLI.hpp>
 #include <algorithm>
@@ -12,6 +14,7 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <regex>
 #include <sstream>
 
 #include "gl/context.h"
@@ -23,6 +26,7 @@
 #include "host/model/cost_model.h"
 #include "host/scene/camera.h"
 #include "host/scene/gltf_loader.h"
+#include "host/trace/sampling.h"
 #include "host/trace/stream_tracer.h"
 
 namespace {
@@ -124,10 +128,32 @@ Fixed time_passes(gl::GlDevice& d, int size, int n, int runs, bool readback, con
   return {median(wall), median(gpu)};
 }
 
+// A sampling mode of --sampling: spp:N (N rays per pixel, the accumulation frames),
+// adaptive:N (adaptive supersampling up to N) or undersample:K (the lattice of every K-th
+// pixel, then the gaps). Returns false for anything else, or N not a square from 1 to 256.
+bool parse_sampling(const std::string& text, host::RenderOptions& opt) {
+  std::smatch m;
+  if (!std::regex_match(text, m, std::regex(R"((spp|adaptive|undersample):(\d{1,4}))")))
+    return false;
+  const int n = std::stoi(m[2]);
+  opt.spp = 1;
+  opt.adaptive = false;
+  opt.undersample = 0;
+  if (m[1] == "undersample") {
+    opt.undersample = n;
+    return n >= 1 && n <= 64;
+  }
+  opt.spp = n;
+  opt.adaptive = m[1] == "adaptive";
+  return host::spp_refusal(n).empty();
+}
+
 struct FrameRun {
   std::vector<double> wall, gpu, host, wait;
   std::map<std::string, std::vector<double>> kernel_gpu, kernel_host;
   vgpu::FrameStats stats;
+  uint64_t rays_traced = 0;
+  bool streams = false;  // the frame ran as ray streams (--ray-streams on, or a glass scene)
   std::string device;
 };
 
@@ -149,6 +175,8 @@ FrameRun run_frames(const host::Scene& scene, const host::Accel& accel, const ho
       fr.kernel_host[p.name].push_back(p.counters.host_ms);
     }
     fr.stats = res.stats;
+    fr.rays_traced = res.rays_traced;
+    fr.streams = res.streams.on;
   }
   return fr;
 }
@@ -166,6 +194,8 @@ int main(int argc, char** argv) {
   std::vector<std::string> variants = {"multipass"};
   std::vector<std::string> accels = {"grid"};
   int bounces = 2;
+  std::vector<std::string> ray_streams = {"off"}, sampling = {"spp:1"};
+  bool shadows = false, no_fixed = false;
   app.add_option("--gl-device", device, "auto, or an EGL device index")->capture_default_str();
   app.add_option("--scenes", scenes, "Scene names or .gltf paths")->capture_default_str();
   app.add_option("--sizes", sizes, "Image sizes (square)")
@@ -204,9 +234,34 @@ int main(int argc, char** argv) {
                  "rays only)")
       ->capture_default_str()
       ->check(CLI::Range(0, 16));
+  app.add_option("--ray-streams", ray_streams,
+                 "Per frame: off (the paper's reflections), on (reflections through glass's ray "
+                 "streams: split, compaction, gather); a scene with glass always runs them")
+      ->check(CLI::IsMember({"off", "on"}))
+      ->capture_default_str();
+  app.add_option("--sampling", sampling,
+                 "Sampling modes per frame: spp:N (N a square, 1 to 256), adaptive:N (--aa "
+                 "adaptive up to N), undersample:K (--aa undersample:K, K 1 to 64)")
+      ->check(CLI::Validator(
+          [](std::string& t) -> std::string {
+            host::RenderOptions o;
+            return parse_sampling(t, o)
+                       ? ""
+                       : "expected spp:N, adaptive:N (N 1, 4, 9, ..., 256) or undersample:K (K "
+                         "1 to 64), got '" +
+                             t + "'";
+          },
+          "MODE", "sampling"))
+      ->capture_default_str();
+  app.add_flag("--shadows", shadows, "Shadow rays in the frames (off: Table 1's setting)");
+  app.add_flag("--no-fixed", no_fixed, "Skip the fixed-cost passes (frames only)");
   app.add_flag("--no-frames", no_frames, "Only the fixed costs");
   app.add_option("--json", json_path, "Also write every figure as JSON to this file");
-  CLI11_PARSE(app, argc, argv);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {  // --help exits 0; a bad option 2, as vgpu-rt does
+    return app.exit(e) == 0 ? 0 : 2;
+  }
 
   try {
     json out;
@@ -217,6 +272,9 @@ int main(int argc, char** argv) {
       out["renderer"] = d.context().renderer();
       out["gl_version"] = d.context().version();
       std::printf("device: %s\n", d.description().c_str());
+    }
+    if (wait_mode != "none" && !no_fixed) {
+      gl::GlDevice d(vgpu::profile("gf6600"), device, gl::GlDevice::ReadbackWait::block);
       vgpu::KernelProgram<CopyTexel> copy;
       vgpu::KernelProgram<ScaleTexel> scale;
       vgpu::KernelProgram<CopyTwice> twice;
@@ -297,7 +355,7 @@ int main(int argc, char** argv) {
           opt.width = opt.height = size;
           opt.bounces = bounces;
           opt.shading = kernels::ShadingModel::phong;
-          opt.shadows = false;
+          opt.shadows = shadows;
           opt.threads = threads;
           opt.gl_device = device;
           const host::Grid grid =
@@ -324,69 +382,79 @@ int main(int argc, char** argv) {
               opt.mrt = variant == "mrt";
               opt.looping = variant == "looping";
               opt.profile = variant == "multipass" ? "gf5700" : "h200";
-              for (const std::string& engine : engines) {
-                const bool gl = engine != "stream";
-                opt.device = gl ? "gl" : "vgpu";
-                opt.gl_readback = engine == "gl-poll" ? "poll" : "block";
-                const FrameRun fr = run_frames(scene, accel, cam, opt, runs);
-                json f = {{"scene", scene.name},
-                          {"accel", accel_name},
-                          {"bounces", opt.bounces},
-                          {"variant", variant},
-                          {"size", size},
-                          {"engine", engine},
-                          {"device", fr.device},
-                          {"runs", runs},
-                          {"wall_ms", median(fr.wall)},
-                          {"gpu_ms", gl ? json(median(fr.gpu)) : json()},
-                          {"readback_wait_ms", gl ? json(median(fr.wait)) : json()},
-                          {"passes", fr.stats.totals.passes},
-                          {"query_readbacks", fr.stats.totals.query_readbacks},
-                          {"program_loads", fr.stats.totals.program_loads},
-                          {"fragments_shaded", fr.stats.totals.fragments_shaded}};
-                json kernels = json::array();
-                for (const auto& p : fr.stats.programs) {
-                  json k = {{"name", p.name},
-                            {"paper_name", p.paper_name},
-                            {"passes", p.counters.passes},
-                            {"gpu_ms", gl ? json(median(fr.kernel_gpu.at(p.name))) : json()},
-                            {"host_ms", median(fr.kernel_host.at(p.name))}};
-                  if (!gl) {  // the cost model per kernel: its passes' work and fixed costs
-                    vgpu::FrameStats one;
-                    one.programs = {p};
-                    one.totals = p.counters;
-                    const vgpu::Profile& hp = vgpu::profile("h200");
-                    const host::CostBreakdown b = host::predict(one, hp, params_for(hp));
-                    k["predicted_h200_ms"] = b.total_ms;
-                    k["predicted_h200_work_ms"] = b.arithmetic_ms + b.texture_ms + b.memory_ms;
+              for (const std::string& streams : ray_streams)
+                for (const std::string& mode : sampling)
+                  for (const std::string& engine : engines) {
+                    opt.ray_streams = streams == "on";
+                    parse_sampling(mode, opt);  // checked when parsed
+                    const bool gl = engine != "stream";
+                    opt.device = gl ? "gl" : "vgpu";
+                    opt.gl_readback = engine == "gl-poll" ? "poll" : "block";
+                    const FrameRun fr = run_frames(scene, accel, cam, opt, runs);
+                    json f = {{"scene", scene.name},
+                              {"accel", accel_name},
+                              {"bounces", opt.bounces},
+                              {"variant", variant},
+                              {"shadows", opt.shadows},
+                              {"ray_streams", streams},
+                              {"streams_ran", fr.streams},
+                              {"sampling", mode},
+                              {"size", size},
+                              {"engine", engine},
+                              {"device", fr.device},
+                              {"runs", runs},
+                              {"wall_ms", median(fr.wall)},
+                              {"gpu_ms", gl ? json(median(fr.gpu)) : json()},
+                              {"readback_wait_ms", gl ? json(median(fr.wait)) : json()},
+                              {"passes", fr.stats.totals.passes},
+                              {"query_readbacks", fr.stats.totals.query_readbacks},
+                              {"program_loads", fr.stats.totals.program_loads},
+                              {"fragments_shaded", fr.stats.totals.fragments_shaded},
+                              {"rays_traced", fr.rays_traced}};
+                    json kernels = json::array();
+                    for (const auto& p : fr.stats.programs) {
+                      json k = {{"name", p.name},
+                                {"paper_name", p.paper_name},
+                                {"passes", p.counters.passes},
+                                {"gpu_ms", gl ? json(median(fr.kernel_gpu.at(p.name))) : json()},
+                                {"host_ms", median(fr.kernel_host.at(p.name))}};
+                      if (!gl) {  // the cost model per kernel: its passes' work and fixed costs
+                        vgpu::FrameStats one;
+                        one.programs = {p};
+                        one.totals = p.counters;
+                        const vgpu::Profile& hp = vgpu::profile("h200");
+                        const host::CostBreakdown b = host::predict(one, hp, params_for(hp));
+                        k["predicted_h200_ms"] = b.total_ms;
+                        k["predicted_h200_work_ms"] = b.arithmetic_ms + b.texture_ms + b.memory_ms;
+                      }
+                      kernels.push_back(k);
+                    }
+                    f["kernels"] = kernels;
+                    if (!gl) {
+                      json pred;
+                      for (const vgpu::Profile& p : vgpu::profiles())
+                        pred[p.name] = host::predict(fr.stats, p, params_for(p)).total_ms;
+                      f["predicted_ms"] = pred;
+                      json h200 = json::object();
+                      const vgpu::Profile& hp = vgpu::profile("h200");
+                      for (const auto& [k, v] : host::predict(fr.stats, hp, params_for(hp)).items())
+                        h200[k] = v;
+                      f["predicted_h200"] = h200;
+                    }
+                    std::printf("%-14s %4dx%-4d %-6s %-9s %-7s streams %-3s %-13s wall %9.1f ms",
+                                scene.name.c_str(), size, size, accel_name.c_str(), variant.c_str(),
+                                engine.c_str(), streams.c_str(), mode.c_str(), median(fr.wall));
+                    if (gl)
+                      std::printf("  gpu %9.1f ms  wait %8.1f ms", median(fr.gpu), median(fr.wait));
+                    else
+                      std::printf("  h200 predicted %8.1f ms",
+                                  f["predicted_ms"]["h200"].get<double>());
+                    std::printf("  passes %6llu  read-backs %5llu\n",
+                                static_cast<unsigned long long>(fr.stats.totals.passes),
+                                static_cast<unsigned long long>(fr.stats.totals.query_readbacks));
+                    std::fflush(stdout);
+                    frames.push_back(f);
                   }
-                  kernels.push_back(k);
-                }
-                f["kernels"] = kernels;
-                if (!gl) {
-                  json pred;
-                  for (const vgpu::Profile& p : vgpu::profiles())
-                    pred[p.name] = host::predict(fr.stats, p, params_for(p)).total_ms;
-                  f["predicted_ms"] = pred;
-                  json h200 = json::object();
-                  const vgpu::Profile& hp = vgpu::profile("h200");
-                  for (const auto& [k, v] : host::predict(fr.stats, hp, params_for(hp)).items())
-                    h200[k] = v;
-                  f["predicted_h200"] = h200;
-                }
-                std::printf("%-14s %4dx%-4d %-6s %-9s %-7s wall %9.1f ms", scene.name.c_str(), size,
-                            size, accel_name.c_str(), variant.c_str(), engine.c_str(),
-                            median(fr.wall));
-                if (gl)
-                  std::printf("  gpu %9.1f ms  wait %8.1f ms", median(fr.gpu), median(fr.wait));
-                else
-                  std::printf("  h200 predicted %8.1f ms", f["predicted_ms"]["h200"].get<double>());
-                std::printf("  passes %6llu  read-backs %5llu\n",
-                            static_cast<unsigned long long>(fr.stats.totals.passes),
-                            static_cast<unsigned long long>(fr.stats.totals.query_readbacks));
-                std::fflush(stdout);
-                frames.push_back(f);
-              }
             }
         }
       }

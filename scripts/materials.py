@@ -41,19 +41,25 @@ def shader(stats):
 BEGIN, END = "<!-- glass-measured:begin -->", "<!-- glass-measured:end -->"
 
 
+def opaque_copy(path):
+    """Writes the glass scene with every transmissionFactor 0 (the paper's opaque materials; the
+    buffers are embedded, so the copy can lie anywhere) to path."""
+    doc = json.load(open(os.path.join(ROOT, "scenes", "glass.gltf")))
+    for m in doc["materials"]:
+        ext = m.get("extensions", {}).get("KHR_materials_transmission")
+        if ext is not None:
+            ext["transmissionFactor"] = 0.0
+    json.dump(doc, open(path, "w"))
+
+
 def glass(exe, size):
     """The glass scene and its opaque copy (every transmissionFactor 0) on both engines, gf5700
     defaults; returns the markdown that goes between the markers."""
     scene = os.path.join(ROOT, "scenes", "glass.gltf")
     out = []
     with tempfile.TemporaryDirectory() as tmp:
-        doc = json.load(open(scene))
-        for m in doc["materials"]:
-            ext = m.get("extensions", {}).get("KHR_materials_transmission")
-            if ext is not None:
-                ext["transmissionFactor"] = 0.0
         opaque = os.path.join(tmp, "glass-opaque.gltf")
-        json.dump(doc, open(opaque, "w"))
+        opaque_copy(opaque)
         runs = {}
         for label, path in [("glass", scene), ("opaque", opaque)]:
             for engine in ["stream", "cpu"]:
@@ -111,8 +117,13 @@ def main():
     ap.add_argument("--size", type=int, default=256)
     ap.add_argument("--glass", action="store_true",
                     help="measure the glass scene and write docs/materials.md's glass tables")
+    ap.add_argument("--opaque-copy", metavar="PATH",
+                    help="only write the glass scene's opaque copy to PATH (for bench_gl)")
     args = ap.parse_args()
     exe, size = args.vgpu_rt, args.size
+    if args.opaque_copy:
+        opaque_copy(args.opaque_copy)
+        return
     if args.glass:
         write_glass(exe, size)
         return

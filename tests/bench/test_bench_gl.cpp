@@ -1,0 +1,107 @@
+// bench_gl's frame options as a user meets them: ray streams and sampling modes are run and
+// priced per frame (on the emulator alone, --readback-wait none, so no GL driver is needed),
+// and a bad mode is refused with exit 2 and nothing written.
+#include <doctest/doctest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Outcome {
+  int status = -1;
+  std::string err;
+};
+
+// Runs `bench_gl ARGS`, stdout discarded, stderr captured.
+Outcome bench(const std::string& args) {
+  const fs::path err =
+      fs::temp_directory_path() / ("vgpu_bench_gl_err_" + std::to_string(::getpid()));
+  const std::string cmd = std::string(BENCH_GL) + " " + args + " >/dev/null 2>" + err.string();
+  const int raw = std::system(cmd.c_str());
+  Outcome o;
+  o.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+  std::ifstream f(err);
+  std::stringstream ss;
+  ss << f.rdbuf();
+  o.err = ss.str();
+  fs::remove(err);
+  return o;
+}
+
+fs::path json_path() {
+  return fs::temp_directory_path() / ("vgpu_bench_gl_" + std::to_string(::getpid()) + ".json");
+}
+
+uint64_t kernel_passes(const nlohmann::json& frame, const std::string& name) {
+  for (const auto& k : frame["kernels"])
+    if (k["name"] == name) return k["passes"].get<uint64_t>();
+  return 0;
+}
+
+}  // namespace
+
+TEST_CASE("bench_gl refuses sampling modes and ray-stream settings it does not know, exit 2") {
+  const fs::path js = json_path();
+  for (const std::string bad :
+       {"--sampling spp:7", "--sampling adaptive:0", "--sampling undersample:0",
+        "--sampling undersample:65", "--sampling magic", "--sampling spp:", "--ray-streams yes"}) {
+    INFO("bench_gl " << bad);
+    fs::remove(js);
+    const Outcome o = bench("--readback-wait none --sizes 8 " + bad + " --json " + js.string());
+    CHECK(o.status == 2);
+    CHECK(o.err.find(bad.substr(0, bad.find(' '))) != std::string::npos);
+    CHECK_FALSE(fs::exists(js));
+  }
+}
+
+TEST_CASE("bench_gl runs each sampling mode with and without ray streams and prices every frame") {
+  const fs::path js = json_path();
+  const Outcome o = bench(
+      "--readback-wait none --sizes 8 --runs 1 --threads 1 --bounces 2 "
+      "--variants multipass --ray-streams off on --sampling spp:1 spp:4 "
+      "adaptive:4 undersample:2 --scenes " +
+      std::string(VGPU_SCENES) + "/bunny-refl.gltf --json " + js.string());
+  REQUIRE(o.status == 0);
+  std::ifstream f(js);
+  const nlohmann::json doc = nlohmann::json::parse(f);
+  fs::remove(js);
+  REQUIRE(doc["frames"].size() == 8);
+  std::map<std::pair<std::string, std::string>, nlohmann::json> frames;
+  for (const auto& fr : doc["frames"]) {
+    CHECK(fr["engine"] == "stream");
+    CHECK(fr["predicted_ms"]["h200"].get<double>() > 0);
+    frames[{fr["ray_streams"], fr["sampling"]}] = fr;
+  }
+  REQUIRE(frames.size() == 8);
+  for (const std::string mode : {"spp:1", "spp:4", "adaptive:4", "undersample:2"}) {
+    INFO(mode);
+    const auto& off = frames.at({"off", mode});
+    const auto& on = frames.at({"on", mode});
+    // Ray streams: the streams' own passes (compaction) appear only with them.
+    CHECK_FALSE(off["streams_ran"].get<bool>());
+    CHECK(on["streams_ran"].get<bool>());
+    CHECK(kernel_passes(off, "stream compaction") == 0);
+    CHECK(kernel_passes(on, "stream compaction") > 0);
+    CHECK(on["passes"].get<uint64_t>() > off["passes"].get<uint64_t>());
+  }
+  // Sampling: 4 sample frames trace 4 times the primary rays, and cost more passes and ms.
+  const auto& one = frames.at({"off", "spp:1"});
+  const auto& four = frames.at({"off", "spp:4"});
+  CHECK(four["rays_traced"].get<uint64_t>() > 3 * one["rays_traced"].get<uint64_t>());
+  CHECK(four["passes"].get<uint64_t>() > 3 * one["passes"].get<uint64_t>());
+  CHECK(four["predicted_ms"]["h200"].get<double>() > 3 * one["predicted_ms"]["h200"].get<double>());
+  for (const std::string mode : {"adaptive:4", "undersample:2"}) {
+    INFO(mode);
+    CHECK(frames.at({"off", mode})["passes"].get<uint64_t>() > one["passes"].get<uint64_t>());
+  }
+}
