@@ -12,7 +12,8 @@
 # run here:
 #   /usr/bin/python3 scripts/materials.py --h200 docs/materials_h200_glass.json \
 #     docs/materials_h200_streams.json
-#   /usr/bin/python3 scripts/sampling.py --h200 docs/sampling_h200.json docs/sampling_h200_bunny.json
+#   /usr/bin/python3 scripts/sampling.py --h200 docs/sampling_h200.json \
+#     docs/sampling_h200_bunny.json
 set -u
 out="${OUT:?set OUT to a folder}"
 size="${SIZE:-256}"
