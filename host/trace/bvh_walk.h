@@ -16,7 +16,7 @@
 
 namespace host {
 
-class BvhWalk : public AccelWalk {
+class BvhWalk : public ListWalk {
  public:
   // Passes of the walk by where it issues them (walk::PassKey).
   enum Site : int {
@@ -50,30 +50,17 @@ class BvhWalk : public AccelWalk {
   void trace(PassRunner& r, vgpu::Texture& origins, vgpu::Texture& rays, bool primary,
              glm::vec3 eye) override;
 
-  struct Cursor {
-    vgpu::Texture *origins, *rays;
-    int trav, vs, isect;
-  };
+  // The multipass walk (host/trace/walk.h); Cursor and write_back are ListWalk's.
   template <class X>
   void walk(X& x, Cursor& c);
-  WriteBack write_back(const Cursor& c) const;
 
  private:
-  void walk_looping(PassRunner& r, vgpu::Texture& origins, vgpu::Texture& rays, uint64_t walking);
-
-  const RenderOptions& opt_;
   int nodes_ = 0, max_leaf_ = 0;
-  WalkShared sh_{};
   vgpu::Texture nodes_lo_, nodes_hi_, lists_;
-  vgpu::Texture trav_[2], vs_[2];
-  int cur_trav_ = 0, cur_vs_ = 0;
   vgpu::KernelProgram<kernels::BvhEnter> enter_;
   vgpu::KernelProgram<kernels::BvhStep> step_;
   vgpu::KernelProgram<kernels::BvhLoadLeaf> load_;
   vgpu::KernelProgram<kernels::BvhIntersections> intersect_;
-  vgpu::KernelProgram<kernels::NextTriangle> next_;
-  vgpu::KernelProgram<kernels::RaysIntersecting> intersecting_;
-  vgpu::KernelProgram<kernels::RaysInGrid> walking_;
   vgpu::KernelProgram<kernels::BvhStepLoad> step_load_;
   vgpu::KernelProgram<kernels::BvhIntersectNext> intersect_next_;
   vgpu::KernelProgram<kernels::BvhLooping> looping_;

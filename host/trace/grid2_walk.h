@@ -18,7 +18,7 @@
 
 namespace host {
 
-class Grid2Walk : public AccelWalk {
+class Grid2Walk : public ListWalk {
  public:
   // Passes of the walk by where it issues them (walk::PassKey).
   enum Site : int {
@@ -54,31 +54,18 @@ class Grid2Walk : public AccelWalk {
   void trace(PassRunner& r, vgpu::Texture& origins, vgpu::Texture& rays, bool primary,
              glm::vec3 eye) override;
 
-  struct Cursor {
-    vgpu::Texture *origins, *rays;
-    int trav, vs, isect;
-  };
+  // The multipass walk (host/trace/walk.h); Cursor and write_back are ListWalk's.
   template <class X>
   void walk(X& x, Cursor& c);
-  WriteBack write_back(const Cursor& c) const;
 
  private:
-  void walk_looping(PassRunner& r, vgpu::Texture& origins, vgpu::Texture& rays, uint64_t walking);
-
-  const RenderOptions& opt_;
   int max_list_ = 0;
   int64_t max_steps_ = 0;  // sub-cells a ray can visit at most
-  WalkShared sh_{};
   vgpu::Texture cells_, subs_, lists_;
-  vgpu::Texture trav_[2], vs_[2];
-  int cur_trav_ = 0, cur_vs_ = 0;
   vgpu::KernelProgram<kernels::Grid2Enter> enter_;
   vgpu::KernelProgram<kernels::Grid2Step> step_;
   vgpu::KernelProgram<kernels::Grid2LoadCell> load_;
   vgpu::KernelProgram<kernels::Grid2Intersections> intersect_;
-  vgpu::KernelProgram<kernels::NextTriangle> next_;
-  vgpu::KernelProgram<kernels::RaysIntersecting> intersecting_;
-  vgpu::KernelProgram<kernels::RaysInGrid> walking_;
   vgpu::KernelProgram<kernels::Grid2StepLoad> step_load_;
   vgpu::KernelProgram<kernels::Grid2IntersectNext> intersect_next_;
   vgpu::KernelProgram<kernels::Grid2Looping> looping_;
