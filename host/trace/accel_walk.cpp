@@ -49,11 +49,29 @@ uint64_t replace_texels(
   return bytes;
 }
 
-ListWalk::ListWalk(const RenderOptions& options) : opt_(options) {
+ListWalk::ListWalk(const RenderOptions& options,
+                   std::initializer_list<const vgpu::Texture*> statics)
+    : opt_(options), statics_(statics) {
   const Formats& fm = opt_.formats;
   next_.set_precision(fm.arithmetic(Group::voxel));
   intersecting_.set_precision(fm.arithmetic(Group::queries));
   walking_.set_precision(fm.arithmetic(Group::queries));
+}
+
+void ListWalk::compute_in_groups(vgpu::Program& enter, vgpu::Program& step,
+                                 vgpu::Program& step_load, vgpu::Program& load,
+                                 vgpu::Program& intersect, vgpu::Program& intersect_next,
+                                 vgpu::Program& looping) const {
+  const Formats& fm = opt_.formats;
+  for (auto [prog, g] :
+       std::initializer_list<std::pair<vgpu::Program*, Group>>{{&enter, Group::traversal},
+                                                               {&step, Group::traversal},
+                                                               {&step_load, Group::traversal},
+                                                               {&load, Group::voxel},
+                                                               {&intersect, Group::hits},
+                                                               {&intersect_next, Group::hits}})
+    prog->set_precision(fm.arithmetic(g));
+  looping.set_precision(looping_arithmetic(fm));
 }
 
 void ListWalk::make_pairs(vgpu::Device& gpu, const WalkShared& shared, const std::string& trav_name,
@@ -65,6 +83,20 @@ void ListWalk::make_pairs(vgpu::Device& gpu, const WalkShared& shared, const std
     trav_[i] = gpu.make_texture(trav_name + sfx, opt_.width, opt_.height, 4, fm[Group::traversal]);
     vs_[i] = gpu.make_texture(state_name + sfx, opt_.width, opt_.height, 4, fm[Group::voxel]);
   }
+}
+
+void ListWalk::upload(vgpu::Device& gpu) const {
+  for (const Texture* t : statics_) gpu.upload(*t);
+}
+
+uint64_t ListWalk::static_bytes() const {
+  uint64_t bytes = 0;
+  for (const Texture* t : statics_) bytes += t->bytes();
+  return bytes;
+}
+
+uint64_t ListWalk::texture_bytes() const {
+  return static_bytes() + state_bytes();
 }
 
 uint64_t ListWalk::state_bytes() const {

@@ -92,12 +92,29 @@ class ListWalk : public AccelWalk {
     vgpu::Texture *origins, *rays;
     int trav, vs, isect;
   };
+  // Not copied: statics_ points at the walk's own members.
+  ListWalk(const ListWalk&) = delete;
+  ListWalk& operator=(const ListWalk&) = delete;
+
   // The state a batch walk hands back: the three ping-pong pairs and both masks.
   WriteBack write_back(const Cursor& c) const;
 
+  void upload(vgpu::Device& gpu) const final;  // each static texture, in the walk's order
+  uint64_t static_bytes() const final;
+  uint64_t texture_bytes() const final;
+
  protected:
-  // The shared programs compute in their groups' arithmetic formats.
-  explicit ListWalk(const RenderOptions& options);
+  // `statics`: the walk's static textures (members of the walk, made by it), in the order they
+  // are uploaded. The shared programs compute in their groups' arithmetic formats.
+  ListWalk(const RenderOptions& options, std::initializer_list<const vgpu::Texture*> statics);
+
+  // The programs of an extension's walk (BVH, kd-tree, two-level grid), each computing in its
+  // group's arithmetic format: the entry and step in the traversal group's, the list load in
+  // the voxel group's, the intersection in the hits group's, a fused program in its first
+  // kernel's (mrt_refusal checked both agree), the looping one in looping_arithmetic.
+  void compute_in_groups(vgpu::Program& enter, vgpu::Program& step, vgpu::Program& step_load,
+                         vgpu::Program& load, vgpu::Program& intersect,
+                         vgpu::Program& intersect_next, vgpu::Program& looping) const;
 
   // The per-pixel state textures: `trav_name` A and B in the traversal group's format,
   // `state_name` A and B in the voxel group's.
@@ -134,6 +151,21 @@ class ListWalk : public AccelWalk {
                       const vgpu::Program& intersect_next, const vgpu::Texture& lists,
                       bool reads_traversal);
 
+  // The passes of a step by where it issues them (the walk's own Site numbers).
+  struct StepSites {
+    int step, load, step_load;
+  };
+  // One step of every walking ray to its next node or cell, then the load of the list it
+  // reached: `step` (reading origins, rays, traversal, hits, `nodes`, `more_nodes`) and `load`
+  // (traversal, list state, `lists`), or under --mrt on both in one pass, `step_load` (as
+  // `step`, with the list state before the nodes and `lists` after). `more_nodes` may be
+  // nullptr (a structure with one node texture).
+  template <class X, class Key>
+  void step_and_load(X& x, Cursor& c, const Key& key, int step, const StepSites& site,
+                     const vgpu::Program& step_p, const vgpu::Program& load,
+                     const vgpu::Program& step_load, const vgpu::Texture& nodes,
+                     const vgpu::Texture* more_nodes, const vgpu::Texture& lists);
+
   // The looping variant (RenderOptions::looping): `looping`, reading (origins, rays,
   // traversal, list state, hits, vertices, then `statics`), drawn again while rays walk,
   // steps_per_pass iterations per pass. Past max_iterations (rounded up to whole passes) the
@@ -143,6 +175,7 @@ class ListWalk : public AccelWalk {
                     int64_t max_iterations, uint64_t walking);
 
   const RenderOptions& opt_;
+  std::vector<const vgpu::Texture*> statics_;
   WalkShared sh_{};
   // Per-pixel state (ping-pong pairs): traversal and list state.
   vgpu::Texture trav_[2], vs_[2];
@@ -195,6 +228,39 @@ void ListWalk::test_triangles(X& x, Cursor& c, const Key& key, int step, const T
     testing =
         x.count(key(step, k, site.testing_on), intersecting_, vs_[c.vs], &isect_mask, &isect_mask);
   }
+}
+
+template <class X, class Key>
+void ListWalk::step_and_load(X& x, Cursor& c, const Key& key, int step, const StepSites& site,
+                             const vgpu::Program& step_p, const vgpu::Program& load,
+                             const vgpu::Program& step_load, const vgpu::Texture& nodes,
+                             const vgpu::Texture* more_nodes, const vgpu::Texture& lists) {
+  vgpu::Texture &origins = *c.origins, &rays = *c.rays;
+  const vgpu::Texture *trav = &trav_[c.trav], *hits = sh_.isect[c.isect];
+  vgpu::Stencil* grid_mask = sh_.grid_mask;
+  if (opt_.mrt) {
+    const auto key_s = key(step, -1, site.step_load);
+    const vgpu::Texture* vs = &vs_[c.vs];
+    if (more_nodes)
+      x.pass(key_s, step_load, {&origins, &rays, trav, hits, vs, &nodes, more_nodes, &lists},
+             {&trav_[c.trav ^ 1], &vs_[c.vs ^ 1]}, grid_mask);
+    else
+      x.pass(key_s, step_load, {&origins, &rays, trav, hits, vs, &nodes, &lists},
+             {&trav_[c.trav ^ 1], &vs_[c.vs ^ 1]}, grid_mask);
+    c.trav ^= 1;
+    c.vs ^= 1;
+    return;
+  }
+  const auto key_s = key(step, -1, site.step);
+  if (more_nodes)
+    x.pass(key_s, step_p, {&origins, &rays, trav, hits, &nodes, more_nodes}, {&trav_[c.trav ^ 1]},
+           grid_mask);
+  else
+    x.pass(key_s, step_p, {&origins, &rays, trav, hits, &nodes}, {&trav_[c.trav ^ 1]}, grid_mask);
+  c.trav ^= 1;
+  x.pass(key(step, -1, site.load), load, {&trav_[c.trav], &vs_[c.vs], &lists}, {&vs_[c.vs ^ 1]},
+         grid_mask);
+  c.vs ^= 1;
 }
 
 }  // namespace host

@@ -14,18 +14,8 @@ using vgpu::Stencil;
 using vgpu::Texture;
 
 BvhWalk::BvhWalk(vgpu::Device& gpu, const Bvh& bvh, const RenderOptions& options, float scene_width)
-    : ListWalk(options) {
-  const Formats& fm = opt_.formats;
-  // The fused programs compute in their first kernel's group (mrt_refusal checked both agree).
-  for (auto [prog, g] :
-       std::initializer_list<std::pair<vgpu::Program*, Group>>{{&enter_, Group::traversal},
-                                                               {&step_, Group::traversal},
-                                                               {&step_load_, Group::traversal},
-                                                               {&load_, Group::voxel},
-                                                               {&intersect_, Group::hits},
-                                                               {&intersect_next_, Group::hits}})
-    prog->set_precision(fm.arithmetic(g));
-  looping_.set_precision(looping_arithmetic(fm));
+    : ListWalk(options, {&nodes_lo_, &nodes_hi_, &lists_}) {
+  compute_in_groups(enter_, step_, step_load_, load_, intersect_, intersect_next_, looping_);
   set_bvh(gpu, bvh, scene_width, nullptr);
 }
 
@@ -86,22 +76,8 @@ uint64_t BvhWalk::rebuild(vgpu::Device& gpu, const Accel& accel, float scene_wid
   return set_bvh(gpu, *accel.bvh, scene_width, &uploaded);
 }
 
-uint64_t BvhWalk::static_bytes() const {
-  return nodes_lo_.bytes() + nodes_hi_.bytes() + lists_.bytes();
-}
-
 void BvhWalk::make_state(vgpu::Device& gpu, const WalkShared& shared) {
   make_pairs(gpu, shared, "bvh traversal", "leaf state");
-}
-
-void BvhWalk::upload(vgpu::Device& gpu) const {
-  gpu.upload(nodes_lo_);
-  gpu.upload(nodes_hi_);
-  gpu.upload(lists_);
-}
-
-uint64_t BvhWalk::texture_bytes() const {
-  return static_bytes() + state_bytes();
 }
 
 void BvhWalk::trace(PassRunner& r, Texture& origins, Texture& rays, bool, glm::vec3) {
@@ -123,12 +99,8 @@ void BvhWalk::trace(PassRunner& r, Texture& origins, Texture& rays, bool, glm::v
 
 template <class X>
 void BvhWalk::walk(X& x, Cursor& c) {
-  Texture &origins = *c.origins, &rays = *c.rays;
-  Texture* const* isect = sh_.isect;
   Stencil& grid_mask = *sh_.grid_mask;
-  auto key = [&c](int step, int k, int site) {
-    return walk::PassKey{step, k, site, uint8_t(c.trav | c.vs << 1 | c.isect << 2)};
-  };
+  const auto key = walk::keys(c);
   x.fill(grid_mask, 1);
   auto walking = x.count(key(-1, -1, kEnter), walking_, trav_[c.trav], nullptr, &grid_mask);
   x.traced(walking);
@@ -141,22 +113,8 @@ void BvhWalk::walk(X& x, Cursor& c) {
       x.unfinished(walking);
       break;
     }
-    if (opt_.mrt) {
-      x.pass(key(step, -1, kStepLoad), step_load_,
-             {&origins, &rays, &trav_[c.trav], isect[c.isect], &vs_[c.vs], &nodes_lo_, &nodes_hi_,
-              &lists_},
-             {&trav_[c.trav ^ 1], &vs_[c.vs ^ 1]}, &grid_mask);
-      c.trav ^= 1;
-      c.vs ^= 1;
-    } else {
-      x.pass(key(step, -1, kStep), step_,
-             {&origins, &rays, &trav_[c.trav], isect[c.isect], &nodes_lo_, &nodes_hi_},
-             {&trav_[c.trav ^ 1]}, &grid_mask);
-      c.trav ^= 1;
-      x.pass(key(step, -1, kLoad), load_, {&trav_[c.trav], &vs_[c.vs], &lists_}, {&vs_[c.vs ^ 1]},
-             &grid_mask);
-      c.vs ^= 1;
-    }
+    step_and_load(x, c, key, step, {kStep, kLoad, kStepLoad}, step_, load_, step_load_, nodes_lo_,
+                  &nodes_hi_, lists_);
     test_triangles(x, c, key, step, {kTesting, kIntersect, kNext, kIntersectNext, kTestingOn},
                    max_leaf_, intersect_, intersect_next_, lists_, false);
     walking = x.count(key(step, -1, kWalking), walking_, trav_[c.trav], &grid_mask, &grid_mask);

@@ -16,17 +16,8 @@ using vgpu::Texture;
 
 Grid2Walk::Grid2Walk(vgpu::Device& gpu, const Grid2& g2, const RenderOptions& options,
                      float scene_width, float t_slack)
-    : ListWalk(options) {
-  const Formats& fm = opt_.formats;
-  for (auto [prog, g] :
-       std::initializer_list<std::pair<vgpu::Program*, Group>>{{&enter_, Group::traversal},
-                                                               {&step_, Group::traversal},
-                                                               {&step_load_, Group::traversal},
-                                                               {&load_, Group::voxel},
-                                                               {&intersect_, Group::hits},
-                                                               {&intersect_next_, Group::hits}})
-    prog->set_precision(fm.arithmetic(g));
-  looping_.set_precision(looping_arithmetic(fm));
+    : ListWalk(options, {&cells_, &subs_, &lists_}) {
+  compute_in_groups(enter_, step_, step_load_, load_, intersect_, intersect_next_, looping_);
   set_grid(gpu, g2, scene_width, t_slack, nullptr);
 }
 
@@ -110,22 +101,8 @@ uint64_t Grid2Walk::rebuild(vgpu::Device& gpu, const Accel& accel, float scene_w
   return set_grid(gpu, *accel.grid2, scene_width, t_slack, &uploaded);
 }
 
-uint64_t Grid2Walk::static_bytes() const {
-  return cells_.bytes() + subs_.bytes() + lists_.bytes();
-}
-
 void Grid2Walk::make_state(vgpu::Device& gpu, const WalkShared& shared) {
   make_pairs(gpu, shared, "grid2 traversal", "cell state");
-}
-
-void Grid2Walk::upload(vgpu::Device& gpu) const {
-  gpu.upload(cells_);
-  gpu.upload(subs_);
-  gpu.upload(lists_);
-}
-
-uint64_t Grid2Walk::texture_bytes() const {
-  return static_bytes() + state_bytes();
 }
 
 void Grid2Walk::trace(PassRunner& r, Texture& origins, Texture& rays, bool, glm::vec3) {
@@ -150,12 +127,8 @@ void Grid2Walk::trace(PassRunner& r, Texture& origins, Texture& rays, bool, glm:
 
 template <class X>
 void Grid2Walk::walk(X& x, Cursor& c) {
-  Texture &origins = *c.origins, &rays = *c.rays;
-  Texture* const* isect = sh_.isect;
   Stencil& grid_mask = *sh_.grid_mask;
-  auto key = [&c](int step, int k, int site) {
-    return walk::PassKey{step, k, site, uint8_t(c.trav | c.vs << 1 | c.isect << 2)};
-  };
+  const auto key = walk::keys(c);
   x.fill(grid_mask, 1);
   auto walking = x.count(key(-1, -1, kEnter), walking_, trav_[c.trav], nullptr, &grid_mask);
   x.traced(walking);
@@ -168,22 +141,8 @@ void Grid2Walk::walk(X& x, Cursor& c) {
     test_triangles(x, c, key, int(step), {kTesting, kIntersect, kNext, kIntersectNext, kTestingOn},
                    max_list_, intersect_, intersect_next_, lists_, true);
     // Then one step to the next sub-cell (done at a hit or out of the box), its list loaded.
-    if (opt_.mrt) {
-      x.pass(
-          key(int(step), -1, kStepLoad), step_load_,
-          {&origins, &rays, &trav_[c.trav], isect[c.isect], &vs_[c.vs], &cells_, &subs_, &lists_},
-          {&trav_[c.trav ^ 1], &vs_[c.vs ^ 1]}, &grid_mask);
-      c.trav ^= 1;
-      c.vs ^= 1;
-    } else {
-      x.pass(key(int(step), -1, kStep), step_,
-             {&origins, &rays, &trav_[c.trav], isect[c.isect], &cells_, &subs_},
-             {&trav_[c.trav ^ 1]}, &grid_mask);
-      c.trav ^= 1;
-      x.pass(key(int(step), -1, kLoad), load_, {&trav_[c.trav], &vs_[c.vs], &lists_},
-             {&vs_[c.vs ^ 1]}, &grid_mask);
-      c.vs ^= 1;
-    }
+    step_and_load(x, c, key, int(step), {kStep, kLoad, kStepLoad}, step_, load_, step_load_, cells_,
+                  &subs_, lists_);
     walking =
         x.count(key(int(step), -1, kWalking), walking_, trav_[c.trav], &grid_mask, &grid_mask);
     if (!X::any(walking)) break;

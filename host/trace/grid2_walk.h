@@ -41,7 +41,6 @@ class Grid2Walk : public ListWalk {
   Grid2Walk(vgpu::Device& gpu, const Grid2& g2, const RenderOptions& options, float scene_width,
             float t_slack);
   void make_state(vgpu::Device& gpu, const WalkShared& shared) override;
-  void upload(vgpu::Device& gpu) const override;
   // The textures and the uniforms that depend on them; with `uploaded` (between frames,
   // AccelWalk::rebuild), the textures are kept where the new structure fits them and each one
   // whose texels changed is uploaded again and named there. Returns those bytes.
@@ -49,8 +48,6 @@ class Grid2Walk : public ListWalk {
                     std::vector<std::string>* uploaded);
   uint64_t rebuild(vgpu::Device& gpu, const Accel& accel, float scene_width,
                    std::vector<std::string>& uploaded) override;
-  uint64_t static_bytes() const override;
-  uint64_t texture_bytes() const override;
   void trace(PassRunner& r, vgpu::Texture& origins, vgpu::Texture& rays, bool primary,
              glm::vec3 eye) override;
 

@@ -70,7 +70,7 @@ std::vector<std::string> mrt_programs() {
 
 GridWalk::GridWalk(vgpu::Device& gpu, const Grid& grid, const RenderOptions& options,
                    float scene_width)
-    : ListWalk(options) {
+    : ListWalk(options, {&lists_, &pointers_}) {
   // Each program computes in its group's arithmetic format (formats.h: which kernel is where).
   const Formats& fm = opt_.formats;
   for (auto [prog, g] :
@@ -176,19 +176,6 @@ void GridWalk::make_state(vgpu::Device& gpu, const Shared& shared) {
   make_pairs(gpu, shared, "traversal", "voxel state");
 }
 
-void GridWalk::upload(vgpu::Device& gpu) const {
-  gpu.upload(lists_);
-  gpu.upload(pointers_);
-}
-
-uint64_t GridWalk::static_bytes() const {
-  return lists_.bytes() + pointers_.bytes();
-}
-
-uint64_t GridWalk::texture_bytes() const {
-  return static_bytes() + state_bytes();
-}
-
 void GridWalk::trace(PassRunner& r, Texture& origins, Texture& rays, bool primary, glm::vec3 eye) {
   clear(r.device());
   // Enter the grid.
@@ -216,9 +203,7 @@ void GridWalk::walk(X& x, Cursor& c) {
   Texture &origins = *c.origins, &rays = *c.rays;
   Texture* const* isect = sh_.isect;
   Stencil& grid_mask = *sh_.grid_mask;
-  auto key = [&c](int step, int k, int site) {
-    return walk::PassKey{step, k, site, uint8_t(c.trav | c.vs << 1 | c.isect << 2)};
-  };
+  const auto key = walk::keys(c);
   x.fill(grid_mask, 1);
   auto walking = x.count(key(-1, -1, kEnter), walking_, trav_[c.trav], nullptr, &grid_mask);
   x.traced(walking);

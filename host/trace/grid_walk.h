@@ -49,8 +49,6 @@ class GridWalk : public ListWalk {
   GridWalk(vgpu::Device& gpu, const Grid& grid, const RenderOptions& options, float scene_width);
   // The per-pixel state textures (traversal, voxel state), made after the tracer's own.
   void make_state(vgpu::Device& gpu, const Shared& shared) override;
-  // Video memory gets the static textures at initialization.
-  void upload(vgpu::Device& gpu) const override;
   // A new grid for the same scene texture layout, between frames of a moving scene: the
   // static textures rewritten (kept where the new grid fits them) and uniforms set; with
   // `uploaded`, each texture whose texels changed is uploaded again and named there. Returns
@@ -62,8 +60,6 @@ class GridWalk : public ListWalk {
                    std::vector<std::string>& uploaded) override {
     return set_grid(gpu, *accel.grid, scene_width, &uploaded);
   }
-  uint64_t static_bytes() const override;   // the grid's textures (lists, voxel pointers)
-  uint64_t texture_bytes() const override;  // those and the per-pixel state
 
   // One stream of rays through the grid: enter it (initTraversal for primary rays, from the eye;
   // reinicializarTraversal otherwise), then walk it until no ray is walking. Leaves the nearest

@@ -16,17 +16,8 @@ using vgpu::Texture;
 
 KdWalk::KdWalk(vgpu::Device& gpu, const KdTree& kd, const RenderOptions& options, float scene_width,
                float t_slack)
-    : ListWalk(options) {
-  const Formats& fm = opt_.formats;
-  for (auto [prog, g] :
-       std::initializer_list<std::pair<vgpu::Program*, Group>>{{&enter_, Group::traversal},
-                                                               {&step_, Group::traversal},
-                                                               {&step_load_, Group::traversal},
-                                                               {&load_, Group::voxel},
-                                                               {&intersect_, Group::hits},
-                                                               {&intersect_next_, Group::hits}})
-    prog->set_precision(fm.arithmetic(g));
-  looping_.set_precision(looping_arithmetic(fm));
+    : ListWalk(options, {&tree_, &lists_}) {
+  compute_in_groups(enter_, step_, step_load_, load_, intersect_, intersect_next_, looping_);
   set_tree(gpu, kd, scene_width, t_slack, nullptr);
 }
 
@@ -95,21 +86,8 @@ uint64_t KdWalk::rebuild(vgpu::Device& gpu, const Accel& accel, float scene_widt
   return set_tree(gpu, *accel.kd, scene_width, t_slack, &uploaded);
 }
 
-uint64_t KdWalk::static_bytes() const {
-  return tree_.bytes() + lists_.bytes();
-}
-
 void KdWalk::make_state(vgpu::Device& gpu, const WalkShared& shared) {
   make_pairs(gpu, shared, "kd traversal", "leaf state");
-}
-
-void KdWalk::upload(vgpu::Device& gpu) const {
-  gpu.upload(tree_);
-  gpu.upload(lists_);
-}
-
-uint64_t KdWalk::texture_bytes() const {
-  return static_bytes() + state_bytes();
 }
 
 void KdWalk::trace(PassRunner& r, Texture& origins, Texture& rays, bool, glm::vec3) {
@@ -131,12 +109,8 @@ void KdWalk::trace(PassRunner& r, Texture& origins, Texture& rays, bool, glm::ve
 
 template <class X>
 void KdWalk::walk(X& x, Cursor& c) {
-  Texture &origins = *c.origins, &rays = *c.rays;
-  Texture* const* isect = sh_.isect;
   Stencil& grid_mask = *sh_.grid_mask;
-  auto key = [&c](int step, int k, int site) {
-    return walk::PassKey{step, k, site, uint8_t(c.trav | c.vs << 1 | c.isect << 2)};
-  };
+  const auto key = walk::keys(c);
   x.fill(grid_mask, 1);
   auto walking = x.count(key(-1, -1, kEnter), walking_, trav_[c.trav], nullptr, &grid_mask);
   x.traced(walking);
@@ -149,20 +123,8 @@ void KdWalk::walk(X& x, Cursor& c) {
       x.unfinished(walking);
       break;
     }
-    if (opt_.mrt) {
-      x.pass(key(step, -1, kStepLoad), step_load_,
-             {&origins, &rays, &trav_[c.trav], isect[c.isect], &vs_[c.vs], &tree_, &lists_},
-             {&trav_[c.trav ^ 1], &vs_[c.vs ^ 1]}, &grid_mask);
-      c.trav ^= 1;
-      c.vs ^= 1;
-    } else {
-      x.pass(key(step, -1, kStep), step_, {&origins, &rays, &trav_[c.trav], isect[c.isect], &tree_},
-             {&trav_[c.trav ^ 1]}, &grid_mask);
-      c.trav ^= 1;
-      x.pass(key(step, -1, kLoad), load_, {&trav_[c.trav], &vs_[c.vs], &lists_}, {&vs_[c.vs ^ 1]},
-             &grid_mask);
-      c.vs ^= 1;
-    }
+    step_and_load(x, c, key, step, {kStep, kLoad, kStepLoad}, step_, load_, step_load_, tree_,
+                  nullptr, lists_);
     test_triangles(x, c, key, step, {kTesting, kIntersect, kNext, kIntersectNext, kTestingOn},
                    max_leaf_, intersect_, intersect_next_, lists_, true);
     walking = x.count(key(step, -1, kWalking), walking_, trav_[c.trav], &grid_mask, &grid_mask);

@@ -52,6 +52,16 @@ struct PassKey {
   uint8_t parity = 0;
 };
 
+// Names the passes of a walk at cursor c (a ListWalk::Cursor: current traversal, list state
+// and intersection textures): key(step, k, site) is the PassKey with c's parity as it is when
+// the key is made.
+template <class Cursor>
+auto keys(const Cursor& c) {
+  return [&c](int step, int k, int site) {
+    return PassKey{step, k, site, uint8_t(c.trav | c.vs << 1 | c.isect << 2)};
+  };
+}
+
 // Per pass of the walk (by PassKey), a T: grown on first use, cheap to look up.
 template <class T>
 class Keyed {
