@@ -52,26 +52,25 @@ uint64_t replace_texels(
 ListWalk::ListWalk(const RenderOptions& options,
                    std::initializer_list<const vgpu::Texture*> statics)
     : opt_(options), statics_(statics) {
-  const Formats& fm = opt_.formats;
-  next_.set_precision(fm.arithmetic(Group::voxel));
-  intersecting_.set_precision(fm.arithmetic(Group::queries));
-  walking_.set_precision(fm.arithmetic(Group::queries));
+  compute_in(
+      {{&next_, Group::voxel}, {&intersecting_, Group::queries}, {&walking_, Group::queries}});
+}
+
+void ListWalk::compute_in(std::initializer_list<std::pair<vgpu::Program*, Group>> programs) const {
+  for (auto [prog, g] : programs) prog->set_precision(opt_.formats.arithmetic(g));
 }
 
 void ListWalk::compute_in_groups(vgpu::Program& enter, vgpu::Program& step,
                                  vgpu::Program& step_load, vgpu::Program& load,
                                  vgpu::Program& intersect, vgpu::Program& intersect_next,
                                  vgpu::Program& looping) const {
-  const Formats& fm = opt_.formats;
-  for (auto [prog, g] :
-       std::initializer_list<std::pair<vgpu::Program*, Group>>{{&enter, Group::traversal},
-                                                               {&step, Group::traversal},
-                                                               {&step_load, Group::traversal},
-                                                               {&load, Group::voxel},
-                                                               {&intersect, Group::hits},
-                                                               {&intersect_next, Group::hits}})
-    prog->set_precision(fm.arithmetic(g));
-  looping.set_precision(looping_arithmetic(fm));
+  compute_in({{&enter, Group::traversal},
+              {&step, Group::traversal},
+              {&step_load, Group::traversal},
+              {&load, Group::voxel},
+              {&intersect, Group::hits},
+              {&intersect_next, Group::hits}});
+  looping.set_precision(looping_arithmetic(opt_.formats));
 }
 
 void ListWalk::make_pairs(vgpu::Device& gpu, const WalkShared& shared, const std::string& trav_name,

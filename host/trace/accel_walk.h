@@ -108,6 +108,9 @@ class ListWalk : public AccelWalk {
   // are uploaded. The shared programs compute in their groups' arithmetic formats.
   ListWalk(const RenderOptions& options, std::initializer_list<const vgpu::Texture*> statics);
 
+  // Each program computes in its group's arithmetic format (host/model/formats.h: which kernel
+  // is where).
+  void compute_in(std::initializer_list<std::pair<vgpu::Program*, Group>> programs) const;
   // The programs of an extension's walk (BVH, kd-tree, two-level grid), each computing in its
   // group's arithmetic format: the entry and step in the traversal group's, the list load in
   // the voxel group's, the intersection in the hits group's, a fused program in its first

@@ -71,21 +71,15 @@ std::vector<std::string> mrt_programs() {
 GridWalk::GridWalk(vgpu::Device& gpu, const Grid& grid, const RenderOptions& options,
                    float scene_width)
     : ListWalk(options, {&lists_, &pointers_}) {
-  // Each program computes in its group's arithmetic format (formats.h: which kernel is where).
-  const Formats& fm = opt_.formats;
-  for (auto [prog, g] :
-       std::initializer_list<std::pair<vgpu::Program*, Group>>{{&init_, Group::traversal},
-                                                               {&reset_, Group::traversal},
-                                                               {&traversal_, Group::traversal},
-                                                               {&update_, Group::voxel},
-                                                               {&intersect_, Group::hits}})
-    prog->set_precision(fm.arithmetic(g));
-  if (opt_.mrt) {
-    // The tracer checked mrt_refusal: both kernels' groups compute alike.
-    intersect_next_.set_precision(fm.arithmetic(Group::hits));
-    traverse_update_.set_precision(fm.arithmetic(Group::traversal));
-  }
-  looping_.set_precision(looping_arithmetic(fm));
+  compute_in({{&init_, Group::traversal},
+              {&reset_, Group::traversal},
+              {&traversal_, Group::traversal},
+              {&update_, Group::voxel},
+              {&intersect_, Group::hits}});
+  // The tracer checked mrt_refusal: both kernels' groups compute alike.
+  if (opt_.mrt)
+    compute_in({{&intersect_next_, Group::hits}, {&traverse_update_, Group::traversal}});
+  looping_.set_precision(looping_arithmetic(opt_.formats));
   set_grid(gpu, grid, scene_width, nullptr);
 }
 
