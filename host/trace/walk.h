@@ -43,9 +43,8 @@ inline constexpr int kMaxSites = 16;
 
 // A pass of the walk: the site of the call, the step (-1 before the first) and the index k
 // within a step (-1 outside an inner loop) name one pass of the walk's sequence; `parity` says
-// which texture of each ping-pong pair is current, which fixes the bindings.
-// A pass of the walk: its site, step and k; `parity` says which texture of each ping-pong pair
-// is current (bit 0 traversal, 1 voxel state, 2 intersection), which fixes the bindings.
+// which texture of each ping-pong pair is current (bit 0 traversal, 1 voxel state, 2
+// intersection), which fixes the bindings.
 struct PassKey {
   int step, k;
   int site;  // one of the walk's sites, below kMaxSites
