@@ -1,5 +1,6 @@
-// The stackless BVH walk (host/trace/bvh_walk.h): its textures, its pass sequence (multipass and
-// looping) and the walkers instantiated for it.
+// The stackless BVH walk (host/trace/bvh_walk.h): its textures, its pass sequence
+// (multipass and looping, on the parts every walk shares: ListWalk, host/trace/accel_walk.h)
+// and the walkers instantiated for it.
 #include "host/trace/bvh_walk.h"
 
 #include <algorithm>

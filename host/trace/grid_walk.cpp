@@ -1,5 +1,6 @@
 // The paper's walk through the uniform grid (host/trace/grid_walk.h): its textures, its pass
-// sequence (multipass and looping) and the walkers instantiated for it.
+// sequence (multipass and looping, on the parts every walk shares: ListWalk,
+// host/trace/accel_walk.h) and the walkers instantiated for it.
 #include "host/trace/grid_walk.h"
 
 #include <algorithm>

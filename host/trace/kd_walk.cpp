@@ -1,5 +1,6 @@
-// The kd-restart walk (host/trace/kd_walk.h): its textures, its pass sequence (multipass and
-// looping) and the walkers instantiated for it.
+// The kd-restart walk (host/trace/kd_walk.h): its textures, its pass sequence
+// (multipass and looping, on the parts every walk shares: ListWalk, host/trace/accel_walk.h)
+// and the walkers instantiated for it.
 #include "host/trace/kd_walk.h"
 
 #include <algorithm>
