@@ -1,17 +1,22 @@
-// What the host loop (host/trace/stream_tracer.cpp) needs of an acceleration structure's walk:
-// its static textures, its per-pixel state, and one stream of rays traced through it. The
-// paper's uniform grid (grid_walk.h) and the extensions (bvh_walk.h) implement it; how their
-// pass sequences run is host/trace/walk.h's business.
+// What the host loop (host/trace/stream_tracer.cpp) needs of an acceleration structure's walk
+// (AccelWalk), and what the four walks share (ListWalk): the paper's uniform grid (grid_walk.h)
+// and the extensions (bvh_walk.h, kd_walk.h, grid2_walk.h) each keep only their textures,
+// programs, pass sites and sequence. How a pass sequence runs is host/trace/walk.h's business.
 #pragma once
 
 #include <cstdint>
 #include <glm/glm.hpp>
+#include <initializer_list>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "host/accel/accel.h"
+#include "host/model/formats.h"
 #include "host/trace/passes.h"
+#include "host/trace/render_options.h"
+#include "kernels/kernels.h"
 #include "vgpu/vgpu.h"
 
 namespace host {
@@ -47,5 +52,218 @@ class AccelWalk {
   virtual void trace(PassRunner& r, vgpu::Texture& origins, vgpu::Texture& rays, bool primary,
                      glm::vec3 eye) = 0;
 };
+
+// The arithmetic of a looping program, which does the traversal, voxel and hits groups' work:
+// the finest of their arithmetic formats (their textures keep their own formats).
+vgpu::Format looping_arithmetic(const Formats& formats);
+
+// A structure's node indices or list positions (`count` of them, `kind`) held in `group`'s
+// texels and arithmetic.
+struct AddressUse {
+  uint64_t count;
+  Group group;
+  const char* kind;
+};
+// Refuses a format that cannot hold the addresses (a walk would stall at an index that no
+// longer counts up, as the grid's does past its cap): throws vgpu::Error "STRUCTURE: KIND
+// reach N; ...". The advice names fp32 alone where fp24 cannot hold them either only with
+// `advice_by_need` (the two-level grid's message; the BVH's and kd-tree's name both).
+void check_addresses(const Formats& formats, const std::string& structure,
+                     std::initializer_list<AddressUse> uses, bool advice_by_need);
+
+// Whether a static texture holds `count` entries (between frames it is kept where it does).
+bool holds(const vgpu::Texture& t, size_t count);
+
+// Static textures get their new texels; with `uploaded` (between frames), each one whose texels
+// changed is uploaded again and named there. Returns the bytes uploaded.
+uint64_t replace_texels(
+    vgpu::Device& gpu,
+    std::initializer_list<std::pair<vgpu::Texture*, const std::vector<float>*>> textures,
+    std::vector<std::string>* uploaded);
+
+// What the four walks share: per pixel a traversal pair (where the ray is in the structure)
+// and a list-state pair (its position in the triangle list it tests), the queries that count
+// walking and testing rays (rayosEnGrilla, rayosIntersectando), proximoTriangulo, the triangle
+// loop of the multipass walk and the host loop of the looping variant.
+class ListWalk : public AccelWalk {
+ public:
+  // Where the walk is: the rays it traces and the current texture of each ping-pong pair.
+  struct Cursor {
+    vgpu::Texture *origins, *rays;
+    int trav, vs, isect;
+  };
+  // Not copied: statics_ points at the walk's own members.
+  ListWalk(const ListWalk&) = delete;
+  ListWalk& operator=(const ListWalk&) = delete;
+
+  // The state a batch walk hands back: the three ping-pong pairs and both masks.
+  WriteBack write_back(const Cursor& c) const;
+
+  void upload(vgpu::Device& gpu) const final;  // each static texture, in the walk's order
+  uint64_t static_bytes() const final;
+  uint64_t texture_bytes() const final;
+
+ protected:
+  // `statics`: the walk's static textures (members of the walk, made by it), in the order they
+  // are uploaded. The shared programs compute in their groups' arithmetic formats.
+  ListWalk(const RenderOptions& options, std::initializer_list<const vgpu::Texture*> statics);
+
+  // Each program computes in its group's arithmetic format (host/model/formats.h: which kernel
+  // is where).
+  void compute_in(std::initializer_list<std::pair<vgpu::Program*, Group>> programs) const;
+  // The programs of an extension's walk (BVH, kd-tree, two-level grid), each computing in its
+  // group's arithmetic format: the entry and step in the traversal group's, the list load in
+  // the voxel group's, the intersection in the hits group's, a fused program in its first
+  // kernel's (mrt_refusal checked both agree), the looping one in looping_arithmetic.
+  void compute_in_groups(vgpu::Program& enter, vgpu::Program& step, vgpu::Program& step_load,
+                         vgpu::Program& load, vgpu::Program& intersect,
+                         vgpu::Program& intersect_next, vgpu::Program& looping) const;
+
+  // The per-pixel state textures: `trav_name` A and B in the traversal group's format,
+  // `state_name` A and B in the voxel group's.
+  void make_pairs(vgpu::Device& gpu, const WalkShared& shared, const std::string& trav_name,
+                  const std::string& state_name);
+  uint64_t state_bytes() const;  // both pairs
+  // Before a trace's entry pass: no hit yet, no list position.
+  void clear(vgpu::Device& gpu);
+  // The looping variant, after the entry pass: every ray the entry left walking is marked in
+  // the walking mask and counted as traced. Returns how many.
+  uint64_t count_entered(PassRunner& r);
+  // The multipass walk starts from the current textures and leaves them where it ends.
+  Cursor cursor(vgpu::Texture& origins, vgpu::Texture& rays) const {
+    return {&origins, &rays, cur_trav_, cur_vs_, *sh_.cur_isect};
+  }
+  void settle(const Cursor& c) {
+    cur_trav_ = c.trav;
+    cur_vs_ = c.vs;
+    *sh_.cur_isect = c.isect;
+  }
+
+  // The passes of the triangle loop by where it issues them (the walk's own Site numbers).
+  struct TriangleSites {
+    int testing, intersect, next, intersect_next, testing_on;
+  };
+  // The triangles of the list each walking ray stands at, one per pass, until no ray has one
+  // left (at most max_list + 1 passes: lists are not longer, a stuck position is fp16's).
+  // `intersect` reads (origins, rays, [traversal,] list state, hits, vertices) as
+  // `reads_traversal` says, `intersect_next` the same and `lists` (--mrt on). `key(step, k,
+  // site)` names each pass (walk::PassKey). Written once for every X of host/trace/walk.h.
+  template <class X, class Key>
+  void test_triangles(X& x, Cursor& c, const Key& key, int step, const TriangleSites& site,
+                      int max_list, const vgpu::Program& intersect,
+                      const vgpu::Program& intersect_next, const vgpu::Texture& lists,
+                      bool reads_traversal);
+
+  // The passes of a step by where it issues them (the walk's own Site numbers).
+  struct StepSites {
+    int step, load, step_load;
+  };
+  // One step of every walking ray to its next node or cell, then the load of the list it
+  // reached: `step` (reading origins, rays, traversal, hits, `nodes`, `more_nodes`) and `load`
+  // (traversal, list state, `lists`), or under --mrt on both in one pass, `step_load` (as
+  // `step`, with the list state before the nodes and `lists` after). `more_nodes` may be
+  // nullptr (a structure with one node texture).
+  template <class X, class Key>
+  void step_and_load(X& x, Cursor& c, const Key& key, int step, const StepSites& site,
+                     const vgpu::Program& step_p, const vgpu::Program& load,
+                     const vgpu::Program& step_load, const vgpu::Texture& nodes,
+                     const vgpu::Texture* more_nodes, const vgpu::Texture& lists);
+
+  // The looping variant (RenderOptions::looping): `looping`, reading (origins, rays,
+  // traversal, list state, hits, vertices, then `statics`), drawn again while rays walk,
+  // steps_per_pass iterations per pass. Past max_iterations (rounded up to whole passes) the
+  // host stops, as the multipass loop does, and reports the rays left unfinished.
+  void walk_looping(PassRunner& r, const vgpu::Program& looping, vgpu::Texture& origins,
+                    vgpu::Texture& rays, std::initializer_list<const vgpu::Texture*> statics,
+                    int64_t max_iterations, uint64_t walking);
+
+  const RenderOptions& opt_;
+  std::vector<const vgpu::Texture*> statics_;
+  WalkShared sh_{};
+  // Per-pixel state (ping-pong pairs): traversal and list state.
+  vgpu::Texture trav_[2], vs_[2];
+  int cur_trav_ = 0, cur_vs_ = 0;
+  vgpu::KernelProgram<kernels::NextTriangle> next_;
+  vgpu::KernelProgram<kernels::RaysIntersecting> intersecting_;
+  vgpu::KernelProgram<kernels::RaysInGrid> walking_;
+};
+
+template <class X, class Key>
+void ListWalk::test_triangles(X& x, Cursor& c, const Key& key, int step, const TriangleSites& site,
+                              int max_list, const vgpu::Program& intersect,
+                              const vgpu::Program& intersect_next, const vgpu::Texture& lists,
+                              bool reads_traversal) {
+  vgpu::Texture &origins = *c.origins, &rays = *c.rays;
+  vgpu::Texture* const* isect = sh_.isect;
+  const vgpu::Texture* const* v = sh_.vertices;
+  vgpu::Stencil &grid_mask = *sh_.grid_mask, &isect_mask = *sh_.isect_mask;
+  x.copy(isect_mask, grid_mask);
+  auto testing =
+      x.count(key(step, -1, site.testing), intersecting_, vs_[c.vs], &grid_mask, &isect_mask);
+  for (int k = 0; X::any(testing); ++k) {
+    if (k == max_list + 1) break;  // lists cannot be longer: stuck positions (fp16)
+    const vgpu::Texture *trav = &trav_[c.trav], *vs = &vs_[c.vs];
+    if (opt_.mrt) {
+      // The intersection and proximoTriangulo in one pass, two targets.
+      const auto key_k = key(step, k, site.intersect_next);
+      if (reads_traversal)
+        x.pass(key_k, intersect_next,
+               {&origins, &rays, trav, vs, isect[c.isect], v[0], v[1], v[2], &lists},
+               {isect[c.isect ^ 1], &vs_[c.vs ^ 1]}, &isect_mask);
+      else
+        x.pass(key_k, intersect_next,
+               {&origins, &rays, vs, isect[c.isect], v[0], v[1], v[2], &lists},
+               {isect[c.isect ^ 1], &vs_[c.vs ^ 1]}, &isect_mask);
+      c.isect ^= 1;
+      c.vs ^= 1;
+    } else {
+      const auto key_k = key(step, k, site.intersect);
+      if (reads_traversal)
+        x.pass(key_k, intersect, {&origins, &rays, trav, vs, isect[c.isect], v[0], v[1], v[2]},
+               {isect[c.isect ^ 1]}, &isect_mask);
+      else
+        x.pass(key_k, intersect, {&origins, &rays, vs, isect[c.isect], v[0], v[1], v[2]},
+               {isect[c.isect ^ 1]}, &isect_mask);
+      c.isect ^= 1;
+      x.pass(key(step, k, site.next), next_, {&vs_[c.vs], &lists}, {&vs_[c.vs ^ 1]}, &isect_mask);
+      c.vs ^= 1;
+    }
+    testing =
+        x.count(key(step, k, site.testing_on), intersecting_, vs_[c.vs], &isect_mask, &isect_mask);
+  }
+}
+
+template <class X, class Key>
+void ListWalk::step_and_load(X& x, Cursor& c, const Key& key, int step, const StepSites& site,
+                             const vgpu::Program& step_p, const vgpu::Program& load,
+                             const vgpu::Program& step_load, const vgpu::Texture& nodes,
+                             const vgpu::Texture* more_nodes, const vgpu::Texture& lists) {
+  vgpu::Texture &origins = *c.origins, &rays = *c.rays;
+  const vgpu::Texture *trav = &trav_[c.trav], *hits = sh_.isect[c.isect];
+  vgpu::Stencil* grid_mask = sh_.grid_mask;
+  if (opt_.mrt) {
+    const auto key_s = key(step, -1, site.step_load);
+    const vgpu::Texture* vs = &vs_[c.vs];
+    if (more_nodes)
+      x.pass(key_s, step_load, {&origins, &rays, trav, hits, vs, &nodes, more_nodes, &lists},
+             {&trav_[c.trav ^ 1], &vs_[c.vs ^ 1]}, grid_mask);
+    else
+      x.pass(key_s, step_load, {&origins, &rays, trav, hits, vs, &nodes, &lists},
+             {&trav_[c.trav ^ 1], &vs_[c.vs ^ 1]}, grid_mask);
+    c.trav ^= 1;
+    c.vs ^= 1;
+    return;
+  }
+  const auto key_s = key(step, -1, site.step);
+  if (more_nodes)
+    x.pass(key_s, step_p, {&origins, &rays, trav, hits, &nodes, more_nodes}, {&trav_[c.trav ^ 1]},
+           grid_mask);
+  else
+    x.pass(key_s, step_p, {&origins, &rays, trav, hits, &nodes}, {&trav_[c.trav ^ 1]}, grid_mask);
+  c.trav ^= 1;
+  x.pass(key(step, -1, site.load), load, {&trav_[c.trav], &vs_[c.vs], &lists}, {&vs_[c.vs ^ 1]},
+         grid_mask);
+  c.vs ^= 1;
+}
 
 }  // namespace host

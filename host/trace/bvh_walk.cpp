@@ -1,9 +1,9 @@
-// The stackless BVH walk (host/trace/bvh_walk.h): its textures, its pass sequence (multipass and
-// looping) and the walkers instantiated for it.
+// The stackless BVH walk (host/trace/bvh_walk.h): its textures, its pass sequence
+// (multipass and looping, on the parts every walk shares: ListWalk, host/trace/accel_walk.h)
+// and the walkers instantiated for it.
 #include "host/trace/bvh_walk.h"
 
 #include <algorithm>
-#include <tuple>
 
 #include "host/trace/walk.h"
 
@@ -15,57 +15,28 @@ using vgpu::Stencil;
 using vgpu::Texture;
 
 BvhWalk::BvhWalk(vgpu::Device& gpu, const Bvh& bvh, const RenderOptions& options, float scene_width)
-    : opt_(options) {
-  const Formats& fm = opt_.formats;
-  for (auto [prog, g] :
-       std::initializer_list<std::pair<vgpu::Program*, Group>>{{&enter_, Group::traversal},
-                                                               {&step_, Group::traversal},
-                                                               {&load_, Group::voxel},
-                                                               {&next_, Group::voxel},
-                                                               {&intersecting_, Group::queries},
-                                                               {&walking_, Group::queries},
-                                                               {&intersect_, Group::hits}})
-    prog->set_precision(fm.arithmetic(g));
-  // The fused programs compute in their first kernel's group (mrt_refusal checked both agree).
-  step_load_.set_precision(fm.arithmetic(Group::traversal));
-  intersect_next_.set_precision(fm.arithmetic(Group::hits));
-  Format loop_arith = fm.arithmetic(Group::traversal);
-  for (Group g : {Group::voxel, Group::hits})
-    if (vgpu::significand_bits(fm.arithmetic(g)) > vgpu::significand_bits(loop_arith))
-      loop_arith = fm.arithmetic(g);
-  looping_.set_precision(loop_arith);
+    : ListWalk(options, {&nodes_lo_, &nodes_hi_, &lists_}) {
+  compute_in_groups(enter_, step_, step_load_, load_, intersect_, intersect_next_, looping_);
   set_bvh(gpu, bvh, scene_width, nullptr);
 }
 
 uint64_t BvhWalk::set_bvh(vgpu::Device& gpu, const Bvh& bvh, float scene_width,
                           std::vector<std::string>* uploaded) {
-  const Formats& fm = opt_.formats;
-  // Node indices and list positions are texel addresses: refuse a format that cannot hold them
-  // (a walk would stall at an index that no longer counts up, as the grid's does past its cap),
-  // at construction and for each frame's rebuilt structure.
-  for (const auto& [count, g, kind] :
-       {std::tuple{uint64_t(bvh.nodes.size()), Group::traversal, "node indices"},
-        std::tuple{uint64_t(bvh.lists.size()), Group::voxel, "list positions"}})
-    for (const Format f : {fm[g], fm.arithmetic(g)})
-      if (count - 1 > exact_addresses(f))
-        throw vgpu::Error(
-            "bvh: " + std::string(kind) + " reach " + std::to_string(count - 1) + "; the " +
-            std::string(group_name(g)) + " group's " + std::string(vgpu::format_name(f)) +
-            " addresses texels exactly only to " + std::to_string(exact_addresses(f)) +
-            " (give it fp24 or fp32: --formats " + std::string(group_name(g)) + "=fp32)");
+  // Node indices and list positions are texel addresses.
+  check_addresses(opt_.formats, "bvh",
+                  {{bvh.nodes.size(), Group::traversal, "node indices"},
+                   {bvh.lists.size(), Group::voxel, "list positions"}},
+                  false);
   nodes_ = int(bvh.nodes.size());
   max_leaf_ = bvh.max_leaf;
   // Between frames the textures are kept where the new hierarchy fits them (entries past its
   // nodes and lists are never reached: escapes end the walk, lists are closed by -1).
   const bool fresh = uploaded == nullptr;
-  auto fits = [](const Texture& t, size_t count) {
-    return uint64_t(t.width()) * uint64_t(t.height()) >= count;
-  };
-  if (fresh || !fits(nodes_lo_, bvh.nodes.size())) {
+  if (fresh || !holds(nodes_lo_, bvh.nodes.size())) {
     nodes_lo_ = entry_texture(gpu, "bvh nodes lo", bvh.nodes.size(), 4, "bvh nodes");
     nodes_hi_ = entry_texture(gpu, "bvh nodes hi", bvh.nodes.size(), 4, "bvh nodes");
   }
-  if (fresh || !fits(lists_, bvh.lists.size()))
+  if (fresh || !holds(lists_, bvh.lists.size()))
     lists_ = entry_texture(gpu, "bvh lists", bvh.lists.size(), 1, "bvh lists");
   const int nw = nodes_lo_.width(), lw = lists_.width();
   std::vector<float> lo(nodes_lo_.data().begin(), nodes_lo_.data().end());
@@ -78,14 +49,8 @@ uint64_t BvhWalk::set_bvh(vgpu::Device& gpu, const Bvh& bvh, float scene_width,
     hi[4 * i + 3] = n.count > 0 ? float(n.leaf) : kNone;
   }
   for (size_t k = 0; k < bvh.lists.size(); ++k) entries[k] = float(bvh.lists[k]);
-  uint64_t bytes = 0;
-  for (auto [t, texels] :
-       {std::pair{&nodes_lo_, &lo}, std::pair{&nodes_hi_, &hi}, std::pair{&lists_, &entries}})
-    if (t->replace(*texels) && uploaded) {
-      gpu.upload(*t);
-      bytes += t->bytes();
-      uploaded->push_back(t->name());
-    }
+  const uint64_t bytes =
+      replace_texels(gpu, {{&nodes_lo_, &lo}, {&nodes_hi_, &hi}, {&lists_, &entries}}, uploaded);
 
   BvhUniforms u;
   u.node_width = float(nw);
@@ -112,75 +77,31 @@ uint64_t BvhWalk::rebuild(vgpu::Device& gpu, const Accel& accel, float scene_wid
   return set_bvh(gpu, *accel.bvh, scene_width, &uploaded);
 }
 
-uint64_t BvhWalk::static_bytes() const {
-  return nodes_lo_.bytes() + nodes_hi_.bytes() + lists_.bytes();
-}
-
 void BvhWalk::make_state(vgpu::Device& gpu, const WalkShared& shared) {
-  sh_ = shared;
-  const Formats& fm = opt_.formats;
-  for (int i = 0; i < 2; ++i) {
-    const std::string sfx = i ? " B" : " A";
-    trav_[i] =
-        gpu.make_texture("bvh traversal" + sfx, opt_.width, opt_.height, 4, fm[Group::traversal]);
-    vs_[i] = gpu.make_texture("leaf state" + sfx, opt_.width, opt_.height, 4, fm[Group::voxel]);
-  }
-}
-
-void BvhWalk::upload(vgpu::Device& gpu) const {
-  gpu.upload(nodes_lo_);
-  gpu.upload(nodes_hi_);
-  gpu.upload(lists_);
-}
-
-uint64_t BvhWalk::texture_bytes() const {
-  return nodes_lo_.bytes() + nodes_hi_.bytes() + lists_.bytes() + trav_[0].bytes() +
-         trav_[1].bytes() + vs_[0].bytes() + vs_[1].bytes();
-}
-
-WriteBack BvhWalk::write_back(const Cursor& c) const {
-  WriteBack wb;
-  wb.npairs = 3;
-  wb.pairs[0] = {const_cast<Texture*>(&trav_[0]), const_cast<Texture*>(&trav_[1])};
-  wb.pairs[1] = {const_cast<Texture*>(&vs_[0]), const_cast<Texture*>(&vs_[1])};
-  wb.pairs[2] = {sh_.isect[0], sh_.isect[1]};
-  wb.current = {c.trav, c.vs, c.isect, 0};
-  wb.nmasks = 2;
-  wb.masks = {sh_.grid_mask, sh_.isect_mask, nullptr, nullptr};
-  return wb;
+  make_pairs(gpu, shared, "bvh traversal", "leaf state");
 }
 
 void BvhWalk::trace(PassRunner& r, Texture& origins, Texture& rays, bool, glm::vec3) {
-  vgpu::Device& gpu = r.device();
-  int& cur_isect = *sh_.cur_isect;
-  gpu.clear(*sh_.isect[cur_isect], {kFar, 0, 0, kNone});
-  gpu.clear(vs_[cur_vs_], {0, 0, 0, kNone});
+  clear(r.device());
   // Every ray starts at the root (primary and secondary alike: the walk needs no entry point).
   r.pass(enter_, {&rays}, trav_[cur_trav_ ^ 1]);
   cur_trav_ ^= 1;
   if (opt_.looping) {
-    sh_.grid_mask->fill(1);
-    const uint64_t walking = r.count(walking_, trav_[cur_trav_], nullptr, sh_.grid_mask);
-    r.counts.rays_traced += walking;
-    walk_looping(r, origins, rays, walking);
+    // A ray iterates once per node and once per triangle of each leaf it enters, plus once to
+    // end.
+    walk_looping(r, looping_, origins, rays, {&nodes_lo_, &nodes_hi_, &lists_},
+                 int64_t(nodes_) * int64_t(max_leaf_ + 1) + 2, count_entered(r));
     return;
   }
-  Cursor c{&origins, &rays, cur_trav_, cur_vs_, cur_isect};
+  Cursor c = cursor(origins, rays);
   walk::run_walk(r, *this, c);
-  cur_trav_ = c.trav;
-  cur_vs_ = c.vs;
-  cur_isect = c.isect;
+  settle(c);
 }
 
 template <class X>
 void BvhWalk::walk(X& x, Cursor& c) {
-  Texture &origins = *c.origins, &rays = *c.rays;
-  Texture* const* isect = sh_.isect;
-  const Texture* const* v = sh_.vertices;
-  Stencil &grid_mask = *sh_.grid_mask, &isect_mask = *sh_.isect_mask;
-  auto key = [&c](int step, int k, Site site) {
-    return walk::PassKey{step, k, site, uint8_t(c.trav | c.vs << 1 | c.isect << 2)};
-  };
+  Stencil& grid_mask = *sh_.grid_mask;
+  const auto key = walk::keys(c);
   x.fill(grid_mask, 1);
   auto walking = x.count(key(-1, -1, kEnter), walking_, trav_[c.trav], nullptr, &grid_mask);
   x.traced(walking);
@@ -193,79 +114,11 @@ void BvhWalk::walk(X& x, Cursor& c) {
       x.unfinished(walking);
       break;
     }
-    if (opt_.mrt) {
-      x.pass(key(step, -1, kStepLoad), step_load_,
-             {&origins, &rays, &trav_[c.trav], isect[c.isect], &vs_[c.vs], &nodes_lo_, &nodes_hi_,
-              &lists_},
-             {&trav_[c.trav ^ 1], &vs_[c.vs ^ 1]}, &grid_mask);
-      c.trav ^= 1;
-      c.vs ^= 1;
-    } else {
-      x.pass(key(step, -1, kStep), step_,
-             {&origins, &rays, &trav_[c.trav], isect[c.isect], &nodes_lo_, &nodes_hi_},
-             {&trav_[c.trav ^ 1]}, &grid_mask);
-      c.trav ^= 1;
-      x.pass(key(step, -1, kLoad), load_, {&trav_[c.trav], &vs_[c.vs], &lists_}, {&vs_[c.vs ^ 1]},
-             &grid_mask);
-      c.vs ^= 1;
-    }
-    x.copy(isect_mask, grid_mask);
-    auto testing =
-        x.count(key(step, -1, kTesting), intersecting_, vs_[c.vs], &grid_mask, &isect_mask);
-    for (int k = 0; X::any(testing); ++k) {
-      if (k == max_leaf_ + 1) break;  // leaves are not longer: stuck positions (fp16)
-      if (opt_.mrt) {
-        x.pass(key(step, k, kIntersectNext), intersect_next_,
-               {&origins, &rays, &vs_[c.vs], isect[c.isect], v[0], v[1], v[2], &lists_},
-               {isect[c.isect ^ 1], &vs_[c.vs ^ 1]}, &isect_mask);
-        c.isect ^= 1;
-        c.vs ^= 1;
-      } else {
-        x.pass(key(step, k, kIntersect), intersect_,
-               {&origins, &rays, &vs_[c.vs], isect[c.isect], v[0], v[1], v[2]},
-               {isect[c.isect ^ 1]}, &isect_mask);
-        c.isect ^= 1;
-        x.pass(key(step, k, kNext), next_, {&vs_[c.vs], &lists_}, {&vs_[c.vs ^ 1]}, &isect_mask);
-        c.vs ^= 1;
-      }
-      testing =
-          x.count(key(step, k, kTestingOn), intersecting_, vs_[c.vs], &isect_mask, &isect_mask);
-    }
+    step_and_load(x, c, key, step, {kStep, kLoad, kStepLoad}, step_, load_, step_load_, nodes_lo_,
+                  &nodes_hi_, lists_);
+    test_triangles(x, c, key, step, {kTesting, kIntersect, kNext, kIntersectNext, kTestingOn},
+                   max_leaf_, intersect_, intersect_next_, lists_, false);
     walking = x.count(key(step, -1, kWalking), walking_, trav_[c.trav], &grid_mask, &grid_mask);
-  }
-}
-
-void BvhWalk::walk_looping(PassRunner& r, Texture& origins, Texture& rays, uint64_t walking) {
-  vgpu::Device& gpu = r.device();
-  const vgpu::Program& p = looping_;
-  int& cur_isect = *sh_.cur_isect;
-  // A ray iterates once per node and once per triangle of each leaf it enters, plus once to end.
-  const int64_t max_iterations = int64_t(nodes_) * int64_t(max_leaf_ + 1) + 2;
-  const int64_t max_passes = (max_iterations + opt_.steps_per_pass - 1) / opt_.steps_per_pass;
-  for (int64_t k = 0; walking > 0; ++k) {
-    if (k == max_passes) {
-      r.counts.rays_unfinished += walking;
-      break;
-    }
-    Texture& trav = trav_[cur_trav_ ^ 1];
-    gpu.use_program(p);
-    gpu.unbind_textures();
-    int unit = 0;
-    for (const Texture* t : std::initializer_list<const Texture*>{
-             &origins, &rays, &trav_[cur_trav_], &vs_[cur_vs_], sh_.isect[cur_isect],
-             sh_.vertices[0], sh_.vertices[1], sh_.vertices[2], &nodes_lo_, &nodes_hi_, &lists_})
-      gpu.bind_texture(unit++, *t);
-    gpu.set_targets({&trav, &vs_[cur_vs_ ^ 1], sh_.isect[cur_isect ^ 1]});
-    r.set_work(sh_.grid_mask);
-    const bool traced = r.traces_pixel(sh_.grid_mask);
-    if (opt_.observer) opt_.observer->pass_begin(sh_.grid_mask);
-    const vgpu::PassRecord& rec = gpu.draw();
-    if (opt_.observer) opt_.observer->pass({p, rec, trav, gpu.branch_flags(), gpu.stats()});
-    cur_trav_ ^= 1;
-    cur_vs_ ^= 1;
-    cur_isect ^= 1;
-    if (traced) r.trace_targets(p, {&trav_[cur_trav_], &vs_[cur_vs_], sh_.isect[cur_isect]});
-    walking = r.count(walking_, trav_[cur_trav_], sh_.grid_mask, sh_.grid_mask);
   }
 }
 

@@ -16,7 +16,7 @@
 
 namespace host {
 
-class BvhWalk : public AccelWalk {
+class BvhWalk : public ListWalk {
  public:
   // Passes of the walk by where it issues them (walk::PassKey).
   enum Site : int {
@@ -37,7 +37,6 @@ class BvhWalk : public AccelWalk {
   // naming the limit); the walk's programs in their groups' formats.
   BvhWalk(vgpu::Device& gpu, const Bvh& bvh, const RenderOptions& options, float scene_width);
   void make_state(vgpu::Device& gpu, const WalkShared& shared) override;
-  void upload(vgpu::Device& gpu) const override;
   // The hierarchy's textures and the uniforms that depend on them; with `uploaded` (between
   // frames, AccelWalk::rebuild), the textures are kept where the new hierarchy fits them and
   // each one whose texels changed is uploaded again and named there. Returns those bytes.
@@ -45,35 +44,20 @@ class BvhWalk : public AccelWalk {
                    std::vector<std::string>* uploaded);
   uint64_t rebuild(vgpu::Device& gpu, const Accel& accel, float scene_width,
                    std::vector<std::string>& uploaded) override;
-  uint64_t static_bytes() const override;
-  uint64_t texture_bytes() const override;
   void trace(PassRunner& r, vgpu::Texture& origins, vgpu::Texture& rays, bool primary,
              glm::vec3 eye) override;
 
-  struct Cursor {
-    vgpu::Texture *origins, *rays;
-    int trav, vs, isect;
-  };
+  // The multipass walk (host/trace/walk.h); Cursor and write_back are ListWalk's.
   template <class X>
   void walk(X& x, Cursor& c);
-  WriteBack write_back(const Cursor& c) const;
 
  private:
-  void walk_looping(PassRunner& r, vgpu::Texture& origins, vgpu::Texture& rays, uint64_t walking);
-
-  const RenderOptions& opt_;
   int nodes_ = 0, max_leaf_ = 0;
-  WalkShared sh_{};
   vgpu::Texture nodes_lo_, nodes_hi_, lists_;
-  vgpu::Texture trav_[2], vs_[2];
-  int cur_trav_ = 0, cur_vs_ = 0;
   vgpu::KernelProgram<kernels::BvhEnter> enter_;
   vgpu::KernelProgram<kernels::BvhStep> step_;
   vgpu::KernelProgram<kernels::BvhLoadLeaf> load_;
   vgpu::KernelProgram<kernels::BvhIntersections> intersect_;
-  vgpu::KernelProgram<kernels::NextTriangle> next_;
-  vgpu::KernelProgram<kernels::RaysIntersecting> intersecting_;
-  vgpu::KernelProgram<kernels::RaysInGrid> walking_;
   vgpu::KernelProgram<kernels::BvhStepLoad> step_load_;
   vgpu::KernelProgram<kernels::BvhIntersectNext> intersect_next_;
   vgpu::KernelProgram<kernels::BvhLooping> looping_;

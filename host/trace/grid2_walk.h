@@ -18,7 +18,7 @@
 
 namespace host {
 
-class Grid2Walk : public AccelWalk {
+class Grid2Walk : public ListWalk {
  public:
   // Passes of the walk by where it issues them (walk::PassKey).
   enum Site : int {
@@ -41,7 +41,6 @@ class Grid2Walk : public AccelWalk {
   Grid2Walk(vgpu::Device& gpu, const Grid2& g2, const RenderOptions& options, float scene_width,
             float t_slack);
   void make_state(vgpu::Device& gpu, const WalkShared& shared) override;
-  void upload(vgpu::Device& gpu) const override;
   // The textures and the uniforms that depend on them; with `uploaded` (between frames,
   // AccelWalk::rebuild), the textures are kept where the new structure fits them and each one
   // whose texels changed is uploaded again and named there. Returns those bytes.
@@ -49,36 +48,21 @@ class Grid2Walk : public AccelWalk {
                     std::vector<std::string>* uploaded);
   uint64_t rebuild(vgpu::Device& gpu, const Accel& accel, float scene_width,
                    std::vector<std::string>& uploaded) override;
-  uint64_t static_bytes() const override;
-  uint64_t texture_bytes() const override;
   void trace(PassRunner& r, vgpu::Texture& origins, vgpu::Texture& rays, bool primary,
              glm::vec3 eye) override;
 
-  struct Cursor {
-    vgpu::Texture *origins, *rays;
-    int trav, vs, isect;
-  };
+  // The multipass walk (host/trace/walk.h); Cursor and write_back are ListWalk's.
   template <class X>
   void walk(X& x, Cursor& c);
-  WriteBack write_back(const Cursor& c) const;
 
  private:
-  void walk_looping(PassRunner& r, vgpu::Texture& origins, vgpu::Texture& rays, uint64_t walking);
-
-  const RenderOptions& opt_;
   int max_list_ = 0;
   int64_t max_steps_ = 0;  // sub-cells a ray can visit at most
-  WalkShared sh_{};
   vgpu::Texture cells_, subs_, lists_;
-  vgpu::Texture trav_[2], vs_[2];
-  int cur_trav_ = 0, cur_vs_ = 0;
   vgpu::KernelProgram<kernels::Grid2Enter> enter_;
   vgpu::KernelProgram<kernels::Grid2Step> step_;
   vgpu::KernelProgram<kernels::Grid2LoadCell> load_;
   vgpu::KernelProgram<kernels::Grid2Intersections> intersect_;
-  vgpu::KernelProgram<kernels::NextTriangle> next_;
-  vgpu::KernelProgram<kernels::RaysIntersecting> intersecting_;
-  vgpu::KernelProgram<kernels::RaysInGrid> walking_;
   vgpu::KernelProgram<kernels::Grid2StepLoad> step_load_;
   vgpu::KernelProgram<kernels::Grid2IntersectNext> intersect_next_;
   vgpu::KernelProgram<kernels::Grid2Looping> looping_;

@@ -1,5 +1,6 @@
 // The paper's walk through the uniform grid (host/trace/grid_walk.h): its textures, its pass
-// sequence (multipass and looping) and the walkers instantiated for it.
+// sequence (multipass and looping, on the parts every walk shares: ListWalk,
+// host/trace/accel_walk.h) and the walkers instantiated for it.
 #include "host/trace/grid_walk.h"
 
 #include <algorithm>
@@ -70,31 +71,16 @@ std::vector<std::string> mrt_programs() {
 
 GridWalk::GridWalk(vgpu::Device& gpu, const Grid& grid, const RenderOptions& options,
                    float scene_width)
-    : opt_(options) {
-  // Each program computes in its group's arithmetic format (formats.h: which kernel is where).
-  const Formats& fm = opt_.formats;
-  for (auto [prog, g] :
-       std::initializer_list<std::pair<vgpu::Program*, Group>>{{&init_, Group::traversal},
-                                                               {&reset_, Group::traversal},
-                                                               {&traversal_, Group::traversal},
-                                                               {&in_grid_, Group::queries},
-                                                               {&update_, Group::voxel},
-                                                               {&next_, Group::voxel},
-                                                               {&intersecting_, Group::queries},
-                                                               {&intersect_, Group::hits}})
-    prog->set_precision(fm.arithmetic(g));
-  if (opt_.mrt) {
-    // The tracer checked mrt_refusal: both kernels' groups compute alike.
-    intersect_next_.set_precision(fm.arithmetic(Group::hits));
-    traverse_update_.set_precision(fm.arithmetic(Group::traversal));
-  }
-  // The looping program does the traversal, voxel and hits groups' work: it computes in the
-  // finest of their arithmetic formats (their textures keep their own formats).
-  Format loop_arith = fm.arithmetic(Group::traversal);
-  for (Group g : {Group::voxel, Group::hits})
-    if (vgpu::significand_bits(fm.arithmetic(g)) > vgpu::significand_bits(loop_arith))
-      loop_arith = fm.arithmetic(g);
-  looping_.set_precision(loop_arith);
+    : ListWalk(options, {&lists_, &pointers_}) {
+  compute_in({{&init_, Group::traversal},
+              {&reset_, Group::traversal},
+              {&traversal_, Group::traversal},
+              {&update_, Group::voxel},
+              {&intersect_, Group::hits}});
+  // The tracer checked mrt_refusal: both kernels' groups compute alike.
+  if (opt_.mrt)
+    compute_in({{&intersect_next_, Group::hits}, {&traverse_update_, Group::traversal}});
+  looping_.set_precision(looping_arithmetic(opt_.formats));
   set_grid(gpu, grid, scene_width, nullptr);
 }
 
@@ -153,13 +139,8 @@ uint64_t GridWalk::set_grid(vgpu::Device& gpu, const Grid& grid, float scene_wid
         }
         pointers[size_t(z) * size_t(r.x * r.y) + size_t(x * r.y + y)] = start;
       }
-  uint64_t bytes = 0;
-  for (auto [t, texels] : {std::pair{&lists_, &lists}, std::pair{&pointers_, &pointers}})
-    if (t->replace(*texels) && uploaded) {
-      gpu.upload(*t);
-      bytes += t->bytes();
-      uploaded->push_back(t->name());
-    }
+  const uint64_t bytes =
+      replace_texels(gpu, {{&lists_, &lists}, {&pointers_, &pointers}}, uploaded);
 
   // Uniforms that do not change during a frame.
   GridUniforms g;
@@ -187,47 +168,11 @@ uint64_t GridWalk::set_grid(vgpu::Device& gpu, const Grid& grid, float scene_wid
 }
 
 void GridWalk::make_state(vgpu::Device& gpu, const Shared& shared) {
-  sh_ = shared;
-  const Formats& fm = opt_.formats;
-  for (int i = 0; i < 2; ++i) {
-    const std::string sfx = i ? " B" : " A";
-    trav_[i] =
-        gpu.make_texture("traversal" + sfx, opt_.width, opt_.height, 4, fm[Group::traversal]);
-    vs_[i] = gpu.make_texture("voxel state" + sfx, opt_.width, opt_.height, 4, fm[Group::voxel]);
-  }
-}
-
-void GridWalk::upload(vgpu::Device& gpu) const {
-  gpu.upload(lists_);
-  gpu.upload(pointers_);
-}
-
-uint64_t GridWalk::static_bytes() const {
-  return lists_.bytes() + pointers_.bytes();
-}
-
-uint64_t GridWalk::texture_bytes() const {
-  return lists_.bytes() + pointers_.bytes() + trav_[0].bytes() + trav_[1].bytes() + vs_[0].bytes() +
-         vs_[1].bytes();
-}
-
-WriteBack GridWalk::write_back(const Cursor& c) const {
-  WriteBack wb;
-  wb.npairs = 3;
-  wb.pairs[0] = {const_cast<Texture*>(&trav_[0]), const_cast<Texture*>(&trav_[1])};
-  wb.pairs[1] = {const_cast<Texture*>(&vs_[0]), const_cast<Texture*>(&vs_[1])};
-  wb.pairs[2] = {sh_.isect[0], sh_.isect[1]};
-  wb.current = {c.trav, c.vs, c.isect, 0};
-  wb.nmasks = 2;
-  wb.masks = {sh_.grid_mask, sh_.isect_mask, nullptr, nullptr};
-  return wb;
+  make_pairs(gpu, shared, "traversal", "voxel state");
 }
 
 void GridWalk::trace(PassRunner& r, Texture& origins, Texture& rays, bool primary, glm::vec3 eye) {
-  vgpu::Device& gpu = r.device();
-  int& cur_isect = *sh_.cur_isect;
-  gpu.clear(*sh_.isect[cur_isect], {kFar, 0, 0, kNone});
-  gpu.clear(vs_[cur_vs_], {0, 0, 0, kNone});
+  clear(r.device());
   // Enter the grid.
   if (primary) {
     init_.kernel.eye = eye;
@@ -237,30 +182,25 @@ void GridWalk::trace(PassRunner& r, Texture& origins, Texture& rays, bool primar
   }
   cur_trav_ ^= 1;
   if (opt_.looping) {
-    sh_.grid_mask->fill(1);
-    const uint64_t walking = r.count(in_grid_, trav_[cur_trav_], nullptr, sh_.grid_mask);
-    r.counts.rays_traced += walking;
-    walk_looping(r, origins, rays, walking);
+    // A ray iterates once per triangle it tests and once per voxel it steps through: at most
+    // (nx + ny + nz + 2) voxels of (longest list + 1) iterations each.
+    walk_looping(r, looping_, origins, rays, {&pointers_, &lists_},
+                 int64_t(res_.x + res_.y + res_.z + 2) * int64_t(max_list_ + 1), count_entered(r));
     return;
   }
-  Cursor c{&origins, &rays, cur_trav_, cur_vs_, cur_isect};
+  Cursor c = cursor(origins, rays);
   walk::run_walk(r, *this, c);
-  cur_trav_ = c.trav;
-  cur_vs_ = c.vs;
-  cur_isect = c.isect;
+  settle(c);
 }
 
 template <class X>
 void GridWalk::walk(X& x, Cursor& c) {
   Texture &origins = *c.origins, &rays = *c.rays;
   Texture* const* isect = sh_.isect;
-  const Texture* const* v = sh_.vertices;
-  Stencil &grid_mask = *sh_.grid_mask, &isect_mask = *sh_.isect_mask;
-  auto key = [&c](int step, int k, Site site) {
-    return walk::PassKey{step, k, site, uint8_t(c.trav | c.vs << 1 | c.isect << 2)};
-  };
+  Stencil& grid_mask = *sh_.grid_mask;
+  const auto key = walk::keys(c);
   x.fill(grid_mask, 1);
-  auto walking = x.count(key(-1, -1, kEnter), in_grid_, trav_[c.trav], nullptr, &grid_mask);
+  auto walking = x.count(key(-1, -1, kEnter), walking_, trav_[c.trav], nullptr, &grid_mask);
   x.traced(walking);
   // In exact arithmetic a ray crosses at most nx+ny+nz voxels and tests each voxel's list once.
   // Reduced precision can break both (fp16 cannot count past 2048): the host stops there and
@@ -278,31 +218,9 @@ void GridWalk::walk(X& x, Cursor& c) {
              {&vs_[c.vs ^ 1]}, &grid_mask);
       c.vs ^= 1;
     }
-    x.copy(isect_mask, grid_mask);
-    auto testing =
-        x.count(key(step, -1, kTesting), intersecting_, vs_[c.vs], &grid_mask, &isect_mask);
     // One triangle per pass, until no ray has a triangle left in its voxel.
-    for (int k = 0; X::any(testing); ++k) {
-      if (k == max_list_ + 1) break;  // lists cannot be longer: stuck positions (fp16)
-      if (opt_.mrt) {
-        // intersecciones + proximoTriangulo in one pass, two targets.
-        x.pass(key(step, k, kIntersectNext), intersect_next_,
-               {&origins, &rays, &trav_[c.trav], &vs_[c.vs], isect[c.isect], v[0], v[1], v[2],
-                &lists_},
-               {isect[c.isect ^ 1], &vs_[c.vs ^ 1]}, &isect_mask);
-        c.isect ^= 1;
-        c.vs ^= 1;
-      } else {
-        x.pass(key(step, k, kIntersect), intersect_,
-               {&origins, &rays, &trav_[c.trav], &vs_[c.vs], isect[c.isect], v[0], v[1], v[2]},
-               {isect[c.isect ^ 1]}, &isect_mask);
-        c.isect ^= 1;
-        x.pass(key(step, k, kNext), next_, {&vs_[c.vs], &lists_}, {&vs_[c.vs ^ 1]}, &isect_mask);
-        c.vs ^= 1;
-      }
-      testing =
-          x.count(key(step, k, kTestingOn), intersecting_, vs_[c.vs], &isect_mask, &isect_mask);
-    }
+    test_triangles(x, c, key, step, {kTesting, kIntersect, kNext, kIntersectNext, kTestingOn},
+                   max_list_, intersect_, intersect_next_, lists_, true);
     // One voxel step for every ray still walking (under --mrt on, with the next voxel's first
     // triangle in the same pass).
     if (opt_.mrt) {
@@ -316,44 +234,7 @@ void GridWalk::walk(X& x, Cursor& c) {
              {&origins, &rays, &trav_[c.trav], isect[c.isect]}, {&trav_[c.trav ^ 1]}, &grid_mask);
       c.trav ^= 1;
     }
-    walking = x.count(key(step, -1, kInGrid), in_grid_, trav_[c.trav], &grid_mask, &grid_mask);
-  }
-}
-
-void GridWalk::walk_looping(PassRunner& r, Texture& origins, Texture& rays, uint64_t walking) {
-  vgpu::Device& gpu = r.device();
-  const vgpu::Program& p = looping_;
-  int& cur_isect = *sh_.cur_isect;
-  // A ray iterates once per triangle it tests and once per voxel it steps through: at most
-  // (nx + ny + nz + 2) voxels of (longest list + 1) iterations each. Past that many passes the
-  // host stops, as the multipass loop does, and reports the rays left unfinished.
-  const int64_t max_iterations = int64_t(res_.x + res_.y + res_.z + 2) * int64_t(max_list_ + 1);
-  const int64_t max_passes = (max_iterations + opt_.steps_per_pass - 1) / opt_.steps_per_pass;
-  for (int64_t k = 0; walking > 0; ++k) {
-    if (k == max_passes) {
-      r.counts.rays_unfinished += walking;
-      break;
-    }
-    Texture& trav = trav_[cur_trav_ ^ 1];
-    gpu.use_program(p);
-    gpu.unbind_textures();
-    int unit = 0;
-    for (const Texture* t : std::initializer_list<const Texture*>{
-             &origins, &rays, &trav_[cur_trav_], &vs_[cur_vs_], sh_.isect[cur_isect],
-             sh_.vertices[0], sh_.vertices[1], sh_.vertices[2], &pointers_, &lists_})
-      gpu.bind_texture(unit++, *t);
-    gpu.set_targets({&trav, &vs_[cur_vs_ ^ 1], sh_.isect[cur_isect ^ 1]});
-    // The walking rays' mask, as for the multipass kernels (finished rays keep their state).
-    r.set_work(sh_.grid_mask);
-    const bool traced = r.traces_pixel(sh_.grid_mask);
-    if (opt_.observer) opt_.observer->pass_begin(sh_.grid_mask);
-    const vgpu::PassRecord& rec = gpu.draw();
-    if (opt_.observer) opt_.observer->pass({p, rec, trav, gpu.branch_flags(), gpu.stats()});
-    cur_trav_ ^= 1;
-    cur_vs_ ^= 1;
-    cur_isect ^= 1;
-    if (traced) r.trace_targets(p, {&trav_[cur_trav_], &vs_[cur_vs_], sh_.isect[cur_isect]});
-    walking = r.count(in_grid_, trav_[cur_trav_], sh_.grid_mask, sh_.grid_mask);
+    walking = x.count(key(step, -1, kInGrid), walking_, trav_[c.trav], &grid_mask, &grid_mask);
   }
 }
 

@@ -23,7 +23,7 @@ inline constexpr double kSlackOfDiagonal = 1e-5;   // GridUniforms::t_slack (in-
 inline constexpr double kOffsetOfDiagonal = 1e-4;  // ReflectionOrigin::offset (origin lift)
 inline constexpr double kAttenOfDiagonal = 0.5;    // Shader::atten_dist
 
-class GridWalk : public AccelWalk {
+class GridWalk : public ListWalk {
  public:
   // The passes of the walk, by where the walk issues them. With the step (-1 before the first)
   // and the triangle index k within a step (-1 outside the triangle loop), a site names one
@@ -49,8 +49,6 @@ class GridWalk : public AccelWalk {
   GridWalk(vgpu::Device& gpu, const Grid& grid, const RenderOptions& options, float scene_width);
   // The per-pixel state textures (traversal, voxel state), made after the tracer's own.
   void make_state(vgpu::Device& gpu, const Shared& shared) override;
-  // Video memory gets the static textures at initialization.
-  void upload(vgpu::Device& gpu) const override;
   // A new grid for the same scene texture layout, between frames of a moving scene: the
   // static textures rewritten (kept where the new grid fits them) and uniforms set; with
   // `uploaded`, each texture whose texels changed is uploaded again and named there. Returns
@@ -62,8 +60,6 @@ class GridWalk : public AccelWalk {
                    std::vector<std::string>& uploaded) override {
     return set_grid(gpu, *accel.grid, scene_width, &uploaded);
   }
-  uint64_t static_bytes() const override;   // the grid's textures (lists, voxel pointers)
-  uint64_t texture_bytes() const override;  // those and the per-pixel state
 
   // One stream of rays through the grid: enter it (initTraversal for primary rays, from the eye;
   // reinicializarTraversal otherwise), then walk it until no ray is walking. Leaves the nearest
@@ -71,40 +67,22 @@ class GridWalk : public AccelWalk {
   void trace(PassRunner& r, vgpu::Texture& origins, vgpu::Texture& rays, bool primary,
              glm::vec3 eye) override;
 
-  // Where the walk is: the rays it traces and the current texture of each ping-pong pair.
-  struct Cursor {
-    vgpu::Texture *origins, *rays;
-    int trav, vs, isect;
-  };
   // The multipass walk (one voxel step and one triangle per pass), written once for every way
-  // it runs (host/trace/walk.h).
+  // it runs (host/trace/walk.h). Cursor and write_back are ListWalk's; its per-pixel state is
+  // the traversal (voxel, entry t) and the voxel state (list position).
   template <class X>
   void walk(X& x, Cursor& c);
-  // The state a batch walk hands back: the three ping-pong pairs and both masks.
-  WriteBack write_back(const Cursor& c) const;
 
  private:
-  // The looping variant (RenderOptions::looping): one looping program drawn again while rays
-  // walk, steps_per_pass iterations per pass.
-  void walk_looping(PassRunner& r, vgpu::Texture& origins, vgpu::Texture& rays, uint64_t walking);
-
-  const RenderOptions& opt_;
   glm::ivec3 res_;
   int max_list_ = 0;  // longest voxel list: a ray tests at most this many triangles per voxel
-  Shared sh_{};
   // Static textures: the triangle lists, each closed by -1, and the voxel pointers.
   vgpu::Texture lists_, pointers_;
-  // Per-pixel state (ping-pong pairs): traversal (voxel, entry t) and voxel state (list position).
-  vgpu::Texture trav_[2], vs_[2];
-  int cur_trav_ = 0, cur_vs_ = 0;
   vgpu::KernelProgram<kernels::InitTraversal> init_;
   vgpu::KernelProgram<kernels::ResetTraversal> reset_;
   vgpu::KernelProgram<kernels::Traversal> traversal_;
-  vgpu::KernelProgram<kernels::RaysInGrid> in_grid_;
   vgpu::KernelProgram<kernels::UpdateVoxel> update_;
   vgpu::KernelProgram<kernels::Intersections> intersect_;
-  vgpu::KernelProgram<kernels::NextTriangle> next_;
-  vgpu::KernelProgram<kernels::RaysIntersecting> intersecting_;
   // Fused programs for --mrt on (kernels/fused.h).
   vgpu::KernelProgram<kernels::IntersectNext> intersect_next_;
   vgpu::KernelProgram<kernels::TraverseUpdate> traverse_update_;

@@ -17,7 +17,7 @@
 
 namespace host {
 
-class KdWalk : public AccelWalk {
+class KdWalk : public ListWalk {
  public:
   // Passes of the walk by where it issues them (walk::PassKey).
   enum Site : int {
@@ -39,7 +39,6 @@ class KdWalk : public AccelWalk {
   KdWalk(vgpu::Device& gpu, const KdTree& kd, const RenderOptions& options, float scene_width,
          float t_slack);
   void make_state(vgpu::Device& gpu, const WalkShared& shared) override;
-  void upload(vgpu::Device& gpu) const override;
   // The tree's textures and the uniforms that depend on them; with `uploaded` (between frames,
   // AccelWalk::rebuild), the textures are kept where the new tree fits them and each one whose
   // texels changed is uploaded again and named there. Returns those bytes.
@@ -47,35 +46,20 @@ class KdWalk : public AccelWalk {
                     std::vector<std::string>* uploaded);
   uint64_t rebuild(vgpu::Device& gpu, const Accel& accel, float scene_width,
                    std::vector<std::string>& uploaded) override;
-  uint64_t static_bytes() const override;
-  uint64_t texture_bytes() const override;
   void trace(PassRunner& r, vgpu::Texture& origins, vgpu::Texture& rays, bool primary,
              glm::vec3 eye) override;
 
-  struct Cursor {
-    vgpu::Texture *origins, *rays;
-    int trav, vs, isect;
-  };
+  // The multipass walk (host/trace/walk.h); Cursor and write_back are ListWalk's.
   template <class X>
   void walk(X& x, Cursor& c);
-  WriteBack write_back(const Cursor& c) const;
 
  private:
-  void walk_looping(PassRunner& r, vgpu::Texture& origins, vgpu::Texture& rays, uint64_t walking);
-
-  const RenderOptions& opt_;
   int nodes_ = 0, max_leaf_ = 0, depth_ = 0, leaves_ = 0;
-  WalkShared sh_{};
   vgpu::Texture tree_, lists_;
-  vgpu::Texture trav_[2], vs_[2];
-  int cur_trav_ = 0, cur_vs_ = 0;
   vgpu::KernelProgram<kernels::KdEnter> enter_;
   vgpu::KernelProgram<kernels::KdStep> step_;
   vgpu::KernelProgram<kernels::KdLoadLeaf> load_;
   vgpu::KernelProgram<kernels::KdIntersections> intersect_;
-  vgpu::KernelProgram<kernels::NextTriangle> next_;
-  vgpu::KernelProgram<kernels::RaysIntersecting> intersecting_;
-  vgpu::KernelProgram<kernels::RaysInGrid> walking_;
   vgpu::KernelProgram<kernels::KdStepLoad> step_load_;
   vgpu::KernelProgram<kernels::KdIntersectNext> intersect_next_;
   vgpu::KernelProgram<kernels::KdLooping> looping_;

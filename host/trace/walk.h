@@ -43,14 +43,23 @@ inline constexpr int kMaxSites = 16;
 
 // A pass of the walk: the site of the call, the step (-1 before the first) and the index k
 // within a step (-1 outside an inner loop) name one pass of the walk's sequence; `parity` says
-// which texture of each ping-pong pair is current, which fixes the bindings.
-// A pass of the walk: its site, step and k; `parity` says which texture of each ping-pong pair
-// is current (bit 0 traversal, 1 voxel state, 2 intersection), which fixes the bindings.
+// which texture of each ping-pong pair is current (bit 0 traversal, 1 voxel state, 2
+// intersection), which fixes the bindings.
 struct PassKey {
   int step, k;
   int site;  // one of the walk's sites, below kMaxSites
   uint8_t parity = 0;
 };
+
+// Names the passes of a walk at cursor c (a ListWalk::Cursor: current traversal, list state
+// and intersection textures): key(step, k, site) is the PassKey with c's parity as it is when
+// the key is made.
+template <class Cursor>
+auto keys(const Cursor& c) {
+  return [&c](int step, int k, int site) {
+    return PassKey{step, k, site, uint8_t(c.trav | c.vs << 1 | c.isect << 2)};
+  };
+}
 
 // Per pass of the walk (by PassKey), a T: grown on first use, cheap to look up.
 template <class T>

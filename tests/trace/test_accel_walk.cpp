@@ -1,0 +1,66 @@
+// The helpers every walk shares (host/trace/accel_walk.h): the check that a format addresses a
+// structure's nodes and lists exactly, and the static textures' rewrite between frames.
+#include <doctest/doctest.h>
+
+#include <string>
+#include <vector>
+
+#include "host/trace/accel_walk.h"
+#include "vgpu/gpu.h"
+
+namespace {
+
+std::string refusal(const host::Formats& fm, std::initializer_list<host::AddressUse> uses,
+                    bool advice_by_need) {
+  try {
+    host::check_addresses(fm, "toy", uses, advice_by_need);
+  } catch (const vgpu::Error& e) {
+    return e.what();
+  }
+  return {};
+}
+
+}  // namespace
+
+TEST_CASE("a format that cannot address a structure's entries is refused naming group and need") {
+  host::Formats fm = host::Formats::all(vgpu::Format::fp32);
+  fm.set(host::Group::voxel, vgpu::Format::fp16, vgpu::Format::fp32);
+  // fp16 addresses 0 .. 1023 exactly: 1024 entries (positions 0 .. 1023) fit, 1025 do not.
+  CHECK(refusal(fm, {{1024, host::Group::voxel, "list positions"}}, false).empty());
+  CHECK(refusal(fm, {{1025, host::Group::traversal, "node indices"}}, false).empty());
+  CHECK(refusal(fm, {{1025, host::Group::voxel, "list positions"}}, false) ==
+        "toy: list positions reach 1024; the voxel group's fp16 addresses texels exactly only to "
+        "1023 (give it fp24 or fp32: --formats voxel=fp32)");
+  // The texels' format and the arithmetic are both checked.
+  fm.set(host::Group::voxel, vgpu::Format::fp32, vgpu::Format::fp24);
+  CHECK(refusal(fm, {{65536, host::Group::voxel, "list positions"}}, true).empty());
+  // Past fp24's 65535 the advice names fp32 alone where asked to; the first use refused wins.
+  CHECK(refusal(fm,
+                {{10, host::Group::traversal, "node indices"},
+                 {70000, host::Group::voxel, "list positions"},
+                 {1u << 20, host::Group::voxel, "more"}},
+                true) ==
+        "toy: list positions reach 69999; the voxel group's fp24 addresses texels exactly only to "
+        "65535 (give it fp32: --formats voxel=fp32)");
+  CHECK(refusal(fm, {{70000, host::Group::voxel, "list positions"}}, false) ==
+        "toy: list positions reach 69999; the voxel group's fp24 addresses texels exactly only to "
+        "65535 (give it fp24 or fp32: --formats voxel=fp32)");
+}
+
+TEST_CASE("between frames only the static textures whose texels changed are uploaded again") {
+  vgpu::Gpu gpu(vgpu::profile("gf6600"), 1);
+  vgpu::Texture a = gpu.make_texture("a", 2, 1, 1), b = gpu.make_texture("b", 4, 1, 1);
+  const std::vector<float> a1{1, 2}, b1{3, 4, 5, 6}, b2{3, 4, 5, 7};
+  // At construction (no list to name them in) the texels are set and nothing is counted.
+  CHECK(host::replace_texels(gpu, {{&a, &a1}, {&b, &b1}}, nullptr) == 0);
+  CHECK(a.get(1, 0) == 2.0f);
+  CHECK(b.get(3, 0) == 6.0f);
+  std::vector<std::string> uploaded;
+  CHECK(host::replace_texels(gpu, {{&a, &a1}, {&b, &b1}}, &uploaded) == 0);
+  CHECK(uploaded.empty());
+  CHECK(host::replace_texels(gpu, {{&a, &a1}, {&b, &b2}}, &uploaded) == b.bytes());
+  CHECK(uploaded == std::vector<std::string>{"b"});
+  CHECK(b.get(3, 0) == 7.0f);
+  CHECK(host::holds(b, 4));
+  CHECK_FALSE(host::holds(b, 5));
+}
