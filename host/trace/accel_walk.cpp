@@ -16,12 +16,12 @@ Format looping_arithmetic(const Formats& fm) {
 }
 
 void check_addresses(const Formats& fm, const std::string& structure,
-                     std::initializer_list<AddressUse> uses, bool advice_by_need) {
+                     std::initializer_list<AddressUse> uses) {
   // Checked at construction and for each frame's rebuilt structure.
   for (const AddressUse& u : uses)
     for (const Format f : {fm[u.group], fm.arithmetic(u.group)})
       if (u.count - 1 > exact_addresses(f)) {
-        const bool fp32_only = advice_by_need && u.count - 1 > exact_addresses(Format::fp24);
+        const bool fp32_only = u.count - 1 > exact_addresses(Format::fp24);
         throw vgpu::Error(structure + ": " + u.kind + " reach " + std::to_string(u.count - 1) +
                           "; the " + std::string(group_name(u.group)) + " group's " +
                           std::string(vgpu::format_name(f)) + " addresses texels exactly only to " +

@@ -66,10 +66,9 @@ struct AddressUse {
 };
 // Refuses a format that cannot hold the addresses (a walk would stall at an index that no
 // longer counts up, as the grid's does past its cap): throws vgpu::Error "STRUCTURE: KIND
-// reach N; ...". The advice names fp32 alone where fp24 cannot hold them either only with
-// `advice_by_need` (the two-level grid's message; the BVH's and kd-tree's name both).
+// reach N; ...". The advice names fp32 alone where fp24 cannot hold them either.
 void check_addresses(const Formats& formats, const std::string& structure,
-                     std::initializer_list<AddressUse> uses, bool advice_by_need);
+                     std::initializer_list<AddressUse> uses);
 
 // Whether a static texture holds `count` entries (between frames it is kept where it does).
 bool holds(const vgpu::Texture& t, size_t count);

@@ -29,8 +29,7 @@ uint64_t Grid2Walk::set_grid(vgpu::Device& gpu, const Grid2& g2, float scene_wid
                   {{g2.sub_cells(), Group::traversal, "sub-cell indices"},
                    {g2.cells(), Group::traversal, "coarse cell indices"},
                    {g2.lists.size(), Group::traversal, "list positions"},
-                   {g2.lists.size(), Group::voxel, "list positions"}},
-                  true);
+                   {g2.lists.size(), Group::voxel, "list positions"}});
   max_list_ = g2.max_list;
   // A ray crosses at most res.x + res.y + res.z coarse cells, and in each at most the sum of
   // its sub-grid's resolutions.

@@ -27,8 +27,7 @@ uint64_t KdWalk::set_tree(vgpu::Device& gpu, const KdTree& kd, float scene_width
   // Node indices and list positions are texel addresses.
   check_addresses(opt_.formats, "kd-tree",
                   {{kd.nodes.size(), Group::traversal, "node indices"},
-                   {kd.lists.size(), Group::voxel, "list positions"}},
-                  false);
+                   {kd.lists.size(), Group::voxel, "list positions"}});
   nodes_ = int(kd.nodes.size());
   max_leaf_ = kd.max_leaf;
   depth_ = kd.depth;

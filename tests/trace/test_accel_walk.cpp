@@ -10,10 +10,9 @@
 
 namespace {
 
-std::string refusal(const host::Formats& fm, std::initializer_list<host::AddressUse> uses,
-                    bool advice_by_need) {
+std::string refusal(const host::Formats& fm, std::initializer_list<host::AddressUse> uses) {
   try {
-    host::check_addresses(fm, "toy", uses, advice_by_need);
+    host::check_addresses(fm, "toy", uses);
   } catch (const vgpu::Error& e) {
     return e.what();
   }
@@ -26,25 +25,20 @@ TEST_CASE("a format that cannot address a structure's entries is refused naming 
   host::Formats fm = host::Formats::all(vgpu::Format::fp32);
   fm.set(host::Group::voxel, vgpu::Format::fp16, vgpu::Format::fp32);
   // fp16 addresses 0 .. 1023 exactly: 1024 entries (positions 0 .. 1023) fit, 1025 do not.
-  CHECK(refusal(fm, {{1024, host::Group::voxel, "list positions"}}, false).empty());
-  CHECK(refusal(fm, {{1025, host::Group::traversal, "node indices"}}, false).empty());
-  CHECK(refusal(fm, {{1025, host::Group::voxel, "list positions"}}, false) ==
+  CHECK(refusal(fm, {{1024, host::Group::voxel, "list positions"}}).empty());
+  CHECK(refusal(fm, {{1025, host::Group::traversal, "node indices"}}).empty());
+  CHECK(refusal(fm, {{1025, host::Group::voxel, "list positions"}}) ==
         "toy: list positions reach 1024; the voxel group's fp16 addresses texels exactly only to "
         "1023 (give it fp24 or fp32: --formats voxel=fp32)");
   // The texels' format and the arithmetic are both checked.
   fm.set(host::Group::voxel, vgpu::Format::fp32, vgpu::Format::fp24);
-  CHECK(refusal(fm, {{65536, host::Group::voxel, "list positions"}}, true).empty());
-  // Past fp24's 65535 the advice names fp32 alone where asked to; the first use refused wins.
-  CHECK(refusal(fm,
-                {{10, host::Group::traversal, "node indices"},
-                 {70000, host::Group::voxel, "list positions"},
-                 {1u << 20, host::Group::voxel, "more"}},
-                true) ==
+  CHECK(refusal(fm, {{65536, host::Group::voxel, "list positions"}}).empty());
+  // Past fp24's 65535 the advice names fp32 alone; the first use refused wins.
+  CHECK(refusal(fm, {{10, host::Group::traversal, "node indices"},
+                     {70000, host::Group::voxel, "list positions"},
+                     {1u << 20, host::Group::voxel, "more"}}) ==
         "toy: list positions reach 69999; the voxel group's fp24 addresses texels exactly only to "
         "65535 (give it fp32: --formats voxel=fp32)");
-  CHECK(refusal(fm, {{70000, host::Group::voxel, "list positions"}}, false) ==
-        "toy: list positions reach 69999; the voxel group's fp24 addresses texels exactly only to "
-        "65535 (give it fp24 or fp32: --formats voxel=fp32)");
 }
 
 TEST_CASE("between frames only the static textures whose texels changed are uploaded again") {
