@@ -201,8 +201,9 @@ H200_PROSE = """**What the differences say about the model's pricing of sampling
   stretches at 570 and 645 MHz; a looping frame of 24-34 ms, after a warm-up frame as short, does
   not bring it back to 1,980 MHz. The 500 ms clock samples cannot show the clock inside those
   frames, so this is the likely cause, not a measured one; the undersample:2 looping rows are
-  not evidence about the model. (A bench that runs each configuration's emulator frames before its GL frames, or warms
-  up for a fixed time, would avoid it; not done here.)"""
+  not evidence about the model. `bench_gl --warmup-ms` now warms each configuration up for a
+  fixed time before timing it, and `scripts/sampling_looping_h200.sh` re-runs these looping
+  frames with and without it, logging the clock every 100 ms; that run has not been made yet."""
 
 
 def looping_again(warm, control, clocks):
