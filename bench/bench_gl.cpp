@@ -155,15 +155,35 @@ struct FrameRun {
   uint64_t rays_traced = 0;
   bool streams = false;  // the frame ran as ray streams (--ray-streams on, or a glass scene)
   std::string device;
+  int warmup_frames = 0;    // frames after the compiling one, run before timing (--warmup-ms)
+  double warmup_ms = 0;     // their wall time, ms
+  double timed_from_s = 0;  // when the timed frames began and ended, seconds since the Unix
+  double timed_to_s = 0;    // epoch (system clock): to match them with a GPU clock log
 };
 
+// Seconds since the Unix epoch, as nvidia-smi's log stamps its samples.
+double unix_s() {
+  return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+}
+
 FrameRun run_frames(const host::Scene& scene, const host::Accel& accel, const host::Camera& cam,
-                    host::RenderOptions opt, int runs) {
+                    host::RenderOptions opt, int runs, int warmup_ms) {
   FrameRun fr;
   host::StreamTracer tracer(scene, accel, opt);
   fr.device = tracer.device().description();
   auto* gld = dynamic_cast<gl::GlDevice*>(&tracer.device());
   for (int r = 0; r <= runs; ++r) {  // run 0 warms up (the GL device compiles its programs)
+    if (r == 1 && gld && warmup_ms > 0) {
+      // A GPU left idle (the emulator's frames before) lowers its clock; frames of this very
+      // configuration until warmup_ms have passed bring it back up before timing starts.
+      const auto t0 = Clock::now();
+      while (ms_since(t0) < warmup_ms) {
+        tracer.render(cam);
+        ++fr.warmup_frames;
+      }
+      fr.warmup_ms = ms_since(t0);
+    }
+    if (r == 1) fr.timed_from_s = unix_s();
     const double wait0 = gld ? gld->readback_wait_ms() : 0;
     const host::RenderResult res = tracer.render(cam);
     if (r == 0) continue;
@@ -178,6 +198,7 @@ FrameRun run_frames(const host::Scene& scene, const host::Accel& accel, const ho
     fr.rays_traced = res.rays_traced;
     fr.streams = res.streams.on;
   }
+  fr.timed_to_s = unix_s();
   return fr;
 }
 
@@ -188,7 +209,7 @@ int main(int argc, char** argv) {
   std::string device = "auto", json_path, grid_text = "15";
   std::vector<std::string> scenes = {"sphere-alone", "bunny", "bunny-mirror"};
   std::vector<int> sizes = {256};
-  int runs = 3, micro_passes = 200, threads = 0;
+  int runs = 3, micro_passes = 200, threads = 0, warmup_ms = 0;
   bool no_stream = false, no_frames = false;
   std::string wait_mode = "block";
   std::vector<std::string> variants = {"multipass"};
@@ -205,6 +226,12 @@ int main(int argc, char** argv) {
   app.add_option("--runs", runs, "Timed runs per figure (after one warm-up)")
       ->capture_default_str()
       ->check(CLI::Range(1, 100));
+  app.add_option("--warmup-ms", warmup_ms,
+                 "GL frames: after the warm-up frame, run frames of the same configuration until "
+                 "this many ms have passed before timing (a GPU idle before them has lowered its "
+                 "clock); 0: none")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 600000));
   app.add_option("--micro-passes", micro_passes, "Passes per fixed-cost measurement")
       ->capture_default_str()
       ->check(CLI::Range(10, 100000));
@@ -390,7 +417,7 @@ int main(int argc, char** argv) {
                     const bool gl = engine != "stream";
                     opt.device = gl ? "gl" : "vgpu";
                     opt.gl_readback = engine == "gl-poll" ? "poll" : "block";
-                    const FrameRun fr = run_frames(scene, accel, cam, opt, runs);
+                    const FrameRun fr = run_frames(scene, accel, cam, opt, runs, warmup_ms);
                     json f = {{"scene", scene.name},
                               {"accel", accel_name},
                               {"bounces", opt.bounces},
@@ -403,6 +430,10 @@ int main(int argc, char** argv) {
                               {"engine", engine},
                               {"device", fr.device},
                               {"runs", runs},
+                              {"warmup_frames", fr.warmup_frames},
+                              {"warmup_ms", fr.warmup_ms},
+                              {"timed_from_s", fr.timed_from_s},
+                              {"timed_to_s", fr.timed_to_s},
                               {"wall_ms", median(fr.wall)},
                               {"gpu_ms", gl ? json(median(fr.gpu)) : json()},
                               {"readback_wait_ms", gl ? json(median(fr.wait)) : json()},
@@ -445,7 +476,8 @@ int main(int argc, char** argv) {
                                 scene.name.c_str(), size, size, accel_name.c_str(), variant.c_str(),
                                 engine.c_str(), streams.c_str(), mode.c_str(), median(fr.wall));
                     if (gl)
-                      std::printf("  gpu %9.1f ms  wait %8.1f ms", median(fr.gpu), median(fr.wait));
+                      std::printf("  gpu %9.1f ms  wait %8.1f ms  warm-up %d frames",
+                                  median(fr.gpu), median(fr.wait), fr.warmup_frames);
                     else
                       std::printf("  h200 predicted %8.1f ms",
                                   f["predicted_ms"]["h200"].get<double>());

@@ -5,6 +5,7 @@ sections (scripts/materials.py --h200, scripts/sampling.py --h200), and the mark
 replace. Times are ms; "vs" columns are (predicted - measured) / measured.
 """
 import csv
+import datetime
 import json
 import os
 import statistics
@@ -35,6 +36,9 @@ def frames(paths):
                         "renderer": doc.get("renderer", ""),
                         "gl_version": doc.get("gl_version", ""),
                         "runs": g["runs"], "passes": g["passes"],
+                        "warmup_frames": g.get("warmup_frames", 0),
+                        "warmup_ms": g.get("warmup_ms", 0),
+                        "timed": (g.get("timed_from_s"), g.get("timed_to_s")),
                         "readbacks": g["query_readbacks"], "rays": g["rays_traced"],
                         "wall_ms": g["wall_ms"], "gpu_ms": g["gpu_ms"],
                         "predicted_ms": em["predicted_ms"]["h200"],
@@ -100,6 +104,25 @@ def sm_clock(path):
             if sm and util and int(util.split()[0]) > 0:
                 busy.append(int(sm.split()[0]))
     return (statistics.median(busy), min(busy), max(busy), len(busy)) if busy else None
+
+
+def clock_samples(path, t0, t1):
+    """The SM clock samples (MHz) of the nvidia-smi log stamped from t0 to t1 (seconds since the
+    Unix epoch; the log's stamps are the GPU host's local time, UTC there)."""
+    if not path or not os.path.exists(path) or t0 is None or t1 is None:
+        return []
+    got = []
+    with open(path) as f:
+        for row in csv.DictReader(f, skipinitialspace=True):
+            sm = row.get("clocks.current.sm [MHz]") or row.get("clocks.sm [MHz]")
+            stamp = row.get("timestamp")
+            if not sm or not stamp:
+                continue
+            t = datetime.datetime.strptime(stamp.strip(), "%Y/%m/%d %H:%M:%S.%f")
+            t = t.replace(tzinfo=datetime.timezone.utc).timestamp()
+            if t0 <= t <= t1:
+                got.append(int(sm.split()[0]))
+    return got
 
 
 def replace_section(path, begin, end, text):

@@ -6,9 +6,11 @@ passes and modeled time.
 Usage: /usr/bin/python3 scripts/sampling.py [--bench build/bench/bench_sampling] [--size 128]
     [--reps 3] [--scenes sphere,bunny,...] [--other-scenes hop,teapot,...] [--changed-size 256]
        /usr/bin/python3 scripts/sampling.py --h200 FILE... [--h200-clocks CSV]
+           [--h200-looping FILE... [--h200-looping-control FILE...] [--h200-looping-clocks CSV]]
 --h200 runs nothing: it reads bench_gl's JSON from an H200 (scripts/streams_sampling_h200.sh) and
 rewrites only docs/sampling.md's H200 section (between the h200-measured markers), which a full
-regeneration keeps as it is.
+regeneration keeps as it is. --h200-looping takes the looping rows from a second run with a warm-up
+before timing (scripts/sampling_looping_h200.sh), --h200-looping-control its run without one.
 
 The figures are bench_sampling's (bench/bench_sampling.cpp), which this script runs with --json:
 every image is the stream engine's (the emulator) on gf6600, the reference the CPU tracer at
@@ -199,16 +201,46 @@ H200_PROSE = """**What the differences say about the model's pricing of sampling
   stretches at 570 and 645 MHz; a looping frame of 24-34 ms, after a warm-up frame as short, does
   not bring it back to 1,980 MHz. The 500 ms clock samples cannot show the clock inside those
   frames, so this is the likely cause, not a measured one; the undersample:2 looping rows are
-  not evidence about the model. (A bench that runs each configuration's emulator frames before its GL frames, or warms
-  up for a fixed time, would avoid it; not done here.)"""
+  not evidence about the model. `bench_gl --warmup-ms` now warms each configuration up for a
+  fixed time before timing it, and `scripts/sampling_looping_h200.sh` re-runs these looping
+  frames with and without it, logging the clock every 100 ms; that run has not been made yet."""
 
 
-def h200(paths, clocks):
-    """The sampling modes on the H200 through the GL device beside the model; returns the
+def looping_again(warm, control, clocks):
+    """The looping frames of the second run without (control) and with the warm-up, with the
+    SM clock samples stamped while their timed frames ran."""
+    L = ["", "The looping frames of the second run, without a warm-up (as the first run: one "
+         "warm-up frame, then the timed frames; the control) and with it, each beside the SM "
+         "clock samples (every 100 ms) stamped while its timed frames ran and in the 0.5 s "
+         "before:", "",
+         "| scene | mode | warm-up | H200 wall ms | GPU ms | predicted ms | predicted vs wall | "
+         "SM MHz, 0.5 s before | SM MHz, timed |", "|---|---|---|---:|---:|---:|---:|---|---|"]
+    for r in [*control, *warm]:
+        t0, t1 = r["timed"]
+        before = hf.clock_samples(clocks, t0 - 0.5, t0) if t0 else []
+        timed = hf.clock_samples(clocks, t0, t1)
+        w = (f"{r['warmup_ms'] / 1e3:.1f} s ({r['warmup_frames']} frames)" if r["warmup_frames"]
+             else "one frame")
+        L.append(f"| {r['scene']} | {r['sampling']} | {w} | {hf.fmt(r['wall_ms'])} | "
+                 f"{hf.fmt(r['gpu_ms'])} | {hf.fmt(r['predicted_ms'])} | "
+                 f"{hf.vs(r['predicted_ms'], r['wall_ms'])} | "
+                 f"{', '.join(map(str, before)) or '-'} | {', '.join(map(str, timed)) or '-'} |")
+    return L
+
+
+def h200(paths, clocks, looping=None, control=None, looping_clocks=None):
+    """The sampling modes on the H200 through the GL device beside the model, the looping rows
+    from the files looping (warmed up) where given, beside their control run; returns the
     markdown of the section."""
     rows = hf.frames(paths)
     r0 = rows[0]
     clk = hf.sm_clock(clocks)
+    again = hf.frames(looping) if looping else []
+    if again:  # each scene's multipass rows, then its looping rows from the second run
+        scenes = list(dict.fromkeys(r["scene"] for r in rows))
+        rows = [r for sc in scenes for r in
+                [o for o in rows if o["scene"] == sc and o["variant"] != "looping"] +
+                [o for o in again if o["scene"] == sc]]
     out = ["## Measured on an H200 through the GL device", ""]
     out.append(
         f"The sampling modes on an NVIDIA H200 through the GL device (`bench/bench_gl.cpp "
@@ -223,10 +255,20 @@ def h200(paths, clocks):
         "`--aa adaptive --spp 16`, `undersample:2` `--aa undersample:2`"
         + (f". SM clock {clk[0]:.0f} MHz (median of {clk[3]} samples while the GPU was busy, "
            f"{clk[1]}-{clk[2]} MHz)." if clk else "."))
+    if again:
+        a0 = again[0]
+        out[-1] += (
+            f" The looping rows come from a second run (`scripts/sampling_looping_h200.sh`, the "
+            f"same options, looping frames only): after the warm-up frame, frames of the same "
+            f"configuration for {a0['warmup_ms'] / 1e3:.1f} s (`bench_gl --warmup-ms`) before "
+            f"the {a0['runs']} timed ones, so that the GPU clock is up when timing starts; the "
+            "multipass rows from the first run (one warm-up frame).")
     out.append("")
     label = [("scene", lambda r: r["scene"]), ("mode", lambda r: r["sampling"]),
              ("kernels", lambda r: r["variant"])]
     out += hf.frame_table(rows, label)
+    if again:
+        out += looping_again(again, hf.frames(control) if control else [], looping_clocks)
     out += ["", "Each mode's cost against one ray per pixel (`spp:1`) of the same scene and "
             "kernels, measured and predicted:", "",
             "| scene | kernels | mode | wall / spp:1 | GPU / spp:1 | predicted / spp:1 | "
@@ -275,9 +317,20 @@ def main():
     ap.add_argument("--h200-clocks", metavar="CSV",
                     default=os.path.join(ROOT, "docs", "streams_sampling_h200_clocks.csv"),
                     help="nvidia-smi's clock log of the same run")
+    ap.add_argument("--h200-looping", nargs="+", metavar="FILE",
+                    help="bench_gl JSON of the looping frames run again with --warmup-ms "
+                    "(docs/sampling_h200_looping*.json): the section's looping rows")
+    ap.add_argument("--h200-looping-control", nargs="+", metavar="FILE",
+                    help="the same run's frames without warm-up "
+                    "(docs/sampling_h200_looping_nowarm*.json)")
+    ap.add_argument("--h200-looping-clocks", metavar="CSV",
+                    default=os.path.join(ROOT, "docs", "sampling_h200_looping_clocks.csv"),
+                    help="nvidia-smi's clock log of the looping run")
     args = ap.parse_args()
     if args.h200:
-        hf.replace_section(DOC, H200_BEGIN, H200_END, h200(args.h200, args.h200_clocks))
+        hf.replace_section(DOC, H200_BEGIN, H200_END,
+                           h200(args.h200, args.h200_clocks, args.h200_looping,
+                                args.h200_looping_control, args.h200_looping_clocks))
         print("sampling.py: wrote docs/sampling.md's H200 section", file=sys.stderr)
         return
     scenes = args.scenes.split(",")

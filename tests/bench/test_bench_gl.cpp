@@ -1,6 +1,7 @@
 // bench_gl's frame options as a user meets them: ray streams and sampling modes are run and
 // priced per frame (on the emulator alone, --readback-wait none, so no GL driver is needed),
-// and a bad mode is refused with exit 2 and nothing written.
+// and a bad mode is refused with exit 2 and nothing written; --warmup-ms runs GL frames (llvmpipe
+// here, as test_gl) before timing.
 #include <doctest/doctest.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -54,7 +55,8 @@ TEST_CASE("bench_gl refuses sampling modes and ray-stream settings it does not k
   const fs::path js = json_path();
   for (const std::string bad :
        {"--sampling spp:7", "--sampling adaptive:0", "--sampling undersample:0",
-        "--sampling undersample:65", "--sampling magic", "--sampling spp:", "--ray-streams yes"}) {
+        "--sampling undersample:65", "--sampling magic", "--sampling spp:", "--ray-streams yes",
+        "--warmup-ms -1"}) {
     INFO("bench_gl " << bad);
     fs::remove(js);
     const Outcome o = bench("--readback-wait none --sizes 8 " + bad + " --json " + js.string());
@@ -103,5 +105,33 @@ TEST_CASE("bench_gl runs each sampling mode with and without ray streams and pri
   for (const std::string mode : {"adaptive:4", "undersample:2"}) {
     INFO(mode);
     CHECK(frames.at({"off", mode})["passes"].get<uint64_t>() > one["passes"].get<uint64_t>());
+  }
+}
+
+TEST_CASE("bench_gl runs GL frames until --warmup-ms has passed before it times any") {
+  const fs::path js = json_path();
+  for (const int warmup : {0, 300}) {
+    INFO("--warmup-ms " << warmup);
+    const Outcome o = bench(
+        "--readback-wait poll --no-fixed --sizes 8 --runs 2 --threads 1 "
+        "--warmup-ms " +
+        std::to_string(warmup) + " --scenes sphere-alone --json " + js.string());
+    REQUIRE(o.status == 0);
+    std::ifstream f(js);
+    const nlohmann::json doc = nlohmann::json::parse(f);
+    fs::remove(js);
+    REQUIRE(doc["frames"].size() == 2);  // gl-poll, then the emulator's
+    for (const auto& fr : doc["frames"]) {
+      INFO(fr["engine"]);
+      CHECK(fr["timed_to_s"].get<double>() >= fr["timed_from_s"].get<double>());
+      CHECK(fr["timed_from_s"].get<double>() > 1.7e9);  // seconds since the Unix epoch
+      if (fr["engine"] == "gl-poll" && warmup > 0) {
+        CHECK(fr["warmup_frames"].get<int>() >= 1);
+        CHECK(fr["warmup_ms"].get<double>() >= warmup);
+      } else {  // no warm-up asked for, or the emulator (no GPU clock to raise)
+        CHECK(fr["warmup_frames"].get<int>() == 0);
+        CHECK(fr["warmup_ms"].get<double>() == 0);
+      }
+    }
   }
 }

@@ -1,0 +1,51 @@
+#!/usr/bin/env bash
+# The sampling modes' looping frames on an H200 again (docs/sampling.md's H200 section): the
+# undersample:2 looping frames of scripts/streams_sampling_h200.sh ran 3-5x slower per pass after
+# the GPU idled; here every configuration's GL frames run --warmup-ms of frames before timing,
+# beside a control run without (as that script), and the SM clock is logged every 100 ms.
+# Prepare .h200/ and .gl/ as scripts/streams_sampling_h200.sh says, copy the repository with them
+# to the GPU host and run there, from its root:
+#   OUT=DIR scripts/sampling_looping_h200.sh   (SIZE=64 SCENES=classic WARMUP=200: the end-to-end
+#                                               check on llvmpipe; H200=DIR: bench_gl is in DIR)
+# then copy DIR's files to docs/ (sampling_h200_looping*.json, clocks.csv to
+# docs/sampling_h200_looping_clocks.csv) and run here:
+#   /usr/bin/python3 scripts/sampling.py --h200 docs/sampling_h200.json \
+#     docs/sampling_h200_bunny.json --h200-looping docs/sampling_h200_looping.json
+set -u
+out="${OUT:?set OUT to a folder}"
+size="${SIZE:-256}"
+runs="${RUNS:-5}"
+warmup="${WARMUP:-2000}"
+scenes="${SCENES:-classic bunny}"
+h200="${H200:-.h200}"
+if [ -d .gl ]; then
+  for f in .gl/*.deb; do dpkg -x "$f" /; done
+  ldconfig
+fi
+j=/usr/local/nvidia/share/glvnd/egl_vendor.d/10_nvidia.json
+[ -f "$j" ] && export __EGL_VENDOR_LIBRARY_FILENAMES="$j"
+# The GPU clock every 100 ms in the background (every 500 ms where nvidia-smi refuses 100).
+if command -v nvidia-smi > /dev/null; then
+  q=timestamp,clocks.sm,clocks.mem,utilization.gpu
+  nvidia-smi --query-gpu=$q --format=csv -lms 100 > "$out/clocks.csv" &
+  sampler=$!
+  sleep 1
+  if ! kill -0 $sampler 2> /dev/null; then
+    nvidia-smi --query-gpu=$q --format=csv -lms 500 > "$out/clocks.csv" &
+    sampler=$!
+  fi
+  trap 'kill $sampler 2>/dev/null || true' EXIT
+fi
+# scripts/streams_sampling_h200.sh's options, looping frames only.
+common="--runs $runs --sizes $size --threads 16 --readback-wait poll --grid auto --no-fixed"
+common="$common --shadows --bounces 2 --variants looping"
+common="$common --sampling spp:1 spp:4 adaptive:16 undersample:2"
+# Each scene a call of its own (bunny's looping triangle lists are past llvmpipe's 16,384 texels):
+# first the control without warm-up, then the warmed frames.
+for s in $scenes; do
+  suffix=$([ "$s" = classic ] || echo "_$s")
+  "$h200/bench_gl" $common --warmup-ms 0 --scenes "scenes/$s.gltf" \
+    --json "$out/sampling_h200_looping_nowarm$suffix.json"
+  "$h200/bench_gl" $common --warmup-ms "$warmup" --scenes "scenes/$s.gltf" \
+    --json "$out/sampling_h200_looping$suffix.json"
+done
