@@ -18,24 +18,8 @@ runs="${RUNS:-5}"
 warmup="${WARMUP:-2000}"
 scenes="${SCENES:-classic bunny}"
 h200="${H200:-.h200}"
-if [ -d .gl ]; then
-  for f in .gl/*.deb; do dpkg -x "$f" /; done
-  ldconfig
-fi
-j=/usr/local/nvidia/share/glvnd/egl_vendor.d/10_nvidia.json
-[ -f "$j" ] && export __EGL_VENDOR_LIBRARY_FILENAMES="$j"
-# The GPU clock every 100 ms in the background (every 500 ms where nvidia-smi refuses 100).
-if command -v nvidia-smi > /dev/null; then
-  q=timestamp,clocks.sm,clocks.mem,utilization.gpu
-  nvidia-smi --query-gpu=$q --format=csv -lms 100 > "$out/clocks.csv" &
-  sampler=$!
-  sleep 1
-  if ! kill -0 $sampler 2> /dev/null; then
-    nvidia-smi --query-gpu=$q --format=csv -lms 500 > "$out/clocks.csv" &
-    sampler=$!
-  fi
-  trap 'kill $sampler 2>/dev/null || true' EXIT
-fi
+# The GL libraries, EGL and the SM clock every 100 ms.
+CLOCK_MS=100 . scripts/h200_env.sh
 # scripts/streams_sampling_h200.sh's options, looping frames only.
 common="--runs $runs --sizes $size --threads 16 --readback-wait poll --grid auto --no-fixed"
 common="$common --shadows --bounces 2 --variants looping"

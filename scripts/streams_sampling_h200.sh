@@ -19,19 +19,8 @@ out="${OUT:?set OUT to a folder}"
 size="${SIZE:-256}"
 runs="${RUNS:-5}"
 h200="${H200:-.h200}"
-if [ -d .gl ]; then
-  for f in .gl/*.deb; do dpkg -x "$f" /; done
-  ldconfig
-fi
-j=/usr/local/nvidia/share/glvnd/egl_vendor.d/10_nvidia.json
-[ -f "$j" ] && export __EGL_VENDOR_LIBRARY_FILENAMES="$j"
-# The GPU clock while measured, every 500 ms in the background (none on a machine without one).
-if command -v nvidia-smi > /dev/null; then
-  nvidia-smi --query-gpu=timestamp,clocks.sm,clocks.mem,utilization.gpu --format=csv -lms 500 \
-    > "$out/clocks.csv" &
-  sampler=$!
-  trap 'kill $sampler 2>/dev/null || true' EXIT
-fi
+# The GL libraries, EGL and the SM clock every 500 ms.
+. scripts/h200_env.sh
 # The CLI's defaults (2 bounces, Phong, shadows), the paper's grid (auto resolution); multipass
 # frames run the paper's kernels on gf5700, looping frames the looping walk on h200.
 common="--runs $runs --sizes $size --threads 16 --readback-wait poll --grid auto --no-fixed"

@@ -16,17 +16,8 @@
 set -u
 accels="${ACCELS:-grid grid2 bvh kdtree}"
 out="${OUT:?set OUT to a folder}"
-if [ -d .gl ]; then
-  for f in .gl/*.deb; do dpkg -x "$f" /; done
-  ldconfig
-fi
-j=/usr/local/nvidia/share/glvnd/egl_vendor.d/10_nvidia.json
-[ -f "$j" ] && export __EGL_VENDOR_LIBRARY_FILENAMES="$j"
-# The GPU clock while measured, every 500 ms in the background.
-nvidia-smi --query-gpu=timestamp,clocks.sm,clocks.mem,utilization.gpu --format=csv -lms 500 \
-  > "$out/clocks.csv" &
-sampler=$!
-trap 'kill $sampler 2>/dev/null || true' EXIT
+# The GL libraries, EGL and the SM clock every 500 ms.
+. scripts/h200_env.sh
 S="scenes/sphere.gltf scenes/bunny.gltf scenes/bunny-refl.gltf scenes/classic.gltf"
 S="$S scenes/teapot.gltf .h200/stadium.gltf .h200/scales.gltf"
 if [ -n "${SIZES:-}" ]; then
