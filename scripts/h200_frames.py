@@ -75,6 +75,18 @@ def kernel_sums(r, names):
     return sum(k[0] for k in ks), sum(k[1] for k in ks), sum(k[2] for k in ks)
 
 
+def kernel_sum_table(rows, names):
+    """Per frame, the named kernels summed: passes, GPU ms, the model's ms, and their share of
+    the frame's GPU time."""
+    L = ["| frame | passes | GPU ms | predicted ms | predicted vs GPU | share of the frame's "
+         "GPU ms |", "|---|---:|---:|---:|---:|---:|"]
+    for r in rows:
+        p, g, m = kernel_sums(r, names)
+        L.append(f"| {r['_label']} | {p:,} | {g:.2f} | {m:.2f} | {vs(m, g)} | "
+                 f"{100 * g / r['gpu_ms']:.1f}% |")
+    return L
+
+
 def kernel_table(rows, label, names):
     """Per frame, each of the named kernels it ran: passes, GPU ms (timer queries, medians),
     the model's ms and per pass in us."""

@@ -192,14 +192,8 @@ def h200(paths, clocks):
             "shadows through glass), GPU time per kernel from timer queries beside the model's "
             "ms for the same passes (its fixed costs per pass included):", ""]
     out += hf.kernel_table(streamed, "frame", hf.STREAM_KERNELS)
-    out += ["", "Summed over those kernels:", "",
-            "| frame | passes | GPU ms | predicted ms | predicted vs GPU | share of the frame's "
-            "GPU ms |",
-            "|---|---:|---:|---:|---:|---:|"]
-    for r in streamed:
-        p, g, m = hf.kernel_sums(r, hf.STREAM_KERNELS)
-        out.append(f"| {r['_label']} | {p:,} | {g:.2f} | {m:.2f} | {hf.vs(m, g)} | "
-                   f"{100 * g / r['gpu_ms']:.1f}% |")
+    out += ["", "Summed over those kernels:", ""]
+    out += hf.kernel_sum_table(streamed, hf.STREAM_KERNELS)
     if H200_PROSE:
         out += ["", H200_PROSE]
     return "\n".join(out)

@@ -291,13 +291,8 @@ def h200(paths, clocks, looping=None, control=None, looping_clocks=None):
             "(its fixed costs per pass included):", ""]
     out += hf.kernel_table([r for r in sampled if r["variant"] == "multipass"], "frame",
                            hf.SAMPLING_KERNELS)
-    out += ["", "Summed over those kernels, every frame:", "",
-            "| frame | passes | GPU ms | predicted ms | predicted vs GPU | share of the frame's "
-            "GPU ms |", "|---|---:|---:|---:|---:|---:|"]
-    for r in sampled:
-        p, g, m = hf.kernel_sums(r, hf.SAMPLING_KERNELS)
-        out.append(f"| {r['_label']} | {p:,} | {g:.2f} | {m:.2f} | {hf.vs(m, g)} | "
-                   f"{100 * g / r['gpu_ms']:.1f}% |")
+    out += ["", "Summed over those kernels, every frame:", ""]
+    out += hf.kernel_sum_table(sampled, hf.SAMPLING_KERNELS)
     if H200_PROSE:
         out += ["", H200_PROSE]
     return "\n".join(out)
