@@ -190,20 +190,19 @@ H200_PROSE = """**What the differences say about the model's pricing of sampling
   predicted, about 22.5 us measured) is predicted at 2.3x to 6.7x what it is on the GPU. The
   marked-pixel query (+218%) is the occlusion read-back again: its 12 us wait is in the wall
   time, not in the timer query.
-- *Looping frames:* spp:1, spp:4 and adaptive:16 are 16-27% under the wall time, the looping
-  walk's known under-pricing ([structures.md](structures.md)). undersample:2 looping
-  (-65%, -76%) is not the model's: every kernel of those frames ran 3-5x slower per pass than the
-  same kernel in every other frame (init traversal 68 and 114 us per pass, 23-27 us in all 14
-  other frames; the shader 228 and 394 us against 74-76 us). Those frames were each measured
-  right after the longest stretches without GPU work in the run (the emulator's frames of the
-  mode before: 6 x 876 ms on classic, 6 x 354 ms on bunny), and the clock log shows the SM clock
-  falling to 345 MHz after about 1.5 s without work and the first busy samples after such
-  stretches at 570 and 645 MHz; a looping frame of 24-34 ms, after a warm-up frame as short, does
-  not bring it back to 1,980 MHz. The 500 ms clock samples cannot show the clock inside those
-  frames, so this is the likely cause, not a measured one; the undersample:2 looping rows are
-  not evidence about the model. `bench_gl --warmup-ms` now warms each configuration up for a
-  fixed time before timing it, and `scripts/sampling_looping_h200.sh` re-runs these looping
-  frames with and without it, logging the clock every 100 ms; that run has not been made yet."""
+- *Looping frames* (the second run's, warmed up for 2 s): every mode is 15-30% under the wall
+  time, the looping walk's known under-pricing ([structures.md](structures.md)); undersample:2
+  at -18% (classic) and -15% (bunny), where the first run gave -65% and -76%. That run's
+  undersample:2 looping frames each came right after the longest stretches without GPU work
+  (the emulator's frames of the mode before), with every kernel 3-5x slower per pass. The second
+  run settles it: its control (one warm-up frame, as the first run) repeats the slowdown,
+  classic undersample:2 at 57.1 ms (-80%) with the SM clock at 345 MHz in every sample of its
+  timed frames and the 0.5 s before, bunny's at 14.6 ms (-62%); after 2 s of warm-up frames the
+  same frames take 14.3 and 6.6 ms at 1,980 MHz. The clock, not the kernels: with it up, the
+  mode's cost against spp:1 is predicted 11-15% above the GPU's own ratio (classic 2.04
+  predicted against 1.84 measured, bunny 2.09 against 1.81). The other modes moved little
+  with the warm-up (spp:1 to adaptive:16 within 9% of the control): their frames came after
+  shorter idle stretches."""
 
 
 def looping_again(warm, control, clocks):

@@ -10,7 +10,9 @@
 # then copy DIR's files to docs/ (sampling_h200_looping*.json, clocks.csv to
 # docs/sampling_h200_looping_clocks.csv) and run here:
 #   /usr/bin/python3 scripts/sampling.py --h200 docs/sampling_h200.json \
-#     docs/sampling_h200_bunny.json --h200-looping docs/sampling_h200_looping.json
+#     docs/sampling_h200_bunny.json --h200-looping docs/sampling_h200_looping.json \
+#     docs/sampling_h200_looping_bunny.json --h200-looping-control \
+#     docs/sampling_h200_looping_nowarm.json docs/sampling_h200_looping_nowarm_bunny.json
 set -u
 out="${OUT:?set OUT to a folder}"
 size="${SIZE:-256}"
