@@ -5,7 +5,7 @@ two-level grid, the BVH, the kd-tree and --accel auto on the bundled scenes and 
 
 Usage: /usr/bin/python3 scripts/structures.py [--vgpu-rt build/host/vgpu-rt] [--size 256]
                                               [--runs 3] [--h200 FILE ...]
-                                              [--h200-sizes FILE ...]
+                                              [--h200-looping FILE ...] [--h200-sizes FILE ...]
                                               [--reuse [--only ACCEL ...]]
 
 Per scene and structure, primary rays only (--bounces 0 --shadows off, as the issue's table) and
@@ -59,6 +59,9 @@ def main():
     ap.add_argument("--runs", type=int, default=3)
     ap.add_argument("--h200", nargs="*", default=[],
                     help="bench_gl JSON files measured on an H200 (docs/structures_h200_*.json)")
+    ap.add_argument("--h200-looping", nargs="*", default=[],
+                    help="bench_gl JSON of the looping frames measured again with a warm-up "
+                    "(docs/structures_h200_looping_warm.json): they replace the looping cells")
     ap.add_argument("--h200-sizes", nargs="*", default=[],
                     help="bench_gl JSON files of the same frames at several sizes "
                     "(docs/structures_h200_sizes_*.json)")
@@ -119,20 +122,15 @@ def main():
                 print(f"{name:10s} {mode:7s} {acc:11s} -> {row['chosen']:4s} passes "
                       f"{row['passes']:7d} gf6600 {row['gf6600']:10.1f} ms h200 {row['h200']:8.1f}"
                       f" ms emulator {row['emu_ms']:8.1f} ms", file=sys.stderr)
-    h200 = []
-    for f in a.h200:
-        frames = json.load(open(f))["frames"]
-        for g in frames:
-            if g["engine"] != "gl-poll":
-                continue
-            em = next(e for e in frames if e["engine"] == "stream" and
-                      all(e[k] == g[k] for k in ("scene", "accel", "variant", "bounces", "size")))
-            mode = ("looping" if g["variant"] == "looping" else
-                    "primary" if g["bounces"] == 0 else f"{g['bounces']} bounces")
-            h200.append({"scene": g["scene"], "accel": g["accel"], "mode": mode,
-                         "wall_ms": g["wall_ms"], "gpu_ms": g["gpu_ms"], "passes": g["passes"],
-                         "readbacks": g["query_readbacks"],
-                         "predicted_ms": em["predicted_ms"]["h200"]})
+    h200 = gl_cells(a.h200)
+    # The looping cells measured again with a warm-up (LOOPING=1 scripts/structures_h200.sh)
+    # replace the first runs' and are shown beside them.
+    a.looping_first = []
+    for w in gl_cells(a.h200_looping):
+        for i, r in enumerate(h200):
+            if (r["scene"], r["accel"], r["mode"]) == (w["scene"], w["accel"], w["mode"]):
+                a.looping_first.append((r, w))
+                h200[i] = w
     json.dump({"rows": rows, "h200": h200}, open(os.path.join(a.out, "structures.json"), "w"),
               indent=1)
     write_doc(a, rows, h200)
@@ -206,6 +204,68 @@ def target_verdict(rows):
             out.append(f"{sc} ({mode}): emulator {e:.2f}x {'met' if e <= limit else 'missed'}, "
                        f"modeled H200 {h:.2f}x {'met' if h <= limit else 'missed'}")
     return "Against the targets (3x for the stadium, 5x for many scales): " + "; ".join(out) + "."
+
+
+def gl_cells(files):
+    """The GL frames of bench_gl JSON files, each beside the h200 prediction from the emulator's
+    statistics of the same frame in the same file."""
+    cells = []
+    for f in files:
+        frames = json.load(open(f))["frames"]
+        for g in frames:
+            if g["engine"] != "gl-poll":
+                continue
+            em = next(e for e in frames if e["engine"] == "stream" and
+                      all(e[k] == g[k] for k in ("scene", "accel", "variant", "bounces", "size")))
+            mode = ("looping" if g["variant"] == "looping" else
+                    "primary" if g["bounces"] == 0 else f"{g['bounces']} bounces")
+            cells.append({"scene": g["scene"], "accel": g["accel"], "mode": mode,
+                          "wall_ms": g["wall_ms"], "gpu_ms": g["gpu_ms"], "passes": g["passes"],
+                          "readbacks": g["query_readbacks"],
+                          "warmup_ms": g.get("warmup_ms", 0),
+                          "predicted_ms": em["predicted_ms"]["h200"]})
+    return cells
+
+
+def grid2_loop(h200):
+    """The two-level grid's looping cells against the model, for Left out."""
+    g = [r for r in h200 if r["accel"] == "grid2" and r["mode"] == "looping"]
+    if not g:
+        return "not measured on the H200."
+    e = sorted(100 * (r["predicted_ms"] / r["wall_ms"] - 1) for r in g)
+    out = [r for r in g if abs(r["predicted_ms"] / r["wall_ms"] - 1) > 0.35]
+    return (f"its H200 frames run {-e[-1]:.0f}-{-e[0]:.0f}% longer than predicted (warmed up), "
+            f"the most of any structure's looping frames; {len(out)} of {len(g)} outside 35% ("
+            + (", ".join(f"{r['scene']}, {fmt_ms(r['wall_ms'])} ms" for r in out) or "none") +
+            "). Frames of a few ms are noisy: warmed up, bunny-refl's grid2 and teapot's BVH "
+            "frames came out 13% slower than in the first runs where most got faster (the table "
+            "above), so a cell 5 points past the line is within that spread; the model is not "
+            "recalibrated for it. Its GPU time (timer queries) is above its modeled pass work, as "
+            "the kd-tree's is: a nested DDA's dependent fetches, which the model prices by "
+            "throughput only, are the suspect.")
+
+
+def looping_again(pairs):
+    """The looping cells of the first runs beside the same frames warmed up before timing."""
+    if not pairs:
+        return ""
+    within = sum(abs(w["predicted_ms"] / w["wall_ms"] - 1) <= 0.35 for _, w in pairs)
+    warm_s = sorted(w["warmup_ms"] for _, w in pairs)[len(pairs) // 2] / 1000
+    L = ["", "", f"The looping rows above come from a later run (`LOOPING=1 "
+         "scripts/structures_h200.sh`, `docs/structures_h200_looping_warm.json`): the same frames, "
+         f"each configuration's GL frames run for about {warm_s:.1f} s (`bench_gl --warmup-ms`) "
+         "before the timed ones, since a GPU left idle while the emulator computes the frame's "
+         "prediction lowers its clock (docs/sampling.md's H200 section measured it: 345 MHz, and "
+         f"frames 3-5x slower). {within} of its {len(pairs)} looping cells are within 35%. "
+         "Beside the first runs' (one warm-up frame):", "",
+         "| scene | structure | first run wall ms | vs | warmed wall ms | GPU ms | predicted ms "
+         "| vs |", "|---|---|---:|---:|---:|---:|---:|---:|"]
+    for r, w in pairs:
+        L.append(f"| {w['scene']} | {w['accel']} | {fmt_ms(r['wall_ms'])} | "
+                 f"{100 * (r['predicted_ms'] / r['wall_ms'] - 1):+.0f}% | "
+                 f"{fmt_ms(w['wall_ms'])} | {fmt_ms(w['gpu_ms'])} | {fmt_ms(w['predicted_ms'])} | "
+                 f"{100 * (w['predicted_ms'] / w['wall_ms'] - 1):+.0f}% |")
+    return "\n".join(L)
 
 
 def h200_table(h200):
@@ -330,7 +390,8 @@ def frame_cost(h200_files, sizes_files):
 
     ra, rm = regress(cells), regress(multi)
     text = (
-        "**A cost per frame, tried and refuted.** Every looping cell above is under-predicted "
+        "**A cost per frame, tried and refuted.** Every looping cell of the first runs (one "
+        "warm-up frame) is under-predicted "
         f"(from {100 * max(err(c) for c in loop):+.0f}% to {100 * min(err(c) for c in loop):+.0f}%; "
         f"the multipass cells {100 * min(err(c) for c in multi):+.0f}% to "
         f"{100 * max(err(c) for c in multi):+.0f}%), and looping frames have few passes and "
@@ -483,7 +544,7 @@ A first frame in a fresh process also pays the driver's compilation of every pro
 walk (99.5 ms multipass) where the warm frames below take a few ms (61 ms), so only warm frames
 are compared with the model, which has no compilation term.
 
-{h200_table(h200)}
+{h200_table(h200)}{looping_again(a.looping_first)}
 
 ## Which structure wins where, and why
 
@@ -528,9 +589,7 @@ two-level grid has 96,334 sub-cells: fp16 and fp24 traversal groups both refuse 
 
 ## Left out
 
-- The cost model for the two-level grid's looping kernel: its H200 frames run 33-46% longer
-  than predicted, where every other structure's looping frames stay within 35%. The model is
-  not recalibrated for it.
+- The cost model for the two-level grid's looping kernel: {grid2_loop(h200)}
 {frame_cost(a.h200, a.h200_sizes)}- kd-backtrack and the short stack of Horn et al.: kd-restart (with push-down in the looping
   kernel) is the only kd walk.
 - Front-to-back BVH order: it needs a stack or parent links with a direction flag.

@@ -8,6 +8,9 @@
 #   OUT=DIR scripts/structures_h200.sh              (ACCELS="grid2" measures only those structures)
 #   OUT=DIR SIZES=1 scripts/structures_h200.sh      (the same frames at 8x8 to 512x512 instead:
 #                                                    what grows with the image, docs/structures.md)
+#   OUT=DIR LOOPING=1 CLOCK_MS=100 scripts/structures_h200.sh   (the looping walks again, each
+#                                   warmed up WARMUP ms: docs/structures_h200_looping_warm.json,
+#                                   read by scripts/structures.py --h200-looping)
 # then copy DIR's files to docs/structures_h200_{primary,full}.json and _clocks.csv, and run here:
 #   /usr/bin/python3 scripts/structures.py --h200 docs/structures_h200_primary.json \
 #     docs/structures_h200_full.json
@@ -30,6 +33,16 @@ if [ -n "${SIZES:-}" ]; then
     --accel grid2 bvh --variants multipass --bounces 0 --micro-passes 10 \
     --scenes scenes/bunny.gltf scenes/classic.gltf scenes/teapot.gltf \
     --json "$out/structures_sizes_multipass.json"
+  exit 0
+fi
+if [ -n "${LOOPING:-}" ]; then
+  # The looping walks' primary frames again, each configuration's GL frames warmed up for
+  # WARMUP ms (default 2000) before timing: a GPU idle while the emulator runs lowers its clock
+  # (docs/sampling.md's H200 section). docs/structures_h200_looping_warm.json and _clocks.csv,
+  # read by scripts/structures.py --h200-looping.
+  .h200/bench_gl --runs 5 --sizes 256 --threads 16 --readback-wait poll --grid auto \
+    --accel $accels --variants looping --bounces 0 --no-fixed --warmup-ms "${WARMUP:-2000}" \
+    --scenes $S --json "$out/structures_looping_warm.json"
   exit 0
 fi
 .h200/bench_gl --runs 3 --sizes 256 --threads 16 --readback-wait poll --grid auto \
