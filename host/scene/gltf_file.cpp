@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -492,5 +495,76 @@ std::vector<std::pair<std::string, std::string>> list_scenes() {
   std::sort(out.begin(), out.end());
   return out;
 }
+
+// ---------------------------------------------------------------------------------------------
+// Small readers the loader (gltf_loader.cpp) uses
+
+namespace gltf_detail {
+
+const char* mode_name(int mode) {
+  switch (mode) {
+    case TINYGLTF_MODE_POINTS:
+      return "POINTS";
+    case TINYGLTF_MODE_LINE:
+      return "LINES";
+    case TINYGLTF_MODE_LINE_LOOP:
+      return "LINE_LOOP";
+    case TINYGLTF_MODE_LINE_STRIP:
+      return "LINE_STRIP";
+    case TINYGLTF_MODE_TRIANGLES:
+      return "TRIANGLES";
+    case TINYGLTF_MODE_TRIANGLE_STRIP:
+      return "TRIANGLE_STRIP";
+    case TINYGLTF_MODE_TRIANGLE_FAN:
+      return "TRIANGLE_FAN";
+    default:
+      return "unknown";
+  }
+}
+
+// One component as float; normalized integers follow the glTF spec (max(c / 127, -1), ...).
+float read_component(const unsigned char* p, int component_type, bool normalized) {
+  switch (component_type) {
+    case TINYGLTF_COMPONENT_TYPE_BYTE: {
+      int8_t v;
+      std::memcpy(&v, p, 1);
+      return normalized ? std::max(float(v) / 127.0f, -1.0f) : float(v);
+    }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: {
+      uint8_t v;
+      std::memcpy(&v, p, 1);
+      return normalized ? float(v) / 255.0f : float(v);
+    }
+    case TINYGLTF_COMPONENT_TYPE_SHORT: {
+      int16_t v;
+      std::memcpy(&v, p, 2);
+      return normalized ? std::max(float(v) / 32767.0f, -1.0f) : float(v);
+    }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
+      uint16_t v;
+      std::memcpy(&v, p, 2);
+      return normalized ? float(v) / 65535.0f : float(v);
+    }
+    default: {  // FLOAT, checked by the caller
+      float v;
+      std::memcpy(&v, p, 4);
+      return v;
+    }
+  }
+}
+
+// A number as a message shows it: as the file most likely wrote it (0.5, not 0.500000).
+std::string shortest(double x) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.17g", x);
+  for (int digits = 1; digits < 17; ++digits) {  // the fewest digits that read back the same
+    char shorter[32];
+    std::snprintf(shorter, sizeof shorter, "%.*g", digits, x);
+    if (std::strtod(shorter, nullptr) == x) return shorter;
+  }
+  return text;
+}
+
+}  // namespace gltf_detail
 
 }  // namespace host

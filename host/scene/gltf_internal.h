@@ -86,4 +86,12 @@ class OpenScene {
   std::unique_ptr<Loader> loader_;
 };
 
+// A primitive mode's name as the glTF spec spells it (TRIANGLES, ...), "unknown" past them.
+const char* mode_name(int mode);
+// One accessor component as float; normalized integers follow the glTF spec (max(c / 127, -1),
+// ...); any other component type is read as FLOAT (checked by the caller).
+float read_component(const unsigned char* p, int component_type, bool normalized);
+// A number as a message shows it: as the file most likely wrote it (0.5, not 0.500000).
+std::string shortest(double x);
+
 }  // namespace host::gltf_detail

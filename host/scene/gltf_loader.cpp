@@ -27,7 +27,10 @@ namespace {
 
 using gltf_detail::fail;
 using gltf_detail::le32;
+using gltf_detail::mode_name;
 using gltf_detail::parse_file;
+using gltf_detail::read_component;
+using gltf_detail::shortest;
 namespace fs = std::filesystem;
 
 // glTF binary data is little-endian; accessors are read with memcpy.
@@ -54,58 +57,6 @@ struct PendingLight {
   double intensity;
 };
 
-const char* mode_name(int mode) {
-  switch (mode) {
-    case TINYGLTF_MODE_POINTS:
-      return "POINTS";
-    case TINYGLTF_MODE_LINE:
-      return "LINES";
-    case TINYGLTF_MODE_LINE_LOOP:
-      return "LINE_LOOP";
-    case TINYGLTF_MODE_LINE_STRIP:
-      return "LINE_STRIP";
-    case TINYGLTF_MODE_TRIANGLES:
-      return "TRIANGLES";
-    case TINYGLTF_MODE_TRIANGLE_STRIP:
-      return "TRIANGLE_STRIP";
-    case TINYGLTF_MODE_TRIANGLE_FAN:
-      return "TRIANGLE_FAN";
-    default:
-      return "unknown";
-  }
-}
-
-// One component as float; normalized integers follow the glTF spec (max(c / 127, -1), ...).
-float read_component(const unsigned char* p, int component_type, bool normalized) {
-  switch (component_type) {
-    case TINYGLTF_COMPONENT_TYPE_BYTE: {
-      int8_t v;
-      std::memcpy(&v, p, 1);
-      return normalized ? std::max(float(v) / 127.0f, -1.0f) : float(v);
-    }
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: {
-      uint8_t v;
-      std::memcpy(&v, p, 1);
-      return normalized ? float(v) / 255.0f : float(v);
-    }
-    case TINYGLTF_COMPONENT_TYPE_SHORT: {
-      int16_t v;
-      std::memcpy(&v, p, 2);
-      return normalized ? std::max(float(v) / 32767.0f, -1.0f) : float(v);
-    }
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
-      uint16_t v;
-      std::memcpy(&v, p, 2);
-      return normalized ? float(v) / 65535.0f : float(v);
-    }
-    default: {  // FLOAT, checked by the caller
-      float v;
-      std::memcpy(&v, p, 4);
-      return v;
-    }
-  }
-}
-
 glm::vec3 clamp01(const std::vector<double>& v) {
   return {float(std::clamp(v[0], 0.0, 1.0)), float(std::clamp(v[1], 0.0, 1.0)),
           float(std::clamp(v[2], 0.0, 1.0))};
@@ -115,18 +66,6 @@ glm::vec3 clamp01(const std::vector<double>& v) {
 // also when finite coordinates overflow the sum (the loader's checks have always meant this).
 bool all_finite(glm::vec3 v) {
   return std::isfinite(v.x + v.y + v.z);
-}
-
-// A number as a message shows it: as the file most likely wrote it (0.5, not 0.500000).
-std::string shortest(double x) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.17g", x);
-  for (int digits = 1; digits < 17; ++digits) {  // the fewest digits that read back the same
-    char shorter[32];
-    std::snprintf(shorter, sizeof shorter, "%.*g", digits, x);
-    if (std::strtod(shorter, nullptr) == x) return shorter;
-  }
-  return text;
 }
 
 // The distance between an accessor's elements: the view's byteStride, or `element` (the element
