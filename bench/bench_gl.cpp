@@ -435,8 +435,10 @@ int main(int argc, char** argv) {
                               {"timed_from_s", fr.timed_from_s},
                               {"timed_to_s", fr.timed_to_s},
                               {"wall_ms", median(fr.wall)},
+                              {"wall_runs_ms", fr.wall},  // every timed frame, in order
                               {"gpu_ms", gl ? json(median(fr.gpu)) : json()},
                               {"readback_wait_ms", gl ? json(median(fr.wait)) : json()},
+                              {"gpu_runs_ms", gl ? json(fr.gpu) : json()},
                               {"passes", fr.stats.totals.passes},
                               {"query_readbacks", fr.stats.totals.query_readbacks},
                               {"program_loads", fr.stats.totals.program_loads},

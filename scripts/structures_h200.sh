@@ -10,7 +10,9 @@
 #                                                    what grows with the image, docs/structures.md)
 #   OUT=DIR LOOPING=1 CLOCK_MS=100 scripts/structures_h200.sh   (the looping walks again, each
 #                                   warmed up WARMUP ms: docs/structures_h200_looping_warm.json,
-#                                   read by scripts/structures.py --h200-looping)
+#                                   read by scripts/structures.py --h200-looping; RUNS=15 times
+#                                   15 frames each instead of 5: docs/structures_h200_looping_warm2.json,
+#                                   read by --h200-looping-again)
 # then copy DIR's files to docs/structures_h200_{primary,full}.json and _clocks.csv, and run here:
 #   /usr/bin/python3 scripts/structures.py --h200 docs/structures_h200_primary.json \
 #     docs/structures_h200_full.json
@@ -40,7 +42,8 @@ if [ -n "${LOOPING:-}" ]; then
   # WARMUP ms (default 2000) before timing: a GPU idle while the emulator runs lowers its clock
   # (docs/sampling.md's H200 section). docs/structures_h200_looping_warm.json and _clocks.csv,
   # read by scripts/structures.py --h200-looping.
-  .h200/bench_gl --runs 5 --sizes 256 --threads 16 --readback-wait poll --grid auto \
+  # RUNS (default 5) timed frames each; the JSON keeps every frame's wall and GPU time.
+  .h200/bench_gl --runs "${RUNS:-5}" --sizes 256 --threads 16 --readback-wait poll --grid auto \
     --accel $accels --variants looping --bounces 0 --no-fixed --warmup-ms "${WARMUP:-2000}" \
     --scenes $S --json "$out/structures_looping_warm.json"
   exit 0
