@@ -668,15 +668,6 @@ void adaptive(const Tracer& tracer, const RenderOptions& opt, unsigned workers,
   res.samples = most;
 }
 
-// The one of a and b of smaller magnitude, 0 where their signs differ (rellenarHuecos' limiter).
-double minmod(double a, double b) {
-  return a * b > 0.0 ? (std::fabs(a) < std::fabs(b) ? a : b) : 0.0;
-}
-// ... and 0 unless both are within the threshold (kernels/undersample.h: gentle_bend).
-double gentle_bend(double a, double b, double limit) {
-  return std::max(std::fabs(a), std::fabs(b)) <= limit ? minmod(a, b) : 0.0;
-}
-
 // --aa undersample:K as the stream tracer runs it (render_undersampled): the lattice pixels,
 // then the pixels whose blended lattice pixels' surface keys or colours disagree, the rest
 // blended bilinearly from their cell's corners; AOVs of pixels never traced from the nearest
@@ -700,24 +691,8 @@ void undersample(const Tracer& tracer, const RenderOptions& opt, unsigned worker
   for_each_row(H, workers, [&](unsigned worker, int y) {
     for (int x = 0; x < W; ++x) {
       if (on_lattice(x, y, K, W, H)) continue;
-      const glm::ivec4 c = lattice_cell(x, y, K, W, H);
-      const size_t corner[4] = {
-          size_t(c.z) * size_t(W) + size_t(c.x), size_t(c.z) * size_t(W) + size_t(c.y),
-          size_t(c.w) * size_t(W) + size_t(c.x), size_t(c.w) * size_t(W) + size_t(c.y)};
-      // Only the corners the fill blends: on a lattice row (column) that row's (column's) two.
-      const bool use[4] = {true, x != c.x, y != c.z, x != c.x && y != c.z};
-      glm::dvec3 lo = colour[corner[0]], hi = lo;
-      bool disagree = false;
-      for (int q = 0; q < 4; ++q) {
-        if (!use[q]) continue;
-        const size_t j = corner[q];
-        disagree = disagree || key[j] != key[corner[0]];
-        lo = glm::min(lo, colour[j]);
-        hi = glm::max(hi, colour[j]);
-      }
-      const glm::dvec3 spread = hi - lo;
-      if (disagree || std::max({spread.x, spread.y, spread.z}) > double(opt.aa_threshold))
-        trace(worker, x, y);
+      const GapTest t = undersample_gap_test(colour, key, x, y, K, W, H);
+      if (t.keys_differ || t.spread > double(opt.aa_threshold)) trace(worker, x, y);
     }
   });
   res.rays_per_pixel.assign(n, 0);
@@ -728,37 +703,8 @@ void undersample(const Tracer& tracer, const RenderOptions& opt, unsigned worker
       if (traced[i]) {
         res.rays_per_pixel[i] = 1;
       } else {
+        c = undersample_fill(colour, x, y, K, W, H, double(opt.aa_threshold));
         const glm::ivec4 q = lattice_cell(x, y, K, W, H);
-        auto at = [&](int px, int py) { return colour[size_t(py) * size_t(W) + size_t(px)]; };
-        const double tx = q.y > q.x ? double(x - q.x) / double(q.y - q.x) : 0.0;
-        const double ty = q.w > q.z ? double(y - q.z) / double(q.w - q.z) : 0.0;
-        // rellenarHuecos' blend: bilinear, less the minmod curvature correction along each
-        // axis where the lattice pixels one step beyond the cell are in the image.
-        const bool along_x = q.x - K >= 0 && q.y + K <= W - 1 && q.y - q.x == K;
-        const bool along_y = q.z - K >= 0 && q.w + K <= H - 1 && q.w - q.z == K;
-        const double limit = double(opt.aa_threshold * 0.5f);
-        auto bend = [limit](const glm::dvec3& o, const glm::dvec3& a, const glm::dvec3& b,
-                            const glm::dvec3& p, double t) {
-          glm::dvec3 r;
-          for (int ch = 0; ch < 3; ++ch)
-            r[ch] = t * (1.0 - t) * 0.5 *
-                    gentle_bend(o[ch] - 2.0 * a[ch] + b[ch], a[ch] - 2.0 * b[ch] + p[ch], limit);
-          return r;
-        };
-        glm::dvec3 top = at(q.x, q.z) + (at(q.y, q.z) - at(q.x, q.z)) * tx;
-        glm::dvec3 bottom = at(q.x, q.w) + (at(q.y, q.w) - at(q.x, q.w)) * tx;
-        if (along_x) {
-          top -= bend(at(q.x - K, q.z), at(q.x, q.z), at(q.y, q.z), at(q.y + K, q.z), tx);
-          bottom -= bend(at(q.x - K, q.w), at(q.x, q.w), at(q.y, q.w), at(q.y + K, q.w), tx);
-        }
-        c = top + (bottom - top) * ty;
-        if (along_y) {
-          const glm::dvec3 left =
-              bend(at(q.x, q.z - K), at(q.x, q.z), at(q.x, q.w), at(q.x, q.w + K), ty);
-          const glm::dvec3 right =
-              bend(at(q.y, q.z - K), at(q.y, q.z), at(q.y, q.w), at(q.y, q.w + K), ty);
-          c -= left + (right - left) * tx;
-        }
         const int nx = x - q.x <= q.y - x ? q.x : q.y, ny = y - q.z <= q.w - y ? q.z : q.w;
         const size_t j = size_t(ny) * size_t(W) + size_t(nx);
         res.depth[i] = res.depth[j];

@@ -75,4 +75,73 @@ glm::ivec4 lattice_cell(int x, int y, int k, int width, int height) {
   return {x0, std::min(x0 + k, width - 1), y0, std::min(y0 + k, height - 1)};
 }
 
+GapTest undersample_gap_test(const std::vector<glm::dvec3>& colour, const std::vector<int>& key,
+                             int x, int y, int k, int width, int height) {
+  const glm::ivec4 c = lattice_cell(x, y, k, width, height);
+  const size_t w = size_t(width);
+  const size_t corner[4] = {size_t(c.z) * w + size_t(c.x), size_t(c.z) * w + size_t(c.y),
+                            size_t(c.w) * w + size_t(c.x), size_t(c.w) * w + size_t(c.y)};
+  // Only the corners the fill blends: on a lattice row (column) that row's (column's) two.
+  const bool use[4] = {true, x != c.x, y != c.z, x != c.x && y != c.z};
+  glm::dvec3 lo = colour[corner[0]], hi = lo;
+  GapTest t;
+  for (int q = 1; q < 4; ++q) {
+    if (!use[q]) continue;
+    t.keys_differ = t.keys_differ || key[corner[q]] != key[corner[0]];
+    lo = glm::min(lo, colour[corner[q]]);
+    hi = glm::max(hi, colour[corner[q]]);
+  }
+  const glm::dvec3 spread = hi - lo;
+  t.spread = std::max({spread.x, spread.y, spread.z});
+  return t;
+}
+
+namespace {
+
+// The one of a and b of smaller magnitude, 0 where their signs differ (rellenarHuecos' limiter).
+double minmod(double a, double b) {
+  return a * b > 0.0 ? (std::fabs(a) < std::fabs(b) ? a : b) : 0.0;
+}
+// ... and 0 unless both are within the limit (kernels/undersample.h: gentle_bend).
+double gentle_bend(double a, double b, double limit) {
+  return std::max(std::fabs(a), std::fabs(b)) <= limit ? minmod(a, b) : 0.0;
+}
+
+}  // namespace
+
+glm::dvec3 undersample_fill(const std::vector<glm::dvec3>& colour, int x, int y, int k, int width,
+                            int height, double threshold) {
+  const glm::ivec4 q = lattice_cell(x, y, k, width, height);
+  auto at = [&](int px, int py) { return colour[size_t(py) * size_t(width) + size_t(px)]; };
+  const double tx = q.y > q.x ? double(x - q.x) / double(q.y - q.x) : 0.0;
+  const double ty = q.w > q.z ? double(y - q.z) / double(q.w - q.z) : 0.0;
+  // The correction along an axis needs the lattice pixels one step beyond the cell.
+  const bool along_x = q.x - k >= 0 && q.y + k <= width - 1 && q.y - q.x == k;
+  const bool along_y = q.z - k >= 0 && q.w + k <= height - 1 && q.w - q.z == k;
+  const double limit = threshold * 0.5;
+  auto bend = [limit](const glm::dvec3& o, const glm::dvec3& a, const glm::dvec3& b,
+                      const glm::dvec3& p, double t) {
+    glm::dvec3 r;
+    for (int ch = 0; ch < 3; ++ch)
+      r[ch] = t * (1.0 - t) * 0.5 *
+              gentle_bend(o[ch] - 2.0 * a[ch] + b[ch], a[ch] - 2.0 * b[ch] + p[ch], limit);
+    return r;
+  };
+  glm::dvec3 top = at(q.x, q.z) + (at(q.y, q.z) - at(q.x, q.z)) * tx;
+  glm::dvec3 bottom = at(q.x, q.w) + (at(q.y, q.w) - at(q.x, q.w)) * tx;
+  if (along_x) {
+    top -= bend(at(q.x - k, q.z), at(q.x, q.z), at(q.y, q.z), at(q.y + k, q.z), tx);
+    bottom -= bend(at(q.x - k, q.w), at(q.x, q.w), at(q.y, q.w), at(q.y + k, q.w), tx);
+  }
+  glm::dvec3 c = top + (bottom - top) * ty;
+  if (along_y) {
+    const glm::dvec3 left =
+        bend(at(q.x, q.z - k), at(q.x, q.z), at(q.x, q.w), at(q.x, q.w + k), ty);
+    const glm::dvec3 right =
+        bend(at(q.y, q.z - k), at(q.y, q.z), at(q.y, q.w), at(q.y, q.w + k), ty);
+    c -= left + (right - left) * tx;
+  }
+  return c;
+}
+
 }  // namespace host

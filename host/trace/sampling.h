@@ -36,4 +36,23 @@ uint32_t adaptive_rays(int spp, int samples);
 bool on_lattice(int x, int y, int k, int width, int height);
 glm::ivec4 lattice_cell(int x, int y, int k, int width, int height);  // x0, x1, y0, y1
 
+// What marcarHuecos looks at for pixel (x, y) off the lattice, from the lattice pixels' colours
+// and surface keys (row-major, width x height; only lattice pixels are read): the largest
+// spread, over the three channels, of the lattice pixels its fill blends, and whether their
+// keys differ. The pixel is traced when keys differ or spread > --aa-threshold.
+struct GapTest {
+  double spread = 0;
+  bool keys_differ = false;
+};
+GapTest undersample_gap_test(const std::vector<glm::dvec3>& colour, const std::vector<int>& key,
+                             int x, int y, int k, int width, int height);
+
+// rellenarHuecos' colour for pixel (x, y) off the lattice (kernels/undersample.h, in double):
+// the bilinear blend of its cell's lattice pixels, less the curvature correction along each axis
+// (t(1 - t)/2 of the minmod of the lattice's second differences at the cell's two ends, where
+// both are within threshold / 2 and the lattice pixels one step beyond the cell are in the
+// image). Only lattice pixels of `colour` are read.
+glm::dvec3 undersample_fill(const std::vector<glm::dvec3>& colour, int x, int y, int k, int width,
+                            int height, double threshold);
+
 }  // namespace host

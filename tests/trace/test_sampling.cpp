@@ -334,3 +334,53 @@ TEST_CASE(
     }
   }
 }
+
+TEST_CASE(
+    "the host's undersampling fill gives a quadratic shade back and a step the straight "
+    "blend, and its gap test reads only the corners the fill blends") {
+  // A 9x9 image; only lattice pixels (K = 2) are set, the others hold a value the fill must
+  // never read.
+  const int W = 9, H = 9, K = 2;
+  auto image = [&](auto f) {
+    std::vector<glm::dvec3> c(size_t(W * H), glm::dvec3(99.0));
+    for (int y = 0; y < H; ++y)
+      for (int x = 0; x < W; ++x)
+        if (host::on_lattice(x, y, K, W, H)) c[size_t(y * W + x)] = f(x, y);
+    return c;
+  };
+  // A gentle quadratic in x and y, per channel: the corrected blend is exact off the border
+  // cells (second differences 2 * 0.004 * K^2 = 0.032 <= T / 2).
+  const auto quad = image([](int x, int y) {
+    const double v = 0.2 + 0.004 * x * x + 0.004 * y * y;
+    return glm::dvec3(v, 0.5 * v, 0.25 * v);
+  });
+  for (const auto& [x, y] : {std::pair{3, 3}, {4, 3}, {3, 4}, {5, 5}}) {
+    const glm::dvec3 f = host::undersample_fill(quad, x, y, K, W, H, 0.1);
+    const double v = 0.2 + 0.004 * x * x + 0.004 * y * y;
+    CHECK(f.x == doctest::Approx(v).epsilon(1e-12));
+    CHECK(f.y == doctest::Approx(0.5 * v).epsilon(1e-12));
+    CHECK(f.z == doctest::Approx(0.25 * v).epsilon(1e-12));
+  }
+  // With the limit below the second difference, the straight (bilinear) blend.
+  const glm::dvec3 straight = host::undersample_fill(quad, 3, 3, K, W, H, 0.01);
+  const double mean = (quad[size_t(2 * W + 2)].x + quad[size_t(2 * W + 4)].x +
+                       quad[size_t(4 * W + 2)].x + quad[size_t(4 * W + 4)].x) /
+                      4;
+  CHECK(straight.x == doctest::Approx(mean).epsilon(1e-12));
+  // A step between x = 4 and x = 6: its second differences are large at both ends of the cell
+  // (4, 6), so the pixel between keeps the mean of the two.
+  const auto step = image([](int x, int) { return glm::dvec3(x >= 6 ? 1.0 : 0.0); });
+  CHECK(host::undersample_fill(step, 5, 4, K, W, H, 0.1).x == doctest::Approx(0.5));
+  // The gap test: pixel (5, 4) on lattice row 4 blends (4, 4) and (6, 4) alone.
+  std::vector<int> key(size_t(W * H), 0);
+  key[size_t(2 * W + 6)] = 7;  // a corner of its cell the blend does not use
+  host::GapTest t = host::undersample_gap_test(step, key, 5, 4, K, W, H);
+  CHECK_FALSE(t.keys_differ);
+  CHECK(t.spread == doctest::Approx(1.0));
+  t = host::undersample_gap_test(step, key, 5, 3, K, W, H);  // a centre: all four corners
+  CHECK(t.keys_differ);
+  CHECK(t.spread == doctest::Approx(1.0));
+  t = host::undersample_gap_test(quad, key, 4, 7, K, W, H);  // column 4, rows 6 and 8
+  CHECK_FALSE(t.keys_differ);
+  CHECK(t.spread == doctest::Approx(0.004 * (64 - 36)));
+}
