@@ -6,6 +6,7 @@ two-level grid, the BVH, the kd-tree and --accel auto on the bundled scenes and 
 Usage: /usr/bin/python3 scripts/structures.py [--vgpu-rt build/host/vgpu-rt] [--size 256]
                                               [--runs 3] [--h200 FILE ...]
                                               [--h200-looping FILE ...] [--h200-looping-again FILE ...]
+                                              [--h200-layout SQUARE MULTI_WIDE MULTI_SQUARE WIDE]
                                               [--h200-sizes FILE ...]
                                               [--reuse [--only ACCEL ...]]
 
@@ -67,6 +68,12 @@ def main():
                     help="bench_gl JSON of a second warmed run of the looping frames, with every "
                     "frame's time (docs/structures_h200_looping_warm2.json, RUNS=15): shown beside "
                     "the first, with the traversal kernels' GPU time against their modeled work")
+    ap.add_argument("--h200-layout", nargs=4, default=[], metavar="FILE",
+                    help="the texture-layout trial: looping frames with the structures' textures "
+                    "laid out square (docs/structures_h200_looping_square.json), then multipass "
+                    "frames with the old (wide) and the square layout in one run "
+                    "(docs/structures_h200_layout_multipass_{wide,square}.json), then the same "
+                    "looping frames wide (docs/structures_h200_looping_warm2.json)")
     ap.add_argument("--h200-sizes", nargs="*", default=[],
                     help="bench_gl JSON files of the same frames at several sizes "
                     "(docs/structures_h200_sizes_*.json)")
@@ -259,6 +266,48 @@ def traversal_ratios(files):
                 out.setdefault(g["accel"], []).append(
                     (g["scene"], k["gpu_ms"], m["predicted_h200_work_ms"], k["passes"]))
     return out
+
+
+def layout_trial(files):
+    """The structures' textures laid out square instead of one long row: the H200's GPU time of
+    the same frames, old layout against new."""
+    if not files:
+        return ""
+    square, multi_wide, multi_square, wide = files
+
+    def frames(f):
+        return {(g["scene"], g["accel"]): g for g in json.load(open(f))["frames"]
+                if g["engine"] == "gl-poll"}
+
+    def traversal(g):
+        return next(k["gpu_ms"] for k in g["kernels"] if "looping traversal" in k["name"])
+    sq, wd = frames(square), frames(wide)
+    loop = [traversal(sq[k]) / traversal(wd[k]) - 1 for k in sq if k in wd]
+    walls = [sq[k]["wall_ms"] / wd[k]["wall_ms"] - 1 for k in sq if k in wd]
+    mw, ms = frames(multi_wide), frames(multi_square)
+    multi = [ms[k]["gpu_ms"] / mw[k]["gpu_ms"] - 1 for k in ms if k in mw]
+    cells = [(sq[k], next(e for e in json.load(open(square))["frames"] if e["engine"] == "stream"
+                          and (e["scene"], e["accel"]) == k)["predicted_ms"]["h200"]) for k in sq]
+    out = [(g, p) for g, p in cells if abs(p / g["wall_ms"] - 1) > 0.35]
+    return ("\n\nTried: the structures' textures laid out square. Every structure's entry "
+            "texture (nodes, cells, sub-cells, lists) was one row as long as the profile allows "
+            "(the bunny's two-level grid: 96,334 sub-cells in a 32768 x 3 texture), which a "
+            "texture cache that keeps 2D tiles might serve badly. Laid out in the smallest "
+            "power-of-two width whose square holds them instead (`host/trace/passes.cpp`, "
+            "`entry_texture`; the kernels read the width from a uniform, so images and counts "
+            "are unchanged, and so are the predictions), the same looping frames "
+            "(`docs/structures_h200_looping_square.json`, a third device session) show each "
+            f"traversal kernel's GPU time within {100 * max(abs(x) for x in loop):.1f}% of the "
+            f"wide layout's, and {len(multi)} multipass frames measured with both layouts in one "
+            f"run within {100 * max(abs(x) for x in multi):.2f}%: the layout is not the grid2 "
+            "shortfall. The square layout is kept: it changes nothing on the H200, and a GL "
+            "driver whose textures stop at 16384 texels (llvmpipe) can now run the two-level "
+            "grid of the bunny, whose 32768-wide sub-cell texture it refused. The wall times of "
+            f"that third session moved by {100 * min(walls):+.0f}% to {100 * max(walls):+.0f}% "
+            "against the second's, with the GPU time unchanged; " + str(len(out)) + " of its "
+            f"{len(cells)} looping cells are outside 35% ("
+            + ", ".join(f"{g['scene']} / {g['accel']} {100 * (p / g['wall_ms'] - 1):+.0f}%"
+                        for g, p in out) + ").")
 
 
 def quartiles(v):
@@ -671,7 +720,7 @@ A first frame in a fresh process also pays the driver's compilation of every pro
 walk (99.5 ms multipass) where the warm frames below take a few ms (61 ms), so only warm frames
 are compared with the model, which has no compilation term.
 
-{h200_table(h200)}{looping_again(a.looping_first)}{looping_second(a)}
+{h200_table(h200)}{looping_again(a.looping_first)}{looping_second(a)}{layout_trial(a.h200_layout)}
 
 ## Which structure wins where, and why
 
