@@ -28,11 +28,13 @@ fs::path json_path() {
 
 }  // namespace
 
-TEST_CASE("the undersampling bounds put the floor at the fill's changes beyond a third of the "
-          "rays, and the rule's image is the CPU tracer's") {
+TEST_CASE(
+    "the undersampling bounds put the floor at the fill's changes beyond a third of the "
+    "rays, and the rule's image is the CPU tracer's") {
   const fs::path out = json_path();
   REQUIRE(run("--size 64 --scenes " VGPU_SCENES "/bunny-refl.gltf " VGPU_SCENES
-              "/sphere-alone.gltf --thresholds 0.1 0.02 --json " + out.string()) == 0);
+              "/sphere-alone.gltf --thresholds 0.1 0.02 --json " +
+              out.string()) == 0);
   std::ifstream f(out);
   const nlohmann::json j = nlohmann::json::parse(f);
   fs::remove(out);
