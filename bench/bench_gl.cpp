@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
@@ -167,11 +168,16 @@ double unix_s() {
 }
 
 FrameRun run_frames(const host::Scene& scene, const host::Accel& accel, const host::Camera& cam,
-                    host::RenderOptions opt, int runs, int warmup_ms) {
+                    host::RenderOptions opt, int runs, int warmup_ms,
+                    const std::string& dump_dir = "") {
   FrameRun fr;
   host::StreamTracer tracer(scene, accel, opt);
   fr.device = tracer.device().description();
   auto* gld = dynamic_cast<gl::GlDevice*>(&tracer.device());
+  if (gld && !dump_dir.empty()) {
+    std::filesystem::create_directories(dump_dir);
+    gld->dump_programs_to(dump_dir);
+  }
   for (int r = 0; r <= runs; ++r) {  // run 0 warms up (the GL device compiles its programs)
     if (r == 1 && gld && warmup_ms > 0) {
       // A GPU left idle (the emulator's frames before) lowers its clock; frames of this very
@@ -210,6 +216,7 @@ int main(int argc, char** argv) {
   std::vector<std::string> scenes = {"sphere-alone", "bunny", "bunny-mirror"};
   std::vector<int> sizes = {256};
   int runs = 3, micro_passes = 200, threads = 0, warmup_ms = 0;
+  std::string dump_programs;
   bool no_stream = false, no_frames = false;
   std::string wait_mode = "block";
   std::vector<std::string> variants = {"multipass"};
@@ -226,6 +233,9 @@ int main(int argc, char** argv) {
   app.add_option("--runs", runs, "Timed runs per figure (after one warm-up)")
       ->capture_default_str()
       ->check(CLI::Range(1, 100));
+  app.add_option("--dump-programs", dump_programs,
+                 "GL frames: write every program the driver links, GLSL and program binary "
+                 "(NVIDIA's holds its compiled assembly as text), under DIR/scene_accel_variant/");
   app.add_option("--warmup-ms", warmup_ms,
                  "GL frames: after the warm-up frame, run frames of the same configuration until "
                  "this many ms have passed before timing (a GPU idle before them has lowered its "
@@ -417,7 +427,11 @@ int main(int argc, char** argv) {
                     const bool gl = engine != "stream";
                     opt.device = gl ? "gl" : "vgpu";
                     opt.gl_readback = engine == "gl-poll" ? "poll" : "block";
-                    const FrameRun fr = run_frames(scene, accel, cam, opt, runs, warmup_ms);
+                    const std::string dump =
+                        dump_programs.empty()
+                            ? ""
+                            : dump_programs + "/" + scene.name + "_" + accel_name + "_" + variant;
+                    const FrameRun fr = run_frames(scene, accel, cam, opt, runs, warmup_ms, dump);
                     json f = {{"scene", scene.name},
                               {"accel", accel_name},
                               {"bounces", opt.bounces},

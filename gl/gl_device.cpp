@@ -1,8 +1,12 @@
 // The GL device's operations: texture objects, compiled programs, framebuffers, queries.
 #include "gl/gl_device.h"
 
+#include <algorithm>
+#include <cctype>
 #include <chrono>
+#include <cstdio>
 #include <cstring>
+#include <fstream>
 
 #include "gl/context.h"
 #include "gl/gl.h"
@@ -237,6 +241,8 @@ GlDevice::GlProgram& GlDevice::program_for(const vgpu::Program& p) {
       g->name = glCreateProgram();
       glAttachShader(g->name, vs);
       glAttachShader(g->name, fs);
+      if (!dump_dir_.empty())
+        glProgramParameteri(g->name, GL_PROGRAM_BINARY_RETRIEVABLE_HINT, GL_TRUE);
       glLinkProgram(g->name);
       glDeleteShader(vs);
       glDeleteShader(fs);
@@ -248,6 +254,7 @@ GlDevice::GlProgram& GlDevice::program_for(const vgpu::Program& p) {
         glDeleteProgram(g->name);
         throw Error("the GL driver could not link " + what + ": " + log);
       }
+      if (!dump_dir_.empty()) dump(g->name, p.name(), r.glsl.source);
       g->constants = glGetUniformLocation(g->name, "k");
       for (const std::string& s : r.glsl.samplers)
         g->samplers.push_back(glGetUniformLocation(g->name, s.c_str()));
@@ -256,6 +263,23 @@ GlDevice::GlProgram& GlDevice::program_for(const vgpu::Program& p) {
     r.gl = slot.get();
   }
   return *r.gl;
+}
+
+void GlDevice::dump(unsigned program, const std::string& name, const std::string& source) {
+  std::string file = name;
+  for (char& c : file)
+    if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+  char prefix[8];
+  std::snprintf(prefix, sizeof prefix, "%02d_", dumped_++);
+  const std::string base = dump_dir_ + "/" + prefix + file;
+  std::ofstream(base + ".glsl") << source;
+  GLint length = 0;
+  glGetProgramiv(program, GL_PROGRAM_BINARY_LENGTH, &length);
+  std::vector<char> binary(size_t(std::max(length, 0)));
+  GLenum format = 0;
+  GLsizei written = 0;
+  if (length > 0) glGetProgramBinary(program, length, &written, &format, binary.data());
+  std::ofstream(base + ".bin", std::ios::binary).write(binary.data(), written);
 }
 
 unsigned GlDevice::framebuffer_for(const std::vector<Texture*>& targets) {

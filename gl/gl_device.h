@@ -62,6 +62,10 @@ class GlDevice final : public vgpu::Device {
   // Host milliseconds spent waiting in end_query() since the device was made (a frame's share:
   // the difference of two readings).
   double readback_wait_ms() const { return wait_ms_; }
+  // From now on, write each program the driver links to `dir` (which must exist): its GLSL
+  // source (NN_name.glsl) and the driver's program binary (NN_name.bin, glGetProgramBinary:
+  // NVIDIA's holds the compiled assembly as text, instruction and register counts included).
+  void dump_programs_to(const std::string& dir) { dump_dir_ = dir; }
 
  private:
   struct GlTexture;
@@ -96,6 +100,9 @@ class GlDevice final : public vgpu::Device {
   std::vector<unsigned> free_samples_, free_times_;  // query objects, one pool per target
   vgpu::FrameStats stats_;
   vgpu::PassRecord last_pass_;
+  std::string dump_dir_;  // dump_programs_to; empty: no dumps
+  int dumped_ = 0;
+  void dump(unsigned program, const std::string& name, const std::string& source);
 };
 
 }  // namespace gl

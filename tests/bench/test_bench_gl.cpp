@@ -125,6 +125,9 @@ TEST_CASE("bench_gl runs GL frames until --warmup-ms has passed before it times 
       INFO(fr["engine"]);
       CHECK(fr["timed_to_s"].get<double>() >= fr["timed_from_s"].get<double>());
       CHECK(fr["timed_from_s"].get<double>() > 1.7e9);  // seconds since the Unix epoch
+      // Every timed frame's times, in order.
+      CHECK(fr["wall_runs_ms"].size() == 2);
+      if (fr["engine"] == "gl-poll") CHECK(fr["gpu_runs_ms"].size() == 2);
       if (fr["engine"] == "gl-poll" && warmup > 0) {
         CHECK(fr["warmup_frames"].get<int>() >= 1);
         CHECK(fr["warmup_ms"].get<double>() >= warmup);
@@ -134,4 +137,31 @@ TEST_CASE("bench_gl runs GL frames until --warmup-ms has passed before it times 
       }
     }
   }
+}
+
+TEST_CASE("bench_gl writes each program the GL driver links, as GLSL and as the driver's binary") {
+  const fs::path dir =
+      fs::temp_directory_path() / ("vgpu_bench_gl_dump_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  const Outcome o = bench(
+      "--readback-wait poll --no-fixed --no-stream --sizes 8 --runs 1 "
+      "--threads 1 --bounces 0 --variants looping --accel bvh "
+      "--scenes sphere-alone --dump-programs " +
+      dir.string());
+  REQUIRE(o.status == 0);
+  const fs::path frame = dir / "sphere-alone_bvh_looping";
+  REQUIRE(fs::is_directory(frame));
+  int glsl = 0, binaries = 0;
+  bool traversal = false;
+  for (const auto& e : fs::directory_iterator(frame)) {
+    CHECK(fs::file_size(e.path()) > 0);
+    glsl += e.path().extension() == ".glsl";
+    binaries += e.path().extension() == ".bin";
+    traversal = traversal ||
+                e.path().filename().string().find("bvh_looping_traversal") != std::string::npos;
+  }
+  CHECK(glsl >= 4);
+  CHECK(binaries == glsl);
+  CHECK(traversal);
+  fs::remove_all(dir);
 }
