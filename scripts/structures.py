@@ -7,7 +7,7 @@ Usage: /usr/bin/python3 scripts/structures.py [--vgpu-rt build/host/vgpu-rt] [--
                                               [--runs 3] [--h200 FILE ...]
                                               [--h200-looping FILE ...] [--h200-looping-again FILE ...]
                                               [--h200-layout SQUARE MULTI_WIDE MULTI_SQUARE WIDE]
-                                              [--h200-sizes FILE ...]
+                                              [--h200-programs DIR] [--h200-sizes FILE ...]
                                               [--reuse [--only ACCEL ...]]
 
 Per scene and structure, primary rays only (--bounces 0 --shadows off, as the issue's table) and
@@ -74,6 +74,10 @@ def main():
                     "frames with the old (wide) and the square layout in one run "
                     "(docs/structures_h200_layout_multipass_{wide,square}.json), then the same "
                     "looping frames wide (docs/structures_h200_looping_warm2.json)")
+    ap.add_argument("--h200-programs", metavar="DIR",
+                    help="NVIDIA's compiled assembly of the looping traversal kernels, from "
+                    "bench_gl --dump-programs on the H200 (docs/h200_programs/*.nvfp): their "
+                    "loop bodies beside the vgpu's counts")
     ap.add_argument("--h200-sizes", nargs="*", default=[],
                     help="bench_gl JSON files of the same frames at several sizes "
                     "(docs/structures_h200_sizes_*.json)")
@@ -308,6 +312,50 @@ def layout_trial(files):
             f"{len(cells)} looping cells are outside 35% ("
             + ", ".join(f"{g['scene']} / {g['accel']} {100 * (p / g['wall_ms'] - 1):+.0f}%"
                         for g, p in out) + ").")
+
+
+def compiled_bodies(a):
+    """The looping traversal kernels as NVIDIA's driver compiled them (bench_gl
+    --dump-programs): each loop body's assembly lines, divisions, fetches and IF blocks, beside
+    the scalar operations the vgpu counts for one iteration (loop_body_instructions)."""
+    if not a.h200_programs:
+        return ""
+    L = ["", "", "The same kernels as the H200's driver compiled them (`bench_gl --dump-programs`, "
+         "the program binary's NV_gpu_program5 assembly, in `docs/h200_programs/`; the "
+         "bunny's frames), one loop iteration: the driver turns each of the GLSL's selects "
+         "into an IF / ELSE block, and each division into a DIV.", "",
+         "| structure | assembly lines | DIV | TXF (fetches) | IF blocks | vgpu's scalar "
+         "operations | lines / operation | traversal GPU / modeled work (second run) |",
+         "|---|---:|---:|---:|---:|---:|---:|---|"]
+    seen = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        for acc in ("grid", "grid2", "bvh", "kdtree"):
+            path = os.path.join(a.h200_programs, f"{acc}_looping_traversal.nvfp")
+            if not os.path.exists(path):
+                continue
+            asm = open(path).read().split("\n")
+            body = asm[next(i for i, x in enumerate(asm) if x.startswith("REP")):
+                       next(i for i, x in enumerate(asm) if x.startswith("ENDREP")) + 1]
+            js = os.path.join(tmp, acc + ".json")
+            st = run(a.vgpu_rt, os.path.join(ROOT, "scenes", "bunny.gltf"),
+                     ["--accel", acc, "--kernels", "looping", "--profile", "h200",
+                      "--bounces", "0", "--shadows", "off", "--size", "64x64"], js)
+            ops = next(k["loop_body_instructions"] for k in st["kernels"]
+                       if "looping traversal" in k["name"])
+            count = lambda op: sum(x.startswith(op) for x in body)  # noqa: E731
+            ratios = sorted(g / m for _, g, m, _ in a.kernel_ratios.get(acc, []))
+            span = f"{ratios[0]:.2f}-{ratios[-1]:.2f}x" if ratios else "-"
+            seen[acc] = (len(body) / ops, count("DIV"))
+            L.append(f"| {acc} | {len(body)} | {count('DIV')} | {count('TXF')} | {count('IF')} | "
+                     f"{ops} | {len(body) / ops:.2f} | {span} |")
+    if "grid2" in seen and "bvh" in seen:
+        shortest = min(seen, key=lambda k: seen[k][0])
+        L += ["", f"Per scalar operation the vgpu counts, grid2's compiled body is "
+              f"{seen['grid2'][0]:.2f} assembly lines against {min(v[0] for v in seen.values()):.2f}-"
+              f"{max(v[0] for v in seen.values()):.2f} over the four (shortest: {shortest}), and "
+              f"its {seen['grid2'][1]} divisions against the BVH's {seen['bvh'][1]} are a few "
+              "percent of its lines: its code, as compiled, does not explain its GPU time either."]
+    return "\n".join(L)
 
 
 def quartiles(v):
@@ -720,7 +768,7 @@ A first frame in a fresh process also pays the driver's compilation of every pro
 walk (99.5 ms multipass) where the warm frames below take a few ms (61 ms), so only warm frames
 are compared with the model, which has no compilation term.
 
-{h200_table(h200)}{looping_again(a.looping_first)}{looping_second(a)}{layout_trial(a.h200_layout)}
+{h200_table(h200)}{looping_again(a.looping_first)}{looping_second(a)}{layout_trial(a.h200_layout)}{compiled_bodies(a)}
 
 ## Which structure wins where, and why
 

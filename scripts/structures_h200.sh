@@ -8,6 +8,8 @@
 #   OUT=DIR scripts/structures_h200.sh              (ACCELS="grid2" measures only those structures)
 #   OUT=DIR SIZES=1 scripts/structures_h200.sh      (the same frames at 8x8 to 512x512 instead:
 #                                                    what grows with the image, docs/structures.md)
+#   OUT=DIR PROGRAMS=1 scripts/structures_h200.sh   (the looping traversal kernels' compiled
+#                                   assembly: docs/h200_programs/*.nvfp, --h200-programs)
 #   OUT=DIR LOOPING=1 CLOCK_MS=100 scripts/structures_h200.sh   (the looping walks again, each
 #                                   warmed up WARMUP ms: docs/structures_h200_looping_warm.json,
 #                                   read by scripts/structures.py --h200-looping; RUNS=15 times
@@ -35,6 +37,20 @@ if [ -n "${SIZES:-}" ]; then
     --accel grid2 bvh --variants multipass --bounces 0 --micro-passes 10 \
     --scenes scenes/bunny.gltf scenes/classic.gltf scenes/teapot.gltf \
     --json "$out/structures_sizes_multipass.json"
+  exit 0
+fi
+if [ -n "${PROGRAMS:-}" ]; then
+  # The looping traversal kernels as the driver compiled them: bench_gl --dump-programs writes
+  # each program's binary, whose NV_gpu_program5 assembly is text (docs/h200_programs/*.nvfp,
+  # read by scripts/structures.py --h200-programs).
+  d=$(mktemp -d)
+  .h200/bench_gl --runs 1 --sizes 64 --readback-wait poll --grid auto --accel grid grid2 bvh \
+    kdtree --variants looping --bounces 0 --no-fixed --no-stream --scenes scenes/bunny.gltf \
+    --dump-programs "$d"
+  for a in grid grid2 bvh kdtree; do
+    f=$(ls "$d/bunny_${a}_looping/"*looping_traversal.bin)
+    strings -n 3 "$f" | sed -n '/^!!NVfp5.0/,/^END$/p' > "$out/${a}_looping_traversal.nvfp"
+  done
   exit 0
 fi
 if [ -n "${LOOPING:-}" ]; then
