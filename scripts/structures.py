@@ -7,7 +7,8 @@ Usage: /usr/bin/python3 scripts/structures.py [--vgpu-rt build/host/vgpu-rt] [--
                                               [--runs 3] [--h200 FILE ...]
                                               [--h200-looping FILE ...] [--h200-looping-again FILE ...]
                                               [--h200-layout SQUARE MULTI_WIDE MULTI_SQUARE WIDE]
-                                              [--h200-programs DIR] [--h200-sizes FILE ...]
+                                              [--h200-programs DIR] [--h200-precise ON OFF]
+                                              [--h200-sizes FILE ...]
                                               [--reuse [--only ACCEL ...]]
 
 Per scene and structure, primary rays only (--bounces 0 --shadows off, as the issue's table) and
@@ -25,7 +26,6 @@ renders only those rows again and keeps the others from OUT/structures.json (row
 one that grows with the image, and writes what it finds under "Left out".
 """
 import argparse
-import glob
 import json
 import os
 import re
@@ -36,6 +36,7 @@ import tempfile
 import textwrap
 
 import matplotlib
+import structures_trials as st
 import numpy as np
 
 matplotlib.use("Agg")
@@ -74,6 +75,10 @@ def main():
                     "frames with the old (wide) and the square layout in one run "
                     "(docs/structures_h200_layout_multipass_{wide,square}.json), then the same "
                     "looping frames wide (docs/structures_h200_looping_warm2.json)")
+    ap.add_argument("--h200-precise", nargs=2, default=[], metavar="FILE",
+                    help="the same looping frames with the GLSL's `precise` qualifiers, then "
+                    "with them removed (an experiment binary; docs/structures_h200_precise_"
+                    "{on,off}.json)")
     ap.add_argument("--h200-programs", metavar="DIR",
                     help="NVIDIA's compiled assembly of the looping traversal kernels, from "
                     "bench_gl --dump-programs on the H200 (docs/h200_programs/*.nvfp): their "
@@ -153,7 +158,8 @@ def main():
                       (w["scene"], w["accel"], w["mode"])), None)
         if first:
             a.looping_again.append((first, w))
-    a.kernel_ratios = traversal_ratios(a.h200_looping_again)
+    a.kernel_ratios = st.traversal_ratios(a.h200_looping_again)
+    a.run = run
     json.dump({"rows": rows, "h200": h200}, open(os.path.join(a.out, "structures.json"), "w"),
               indent=1)
     write_doc(a, rows, h200)
@@ -251,208 +257,6 @@ def gl_cells(files):
     return cells
 
 
-def traversal_ratios(files):
-    """Per structure, the looping traversal kernel's GPU time (timer queries) over its modeled
-    work (predicted_h200_work_ms, the pass's fetches and instructions without its fixed costs),
-    one ratio per scene."""
-    out = {}
-    for f in files:
-        frames = json.load(open(f))["frames"]
-        for g in frames:
-            if g["engine"] != "gl-poll" or g["variant"] != "looping":
-                continue
-            em = next(e for e in frames if e["engine"] == "stream" and
-                      all(e[k] == g[k] for k in ("scene", "accel", "variant", "bounces", "size")))
-            for k in g["kernels"]:
-                if "looping traversal" not in k["name"]:
-                    continue
-                m = next(e for e in em["kernels"] if e["name"] == k["name"])
-                out.setdefault(g["accel"], []).append(
-                    (g["scene"], k["gpu_ms"], m["predicted_h200_work_ms"], k["passes"]))
-    return out
-
-
-def layout_trial(files):
-    """The structures' textures laid out square instead of one long row: the H200's GPU time of
-    the same frames, old layout against new."""
-    if not files:
-        return ""
-    square, multi_wide, multi_square, wide = files
-
-    def frames(f):
-        return {(g["scene"], g["accel"]): g for g in json.load(open(f))["frames"]
-                if g["engine"] == "gl-poll"}
-
-    def traversal(g):
-        return next(k["gpu_ms"] for k in g["kernels"] if "looping traversal" in k["name"])
-    sq, wd = frames(square), frames(wide)
-    loop = [traversal(sq[k]) / traversal(wd[k]) - 1 for k in sq if k in wd]
-    walls = [sq[k]["wall_ms"] / wd[k]["wall_ms"] - 1 for k in sq if k in wd]
-    mw, ms = frames(multi_wide), frames(multi_square)
-    multi = [ms[k]["gpu_ms"] / mw[k]["gpu_ms"] - 1 for k in ms if k in mw]
-    cells = [(sq[k], next(e for e in json.load(open(square))["frames"] if e["engine"] == "stream"
-                          and (e["scene"], e["accel"]) == k)["predicted_ms"]["h200"]) for k in sq]
-    out = [(g, p) for g, p in cells if abs(p / g["wall_ms"] - 1) > 0.35]
-    return ("\n\nTried: the structures' textures laid out square. Every structure's entry "
-            "texture (nodes, cells, sub-cells, lists) was one row as long as the profile allows "
-            "(the bunny's two-level grid: 96,334 sub-cells in a 32768 x 3 texture), which a "
-            "texture cache that keeps 2D tiles might serve badly. Laid out in the smallest "
-            "power-of-two width whose square holds them instead (`host/trace/passes.cpp`, "
-            "`entry_texture`; the kernels read the width from a uniform, so images and counts "
-            "are unchanged, and so are the predictions), the same looping frames "
-            "(`docs/structures_h200_looping_square.json`, a third device session) show each "
-            f"traversal kernel's GPU time within {100 * max(abs(x) for x in loop):.1f}% of the "
-            f"wide layout's, and {len(multi)} multipass frames measured with both layouts in one "
-            f"run within {100 * max(abs(x) for x in multi):.2f}%: the layout is not the grid2 "
-            "shortfall. The square layout is kept: it changes nothing on the H200, and a GL "
-            "driver whose textures stop at 16384 texels (llvmpipe) can now run the two-level "
-            "grid of the bunny, whose 32768-wide sub-cell texture it refused. The wall times of "
-            f"that third session moved by {100 * min(walls):+.0f}% to {100 * max(walls):+.0f}% "
-            "against the second's, with the GPU time unchanged; " + str(len(out)) + " of its "
-            f"{len(cells)} looping cells are outside 35% ("
-            + ", ".join(f"{g['scene']} / {g['accel']} {100 * (p / g['wall_ms'] - 1):+.0f}%"
-                        for g, p in out) + ").")
-
-
-def compiled_bodies(a):
-    """The looping traversal kernels as NVIDIA's driver compiled them (bench_gl
-    --dump-programs): each loop body's assembly lines, divisions, fetches and IF blocks, beside
-    the scalar operations the vgpu counts for one iteration (loop_body_instructions)."""
-    if not a.h200_programs:
-        return ""
-    L = ["", "", "The same kernels as the H200's driver compiled them (`bench_gl --dump-programs`, "
-         "the program binary's NV_gpu_program5 assembly, in `docs/h200_programs/`; the "
-         "bunny's frames), one loop iteration: the driver turns each of the GLSL's selects "
-         "into an IF / ELSE block, and each division into a DIV.", "",
-         "| structure | assembly lines | DIV | TXF (fetches) | IF blocks | vgpu's scalar "
-         "operations | lines / operation | traversal GPU / modeled work (second run) |",
-         "|---|---:|---:|---:|---:|---:|---:|---|"]
-    seen = {}
-    with tempfile.TemporaryDirectory() as tmp:
-        for acc in ("grid", "grid2", "bvh", "kdtree"):
-            path = os.path.join(a.h200_programs, f"{acc}_looping_traversal.nvfp")
-            if not os.path.exists(path):
-                continue
-            asm = open(path).read().split("\n")
-            body = asm[next(i for i, x in enumerate(asm) if x.startswith("REP")):
-                       next(i for i, x in enumerate(asm) if x.startswith("ENDREP")) + 1]
-            js = os.path.join(tmp, acc + ".json")
-            st = run(a.vgpu_rt, os.path.join(ROOT, "scenes", "bunny.gltf"),
-                     ["--accel", acc, "--kernels", "looping", "--profile", "h200",
-                      "--bounces", "0", "--shadows", "off", "--size", "64x64"], js)
-            ops = next(k["loop_body_instructions"] for k in st["kernels"]
-                       if "looping traversal" in k["name"])
-            count = lambda op: sum(x.startswith(op) for x in body)  # noqa: E731
-            ratios = sorted(g / m for _, g, m, _ in a.kernel_ratios.get(acc, []))
-            span = f"{ratios[0]:.2f}-{ratios[-1]:.2f}x" if ratios else "-"
-            seen[acc] = (len(body) / ops, count("DIV"))
-            L.append(f"| {acc} | {len(body)} | {count('DIV')} | {count('TXF')} | {count('IF')} | "
-                     f"{ops} | {len(body) / ops:.2f} | {span} |")
-    if "grid2" in seen and "bvh" in seen:
-        shortest = min(seen, key=lambda k: seen[k][0])
-        L += ["", f"Per scalar operation the vgpu counts, grid2's compiled body is "
-              f"{seen['grid2'][0]:.2f} assembly lines against {min(v[0] for v in seen.values()):.2f}-"
-              f"{max(v[0] for v in seen.values()):.2f} over the four (shortest: {shortest}), and "
-              f"its {seen['grid2'][1]} divisions against the BVH's {seen['bvh'][1]} are a few "
-              "percent of its lines: its code, as compiled, does not explain its GPU time either."]
-    return "\n".join(L)
-
-
-def quartiles(v):
-    v = sorted(v)
-    return v[len(v) // 4], v[(3 * len(v)) // 4]
-
-
-def looping_second(a):
-    """The second warmed run of the looping frames (15 frames each) beside the first, and the
-    traversal kernels' GPU time against their modeled work."""
-    pairs = a.looping_again
-    if not pairs:
-        return ""
-    within = sum(abs(w["predicted_ms"] / w["wall_ms"] - 1) <= 0.35 for _, w in pairs)
-    first_within = sum(abs(r["predicted_ms"] / r["wall_ms"] - 1) <= 0.35 for r, _ in pairs)
-    runs = len(pairs[0][1]["wall_runs_ms"])
-    mv = max(pairs, key=lambda p: abs(p[1]["wall_ms"] / p[0]["wall_ms"] - 1))
-    L = ["", "", f"A second warmed run (`LOOPING=1 RUNS={runs} scripts/structures_h200.sh`, "
-         "`docs/structures_h200_looping_warm2.json`, another device session) timed "
-         f"{runs} frames of each configuration instead of 5, and keeps every frame's time: within "
-         "a configuration the frames agree closely (the quartiles below), but between the two "
-         f"runs the same frame moved by up to {100 * abs(mv[1]['wall_ms'] / mv[0]['wall_ms'] - 1):.0f}% "
-         f"({mv[1]['scene']} / {mv[1]['accel']}: wall {mv[0]['wall_ms']:.2f} to "
-         f"{mv[1]['wall_ms']:.2f} ms, GPU {mv[0]['gpu_ms']:.2f} to {mv[1]['gpu_ms']:.2f} ms: the "
-         "move is outside the GPU's timer queries, on the host). "
-         f"{within} of its {len(pairs)} looping cells are within 35% (the first "
-         f"warmed run: {first_within}).", "",
-         "| scene | structure | first warmed wall ms | vs | second: wall ms | quartiles | GPU ms | "
-         "predicted ms | vs |", "|---|---|---:|---:|---:|---|---:|---:|---:|"]
-    for r, w in pairs:
-        q1, q3 = quartiles(w["wall_runs_ms"])
-        L.append(f"| {w['scene']} | {w['accel']} | {fmt_ms(r['wall_ms'])} | "
-                 f"{100 * (r['predicted_ms'] / r['wall_ms'] - 1):+.0f}% | "
-                 f"{fmt_ms(w['wall_ms'])} | {q1:.2f}-{q3:.2f} | {fmt_ms(w['gpu_ms'])} | "
-                 f"{fmt_ms(w['predicted_ms'])} | "
-                 f"{100 * (w['predicted_ms'] / w['wall_ms'] - 1):+.0f}% |")
-    if a.kernel_ratios:
-        L += ["", "Where the two-level grid's shortfall sits: each structure's looping traversal "
-              "kernel alone, its GPU time (timer queries) over the work the model prices for it "
-              "(the pass's fetches, instructions and idle lanes, without the pass's fixed costs), "
-              "over the seven scenes of the second run:", "",
-              "| structure | GPU / modeled work, lowest | median | highest | scene of the highest |",
-              "|---|---:|---:|---:|---|"]
-        for acc in ("grid", "grid2", "bvh", "kdtree"):
-            v = a.kernel_ratios.get(acc)
-            if not v:
-                continue
-            rs = sorted((g / m, sc) for sc, g, m, _ in v)
-            L.append(f"| {acc} | {rs[0][0]:.2f} | {statistics.median(x for x, _ in rs):.2f} | "
-                     f"{rs[-1][0]:.2f} | {rs[-1][1]} |")
-    return "\n".join(L)
-
-
-def slower_sentence(pairs):
-    """Which looping frames came out slower warmed up than in the first runs: their spread."""
-    up = [(w["wall_ms"] / r["wall_ms"] - 1, w) for r, w in pairs if w["wall_ms"] > r["wall_ms"]]
-    if not up:
-        return ""
-    most = max(e for e, _ in up)
-    return ("Frames of a few ms are noisy: warmed up, where most got faster, " +
-            ", ".join(f"{w['scene']}'s {w['accel']}" for _, w in up) +
-            f" came out up to {100 * most:.0f}% slower than in the first runs (the table above). ")
-
-
-def grid2_again(a):
-    """The second warmed run's grid2 cells and the traversal kernels' ratios, for Left out."""
-    g = [w for _, w in a.looping_again if w["accel"] == "grid2"]
-    if not g:
-        return ""
-    out = [w for w in g if abs(w["predicted_ms"] / w["wall_ms"] - 1) > 0.35]
-    text = (f" In the second warmed run (15 frames each) {len(out)} of {len(g)} are outside 35% ("
-            + (", ".join(f"{w['scene']} {100 * (w['predicted_ms'] / w['wall_ms'] - 1):+.0f}%"
-                         for w in out) or "none") + ").")
-    kr = a.kernel_ratios
-    pp = sorted(gm * 1000 / n for _, gm, _, n in kr.get("grid2", []))
-    per_pass = f"{pp[0]:.0f}-{pp[-1]:.0f} us on the GPU" if pp else "longer"
-    if kr.get("grid2") and kr.get("bvh"):
-        r2 = sorted(gm / m for _, gm, m, _ in kr["grid2"])
-        rb = sorted(gm / m for _, gm, m, _ in kr["bvh"])
-        rk = sorted(gm / m for _, gm, m, _ in kr.get("kdtree", []))
-        text += (f" Its traversal kernel alone takes {r2[0]:.2f}-{r2[-1]:.2f}x the GPU time the "
-                 f"model prices for its work, where the BVH's takes {rb[0]:.2f}-{rb[-1]:.2f}x"
-                 + (f" and the kd-tree's {rk[0]:.2f}-{rk[-1]:.2f}x" if rk else "") +
-                 " (the table under \"A second warmed run\"): the shortfall is in that kernel's "
-                 "GPU time (the ratio is highest on scales for every structure). It is not the "
-                 "longest lane's latency: a pass runs at most 32 iterations, and even at 300 "
-                 "clocks (0.15 us) for each of the body's 9 fetches, one after another, a lane "
-                 "takes about 45 us, where grid2's passes take " + per_pass + ". So it is "
-                 "throughput the model misprices: grid2's fetches cost more than the texture "
-                 "unit's texels and bytes per clock say. On scales, where the ratio is highest, "
-                 "its textures total 58 MB, more than the H200's 50 MB L2 (the other structures' "
-                 "24-29 MB), so cache misses are a suspect there; on the bundled scenes its "
-                 "textures are within 1 MB of the others' (14-16 MB, mostly the image-sized "
-                 "ones), and the cause is still open. No model term for it has been built.")
-    return text
-
-
 def grid2_loop(h200, pairs):
     """The two-level grid's looping cells against the model, for Left out."""
     g = [r for r in h200 if r["accel"] == "grid2" and r["mode"] == "looping"]
@@ -463,7 +267,7 @@ def grid2_loop(h200, pairs):
     return (f"its H200 frames (warmed up) are predicted {-e[-1]:.0f}-{-e[0]:.0f}% below their "
             f"wall time, the most of any structure's looping frames; {len(out)} of {len(g)} outside 35% ("
             + (", ".join(f"{r['scene']}, {fmt_ms(r['wall_ms'])} ms" for r in out) or "none") +
-            "). " + slower_sentence(pairs) + "The model is not "
+            "). " + st.slower_sentence(pairs) + "The model is not "
             "recalibrated for it. Its GPU time (timer queries) is above its modeled pass work, as "
             "the kd-tree's is: a nested DDA's dependent fetches, which the model prices by "
             "throughput only, are the suspect.")
@@ -768,7 +572,7 @@ A first frame in a fresh process also pays the driver's compilation of every pro
 walk (99.5 ms multipass) where the warm frames below take a few ms (61 ms), so only warm frames
 are compared with the model, which has no compilation term.
 
-{h200_table(h200)}{looping_again(a.looping_first)}{looping_second(a)}{layout_trial(a.h200_layout)}{compiled_bodies(a)}
+{h200_table(h200)}{looping_again(a.looping_first)}{st.looping_second(a)}{st.layout_trial(a.h200_layout)}{st.compiled_bodies(a)}{st.precise_trial(a.h200_precise)}
 
 ## Which structure wins where, and why
 
@@ -813,7 +617,7 @@ two-level grid has 96,334 sub-cells: fp16 and fp24 traversal groups both refuse 
 
 ## Left out
 
-- The cost model for the two-level grid's looping kernel: {grid2_loop(h200, a.looping_first)}{grid2_again(a)}
+- The cost model for the two-level grid's looping kernel: {grid2_loop(h200, a.looping_first)}{st.grid2_again(a)}
 {frame_cost(a.h200, a.h200_sizes)}- kd-backtrack and the short stack of Horn et al.: kd-restart (with push-down in the looping
   kernel) is the only kd walk.
 - Front-to-back BVH order: it needs a stack or parent links with a direction flag.
