@@ -149,10 +149,10 @@ def bounds_section(exe, work, size):
         v = sorted(b[key] for b in by[scene])
         return f"{100 * v[0]:.2f}-{100 * v[-1]:.2f}%"
     budget = rows[0]["budget"]
-    L = [f"## How far any choice of traced gaps can go", "",
-         f"The fill of a gap reads lattice pixels only, so one render of every pixel tells, for "
-         f"each gap, whether the fill would change it (by more than 1/255): and so, for any "
-         f"choice of gaps to trace, how many pixels change. `bench/bench_undersample_bounds` "
+    L = ["## How far any choice of traced gaps can go", "",
+         "The fill of a gap reads lattice pixels only, so one render of every pixel tells, for "
+         "each gap, whether the fill would change it (by more than 1/255): and so, for any "
+         "choice of gaps to trace, how many pixels change. `bench/bench_undersample_bounds` "
          f"does this on the CPU tracer's images at {j['size']}x{j['size']}, K = {j['k']} "
          f"(its rule's images equal the tracer's own `--aa undersample:2`, which it checks). A "
          f"third of the rays leaves {pct(budget)} of the pixels to gaps after the lattice. If "
