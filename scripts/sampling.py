@@ -462,12 +462,23 @@ def main():
             ax.scatter(r["gf6600"] / 1000, r["rms"], marker=markers[kind],
                        s=60 if i in front else 30, color=colours[kind],
                        edgecolors="black" if i in front else "none")
-            ax.annotate(r["mode"], (r["gf6600"] / 1000, r["rms"]), fontsize=6,
-                        xytext=(3, 3), textcoords="offset points")
         fr = sorted((pts[i][0] / 1000, pts[i][1]) for i in front)
         ax.plot([p[0] for p in fr], [p[1] for p in fr], "k--", lw=0.8, label="Pareto front")
         ax.set_xscale("log")
         ax.set_yscale("log")
+        ax.autoscale_view()
+        # Labels from the top down, each moved down past the labels already placed near it (in
+        # points on the page), so that clustered modes stay readable.
+        placed = []
+        for r in sorted(rs, key=lambda r: -r["rms"]):
+            x, y = ax.transData.transform((r["gf6600"] / 1000, r["rms"])) * 72 / fig.dpi
+            dy = 3
+            while any(abs(y + dy - py) < 7 and abs(x - px) < 75 for px, py in placed):
+                dy -= 7
+            placed.append((x, y + dy))
+            ax.annotate(r["mode"], (r["gf6600"] / 1000, r["rms"]), fontsize=6,
+                        xytext=(3, dy), textcoords="offset points",
+                        arrowprops=None if dy == 3 else dict(arrowstyle="-", lw=0.3, color="0.5"))
         ax.set_title(f"{scene}, {args.size}x{args.size}")
         ax.set_xlabel("predicted gf6600 time (s)")
         ax.grid(True, which="both", lw=0.3)
