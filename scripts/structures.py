@@ -8,6 +8,7 @@ Usage: /usr/bin/python3 scripts/structures.py [--vgpu-rt build/host/vgpu-rt] [--
                                               [--h200-looping FILE ...] [--h200-looping-again FILE ...]
                                               [--h200-layout SQUARE MULTI_WIDE MULTI_SQUARE WIDE]
                                               [--h200-programs DIR] [--h200-precise ON OFF]
+                                              [--h200-ablation FULL STEP TEST]
                                               [--h200-sizes FILE ...]
                                               [--reuse [--only ACCEL ...]]
 
@@ -79,6 +80,10 @@ def main():
                     help="the same looping frames with the GLSL's `precise` qualifiers, then "
                     "with them removed (an experiment binary; docs/structures_h200_precise_"
                     "{on,off}.json)")
+    ap.add_argument("--h200-ablation", nargs=3, default=[], metavar="FILE",
+                    help="grid2's looping frames whole, with the step alone and with the "
+                    "triangle test alone (experiment binaries; "
+                    "docs/structures_h200_grid2_ablation_{full,step,test}.json)")
     ap.add_argument("--h200-programs", metavar="DIR",
                     help="NVIDIA's compiled assembly of the looping traversal kernels, from "
                     "bench_gl --dump-programs on the H200 (docs/h200_programs/*.nvfp): their "
@@ -572,7 +577,7 @@ A first frame in a fresh process also pays the driver's compilation of every pro
 walk (99.5 ms multipass) where the warm frames below take a few ms (61 ms), so only warm frames
 are compared with the model, which has no compilation term.
 
-{h200_table(h200)}{looping_again(a.looping_first)}{st.looping_second(a)}{st.layout_trial(a.h200_layout)}{st.compiled_bodies(a)}{st.precise_trial(a.h200_precise)}
+{h200_table(h200)}{looping_again(a.looping_first)}{st.looping_second(a)}{st.layout_trial(a.h200_layout)}{st.compiled_bodies(a)}{st.precise_trial(a.h200_precise)}{st.ablation_trial(a.h200_ablation)}
 
 ## Which structure wins where, and why
 

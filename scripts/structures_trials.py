@@ -238,3 +238,47 @@ def grid2_again(a):
                  "textures are within 1 MB of the others' (14-16 MB, mostly the image-sized "
                  "ones), and the cause is still open. No model term for it has been built.")
     return text
+
+
+def ablation_trial(files):
+    """grid2's looping traversal with half its body taken out (experiment binaries: the step
+    alone, no triangle test; the triangle test alone, no step), each kernel's GPU time against
+    the work the model prices for it, and the frame's modeled arithmetic and texture demand."""
+    if not files:
+        return ""
+    L = ["", "", "Tried: grid2's loop body in halves. Two experiment binaries (not kept; their "
+         "images are wrong) ran the same looping frames with the triangle test taken out of the "
+         "loop (the step alone: the nested DDA, climbing to the coarse cell and descending into "
+         "the next) and with the step taken out (the triangle test alone: rays stay in their "
+         "sub-cell until the pass cap), `docs/structures_h200_grid2_ablation_{full,step,test}"
+         ".json`, one run:", "",
+         "| body | scene | passes | traversal GPU ms | modeled work ms | GPU / modeled | frame's "
+         "modeled arithmetic / texture demand ms |", "|---|---|---:|---:|---:|---:|---|"]
+    ratio = {}
+    for label, f in zip(("whole", "step alone", "triangle test alone"), files):
+        frames = json.load(open(f))["frames"]
+        for g in frames:
+            if g["engine"] != "gl-poll":
+                continue
+            e = next(x for x in frames if x["engine"] == "stream" and x["scene"] == g["scene"])
+            k = next(x for x in g["kernels"] if "looping traversal" in x["name"])
+            m = next(x for x in e["kernels"] if "looping traversal" in x["name"])
+            p = e["predicted_h200"]
+            r = k["gpu_ms"] / m["predicted_h200_work_ms"]
+            ratio.setdefault(label, []).append(r)
+            L.append(f"| {label} | {g['scene']} | {k['passes']:,} | {fmt_ms(k['gpu_ms'])} | "
+                     f"{fmt_ms(m['predicted_h200_work_ms'])} | {r:.2f} | "
+                     f"{fmt_ms(p['arithmetic_demand_ms'])} / {fmt_ms(p['texture_demand_ms'])} |")
+    st, te = ratio.get("step alone", []), ratio.get("triangle test alone", [])
+    if st and te:
+        L += ["", f"The shortfall is the step's: alone it runs {min(st):.2f}-{max(st):.2f}x its "
+              f"modeled work, where the triangle test alone runs {min(te):.2f}-{max(te):.2f}x. "
+              "The model takes a pass's work as the largest of its arithmetic, texture and "
+              "memory demands, as if they overlapped fully. The step's arithmetic computes the "
+              "next fetch's address from the last fetch's texel (coarse cell, sub-grid, list), "
+              "so its arithmetic and its fetches follow one another, and on these frames its "
+              "GPU time comes near the sum of the two demands. A triangle test's fetches and "
+              "arithmetic overlap, and it comes in under the texture demand alone. A model term "
+              "for how much of a body's arithmetic waits on its own fetches is what the "
+              "two-level grid needs; it has not been built."]
+    return "\n".join(L)
