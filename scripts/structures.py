@@ -273,9 +273,7 @@ def grid2_loop(h200, pairs):
             f"wall time, the most of any structure's looping frames; {len(out)} of {len(g)} outside 35% ("
             + (", ".join(f"{r['scene']}, {fmt_ms(r['wall_ms'])} ms" for r in out) or "none") +
             "). " + st.slower_sentence(pairs) + "The model is not "
-            "recalibrated for it. Its GPU time (timer queries) is above its modeled pass work, as "
-            "the kd-tree's is: a nested DDA's dependent fetches, which the model prices by "
-            "throughput only, are the suspect.")
+            "recalibrated for it.")
 
 
 def looping_again(pairs):

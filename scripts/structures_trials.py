@@ -231,12 +231,13 @@ def grid2_again(a):
                  "longest lane's latency: a pass runs at most 32 iterations, and even at 300 "
                  "clocks (0.15 us) for each of the body's 9 fetches, one after another, a lane "
                  "takes about 45 us, where grid2's passes take " + per_pass + ". So it is "
-                 "throughput the model misprices: grid2's fetches cost more than the texture "
-                 "unit's texels and bytes per clock say. On scales, where the ratio is highest, "
-                 "its textures total 58 MB, more than the H200's 50 MB L2 (the other structures' "
-                 "24-29 MB), so cache misses are a suspect there; on the bundled scenes its "
-                 "textures are within 1 MB of the others' (14-16 MB, mostly the image-sized "
-                 "ones), and the cause is still open. No model term for it has been built.")
+                 "throughput the model misprices. The trials under \"Measured on an H200\" "
+                 "rule out the texture layout, the compiled code's length and exact "
+                 "arithmetic, and locate it in the step (grid2's loop body in halves): its "
+                 "arithmetic waits on its fetches, where the model lets the two overlap. On "
+                 "scales, where the ratio is highest, its textures also total 58 MB, more than "
+                 "the H200's 50 MB L2 (the other structures' 24-29 MB). No model term for it "
+                 "has been built.")
     return text
 
 
