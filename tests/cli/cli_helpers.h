@@ -16,6 +16,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <initializer_list>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
@@ -173,6 +174,31 @@ inline Comparison compare(const fs::path& a, const fs::path& b, double threshold
   CHECK(std::sscanf(o.out.c_str(), "%dx%d, %d channels: %lf%%", &c.width, &c.height, &c.channels,
                     &c.differing_percent) == 4);
   return c;
+}
+
+// Renders `common` once per --update mode into dir: hit and depth AOVs per frame
+// (MODE_hit_#.exr, MODE_depth_#.exr) and the statistics (MODE.json).
+inline void render_update_modes(const std::string& common, const fs::path& dir,
+                                std::initializer_list<const char*> modes) {
+  for (const char* mode : modes) {
+    const std::string m(mode);
+    const Outcome o =
+        run(common + " --update " + m + " --aov hit=" + (dir / (m + "_hit_#.exr")).string() +
+            " --aov depth=" + (dir / (m + "_depth_#.exr")).string() + " --stats-json " +
+            (dir / (m + ".json")).string());
+    INFO(m << ": " << o.err);
+    REQUIRE(o.status == 0);
+  }
+}
+
+// Frame n's hit ids and depths of --update mode `b` equal mode `a`'s, pixel for pixel.
+inline void check_same_hits(const fs::path& dir, const std::string& a, const std::string& b,
+                            int n) {
+  const std::string f = std::to_string(n);
+  CHECK(compare(dir / (a + "_hit_" + f + ".exr"), dir / (b + "_hit_" + f + ".exr"), 0)
+            .differing_percent == 0);
+  CHECK(compare(dir / (a + "_depth_" + f + ".exr"), dir / (b + "_depth_" + f + ".exr"), 0)
+            .differing_percent == 0);
 }
 
 }  // namespace clitest

@@ -178,29 +178,14 @@ TEST_CASE("a refitted BVH gives the rebuilt BVH's hit ids and depths on every fr
   fs::remove_all(dir);
   fs::create_directories(dir);
   const std::string common = "render hop --accel bvh --frames 0:2:5 --size 48x40 -q --stats none";
-  for (const char* mode : {"rebuild", "refit", "auto"}) {
-    const std::string m(mode);
-    const Outcome o =
-        run(common + " --update " + m + " --aov hit=" + (dir / (m + "_hit_#.exr")).string() +
-            " --aov depth=" + (dir / (m + "_depth_#.exr")).string() + " --stats-json " +
-            (dir / (m + ".json")).string());
-    INFO(m << ": " << o.err);
-    REQUIRE(o.status == 0);
-  }
+  render_update_modes(common, dir, {"rebuild", "refit", "auto"});
   const nlohmann::json refit = nlohmann::json::parse(slurp(dir / "refit.json"));
   const nlohmann::json rebuild = nlohmann::json::parse(slurp(dir / "rebuild.json"));
   CHECK(refit["update"] == "refit");
   REQUIRE(refit["frames"].size() == 5);
   for (int f = 1; f <= 5; ++f) {
     CAPTURE(f);
-    const std::string n = std::to_string(f);
-    for (const char* mode : {"refit", "auto"}) {
-      const std::string m(mode);
-      CHECK(compare(dir / ("rebuild_hit_" + n + ".exr"), dir / (m + "_hit_" + n + ".exr"), 0)
-                .differing_percent == 0);
-      CHECK(compare(dir / ("rebuild_depth_" + n + ".exr"), dir / (m + "_depth_" + n + ".exr"), 0)
-                .differing_percent == 0);
-    }
+    for (const char* mode : {"refit", "auto"}) check_same_hits(dir, "rebuild", mode, f);
     const nlohmann::json& u = refit["frames"][size_t(f - 1)]["update"];
     CHECK(u["mode"] == (f == 1 ? "initial" : "refit"));
     // A refit keeps the topology: the same node count as the first frame's build.
@@ -302,15 +287,7 @@ TEST_CASE("the scatter scene's refitted BVH hits what a rebuild hits while its S
   REQUIRE(std::system(("python3 " + script + " " + dir.string() + " >/dev/null").c_str()) == 0);
   const std::string common = "render " + (dir / "scatter.gltf").string() +
                              " --accel bvh --frames 0:0.5:3 --size 16x12 -q --stats none";
-  for (const char* mode : {"rebuild", "refit"}) {
-    const std::string m(mode);
-    const Outcome o =
-        run(common + " --update " + m + " --aov hit=" + (dir / (m + "_hit_#.exr")).string() +
-            " --aov depth=" + (dir / (m + "_depth_#.exr")).string() + " --stats-json " +
-            (dir / (m + ".json")).string());
-    INFO(m << ": " << o.err);
-    REQUIRE(o.status == 0);
-  }
+  render_update_modes(common, dir, {"rebuild", "refit"});
   const nlohmann::json refit = nlohmann::json::parse(slurp(dir / "refit.json"));
   const nlohmann::json rebuild = nlohmann::json::parse(slurp(dir / "rebuild.json"));
   REQUIRE(refit["frames"].size() == 3);
@@ -318,11 +295,7 @@ TEST_CASE("the scatter scene's refitted BVH hits what a rebuild hits while its S
   std::vector<double> ratio;
   for (int f = 1; f <= 3; ++f) {
     CAPTURE(f);
-    const std::string n = std::to_string(f);
-    CHECK(compare(dir / ("rebuild_hit_" + n + ".exr"), dir / ("refit_hit_" + n + ".exr"), 0)
-              .differing_percent == 0);
-    CHECK(compare(dir / ("rebuild_depth_" + n + ".exr"), dir / ("refit_depth_" + n + ".exr"), 0)
-              .differing_percent == 0);
+    check_same_hits(dir, "rebuild", "refit", f);
     ratio.push_back(refit["frames"][size_t(f - 1)]["accel"]["sah_cost"].get<double>() /
                     rebuild["frames"][size_t(f - 1)]["accel"]["sah_cost"].get<double>());
   }
