@@ -56,27 +56,43 @@ struct Bound {
   bool rule_matches_tracer = false;        // the rule's image is render_cpu's undersample:2 (1e-5)
 };
 
-Bound bound(const std::string& name, const host::Scene& scene, const host::Grid& grid,
-            const host::Camera& camera, int size, double threshold) {
-  host::RenderOptions opt;
-  opt.width = opt.height = size;
-  opt.profile = "gf6600";
+// The one-ray render every threshold's figures start from: its colours, surface keys (the
+// material hit, -1 for none) and pixels per triangle hit.
+struct FullRender {
+  std::vector<glm::dvec3> colour;
+  std::vector<int> key;
+  double pixels_per_triangle = 0;
+};
+
+FullRender full_render(const host::Scene& scene, const host::Grid& grid, const host::Camera& camera,
+                       const host::RenderOptions& opt) {
   const host::RenderResult full = host::render_cpu(scene, grid, camera, opt);
-  const int W = size, H = size;
-  const size_t n = size_t(W) * size_t(H);
-  std::vector<glm::dvec3> colour(n);
-  std::vector<int> key(n);
+  const size_t n = size_t(opt.width) * size_t(opt.height);
+  FullRender r;
+  r.colour.resize(n);
+  r.key.resize(n);
   std::set<int> triangles;
   size_t hits = 0;
   for (size_t i = 0; i < n; ++i) {
-    colour[i] = {full.rgb[i * 3], full.rgb[i * 3 + 1], full.rgb[i * 3 + 2]};
+    r.colour[i] = {full.rgb[i * 3], full.rgb[i * 3 + 1], full.rgb[i * 3 + 2]};
     const int tri = int(full.hit_id[i]);
-    key[i] = tri < 0 ? -1 : int(scene.material[size_t(tri)]);
+    r.key[i] = tri < 0 ? -1 : int(scene.material[size_t(tri)]);
     if (tri >= 0) {
       triangles.insert(tri);
       ++hits;
     }
   }
+  r.pixels_per_triangle = triangles.empty() ? 0 : double(hits) / double(triangles.size());
+  return r;
+}
+
+Bound bound(const std::string& name, const host::Scene& scene, const host::Grid& grid,
+            const host::Camera& camera, const host::RenderOptions& opt, const FullRender& full,
+            double threshold) {
+  const int W = opt.width, H = opt.height;
+  const size_t n = size_t(W) * size_t(H);
+  const std::vector<glm::dvec3>& colour = full.colour;
+  const std::vector<int>& key = full.key;
   struct Gap {
     host::GapTest test;
     bool changed;
@@ -99,7 +115,7 @@ Bound bound(const std::string& name, const host::Scene& scene, const host::Grid&
   Bound b;
   b.scene = name;
   b.threshold = threshold;
-  b.pixels_per_triangle = triangles.empty() ? 0 : double(hits) / double(triangles.size());
+  b.pixels_per_triangle = full.pixels_per_triangle;
   const long third = long(n / 3);
   const long budget = third - long(lattice);
   b.lattice = double(lattice) / double(n);
@@ -178,9 +194,13 @@ int main(int argc, char** argv) {
     const host::Grid grid =
         host::build_grid(scene, host::grid_spec_for(host::GridSpec{}, scene, gf6600));
     const host::Camera camera = host::scene_camera(scene, 1.0f);
+    host::RenderOptions opt;
+    opt.width = opt.height = size;
+    opt.profile = gf6600.name;
+    const FullRender full = full_render(scene, grid, camera, opt);
     for (const double t : thresholds) {
       std::fprintf(stderr, "bench_undersample_bounds: %s, T %g\n", name.c_str(), t);
-      rows.push_back(bound(name, scene, grid, camera, size, t));
+      rows.push_back(bound(name, scene, grid, camera, opt, full, t));
     }
   }
   std::printf("%dx%d, K = %d; shares of the pixels; changed: by more than 1/255 (8-bit)\n", size,
