@@ -33,6 +33,15 @@ struct Outcome {
   std::string out, err;  // everything written on stdout, on stderr
 };
 
+// An empty folder of this process under the system's temporary one: vgpu_cli_TAG_PID.
+inline fs::path fresh_dir(const std::string& tag) {
+  const fs::path dir =
+      fs::temp_directory_path() / ("vgpu_cli_" + tag + "_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
 inline std::string slurp(const fs::path& path) {
   std::ifstream f(path, std::ios::binary);
   std::stringstream ss;

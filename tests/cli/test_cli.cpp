@@ -190,10 +190,7 @@ TEST_CASE("a looping render on a profile without loops or past its loop limit na
 }
 
 TEST_CASE("a render writes the image, the AOVs and the statistics asked for, and nothing else") {
-  const fs::path dir =
-      fs::temp_directory_path() / ("vgpu_cli_render_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const fs::path dir = fresh_dir("render");
   const std::string common = "render sphere --size 48x40 -q --stats none";
   const Outcome o = run(common + " --out " + (dir / "image.png").string() + " --aov depth=" +
                         (dir / "depth.exr").string() + " --aov hit=" + (dir / "hit.exr").string() +
@@ -470,9 +467,7 @@ TEST_CASE("a textured glb renders through the CLI, its JSON naming the textures 
 }
 
 TEST_CASE("--accel bvh renders and its statistics name the structure and the hierarchy") {
-  const fs::path dir = fs::temp_directory_path() / ("vgpu_cli_bvh_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const fs::path dir = fresh_dir("bvh");
   for (const char* accel : {"bvh", "grid"}) {
     CAPTURE(accel);
     const Outcome o =

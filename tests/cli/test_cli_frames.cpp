@@ -102,10 +102,7 @@ TEST_CASE("an unknown animation, a skinned mesh and morph-target weights are ref
 }
 
 TEST_CASE("a multi-frame render writes numbered files and one statistics record per frame") {
-  const fs::path dir =
-      fs::temp_directory_path() / ("vgpu_cli_frames_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const fs::path dir = fresh_dir("frames");
   const std::string size = " --size 40x32 --stats none";
   const Outcome o =
       run("render hop --frames 0:2:3" + size + " --out " + (dir / "frame_###.png").string() +
@@ -174,9 +171,7 @@ TEST_CASE("a multi-frame render writes numbered files and one statistics record 
 }
 
 TEST_CASE("a refitted BVH gives the rebuilt BVH's hit ids and depths on every frame of hop") {
-  const fs::path dir = fs::temp_directory_path() / ("vgpu_cli_refit_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const fs::path dir = fresh_dir("refit");
   const std::string common = "render hop --accel bvh --frames 0:2:5 --size 48x40 -q --stats none";
   render_update_modes(common, dir, {"rebuild", "refit", "auto"});
   const nlohmann::json refit = nlohmann::json::parse(slurp(dir / "refit.json"));
@@ -196,10 +191,7 @@ TEST_CASE("a refitted BVH gives the rebuilt BVH's hit ids and depths on every fr
 }
 
 TEST_CASE("--report-frame puts frame K of a refitted sequence in the report and the pass CSV") {
-  const fs::path dir =
-      fs::temp_directory_path() / ("vgpu_cli_report_frame_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const fs::path dir = fresh_dir("report_frame");
   const Outcome o =
       run("render hop --accel bvh --update refit --frames 0:2:4 --size 32x24 -q "
           "--stats none --report " +
@@ -279,10 +271,7 @@ TEST_CASE("the frame table lists each frame's update, its passes and the nodes i
 TEST_CASE("the scatter scene's refitted BVH hits what a rebuild hits while its SAH cost grows") {
   // scripts/scatter_scene.py writes the larger animation of docs/animation.md: ten full bunnies
   // that start inside one another and hop apart.
-  const fs::path dir =
-      fs::temp_directory_path() / ("vgpu_cli_scatter_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const fs::path dir = fresh_dir("scatter");
   const std::string script = std::string(VGPU_TEST_DATA) + "/../../scripts/scatter_scene.py";
   REQUIRE(std::system(("python3 " + script + " " + dir.string() + " >/dev/null").c_str()) == 0);
   const std::string common = "render " + (dir / "scatter.gltf").string() +
@@ -307,10 +296,7 @@ TEST_CASE("the scatter scene's refitted BVH hits what a rebuild hits while its S
 }
 
 TEST_CASE("a static scene at any time renders as it is, and a render without a time is unchanged") {
-  const fs::path dir =
-      fs::temp_directory_path() / ("vgpu_cli_static_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const fs::path dir = fresh_dir("static");
   const std::string common = "render classic --size 32x24 -q --stats none";
   REQUIRE(run(common + " --out " + (dir / "plain.png").string() + " --stats-json " +
               (dir / "plain.json").string())
