@@ -119,6 +119,9 @@ void add_loop_counters(Counters& c, const Program::Analysis& a, const Texture* c
   c.loop_batch_iterations = n.batch_iterations;
   c.loop_idle_instructions = c.loop_lanes_idle * body;
   c.loop_idle_fetches = c.loop_lanes_idle * fetches;
+  c.loop_span_iterations = n.most;
+  c.loop_span_fetches = n.most * uint64_t(lp.chain_fetches);
+  c.loop_span_operations = n.most * uint64_t(lp.chain_operations);
 }
 
 void count_program_load(FrameStats& stats, const Program& program, const Profile& profile) {

@@ -100,6 +100,7 @@ Counters pass_counters(const Program::Analysis& a, const Texture* const* units,
 // body's instructions, fetches and bytes once per active iteration, the loop counters set.
 struct LoopCounts {
   uint64_t shaded = 0, iterations = 0, slots = 0, batch_iterations = 0;
+  uint64_t most = 0;  // the most iterations one shaded fragment ran
 };
 void add_loop_counters(Counters& c, const Program::Analysis& a, const Texture* const* units,
                        const LoopCounts& n);

@@ -45,6 +45,10 @@ struct LoopTally {
   int body_instructions = 0;   // static instructions of the bodies, once each
   FetchTally body_fetches;     // fetches per iteration of the bodies, per unit
   bool branch_inside = false;  // an f.branch() inside a body (not supported)
+  // The longest chain of dependent operations through one iteration (vgpu/span.h): its fetches
+  // and its other operations. Filled by Program::analyze from the recording.
+  int chain_fetches = 0;
+  int chain_operations = 0;
 };
 
 // Transposes between texels (4 channels each, contiguous) and registers (one per channel), for

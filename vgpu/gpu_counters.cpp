@@ -132,6 +132,7 @@ LoopCounts loop_batches(const Rect& r, const uint32_t* iters, uint32_t tw, const
       n.shaded += lanes;
       n.slots += lanes * most;
       n.batch_iterations += most;
+      n.most = std::max(n.most, uint64_t(most));
       uint64_t out = exactly[0];  // fragments out of the loop before iteration j + 1
       for (uint32_t j = 0; j < most; ++j) {
         active[j] += lanes - out;

@@ -3,6 +3,8 @@
 
 #include <atomic>
 
+#include "vgpu/span.h"
+
 namespace vgpu {
 
 Program::Program() {
@@ -21,6 +23,11 @@ Program::Analysis Program::analyze() const {
   run(f);
   a.instructions = int(OpCounter::ops - before);
   a.branches = int(idle);  // the counting run's branch() counts each call as one idle lane
+  if (a.loop.loops > 0) {  // the body's longest wait, from the recorded program (vgpu/span.h)
+    const LoopChain chain = loop_chain(record());
+    a.loop.chain_fetches = chain.fetches;
+    a.loop.chain_operations = chain.operations;
+  }
   return a;
 }
 

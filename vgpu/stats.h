@@ -54,6 +54,13 @@ struct Counters {
   // iteration a fragment was active in).
   uint64_t loop_idle_instructions = 0;
   uint64_t loop_idle_fetches = 0;
+  // The pass's longest lane: per pass, the most iterations one shaded fragment ran, summed over
+  // passes; and that many iterations of the body's longest chain of dependent operations
+  // (Program::Analysis::loop: its fetches and its other operations), what one lane waits for
+  // however many lanes run beside it (the cost model's latency term).
+  uint64_t loop_span_iterations = 0;
+  uint64_t loop_span_fetches = 0;
+  uint64_t loop_span_operations = 0;
 
   Counters& operator+=(const Counters& o);
   // Every integer counter equal (host_ms excluded).
@@ -87,7 +94,10 @@ inline constexpr std::pair<const char*, uint64_t Counters::*> kCounterFields[] =
     {"loop_lanes_idle", &Counters::loop_lanes_idle},
     {"loop_batch_iterations", &Counters::loop_batch_iterations},
     {"loop_idle_instructions", &Counters::loop_idle_instructions},
-    {"loop_idle_fetches", &Counters::loop_idle_fetches}};
+    {"loop_idle_fetches", &Counters::loop_idle_fetches},
+    {"loop_span_iterations", &Counters::loop_span_iterations},
+    {"loop_span_fetches", &Counters::loop_span_fetches},
+    {"loop_span_operations", &Counters::loop_span_operations}};
 
 // The counters as a JSON object: every field of kCounterFields, then host_ms, then device_ms
 // (null unless the device measured it).

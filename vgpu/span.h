@@ -1,0 +1,30 @@
+// The longest wait of one lane through one iteration of a program's loop: what a lane costs
+// however many lanes run beside it (the span of the pass, in the work-span sense: a pass takes
+// at least its work over the processors and at least its longest lane; a greedy scheduler
+// finishes within the sum, Brent 1974). The cost model adds it to a looping pass's work.
+//
+// One iteration of the recorded loop body (Recording::loops, the first copy) is issued in the
+// order the functor performed it, one operation per time unit, on one lane: an operation
+// issues one unit after the one before, or when its operands are ready if later; an
+// arithmetic result is ready one unit after it issues, a fetched texel `fetch_units` units
+// after. The iteration ends when its last result is ready. Operands from before the loop, or
+// carried from the previous iteration, are ready when it starts. The answer is split into the
+// fetch waits and the operation units the schedule's end is made of, so that a profile prices
+// it with its own latencies: fetches x fetch latency + operations x operation latency.
+#pragma once
+
+#include "vgpu/record.h"
+
+namespace vgpu {
+
+struct LoopChain {
+  int fetches = 0;     // fetch latencies the iteration's end waits through
+  int operations = 0;  // operation units (issue and arithmetic latency) it waits through
+};
+
+// The loop of `r` (its first recorded copy); zeros without a loop. fetch_units: how many
+// operation units a fetch's latency lasts in the schedule (the split depends on it only where
+// two paths come close; the H200's measured ratio is about 100, docs/structures.md).
+LoopChain loop_chain(const Recording& r, int fetch_units = 100);
+
+}  // namespace vgpu
