@@ -56,6 +56,10 @@ struct Profile {
   // pixels: it iterates until its last pixel leaves the loop.
   int max_loop_iterations = 0;
   double loop_overhead_clocks = 0;  // clocks a pixel spends on one iteration's loop/break
+  // Latencies of one lane, for a looping pass's longest lane (vgpu/span.h; 0: not modelled):
+  // clocks from a fetch's issue to its texel, and per operation of a dependent chain.
+  double fetch_latency_clocks = 0;
+  double operation_latency_clocks = 0;
 
   // Arithmetic throughput at format f, relative to alu_per_clock (the fp16 rate).
   double rate(Format f) const {

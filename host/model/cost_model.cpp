@@ -26,6 +26,7 @@ std::vector<std::pair<std::string, double>> CostBreakdown::items() const {
           {"wasted_ms", wasted_ms},
           {"loop_idle_ms", loop_idle_ms},
           {"loop_overhead_ms", loop_overhead_ms},
+          {"latency_ms", latency_ms},
           {"total_ms", total_ms},
           {"arithmetic_demand_ms", arithmetic_demand_ms},
           {"texture_demand_ms", texture_demand_ms},
@@ -85,6 +86,14 @@ void add_passes(const vgpu::Counters& c, double n, const vgpu::Profile& hw, cons
   if (hw.output_bytes_per_clock > 0)
     mem_s = std::max(mem_s, double(c.bytes_written) / n / (hw.output_bytes_per_clock * hz));
   const double work_s = std::max({arith_s, tex_s, mem_s});
+  // A looping pass lasts at least as long as its longest lane: that lane's iterations of the
+  // body's longest chain of dependent operations (vgpu/span.h). The work of the other lanes is
+  // spread over the pipelines, so the pass takes about the sum (a greedy schedule's bound:
+  // work over processors plus the span).
+  const double span_s = (double(c.loop_span_fetches) * hw.fetch_latency_clocks +
+                         double(c.loop_span_operations) * hw.operation_latency_clocks) /
+                        n / hz;
+  out.latency_ms += span_s * 1e3 * n;
 
   const double ms = 1e3 * n;
   out.arithmetic_demand_ms += arith_s * ms;
@@ -154,8 +163,8 @@ CostBreakdown predict(const vgpu::FrameStats& stats, const vgpu::Profile& hw, co
   if (hw.download_gbps > 0)
     b.download_ms = 1e-3 * hw.download_us * double(stats.downloads) +
                     1e3 * double(stats.download_bytes) / (hw.download_gbps * 1e9);
-  b.total_ms = b.arithmetic_ms + b.texture_ms + b.memory_ms + b.per_pass_ms + b.program_load_ms +
-               b.readback_ms + b.download_ms;
+  b.total_ms = b.arithmetic_ms + b.texture_ms + b.memory_ms + b.latency_ms + b.per_pass_ms +
+               b.program_load_ms + b.readback_ms + b.download_ms;
   return b;
 }
 
@@ -188,6 +197,12 @@ std::string describe(const CostBreakdown& c, const vgpu::Profile& profile) {
                   "  looping passes: lanes out of the loop while their batch iterates %.1f ms "
                   "(%.0f%%), loop overhead %.1f ms (%.0f%%)\n",
                   c.loop_idle_ms, pct(c.loop_idle_ms), c.loop_overhead_ms, pct(c.loop_overhead_ms));
+    out += buf;
+  }
+  if (c.latency_ms > 0) {
+    std::snprintf(buf, sizeof buf,
+                  "  latency    each looping pass's longest lane %.1f ms (%.0f%%)\n", c.latency_ms,
+                  pct(c.latency_ms));
     out += buf;
   }
   return out;

@@ -2,7 +2,7 @@
 // statistics (vgpu::FrameStats) and the profile's hardware figures (vgpu::Profile). It explains
 // the paper's Table 1; docs/table1.md lists every parameter with its source or marks it fitted.
 //
-// Per pass:  time = max(arithmetic, texture, memory) + pass_us
+// Per pass:  time = max(arithmetic, texture, memory) + latency + pass_us
 //   arithmetic = ALU instructions / (pipelines x clock x alu_per_clock x precision rate), each
 //                at the rate of the precision it ran at (Counters::alu_fp24 / alu_fp16,
 //                Profile::rate: NV3x fp16 full speed, fp32 and fp24 half)
@@ -13,6 +13,11 @@
 // Looping passes add, per lane slot of a batch still iterating (Counters::loop_lane_slots),
 // the body's instructions and fetches for lanes already out (ALU and texture time, no bytes)
 // and Profile::loop_overhead_clocks of the pipeline.
+//   latency    = a looping pass's longest lane: the most iterations one fragment ran times the
+//                body's longest chain of dependent operations (vgpu/span.h), each fetch in it
+//                at Profile::fetch_latency_clocks, each operation at operation_latency_clocks
+//                (0 where the profile does not model them). Work over the pipelines plus the
+//                longest lane: the bound a greedy schedule keeps (Brent 1974).
 // Per frame:  + program loads (bytes over the bus + program_load_us each)
 //             + query read-backs (readback_us each: a pipeline drain and a CPU round trip)
 //             + texture downloads (download_us each + bytes / download_gbps, where modelled)
@@ -57,7 +62,8 @@ CostParams defaults_for(const vgpu::Profile& profile);
 
 // Predicted frame time, ms, by where it goes. The first three are the pass work attributed to
 // each pass's bottleneck (the larger of the three demands), so that
-//   total = arithmetic + texture + memory + per_pass + program_load + readback.
+//   total = arithmetic + texture + memory + latency + per_pass + program_load + readback
+//           + download.
 // wasted_ms is part of that pass work: the share spent on idle fragments, whose ray is finished
 // or has nothing to do in the pass (no triangle left in its voxel while other rays test theirs):
 // the fragments an early-z mask (--masks on) would skip.
@@ -75,6 +81,7 @@ struct CostBreakdown {
   // their batch iterates; of the arithmetic, the loop/break overhead (Profile).
   double loop_idle_ms = 0;
   double loop_overhead_ms = 0;
+  double latency_ms = 0;  // looping passes' longest lanes (not part of the three above)
   double total_ms = 0;
   // Each unit's whole demand, overlapped or not (how close the other bottlenecks are).
   double arithmetic_demand_ms = 0, texture_demand_ms = 0, memory_demand_ms = 0;

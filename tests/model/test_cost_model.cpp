@@ -287,3 +287,24 @@ TEST_CASE("A looping pass pays for its idle lane slots and its loop overhead") {
   CHECK(b.wasted_ms == doctest::Approx(0.110));
   CHECK(b.arithmetic_ms == doctest::Approx(0.340));
 }
+
+TEST_CASE("A looping pass adds its longest lane's fetch and operation latencies to its work") {
+  vgpu::Profile hw = card();
+  vgpu::Counters k = kernel_passes(1, 0);
+  // The longest lane ran 10 iterations of a body whose longest chain waits through 2 fetches
+  // and 30 operation units: 20 fetch latencies and 300 operation units in all.
+  k.loop_span_iterations = 10;
+  k.loop_span_fetches = 20;
+  k.loop_span_operations = 300;
+  const host::CostBreakdown without = host::predict(frame(k), hw, params());
+  CHECK(without.latency_ms == 0.0);  // a profile that does not model latencies
+  hw.fetch_latency_clocks = 400;
+  hw.operation_latency_clocks = 5;
+  const host::CostBreakdown b = host::predict(frame(k), hw, params());
+  // (20 x 400 + 300 x 5) clocks at 1e8 Hz = 95 us, on top of the pass's work.
+  CHECK(b.latency_ms == doctest::Approx(0.095));
+  CHECK(b.total_ms == doctest::Approx(without.total_ms + 0.095));
+  CHECK(b.arithmetic_ms == doctest::Approx(without.arithmetic_ms));
+  CHECK(b.texture_ms == doctest::Approx(without.texture_ms));
+  CHECK(b.memory_ms == doctest::Approx(without.memory_ms));
+}
