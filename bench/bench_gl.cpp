@@ -15,6 +15,7 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <random>
 #include <regex>
 #include <sstream>
 
@@ -82,6 +83,52 @@ struct CopyTwice {
   }
 };
 
+// Latency probes (--latency): one fragment follows a chain of dependent operations in a loop,
+// so the GPU time per iteration is how long one operation waits for the one before, not how
+// many the units can start. FetchChase: each texel holds the coordinates of the next texel to
+// fetch (one random cycle through the texture). AluChain: 16 dependent multiply-adds an
+// iteration (MUL then ADD: the GLSL's `precise` keeps them apart, as the vgpu counts them).
+struct FetchChase {
+  static constexpr const char* name = "fetch chase";
+  static constexpr const char* paper_name = "-";
+  static constexpr int outputs = 1;
+  static constexpr std::array<const char*, 1> units{"links"};
+  int steps = 256;
+  template <class L>
+  void operator()(vgpu::Fragments<L>& f) const {
+    using F = typename L::F;
+    using M = typename L::M;
+    vgpu::Vec4<F> at = f.fetch_own(0);
+    f.loop(steps, at.w >= F(0.0f), [&](const M& act) {
+      at = vgpu::select(act, f.fetch(0, at.x, at.y), at);
+      return act;
+    });
+    f.out(0) = at;
+  }
+};
+struct AluChain {
+  static constexpr const char* name = "arithmetic chain";
+  static constexpr const char* paper_name = "-";
+  static constexpr int outputs = 1;
+  static constexpr std::array<const char*, 1> units{"seed"};
+  static constexpr int kChain = 16;  // multiply-adds per iteration
+  int steps = 256;
+  template <class L>
+  void operator()(vgpu::Fragments<L>& f) const {
+    using F = typename L::F;
+    using M = typename L::M;
+    const vgpu::Vec4<F> s = f.fetch_own(0);  // x, a = 1, b = 0, w = 1: the texture decides
+    F x = s.x;
+    f.loop(steps, s.w >= F(0.0f), [&](const M& act) {
+      F y = x;
+      for (int i = 0; i < kChain; ++i) y = y * s.y + s.z;
+      x = vgpu::select(act, y, x);
+      return act;
+    });
+    f.out(0) = {x, s.y, s.z, s.w};
+  }
+};
+
 // The cost model's parameters for a profile. The h200 runs the GLSL the recorder prints, which
 // has no branches (every f.branch() block runs, under a select): no batch skips a branch body.
 host::CostParams params_for(const vgpu::Profile& p) {
@@ -127,6 +174,88 @@ Fixed time_passes(gl::GlDevice& d, int size, int n, int runs, bool readback, con
     gpu.push_back(1e3 * d.stats().totals.device_ms / n);
   }
   return {median(wall), median(gpu)};
+}
+
+// GPU time of one pass of p over a 1x1 target reading `source`, median of `runs` after
+// `warmup_ms` of the same pass (a GPU that sat idle runs at a lower clock).
+double time_one_fragment(gl::GlDevice& d, const vgpu::Program& p, const vgpu::Texture& source,
+                         int runs, int warmup_ms) {
+  vgpu::Texture target = d.make_texture("latency target", 1, 1, 4);
+  d.upload(target);
+  std::vector<double> gpu;
+  const auto t0 = Clock::now();
+  for (int r = 0; r < runs || ms_since(t0) < warmup_ms; ++r) {
+    d.finish();
+    d.stats().clear();
+    d.use_program(p);
+    d.unbind_textures();
+    d.bind_texture(0, source);
+    d.set_targets({&target});
+    d.draw();
+    d.finish();
+    gpu.push_back(1e3 * d.stats().totals.device_ms);
+  }
+  return median({gpu.end() - std::min<ptrdiff_t>(runs, ptrdiff_t(gpu.size())), gpu.end()});
+}
+
+// The latency probes: per chain, GPU time per iteration from two loop lengths (the difference
+// removes the pass's fixed cost), in ns and in clocks of the h200 profile's boost clock.
+nlohmann::ordered_json measure_latencies(gl::GlDevice& d, int runs, int warmup_ms) {
+  nlohmann::ordered_json rows = nlohmann::ordered_json::array();
+  const int short_steps = 1024, long_steps = 8192;
+  const double mhz = vgpu::profile("h200").core_mhz;
+  auto report = [&](const std::string& what, int texels, const vgpu::Program& a,
+                    const vgpu::Program& b, const vgpu::Texture& t, int ops) {
+    const vgpu::LoopTally chain = a.analyze().loop;  // what the model's span counts of it
+    const double ta = time_one_fragment(d, a, t, runs, warmup_ms);
+    const double tb = time_one_fragment(d, b, t, runs, warmup_ms);
+    const double ns = 1e3 * (tb - ta) / (long_steps - short_steps);
+    std::printf(
+        "  %-34s %9d texels  %5d steps %9.1f us  %5d steps %9.1f us  => %7.1f ns, "
+        "%6.0f clocks an iteration\n",
+        what.c_str(), texels, short_steps, ta, long_steps, tb, ns, ns * mhz * 1e-3);
+    std::fflush(stdout);
+    rows.push_back({{"what", what},
+                    {"texels", texels},
+                    {"bytes", uint64_t(texels) * 16},
+                    {"ops_per_iteration", ops},
+                    {"chain_fetches", chain.chain_fetches},
+                    {"chain_operations", chain.chain_operations},
+                    {"short_steps", short_steps},
+                    {"short_us", ta},
+                    {"long_steps", long_steps},
+                    {"long_us", tb},
+                    {"ns_per_iteration", ns},
+                    {"clocks_per_iteration_at_boost", ns * mhz * 1e-3}});
+  };
+  std::printf("latency probes (one fragment, GPU timer queries, medians of %d passes):\n", runs);
+  for (int side : {16, 512, 2048}) {
+    // One random cycle through every texel: texel i holds the coordinates of texel perm[i + 1].
+    vgpu::Texture links = d.make_texture("links", side, side, 4);
+    std::vector<int> perm(size_t(side) * side);
+    for (size_t i = 0; i < perm.size(); ++i) perm[i] = int(i);
+    std::mt19937 rng(12345);
+    std::shuffle(perm.begin() + 1, perm.end(), rng);  // texel 0 (the fragment's own) starts
+    std::vector<float> data(perm.size() * 4);
+    for (size_t i = 0; i < perm.size(); ++i) {
+      const int next = perm[(i + 1) % perm.size()];
+      const size_t at = size_t(perm[i]) * 4;
+      data[at] = float(next % side) + 0.5f;
+      data[at + 1] = float(next / side) + 0.5f;
+      data[at + 2] = 0.0f;
+      data[at + 3] = 1.0f;
+    }
+    links.replace(data);
+    d.upload(links);
+    vgpu::KernelProgram<FetchChase> a(FetchChase{short_steps}), b(FetchChase{long_steps});
+    report("dependent fetch (RGBA32F)", side * side, a, b, links, 1);
+  }
+  vgpu::Texture seed = d.make_texture("seed", 1, 1, 4);
+  seed.fill(std::array<float, 4>{0.5f, 1.0f, 0.0f, 1.0f});
+  d.upload(seed);
+  vgpu::KernelProgram<AluChain> a(AluChain{short_steps}), b(AluChain{long_steps});
+  report("16 dependent multiply-adds", 1, a, b, seed, 2 * AluChain::kChain);
+  return rows;
 }
 
 // A sampling mode of --sampling: spp:N (N rays per pixel, the accumulation frames),
@@ -223,7 +352,7 @@ int main(int argc, char** argv) {
   std::vector<std::string> accels = {"grid"};
   int bounces = 2;
   std::vector<std::string> ray_streams = {"off"}, sampling = {"spp:1"};
-  bool shadows = false, no_fixed = false;
+  bool shadows = false, no_fixed = false, latency = false;
   app.add_option("--gl-device", device, "auto, or an EGL device index")->capture_default_str();
   app.add_option("--scenes", scenes, "Scene names or .gltf paths")->capture_default_str();
   app.add_option("--sizes", sizes, "Image sizes (square)")
@@ -293,11 +422,21 @@ int main(int argc, char** argv) {
   app.add_flag("--shadows", shadows, "Shadow rays in the frames (off: Table 1's setting)");
   app.add_flag("--no-fixed", no_fixed, "Skip the fixed-cost passes (frames only)");
   app.add_flag("--no-frames", no_frames, "Only the fixed costs");
+  app.add_flag("--latency", latency,
+               "Also measure latencies: one fragment following a chain of dependent texel "
+               "fetches (RGBA32F textures of 16x16, 512x512 and 2048x2048 texels) and of "
+               "dependent multiply-adds, GPU time per iteration (needs a GL device)");
   app.add_option("--json", json_path, "Also write every figure as JSON to this file");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {  // --help exits 0; a bad option 2, as vgpu-rt does
     return app.exit(e) == 0 ? 0 : 2;
+  }
+  if (latency && wait_mode == "none") {
+    std::fprintf(stderr,
+                 "bench_gl: --latency needs a GL device (--readback-wait block, poll or "
+                 "both)\n");
+    return 2;
   }
 
   try {
@@ -378,6 +517,10 @@ int main(int argc, char** argv) {
           out["pass_us"].get<double>(), out["readback_us"].get<double>(),
           out["program_switch_us"].get<double>());
       out["fixed"] = fixed;
+    }
+    if (latency) {
+      gl::GlDevice d(vgpu::profile("h200"), device, gl::GlDevice::ReadbackWait::poll);
+      out["latency"] = measure_latencies(d, runs, std::max(warmup_ms, 200));
     }
     std::vector<std::string> engines;
     if (wait_mode == "block" || wait_mode == "both") engines.push_back("gl");
@@ -473,6 +616,7 @@ int main(int argc, char** argv) {
                         const host::CostBreakdown b = host::predict(one, hp, params_for(hp));
                         k["predicted_h200_ms"] = b.total_ms;
                         k["predicted_h200_work_ms"] = b.arithmetic_ms + b.texture_ms + b.memory_ms;
+                        k["predicted_h200_latency_ms"] = b.latency_ms;
                       }
                       kernels.push_back(k);
                     }

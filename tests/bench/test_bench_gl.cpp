@@ -165,3 +165,31 @@ TEST_CASE("bench_gl writes each program the GL driver links, as GLSL and as the 
   CHECK(traversal);
   fs::remove_all(dir);
 }
+
+TEST_CASE("bench_gl --latency times one fragment's dependent fetches and multiply-adds") {
+  const fs::path js = json_path();
+  const Outcome o =
+      bench("--latency --no-fixed --no-frames --runs 1 --readback-wait poll --json " + js.string());
+  REQUIRE(o.status == 0);
+  std::ifstream f(js);
+  const nlohmann::json doc = nlohmann::json::parse(f);
+  fs::remove(js);
+  const auto& rows = doc["latency"];
+  REQUIRE(rows.size() == 4);  // chases through 16x16, 512x512, 2048x2048 texels; multiply-adds
+  for (size_t i = 0; i < rows.size(); ++i) {
+    const auto& r = rows[i];
+    INFO(r.dump());
+    CHECK(r["long_steps"].get<int>() > r["short_steps"].get<int>());
+    CHECK(r["long_us"].get<double>() > r["short_us"].get<double>());
+    CHECK(r["ns_per_iteration"].get<double>() > 0);
+    // The model's own count of each probe's iteration (vgpu/span.h), which prices it.
+    CHECK(r["chain_fetches"].get<int>() == (i < 3 ? 1 : 0));
+    CHECK(r["chain_operations"].get<int>() == (i < 3 ? 6 : 35));
+  }
+  CHECK(rows[2]["texels"].get<int>() == 2048 * 2048);
+  // Without a GL device there is nothing to time: refused, exit 2, nothing written.
+  const Outcome none = bench("--latency --readback-wait none --json " + js.string());
+  CHECK(none.status == 2);
+  CHECK(none.err.find("--latency needs a GL device") != std::string::npos);
+  CHECK_FALSE(fs::exists(js));
+}
