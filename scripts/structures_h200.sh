@@ -15,6 +15,13 @@
 #                                   read by scripts/structures.py --h200-looping; RUNS=15 times
 #                                   15 frames each instead of 5: docs/structures_h200_looping_warm2.json,
 #                                   read by --h200-looping-again)
+#   OUT=DIR CLOCK_MS=100 LATENCY=1 scripts/structures_h200.sh   (one fragment's fetch and
+#                                   operation latencies, bench_gl --latency: the h200 profile's
+#                                   fetch_latency_clocks and operation_latency_clocks, from
+#                                   docs/structures_h200_latency.json, --h200-latency)
+#   OUT=DIR GRID_SIZES=1 scripts/structures_h200.sh   (the grid's looping walk at 8x8, 64x64 and
+#                                   512x512: docs/structures_h200_sizes_looping_grid.json,
+#                                   --h200-sizes-grid)
 # then copy DIR's files to docs/structures_h200_{primary,full}.json and _clocks.csv, and run here:
 #   /usr/bin/python3 scripts/structures.py --h200 docs/structures_h200_primary.json \
 #     docs/structures_h200_full.json
@@ -37,6 +44,17 @@ if [ -n "${SIZES:-}" ]; then
     --accel grid2 bvh --variants multipass --bounces 0 --micro-passes 10 \
     --scenes scenes/bunny.gltf scenes/classic.gltf scenes/teapot.gltf \
     --json "$out/structures_sizes_multipass.json"
+  exit 0
+fi
+if [ -n "${LATENCY:-}" ]; then
+  .h200/bench_gl --latency --no-fixed --no-frames --runs 9 --warmup-ms 1000 \
+    --readback-wait poll --json "$out/structures_latency.json"
+  exit 0
+fi
+if [ -n "${GRID_SIZES:-}" ]; then
+  .h200/bench_gl --runs 5 --sizes 8 64 512 --threads 16 --readback-wait poll --grid auto \
+    --accel grid --variants looping --bounces 0 --no-fixed --warmup-ms 500 --scenes $S \
+    --json "$out/structures_sizes_looping_grid.json"
   exit 0
 fi
 if [ -n "${PROGRAMS:-}" ]; then
