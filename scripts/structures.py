@@ -9,7 +9,8 @@ Usage: /usr/bin/python3 scripts/structures.py [--vgpu-rt build/host/vgpu-rt] [--
                                               [--h200-layout SQUARE MULTI_WIDE MULTI_SQUARE WIDE]
                                               [--h200-programs DIR] [--h200-precise ON OFF]
                                               [--h200-ablation FULL STEP TEST]
-                                              [--h200-sizes FILE ...]
+                                              [--h200-sizes FILE ...] [--h200-sizes-grid FILE]
+                                              [--h200-latency FILE] [--h200-looping-third FILE]
                                               [--reuse [--only ACCEL ...]]
 
 Per scene and structure, primary rays only (--bounces 0 --shadows off, as the issue's table) and
@@ -88,6 +89,15 @@ def main():
                     help="NVIDIA's compiled assembly of the looping traversal kernels, from "
                     "bench_gl --dump-programs on the H200 (docs/h200_programs/*.nvfp): their "
                     "loop bodies beside the vgpu's counts")
+    ap.add_argument("--h200-latency", metavar="FILE",
+                    help="bench_gl --latency JSON from the H200 (docs/structures_h200_latency.json):"
+                    " the latency term's section")
+    ap.add_argument("--h200-looping-third", nargs="*", default=[],
+                    help="bench_gl JSON of the looping frames measured with the latency term "
+                    "(docs/structures_h200_looping_warm3.json)")
+    ap.add_argument("--h200-sizes-grid", nargs="*", default=[],
+                    help="the grid's looping frames at 8x8, 64x64 and 512x512 "
+                    "(docs/structures_h200_sizes_looping_grid.json), for the latency term")
     ap.add_argument("--h200-sizes", nargs="*", default=[],
                     help="bench_gl JSON files of the same frames at several sizes "
                     "(docs/structures_h200_sizes_*.json)")
@@ -164,6 +174,7 @@ def main():
         if first:
             a.looping_again.append((first, w))
     a.kernel_ratios = st.traversal_ratios(a.h200_looping_again)
+    a.looping_third = gl_cells(a.h200_looping_third)
     a.run = run
     json.dump({"rows": rows, "h200": h200}, open(os.path.join(a.out, "structures.json"), "w"),
               indent=1)
@@ -258,7 +269,8 @@ def gl_cells(files):
                           "readbacks": g["query_readbacks"],
                           "warmup_ms": g.get("warmup_ms", 0),
                           "wall_runs_ms": g.get("wall_runs_ms", []),
-                          "predicted_ms": em["predicted_ms"]["h200"]})
+                          "predicted_ms": em["predicted_ms"]["h200"],
+                          "latency_ms": em["predicted_h200"].get("latency_ms", 0.0)})
     return cells
 
 
@@ -272,8 +284,7 @@ def grid2_loop(h200, pairs):
     return (f"its H200 frames (warmed up) are predicted {-e[-1]:.0f}-{-e[0]:.0f}% below their "
             f"wall time, the most of any structure's looping frames; {len(out)} of {len(g)} outside 35% ("
             + (", ".join(f"{r['scene']}, {fmt_ms(r['wall_ms'])} ms" for r in out) or "none") +
-            "). " + st.slower_sentence(pairs) + "The model is not "
-            "recalibrated for it.")
+            "). " + st.slower_sentence(pairs) + "These figures carry the latency term.")
 
 
 def looping_again(pairs):
@@ -339,7 +350,8 @@ def measured_cells(path):
                       "size": g["size"], "wall": g["wall_ms"], "gpu": g["gpu_ms"],
                       "passes": g["passes"], "readbacks": g["query_readbacks"],
                       "pred": p["total_ms"],
-                      "work": p["arithmetic_ms"] + p["texture_ms"] + p["memory_ms"],
+                      "work": p["arithmetic_ms"] + p["texture_ms"] + p["memory_ms"] +
+                              p.get("latency_ms", 0.0),
                       "fixed": p["per_pass_ms"] + p["readback_ms"] + p["program_load_ms"],
                       "download": p["download_ms"]})
     return cells
@@ -460,9 +472,10 @@ def frame_cost(h200_files, sizes_files):
         f"{min(c['passes'] for c in msized)}-{max(c['passes'] for c in msized)} passes, a few us "
         "a pass, well inside the multipass cells' errors." + clock_note + " The rest of the "
         "two-level grid's shortfall is on the GPU: its looping kernel's timer-query time is "
-        f"{over['grid2']:.2f} ms (median; {100 * over_rel:.0f}%) above its modeled pass work at "
+        f"{over['grid2']:.2f} ms (median; {100 * over_rel:.0f}%) above its modeled pass work and "
+        "longest lanes at "
         f"256x256, the kd-tree's {over['kdtree']:.2f} ms (on longer frames), the BVH's "
-        f"{over['bvh']:+.2f} ms. No term was added: the small frames leave room for "
+        f"{over['bvh']:+.2f} ms. No term per frame or per pixel was added: the small frames leave room for "
         f"about {med([host(c) for c in small]):.2f} ms per frame, not {best:.2f}, and a "
         "cost per pixel fitted on these cells would be validated on the data it came from. The "
         "next step is to time each candidate alone on the H200: a download and a clear inside a "
@@ -575,7 +588,7 @@ A first frame in a fresh process also pays the driver's compilation of every pro
 walk (99.5 ms multipass) where the warm frames below take a few ms (61 ms), so only warm frames
 are compared with the model, which has no compilation term.
 
-{h200_table(h200)}{looping_again(a.looping_first)}{st.looping_second(a)}{st.layout_trial(a.h200_layout)}{st.compiled_bodies(a)}{st.precise_trial(a.h200_precise)}{st.ablation_trial(a.h200_ablation)}
+{h200_table(h200)}{looping_again(a.looping_first)}{st.looping_second(a)}{st.layout_trial(a.h200_layout)}{st.compiled_bodies(a)}{st.precise_trial(a.h200_precise)}{st.ablation_trial(a.h200_ablation)}{st.latency_term(a)}
 
 ## Which structure wins where, and why
 
