@@ -119,8 +119,9 @@ H200_PROSE = """**What the differences say about the model's pricing of stream p
   [structures.md](structures.md) (-10% to +6%): the streams' passes are priced like the paper's.
   What glass adds to its opaque copy is mostly more walks for the refracted rays (20,716 more
   passes, 110 of them the streams' own): +978 ms measured, +899 ms predicted (-8%). The looping
-  frames stay 22-29% under the wall time with streams or without, as the looping walks were in
-  structures.md: that is the looping walk's price, not the streams'.
+  frames are 7-17% under the wall time with streams or without (22-29% before the model priced
+  the looping passes' longest lanes, structures.md's latency term): that is the looping walk's
+  price, not the streams'.
 - *The streams' own kernels* (split, scan, count, compaction, gather, shadows through glass)
   are cheap on this GPU: 110 passes, 2.1 GPU ms of glass's 920 (0.2%), and 7% of the looping
   frame's GPU time, where the walk is only tens of passes. The model gives them 3.6 ms, 72%

@@ -289,17 +289,18 @@ H200_PROSE = """**What the differences say about the model's pricing of sampling
   predicted, about 22.5 us measured) is predicted at 2.3x to 6.7x what it is on the GPU. The
   marked-pixel query (+218%) is the occlusion read-back again: its 12 us wait is in the wall
   time, not in the timer query.
-- *Looping frames* (the second run's, warmed up for 2 s): every mode is 15-30% under the wall
-  time, the looping walk's known under-pricing ([structures.md](structures.md)); undersample:2
-  at -18% (classic) and -15% (bunny), where the first run gave -65% and -76%. That run's
+- *Looping frames* (the second run's, warmed up for 2 s): every mode is 7-22% under the wall
+  time (15-30% before the model priced the looping passes' longest lanes, docs/structures.md's
+  latency term); undersample:2 at -7% on both scenes, where the first run gave -61% (classic)
+  and -74% (bunny). That run's
   undersample:2 looping frames each came right after the longest stretches without GPU work
   (the emulator's frames of the mode before), with every kernel 3-5x slower per pass. The second
   run settles it: its control (one warm-up frame, as the first run) repeats the slowdown,
-  classic undersample:2 at 57.1 ms (-80%) with the SM clock at 345 MHz in every sample of its
-  timed frames and the 0.5 s before, bunny's at 14.6 ms (-62%); after 2 s of warm-up frames the
+  classic undersample:2 at 57.1 ms (-77%) with the SM clock at 345 MHz in every sample of its
+  timed frames and the 0.5 s before, bunny's at 14.6 ms (-58%); after 2 s of warm-up frames the
   same frames take 14.3 and 6.6 ms at 1,980 MHz. The clock, not the kernels: with it up, the
-  mode's cost against spp:1 is predicted 11-15% above the GPU's own ratio (classic 2.04
-  predicted against 1.84 measured, bunny 2.09 against 1.81). The other modes moved little
+  mode's cost against spp:1 is predicted 10-15% above the GPU's own ratio (classic 2.02
+  predicted against 1.84 measured, bunny 2.08 against 1.81). The other modes moved little
   with the warm-up (spp:1 to adaptive:16 within 9% of the control): their frames came after
   shorter idle stretches."""
 
