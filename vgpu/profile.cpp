@@ -174,10 +174,10 @@ const std::vector<Profile>& profiles() {
     m.loop_overhead_clocks = 1;       // model parameter (assumed: a compare and a branch)
     // One fragment on this H200 (bench_gl --latency, docs/structures_h200_latency.json, GPU
     // timer queries, 1024 against 8192 iterations): following links through RGBA32F textures
-    // of 512x512 and 2048x2048 texels, 238.9 ns an iteration (473 clocks at 1980 MHz; 212 where
-    // the 16x16 texture stays in the first-level cache); 16 dependent multiply-adds, 77.3 ns
-    // (153 clocks). Priced as the model counts those loops (vgpu/span.h: the multiply-adds'
-    // iteration is 35 operation units, the chase's one fetch and 6 units):
+    // of 512x512 and 2048x2048 texels, 235.4 and 238.8 ns an iteration (473 clocks at 1980 MHz
+    // for the larger; 212 where the 16x16 texture stays in the first-level cache); 16 dependent
+    // multiply-adds, 77.3 ns (153 clocks). Priced as the model counts those loops (vgpu/span.h:
+    // the multiply-adds' iteration is 35 operation units, the chase's one fetch and 6 units):
     m.operation_latency_clocks = 4.37;  // measured: 153 clocks / 35
     m.fetch_latency_clocks = 447;       // measured: 473 clocks - 6 x 4.37
     t.push_back(m);
