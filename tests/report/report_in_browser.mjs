@@ -1,7 +1,9 @@
 // The HTML report as a person would check it: vgpu-rt writes a report, headless chromium (driven
 // by playwright-core) opens it from disk; the test fails on any page script error, clicks a
 // pixel of the image and compares the history the page shows with that pixel's --trace-pixel
-// output, line by line, and compares the timeline's sums with the --stats-json totals.
+// output, line by line, and compares the timeline's sums with the --stats-json totals; the
+// predicted-time table shows the statistics' predictions, the looping passes' longest lanes on
+// the h200 in a looping frame.
 // Usage: node report_in_browser.mjs VGPU_RT WORK_DIR
 import { execFileSync } from "node:child_process";
 import fs from "node:fs";
@@ -55,6 +57,24 @@ try {
   const totals = JSON.parse(fs.readFileSync(stats, "utf8")).totals;
   const sums = await page.evaluate(() => window.report.timelineTotals());
   for (const [k, v] of Object.entries(sums)) check(totals[k] === v, `timeline sum of ${k}: ${v}, statistics ${totals[k]}`);
+
+  // The predicted-time table: one column per card, its total the statistics' predicted_ms.
+  const cell = (key, card) => page.$eval(`#predicted tr[data-key="${key}"] td[data-card="${card}"]`, td => +td.textContent);
+  const predicted = JSON.parse(fs.readFileSync(stats, "utf8")).predicted_ms;
+  for (const [card, ms] of Object.entries(predicted))
+    if (ms !== null) check(Math.abs((await cell("total_ms", card)) - ms) < 0.001, `predicted total on ${card}: ${ms}`);
+  check(await cell("latency_ms", "h200") === 0, "no longest-lane latency in a multipass frame");
+
+  // A looping frame on the h200: its longest lanes are priced, on the h200 alone.
+  const lhtml = path.join(work, "looping.html"), lstats = path.join(work, "looping.json");
+  execFileSync(vgpu, ["render", "sphere", "--size", "32x32", "--quiet", "--stats", "none", "--threads", "2",
+    "--kernels", "looping", "--profile", "h200", "--bounces", "0", "--report", lhtml, "--stats-json", lstats]);
+  await page.goto("file://" + path.resolve(lhtml));
+  await page.waitForFunction(() => document.body.dataset.ready === "1" || document.body.dataset.error, null, { timeout: 60000 });
+  check(errors.length === 0 && !(await page.evaluate(() => document.body.dataset.error)), `no script errors in the looping frame's report (${errors.join("; ")})`);
+  const lb = JSON.parse(fs.readFileSync(lstats, "utf8")).predicted_breakdown;
+  check(lb.h200.latency_ms > 0 && Math.abs((await cell("latency_ms", "h200")) - lb.h200.latency_ms) < 0.001, `the h200's longest lanes: ${lb.h200.latency_ms} ms`);
+  check(await cell("latency_ms", "gf6600") === 0, "no latency on gf6600, whose latencies are not modeled");
 } finally {
   await browser.close();
 }
