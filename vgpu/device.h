@@ -75,6 +75,10 @@ class Device {
   // (vgpu::Gpu: kBranchTook, kBranchIdle, 0), for the frame report's occupancy; empty on a
   // device that does not see fragments (the GL device) or after a program without a branch.
   virtual std::span<const uint8_t> branch_flags() const { return {}; }
+  // Per texel of the last pass's first target, row by row: the iterations its fragment was
+  // active in the program's loop (0 where none ran), for the frame report; empty after a program
+  // without a loop, or on a device that does not see fragments (the GL device).
+  virtual std::span<const uint32_t> loop_iterations() const { return {}; }
 
   // The frame's statistics so far (a device that measures asynchronously settles them first).
   virtual FrameStats& stats() = 0;

@@ -518,6 +518,7 @@ const PassRecord& Gpu::draw(const Rect& rect) {
     }
   }
 
+  looped_ = false;  // until this pass runs a loop
   if (const PassTally* t = std::exchange(replay_, nullptr)) return replay(p, a, rect, *t, t0);
 
   in_draw_ = true;
@@ -560,6 +561,7 @@ const PassRecord& Gpu::draw(const Rect& rect) {
   const Stencil* work_view = work_mask_;
   const Stencil* test_view = stencil_test_;
   const bool looping = a.loop.loops > 0;
+  looped_ = looping;
   if (looping) {
     loop_map_.assign(size_t(t0tex.width()) * size_t(t0tex.height()), 0);
     plan.loop_map = loop_map_.data();

@@ -98,11 +98,15 @@ class Gpu final : public Device {
     return {batch_flags_.data(), flags_size_};
   }
 
+  std::span<const uint32_t> loop_iterations() const override {
+    return looped_ ? std::span<const uint32_t>(loop_map_) : std::span<const uint32_t>();
+  }
+
   FrameStats& stats() override { return stats_; }
   const FrameStats& stats() const { return stats_; }
 
-  // Emulator shortcut for walks run batch by batch (vgpu/batch.h, host/trace/stream_tracer.cpp): the
-  // next draw() runs no fragment and charges the pass as `t` says its fragments ran (t must
+  // Emulator shortcut for walks run batch by batch (vgpu/batch.h, host/trace/stream_tracer.cpp):
+  // the next draw() runs no fragment and charges the pass as `t` says its fragments ran (t must
   // outlive that draw). Every check a draw makes is still made; the targets and the stencil
   // write hold what the walk left there.
   void replay_next(const PassTally& t) { replay_ = &t; }
@@ -156,6 +160,7 @@ class Gpu final : public Device {
   // Tiles (8x4, 32x32) of the drawn rectangle where some fragment took the branch.
   std::vector<uint8_t> took8_, took32_;
   std::vector<uint32_t> loop_map_;  // a looping pass: iterations per texel of the target
+  bool looped_ = false;             // the last pass ran a loop (loop_map_ is its)
   // Emulator bookkeeping: two textures known to hold the same texels everywhere except at
   // `differ` (texel indices, ascending), as a pass with a work mask leaves its passthrough source
   // and its target. The next pass between them copies only those texels for its idle fragments.

@@ -110,6 +110,7 @@ FrameRecorder::FrameRecorder(int width, int height, bool masks, int history_stri
   voxels_.assign(n, 0);
   tests_.assign(n, 0);
   idle_.assign(n, 0);
+  loops_.assign(n, 0);
   if (stride_ > 0)
     for (int y = 0; y < height; y += stride_)
       for (int x = 0; x < width; x += stride_) hist_px_.push_back({x, y});
@@ -228,6 +229,12 @@ void FrameRecorder::pass(const PassObserver::Pass& p) {
     }
   }
   r.idle = r.counters.fragments_shaded - std::min(r.useful, r.counters.fragments_shaded);
+  // A looping pass: each pixel's iterations, from the device's loop map of the whole target.
+  const std::span<const uint32_t> its = p.loop_iterations;
+  if (per_pixel_ && its.size() == size_t(w_) * size_t(h_) && p.target.width() == w_) {
+    uint32_t* loops = loops_.data();
+    for (size_t i = 0; i < its.size(); ++i) loops[i] += its[i];
+  }
 
   // SIMD occupancy: lanes doing the program's work in each 8x4 and 32x32 tile of the rectangle
   // (took its branch; without a branch, every shaded fragment runs all of it).
@@ -390,6 +397,7 @@ void write_report(const std::string& path, const FrameRecorder& rec, const Rende
   d["maps"] = {{"voxels", pack(rec.voxel_steps())},
                {"tests", pack(rec.triangle_tests())},
                {"idle", pack(rec.idle_passes())},
+               {"loops", pack(rec.loop_iterations())},
                {"rays", pack(rays)}};
   auto wave = json::array();
   for (const auto& w : rec.wavefront()) wave.push_back(pack(w));

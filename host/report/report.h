@@ -82,6 +82,9 @@ class FrameRecorder final : public PassObserver {
   const std::vector<uint32_t>& voxel_steps() const { return voxels_; }
   const std::vector<uint32_t>& triangle_tests() const { return tests_; }
   const std::vector<uint32_t>& idle_passes() const { return idle_; }
+  // Per pixel (row-major): iterations its fragments ran in looping programs' loops (each a
+  // voxel step or node visit, a triangle test or both: --kernels looping).
+  const std::vector<uint32_t>& loop_iterations() const { return loops_; }
   // Per trace and pixel: voxels stepped in that trace (walking after step k: steps > k).
   const std::vector<std::vector<uint16_t>>& wavefront() const { return wave_; }
   // Per kernel (in order of first use): active lanes per batch.
@@ -114,7 +117,7 @@ class FrameRecorder final : public PassObserver {
   bool has_work_ = false;      // the coming pass has a work mask (pass_begin)
   int work_id_ = -1;           // its id, when masks are kept
   std::vector<uint8_t> work_;  // and its bytes, one per pixel
-  std::vector<uint32_t> voxels_, tests_, idle_;
+  std::vector<uint32_t> voxels_, tests_, idle_, loops_;
   std::vector<std::vector<uint16_t>> wave_;
   std::vector<std::pair<std::string, Occupancy>> occ_;
   std::vector<glm::ivec2> hist_px_;

@@ -152,7 +152,8 @@ void ListWalk::walk_looping(PassRunner& r, const vgpu::Program& p, Texture& orig
     const bool traced = r.traces_pixel(sh_.grid_mask);
     if (opt_.observer) opt_.observer->pass_begin(sh_.grid_mask);
     const vgpu::PassRecord& rec = gpu.draw();
-    if (opt_.observer) opt_.observer->pass({p, rec, trav, gpu.branch_flags(), gpu.stats()});
+    if (opt_.observer)
+      opt_.observer->pass({p, rec, trav, gpu.branch_flags(), gpu.stats(), gpu.loop_iterations()});
     cur_trav_ ^= 1;
     cur_vs_ ^= 1;
     cur_isect ^= 1;

@@ -62,7 +62,8 @@ const vgpu::PassRecord& PassRunner::pass(const vgpu::Program& p,
   const vgpu::PassRecord& rec = gpu_.draw();
   // The observer sees the first target (a fused pass's other targets are the same pass).
   if (opt_.observer)
-    opt_.observer->pass({p, rec, **outs.begin(), gpu_.branch_flags(), gpu_.stats()});
+    opt_.observer->pass(
+        {p, rec, **outs.begin(), gpu_.branch_flags(), gpu_.stats(), gpu_.loop_iterations()});
   if (traced && !p.idle_discards()) {
     const int x = opt_.trace_pixel->x, y = opt_.trace_pixel->y;
     for (const Texture* out : outs) {

@@ -164,7 +164,8 @@ const vgpu::PassRecord& RayStreams::pass(PassRunner& r, const vgpu::Program& p,
   r.set_work(nullptr);
   if (opt_.observer) opt_.observer->pass_begin(nullptr);
   const vgpu::PassRecord& rec = rect ? gpu_.draw(*rect) : gpu_.draw();
-  if (opt_.observer) opt_.observer->pass({p, rec, out, gpu_.branch_flags(), gpu_.stats()});
+  if (opt_.observer)
+    opt_.observer->pass({p, rec, out, gpu_.branch_flags(), gpu_.stats(), gpu_.loop_iterations()});
   ++passes;
   bytes += rec.counters.bytes_read + rec.counters.bytes_written;
   return rec;

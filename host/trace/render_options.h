@@ -31,6 +31,9 @@ class PassObserver {
     // shaded); empty when the program does not branch.
     std::span<const uint8_t> branch_flags;
     const vgpu::FrameStats& stats;  // the frame so far, this pass included
+    // Per texel of the target, row by row: iterations of the program's loop each fragment ran;
+    // empty without a loop (vgpu::Device::loop_iterations).
+    std::span<const uint32_t> loop_iterations = {};
   };
   virtual ~PassObserver() = default;
   virtual void iteration(int iteration) = 0;  // 1-based

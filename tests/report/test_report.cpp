@@ -30,9 +30,13 @@ struct Frame {
 
 // sphere.gltf at 48x40 (not a multiple of the 8x4 and 32x32 tiles) with the recorder attached.
 Frame render(host::FrameRecorder& rec, bool masks, std::optional<glm::ivec2> trace_pixel = {},
-             int threads = 2, int lanes = vgpu::kLanes) {
+             int threads = 2, int lanes = vgpu::kLanes, bool looping = false) {
   static const host::Scene scene = host::load_scene(host::resolve_scene("sphere"));
   host::RenderOptions opt;
+  if (looping) {  // the looping kernels need a profile with loops
+    opt.looping = true;
+    opt.profile = "h200";
+  }
   opt.width = 48;
   opt.height = 40;
   opt.masks = masks;
@@ -411,4 +415,22 @@ TEST_CASE("what the recorder sees is the same for any thread count and lane widt
     CHECK(a.occupancy()[k].second.tile8x4 == b.occupancy()[k].second.tile8x4);
     CHECK(a.occupancy()[k].second.tile32x32 == b.occupancy()[k].second.tile32x32);
   }
+}
+
+TEST_CASE("the loop iterations map adds up to the looping kernels' iterations, pixel by pixel") {
+  host::FrameRecorder rec(48, 40, false, 0);
+  const Frame f = render(rec, false, {}, 2, vgpu::kLanes, true);
+  const vgpu::FrameStats& s = f.result.stats;
+  uint64_t sum = 0;
+  for (const uint32_t v : rec.loop_iterations()) sum += v;
+  REQUIRE(s.totals.loop_iterations > 0);
+  CHECK(sum == s.totals.loop_iterations);
+  // Rays through the sphere walk and test more than rays past it.
+  const auto [lo, hi] =
+      std::minmax_element(rec.loop_iterations().begin(), rec.loop_iterations().end());
+  CHECK(*hi > *lo);
+  // A multipass frame has none.
+  host::FrameRecorder multi(48, 40, false, 0);
+  render(multi, false);
+  for (const uint32_t v : multi.loop_iterations()) CHECK(v == 0);
 }
