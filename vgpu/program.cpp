@@ -1,7 +1,10 @@
 // Program identity and the counting run.
 #include "vgpu/program.h"
 
+#include <algorithm>
 #include <atomic>
+#include <unordered_map>
+#include <vector>
 
 #include "vgpu/span.h"
 
@@ -24,9 +27,23 @@ Program::Analysis Program::analyze() const {
   a.instructions = int(OpCounter::ops - before);
   a.branches = int(idle);  // the counting run's branch() counts each call as one idle lane
   if (a.loop.loops > 0) {  // the body's longest wait, from the recorded program (vgpu/span.h)
-    const LoopChain chain = loop_chain(record());
-    a.loop.chain_fetches = chain.fetches;
-    a.loop.chain_operations = chain.operations;
+    // analyze() runs at every draw and program load, and a traversal kernel's recording takes
+    // several us: the chain is kept per program and uniform bytes (equal bytes, equal
+    // recording), per thread, as the GL device keeps its compiled programs.
+    struct Memo {
+      std::vector<std::byte> uniforms;
+      LoopChain chain;
+    };
+    static thread_local std::unordered_map<uint32_t, Memo> memo;
+    const std::span<const std::byte> bytes = uniform_bytes();
+    auto [it, fresh] = memo.try_emplace(id_);
+    Memo& m = it->second;
+    if (fresh || !std::equal(bytes.begin(), bytes.end(), m.uniforms.begin(), m.uniforms.end())) {
+      m.uniforms.assign(bytes.begin(), bytes.end());
+      m.chain = loop_chain(record());
+    }
+    a.loop.chain_fetches = m.chain.fetches;
+    a.loop.chain_operations = m.chain.operations;
   }
   return a;
 }
