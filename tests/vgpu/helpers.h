@@ -1,5 +1,5 @@
 // Helpers shared by the vgpu tests: deterministic texture contents, bitwise comparisons and a
-// kernel that reads one texel at coordinates taken from another texture.
+// kernel that reads one texel at coordinates taken from another texture, and one that loops.
 #pragma once
 
 #include <cmath>
@@ -69,6 +69,27 @@ struct Copy {
   template <class L>
   void operator()(vgpu::Fragments<L>& f) const {
     f.out(0) = f.fetch_own(0);
+  }
+};
+
+// Counts up to the texel's x: out = (iterations run, x, 0, 0). A fragment with x <= 0
+// never enters the loop.
+struct CountTo {
+  static constexpr const char* name = "count to";
+  static constexpr const char* paper_name = "-";
+  static constexpr int outputs = 1;
+  int budget = 16;
+  template <class L>
+  void operator()(vgpu::Fragments<L>& f) const {
+    using F = typename L::F;
+    using M = typename L::M;
+    const F n = f.fetch_own(0).x;
+    F c = F(0.0f);
+    f.loop(budget, n > F(0.0f), [&](const M& active) {
+      c = vgpu::select(active, c + F(1.0f), c);
+      return c < n;
+    });
+    f.out(0) = {c, n, F(0.0f), F(0.0f)};
   }
 };
 

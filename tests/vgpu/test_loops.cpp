@@ -7,33 +7,14 @@
 #include <string>
 #include <vector>
 
+#include "helpers.h"
 #include "vgpu/vgpu.h"
 
 using namespace vgpu;
 using doctest::Contains;
+using vgpu_test::CountTo;
 
 namespace {
-
-// Counts up to the texel's x: out = (iterations run, x, 0, 0). A fragment with x <= 0
-// never enters the loop.
-struct CountTo {
-  static constexpr const char* name = "count to";
-  static constexpr const char* paper_name = "-";
-  static constexpr int outputs = 1;
-  int budget = 16;
-  template <class L>
-  void operator()(Fragments<L>& f) const {
-    using F = typename L::F;
-    using M = typename L::M;
-    const F n = f.fetch_own(0).x;
-    F c = F(0.0f);
-    f.loop(budget, n > F(0.0f), [&](const M& active) {
-      c = select(active, c + F(1.0f), c);
-      return c < n;
-    });
-    f.out(0) = {c, n, F(0.0f), F(0.0f)};
-  }
-};
 
 // A loop whose body has `ops` additions.
 struct LongBody {

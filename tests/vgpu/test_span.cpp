@@ -3,6 +3,7 @@
 // looping pass gets from it (the most iterations one fragment ran, times that chain).
 #include <doctest/doctest.h>
 
+#include "helpers.h"
 #include "vgpu/span.h"
 #include "vgpu/vgpu.h"
 
@@ -49,25 +50,6 @@ struct AddChain {
       return act;
     });
     f.out(0) = {y, y, y, y};
-  }
-};
-
-// Counts up to the texel's x, as tests/vgpu/test_loops.cpp's CountTo.
-struct CountUp {
-  static constexpr const char* name = "count up";
-  static constexpr const char* paper_name = "-";
-  static constexpr int outputs = 1;
-  template <class L>
-  void operator()(Fragments<L>& f) const {
-    using F = typename L::F;
-    using M = typename L::M;
-    const F n = f.fetch_own(0).x;
-    F c = F(0.0f);
-    f.loop(16, n > F(0.0f), [&](const M& active) {
-      c = select(active, c + F(1.0f), c);
-      return c < n;
-    });
-    f.out(0) = {c, n, F(0.0f), F(0.0f)};
   }
 };
 
@@ -134,7 +116,7 @@ TEST_CASE("a looping pass counts its longest lane's iterations and their chain, 
   Texture in("needed", 16, 1, 4);
   const float need[16] = {1, 3, 7, 0, 0, 0, 0, 0, 2, 2, 2, 2, 2, 2, 2, 2};
   for (int x = 0; x < 16; ++x) in.set(x, 0, 0, need[x]);
-  KernelProgram<CountUp> p;
+  KernelProgram<vgpu_test::CountTo> p;
   const Program::Analysis a = p.analyze();
   CHECK(a.loop.chain_fetches == 0);
   CHECK(a.loop.chain_operations == 5);  // add, select, compare, mask after the first issue
