@@ -288,31 +288,16 @@ def ablation_trial(files):
     return "\n".join(L)
 
 
-def chains(a):
-    """Per structure, the looping traversal body's longest wait as the vgpu counts it (vgpu/span.h:
-    fetches and operation units of one iteration), from an 8x8 render of the bunny."""
-    out = {}
-    with tempfile.TemporaryDirectory() as tmp:
-        for acc in ("grid", "grid2", "bvh", "kdtree"):
-            js = os.path.join(tmp, acc + ".json")
-            st = a.run(a.vgpu_rt, os.path.join(ROOT, "scenes", "bunny.gltf"),
-                       ["--accel", acc, "--kernels", "looping", "--profile", "h200",
-                        "--bounces", "0", "--shadows", "off", "--size", "8x8"], js)
-            k = next(k for k in st["kernels"] if "looping traversal" in k["name"])
-            it = k["loop_span_iterations"]
-            out[acc] = (k["loop_span_fetches"] // it, k["loop_span_operations"] // it)
-    return out
-
-
-def span_per_iteration(a, files):
-    """Per structure, the looping traversal kernel's GPU time at 8x8 (two warps: a frame of
-    longest lanes) over its longest lanes' iterations (the emulator's loop_span_iterations of
-    the same frame), least squares through zero over the scenes but scales."""
-    out = {}
+def looping_8x8(a, files):
+    """Per structure, from the H200's looping frames at 8x8 (two warps: a frame of longest lanes)
+    and the emulator's run of each: the traversal body's chain as the vgpu counts it
+    (vgpu/span.h: fetches and operation units of one iteration), and the GPU ns of one of its
+    iterations, the traversal kernel's GPU time over its loop_span_iterations, least squares
+    through zero over the scenes but scales."""
+    chain, runs = {}, {}
     with tempfile.TemporaryDirectory() as tmp:
         for f in files:
-            frames = json.load(open(f))["frames"]
-            for g in frames:
+            for g in json.load(open(f))["frames"]:
                 if (g["engine"] != "gl-poll" or g["variant"] != "looping" or g["size"] != 8
                         or g["scene"] == "scales"):
                     continue
@@ -321,14 +306,19 @@ def span_per_iteration(a, files):
                     scene = os.path.join(ROOT, ".h200", g["scene"] + ".gltf")
                 if not os.path.exists(scene):
                     continue
-                js = os.path.join(tmp, "s.json")
                 st = a.run(a.vgpu_rt, scene,
                            ["--accel", g["accel"], "--kernels", "looping", "--profile", "h200",
-                            "--bounces", "0", "--shadows", "off", "--size", "8x8"], js)
-                it = next(k for k in st["kernels"] if "looping traversal" in k["name"])
+                            "--bounces", "0", "--shadows", "off", "--size", "8x8"],
+                           os.path.join(tmp, "s.json"))
+                k = next(k for k in st["kernels"] if "looping traversal" in k["name"])
+                it = k["loop_span_iterations"]
+                chain[g["accel"]] = (k["loop_span_fetches"] // it, k["loop_span_operations"] // it)
                 gpu = next(k for k in g["kernels"] if "looping traversal" in k["name"])["gpu_ms"]
-                out.setdefault(g["accel"], []).append((it["loop_span_iterations"], gpu))
-    return {acc: sum(i * g for i, g in v) / sum(i * i for i, _ in v) * 1e6 for acc, v in out.items()}
+                runs.setdefault(g["accel"], []).append((it, gpu))
+    per = {acc: sum(i * g for i, g in v) / sum(i * i for i, _ in v) * 1e6
+           for acc, v in runs.items()}
+    order = [acc for acc in ("grid", "grid2", "bvh", "kdtree") if acc in chain]
+    return {acc: chain[acc] for acc in order}, per
 
 
 def latency_term(a):
@@ -337,12 +327,12 @@ def latency_term(a):
     if not a.h200_latency:
         return ""
     probes = json.load(open(a.h200_latency))["latency"]
-    mhz = 1980
     alu = next(p for p in probes if p["chain_fetches"] == 0)
     op_clk = alu["clocks_per_iteration_at_boost"] / alu["chain_operations"]
     far = max((p for p in probes if p["chain_fetches"] == 1), key=lambda p: p["texels"])
     mid = [p for p in probes if p["chain_fetches"] == 1 and 256 < p["texels"] < far["texels"]]
     fetch_clk = far["clocks_per_iteration_at_boost"] - far["chain_operations"] * op_clk
+    mhz = 1e3 * far["clocks_per_iteration_at_boost"] / far["ns_per_iteration"]  # the probes' clock
     L = ["", "", "### The looping passes' longest lane: the latency term", "",
          "The model took a pass as long as the largest of its arithmetic, texture and memory "
          "demands: the work spread over every pipeline. That is a lower bound, and so is the "
@@ -379,8 +369,7 @@ def latency_term(a):
           "takes under half as long, which the model does not price. Both are per lane, whatever "
           "the lanes beside it do. Only the `h200` profile has them: the 2004 cards' latencies "
           "were not measured, and their predictions are unchanged."]
-    ch = chains(a)
-    per = span_per_iteration(a, a.h200_sizes + a.h200_sizes_grid)
+    ch, per = looping_8x8(a, a.h200_sizes + a.h200_sizes_grid)
     if ch:
         L += ["", "Each looping walk's iteration as the model counts it, priced, against the H200's "
               "8x8 frames (`SIZES=1 scripts/structures_h200.sh`; two warps, so the traversal "
