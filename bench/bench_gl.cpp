@@ -29,7 +29,7 @@
 #include "host/scene/camera.h"
 #include "host/scene/gltf_loader.h"
 #include "host/trace/sampling.h"
-#include "host/trace/stream_tracer.h"
+#include "host/trace/stream/stream_tracer.h"
 
 namespace {
 

@@ -17,9 +17,9 @@
 #include "host/model/cost_model.h"
 #include "host/scene/camera.h"
 #include "host/scene/gltf_loader.h"
-#include "host/trace/cpu_tracer.h"
+#include "host/trace/cpu/cpu_tracer.h"
 #include "host/trace/sampling.h"
-#include "host/trace/stream_tracer.h"
+#include "host/trace/stream/stream_tracer.h"
 
 namespace {
 

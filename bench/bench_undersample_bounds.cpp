@@ -24,7 +24,7 @@
 #include "host/image/image_io.h"
 #include "host/scene/camera.h"
 #include "host/scene/gltf_loader.h"
-#include "host/trace/cpu_tracer.h"
+#include "host/trace/cpu/cpu_tracer.h"
 #include "host/trace/sampling.h"
 
 namespace {

@@ -66,7 +66,7 @@
 //   sample sum      rgb = sum of the sample frames' colours, a = samples added (--spp N > 1;
 //                   an extension, kernels/accumulate_samples.h)
 //
-// Ray streams (glass, or --ray-streams on; host/trace/ray_streams.h). Static, per triangle like
+// Ray streams (glass, or --ray-streams on; host/trace/stream/ray_streams.h). Static, per triangle like
 // the colours:
 //   glass           x = mirror coefficient a, y = transmission t, z = index of refraction
 //   colors          under ray streams a = 1 - (1 - t)(1 - a): the share of a ray's weight its

@@ -12,7 +12,7 @@ import statistics
 
 # The frame's settings that must agree between a GL frame and the emulator frame it is priced by.
 KEYS = ("scene", "accel", "variant", "bounces", "size", "shadows", "ray_streams", "sampling")
-# The ray streams' own kernels (host/trace/ray_streams.h) and the sampling modes' (sampling.h).
+# The ray streams' own kernels (host/trace/stream/ray_streams.h) and the sampling modes' (sampling.h).
 STREAM_KERNELS = ["split rays", "stream scan", "stream count", "stream compaction", "row copy",
                   "children gather", "shadow through glass"]
 SAMPLING_KERNELS = ["generate sample rays", "accumulate samples", "resolve samples", "keep hits",

@@ -105,7 +105,7 @@ class Gpu final : public Device {
   FrameStats& stats() override { return stats_; }
   const FrameStats& stats() const { return stats_; }
 
-  // Emulator shortcut for walks run batch by batch (vgpu/batch.h, host/trace/stream_tracer.cpp):
+  // Emulator shortcut for walks run batch by batch (vgpu/batch.h, host/trace/stream/stream_tracer.cpp):
   // the next draw() runs no fragment and charges the pass as `t` says its fragments ran (t must
   // outlive that draw). Every check a draw makes is still made; the targets and the stencil
   // write hold what the walk left there.

@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "host/trace/stream_tracer.h"
+#include "host/trace/stream/stream_tracer.h"
 
 namespace host {
 

@@ -18,7 +18,7 @@ namespace host {
 struct WalkCounts {
   uint64_t rays_traced = 0;      // rays entering a trace
   uint64_t rays_unfinished = 0;  // rays stopped by a walk's pass cap (reduced precision)
-  bool batch_walk = false;       // a walk of this frame ran in batches (host/trace/walk.h)
+  bool batch_walk = false;       // a walk of this frame ran in batches (host/trace/walks/walk.h)
 };
 
 // The state a batch walk hands back to the textures and masks: each ping-pong pair of state

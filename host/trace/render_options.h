@@ -108,7 +108,7 @@ struct RenderOptions {
   // pixels whose surfaces (host/trace/sampling.h) disagree; the rest are blended from the four
   // lattice pixels around them. One ray per traced pixel (spp 1).
   int undersample = 0;
-  // Ray streams (glass, host/trace/ray_streams.h) on a scene without glass: the paper's
+  // Ray streams (glass, host/trace/stream/ray_streams.h) on a scene without glass: the paper's
   // reflections through the same streams, compaction and gather back. A scene with a
   // transmissive material always runs them.
   bool ray_streams = false;
@@ -120,7 +120,7 @@ struct RenderOptions {
   PassObserver* observer = nullptr;  // not owned
 };
 
-// Glass's ray streams (host/trace/ray_streams.h): what one frame's streams held and cost,
+// Glass's ray streams (host/trace/stream/ray_streams.h): what one frame's streams held and cost,
 // summed over its sample frames.
 struct StreamLevel {
   uint64_t rays = 0;            // rays traced at this level (level 0: every pixel's)

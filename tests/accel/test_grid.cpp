@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "host/accel/grid.h"
-#include "host/trace/reference.h"
+#include "tests/support/reference.h"
 
 namespace {
 

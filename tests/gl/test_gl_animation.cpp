@@ -13,7 +13,7 @@
 #include "host/scene/animation.h"
 #include "host/scene/camera.h"
 #include "host/scene/gltf_loader.h"
-#include "host/trace/stream_tracer.h"
+#include "host/trace/stream/stream_tracer.h"
 #include "tests/gl/gl_compare.h"
 
 namespace {

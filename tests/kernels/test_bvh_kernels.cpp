@@ -3,7 +3,7 @@
 // hand-made texels, every channel of every output checked against values worked out here. Built
 // into test_gl (KTEST_GL), every pass is made again on the GL device from the same texels.
 //
-// The hand-made hierarchy (texture layouts of kernels/bvh.h and host/trace/bvh_walk.cpp), node
+// The hand-made hierarchy (texture layouts of kernels/bvh.h and host/trace/walks/bvh_walk.cpp), node
 // textures 2 texels wide (nodes 2 to 4 sit on the second and third rows):
 //   node 0  root, inner  box [0, 4]^3                     escape -1
 //   node 1  inner L      box [1, 2] x [0, 1] x [0, 1]     escape 4 (past its subtree)

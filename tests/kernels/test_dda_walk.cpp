@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "host/accel/grid.h"
-#include "host/trace/reference.h"
+#include "tests/support/reference.h"
 #include "kernel_pass.h"
 
 using kernels::kFar;

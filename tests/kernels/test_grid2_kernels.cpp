@@ -139,7 +139,7 @@ struct State {
   int steps = 0;
 };
 
-// The multipass sequence of host/trace/grid2_walk.cpp: enter, load the entry sub-cell, then
+// The multipass sequence of host/trace/walks/grid2_walk.cpp: enter, load the entry sub-cell, then
 // the sub-cell's triangles one per pass until no ray tests, a step (and load) until no ray
 // walks. With fused, the --mrt on forms.
 State multipass(const Structure& t, const Rays& r, bool fused) {

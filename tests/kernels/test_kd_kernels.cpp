@@ -287,7 +287,7 @@ struct State {
   int steps = 0;
 };
 
-// The multipass sequence of host/trace/kd_walk.cpp, single kernels: step, load, then the
+// The multipass sequence of host/trace/walks/kd_walk.cpp, single kernels: step, load, then the
 // leaf's triangles one per pass (intersections, next triangle) until no ray tests, until no ray
 // walks. With fused, the --mrt on forms (step + load, intersections + next triangle).
 State multipass(const Walk& w, bool fused) {

@@ -6,7 +6,7 @@
 #include "host/accel/grid.h"
 #include "host/model/cost_model.h"
 #include "host/scene/gltf_loader.h"
-#include "host/trace/stream_tracer.h"
+#include "host/trace/stream/stream_tracer.h"
 
 namespace {
 

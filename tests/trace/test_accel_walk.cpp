@@ -1,11 +1,11 @@
-// The helpers every walk shares (host/trace/accel_walk.h): the check that a format addresses a
+// The helpers every walk shares (host/trace/walks/accel_walk.h): the check that a format addresses a
 // structure's nodes and lists exactly, and the static textures' rewrite between frames.
 #include <doctest/doctest.h>
 
 #include <string>
 #include <vector>
 
-#include "host/trace/accel_walk.h"
+#include "host/trace/walks/accel_walk.h"
 #include "vgpu/gpu.h"
 
 namespace {

@@ -16,7 +16,7 @@
 #include "host/accel/grid2.h"
 #include "host/scene/animation.h"
 #include "host/scene/camera.h"
-#include "host/trace/stream_tracer.h"
+#include "host/trace/stream/stream_tracer.h"
 
 using host::RenderOptions;
 using host::RenderResult;

@@ -1,4 +1,4 @@
-// The BVH walk (--accel bvh, host/trace/bvh_walk.h) against the paper's grid walk and against
+// The BVH walk (--accel bvh, host/trace/walks/bvh_walk.h) against the paper's grid walk and against
 // itself: the same primary hit ids as the grid on every bundled scene and every stability case;
 // batches equal to pass by pass; --mrt on and the looping kernel equal to the multipass walk;
 // the CPU tracer's BVH walk equal to its grid walk and to the stream tracer's BVH walk; fp16
@@ -20,8 +20,8 @@
 #include "host/image/image_io.h"
 #include "host/scene/camera.h"
 #include "host/scene/gltf_loader.h"
-#include "host/trace/cpu_tracer.h"
-#include "host/trace/stream_tracer.h"
+#include "host/trace/cpu/cpu_tracer.h"
+#include "host/trace/stream/stream_tracer.h"
 #include "stability_cases.h"
 
 using host::RenderOptions;

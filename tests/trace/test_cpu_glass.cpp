@@ -13,9 +13,9 @@
 #include "host/accel/grid.h"
 #include "host/accel/grid2.h"
 #include "host/accel/kdtree.h"
-#include "host/trace/cpu_tracer.h"
-#include "host/trace/grid_walk.h"
-#include "host/trace/optics.h"
+#include "host/trace/cpu/cpu_tracer.h"
+#include "host/trace/walks/grid_walk.h"
+#include "host/trace/cpu/optics.h"
 #include "kernels/kernels.h"
 
 namespace {

@@ -11,9 +11,9 @@
 #include "host/accel/grid.h"
 #include "host/scene/camera.h"
 #include "host/scene/gltf_loader.h"
-#include "host/trace/cpu_tracer.h"
-#include "host/trace/reference.h"
-#include "host/trace/stream_tracer.h"
+#include "host/trace/cpu/cpu_tracer.h"
+#include "tests/support/reference.h"
+#include "host/trace/stream/stream_tracer.h"
 
 namespace {
 

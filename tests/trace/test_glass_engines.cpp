@@ -14,9 +14,9 @@
 #include "host/accel/kdtree.h"
 #include "host/scene/camera.h"
 #include "host/scene/gltf_loader.h"
-#include "host/trace/cpu_tracer.h"
-#include "host/trace/grid_walk.h"
-#include "host/trace/stream_tracer.h"
+#include "host/trace/cpu/cpu_tracer.h"
+#include "host/trace/walks/grid_walk.h"
+#include "host/trace/stream/stream_tracer.h"
 #include "vgpu/profile.h"
 
 namespace {

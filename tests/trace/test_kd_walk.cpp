@@ -1,4 +1,4 @@
-// The kd-tree walk (--accel kdtree, host/trace/kd_walk.h) against the grid's: the same primary
+// The kd-tree walk (--accel kdtree, host/trace/walks/kd_walk.h) against the grid's: the same primary
 // hit ids on every bundled scene and every stability case (but for ties: a ray through an edge
 // two triangles share, or a vertex, hits both at the same t and either answer is right), the
 // same coverage; batch walks, --mrt on and looping against pass by pass; the CPU tracer's
@@ -19,10 +19,10 @@
 #include "host/model/formats.h"
 #include "host/scene/camera.h"
 #include "host/scene/gltf_loader.h"
-#include "host/trace/accel_choice.h"
-#include "host/trace/cpu_tracer.h"
-#include "host/trace/grid_walk.h"
-#include "host/trace/stream_tracer.h"
+#include "host/trace/stream/accel_choice.h"
+#include "host/trace/cpu/cpu_tracer.h"
+#include "host/trace/walks/grid_walk.h"
+#include "host/trace/stream/stream_tracer.h"
 #include "stability_cases.h"
 
 namespace {

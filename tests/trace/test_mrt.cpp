@@ -12,7 +12,7 @@
 #include "host/image/image_io.h"
 #include "host/scene/camera.h"
 #include "host/scene/gltf_loader.h"
-#include "host/trace/stream_tracer.h"
+#include "host/trace/stream/stream_tracer.h"
 #include "stability_cases.h"
 
 namespace {

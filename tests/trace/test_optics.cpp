@@ -1,4 +1,4 @@
-// Known answers for host/trace/optics.h, the glass optics of the CPU reference tracer: Fresnel at
+// Known answers for host/trace/cpu/optics.h, the glass optics of the CPU reference tracer: Fresnel at
 // normal incidence, total internal reflection exactly at the critical angle, Snell's law, the
 // reflectance seen from both sides, and a slab's parallel displacement.
 #include <doctest/doctest.h>
@@ -6,7 +6,7 @@
 #include <cmath>
 #include <numbers>
 
-#include "host/trace/optics.h"
+#include "host/trace/cpu/optics.h"
 
 namespace {
 

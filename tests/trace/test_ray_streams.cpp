@@ -1,4 +1,4 @@
-// Glass on the virtual GPU (issue 25): the ray streams of host/trace/ray_streams.h end to end.
+// Glass on the virtual GPU (issue 25): the ray streams of host/trace/stream/ray_streams.h end to end.
 // A glass slab in front of a wall, seen along its axis, against Whitted's recursion in double
 // written out here (every hit on the axis is at normal incidence); levels longer than one
 // chunk; shadow rays through glass; the paper's reflections through the streams; and the same
@@ -11,7 +11,7 @@
 
 #include "host/accel/grid.h"
 #include "host/scene/gltf_loader.h"
-#include "host/trace/stream_tracer.h"
+#include "host/trace/stream/stream_tracer.h"
 
 using host::RenderOptions;
 using host::RenderResult;

@@ -10,7 +10,7 @@
 #include <string>
 #include <tuple>
 
-#include "host/trace/reference.h"
+#include "tests/support/reference.h"
 #include "stability_cases.h"
 
 namespace {

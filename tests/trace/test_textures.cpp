@@ -13,8 +13,8 @@
 #include "host/image/image_io.h"
 #include "host/scene/camera.h"
 #include "host/scene/gltf_loader.h"
-#include "host/trace/cpu_tracer.h"
-#include "host/trace/stream_tracer.h"
+#include "host/trace/cpu/cpu_tracer.h"
+#include "host/trace/stream/stream_tracer.h"
 #include "host/trace/textures.h"
 
 namespace {

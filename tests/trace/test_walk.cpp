@@ -1,4 +1,4 @@
-// The walk machinery of host/trace/walk.h on a walk that is not the grid's: a toy pass sequence
+// The walk machinery of host/trace/walks/walk.h on a walk that is not the grid's: a toy pass sequence
 // (count each pixel's counter down to zero, one step per pass, steered by a query) with its own
 // sites gets batch walks and their replay from run_walk, with the textures, query counts and
 // statistics of the same walk run pass by pass.
@@ -9,7 +9,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "host/trace/walk.h"
+#include "host/trace/walks/walk.h"
 #include "kernels/common.h"
 
 namespace {

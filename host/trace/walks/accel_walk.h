@@ -1,7 +1,7 @@
-// What the host loop (host/trace/stream_tracer.cpp) needs of an acceleration structure's walk
+// What the host loop (host/trace/stream/stream_tracer.cpp) needs of an acceleration structure's walk
 // (AccelWalk), and what the four walks share (ListWalk): the paper's uniform grid (grid_walk.h)
 // and the extensions (bvh_walk.h, kd_walk.h, grid2_walk.h) each keep only their textures,
-// programs, pass sites and sequence. How a pass sequence runs is host/trace/walk.h's business.
+// programs, pass sites and sequence. How a pass sequence runs is host/trace/walks/walk.h's business.
 #pragma once
 
 #include <cstdint>
@@ -146,7 +146,7 @@ class ListWalk : public AccelWalk {
   // left (at most max_list + 1 passes: lists are not longer, a stuck position is fp16's).
   // `intersect` reads (origins, rays, [traversal,] list state, hits, vertices) as
   // `reads_traversal` says, `intersect_next` the same and `lists` (--mrt on). `key(step, k,
-  // site)` names each pass (walk::PassKey). Written once for every X of host/trace/walk.h.
+  // site)` names each pass (walk::PassKey). Written once for every X of host/trace/walks/walk.h.
   template <class X, class Key>
   void test_triangles(X& x, Cursor& c, const Key& key, int step, const TriangleSites& site,
                       int max_list, const vgpu::Program& intersect,

@@ -1,13 +1,13 @@
-// The paper's walk through the uniform grid (host/trace/grid_walk.h): its textures, its pass
+// The paper's walk through the uniform grid (host/trace/walks/grid_walk.h): its textures, its pass
 // sequence (multipass and looping, on the parts every walk shares: ListWalk,
-// host/trace/accel_walk.h) and the walkers instantiated for it.
-#include "host/trace/grid_walk.h"
+// host/trace/walks/accel_walk.h) and the walkers instantiated for it.
+#include "host/trace/walks/grid_walk.h"
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 
-#include "host/trace/walk.h"
+#include "host/trace/walks/walk.h"
 
 namespace host {
 

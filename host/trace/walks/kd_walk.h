@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "host/accel/kdtree.h"
-#include "host/trace/accel_walk.h"
+#include "host/trace/walks/accel_walk.h"
 #include "host/trace/passes.h"
 #include "host/trace/render_options.h"
 #include "kernels/kernels.h"
@@ -49,7 +49,7 @@ class KdWalk : public ListWalk {
   void trace(PassRunner& r, vgpu::Texture& origins, vgpu::Texture& rays, bool primary,
              glm::vec3 eye) override;
 
-  // The multipass walk (host/trace/walk.h); Cursor and write_back are ListWalk's.
+  // The multipass walk (host/trace/walks/walk.h); Cursor and write_back are ListWalk's.
   template <class X>
   void walk(X& x, Cursor& c);
 

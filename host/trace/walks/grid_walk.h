@@ -1,5 +1,5 @@
 // The paper's walk through the uniform grid (Sec. 2.2-2.3): the grid's textures, and which pass
-// runs next, steered by which query. How the passes run is host/trace/walk.h's business.
+// runs next, steered by which query. How the passes run is host/trace/walks/walk.h's business.
 #pragma once
 
 #include <cstdint>
@@ -9,7 +9,7 @@
 #include "host/accel/grid.h"
 #include "host/model/formats.h"
 #include "host/scene/scene.h"
-#include "host/trace/accel_walk.h"
+#include "host/trace/walks/accel_walk.h"
 #include "host/trace/passes.h"
 #include "host/trace/render_options.h"
 #include "kernels/kernels.h"
@@ -68,7 +68,7 @@ class GridWalk : public ListWalk {
              glm::vec3 eye) override;
 
   // The multipass walk (one voxel step and one triangle per pass), written once for every way
-  // it runs (host/trace/walk.h). Cursor and write_back are ListWalk's; its per-pixel state is
+  // it runs (host/trace/walks/walk.h). Cursor and write_back are ListWalk's; its per-pixel state is
   // the traversal (voxel, entry t) and the voxel state (list position).
   template <class X>
   void walk(X& x, Cursor& c);

@@ -1,12 +1,12 @@
-// --accel auto (host/trace/accel_choice.h): probe frames priced by the cost model.
-#include "host/trace/accel_choice.h"
+// --accel auto (host/trace/stream/accel_choice.h): probe frames priced by the cost model.
+#include "host/trace/stream/accel_choice.h"
 
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 
 #include "host/model/cost_model.h"
-#include "host/trace/stream_tracer.h"
+#include "host/trace/stream/stream_tracer.h"
 #include "kernels/kernels.h"
 
 namespace host {

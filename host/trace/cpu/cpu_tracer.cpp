@@ -1,6 +1,6 @@
 // The CPU reference tracer (see cpu_tracer.h): Whitted's recursion per pixel, in double
 // precision, over the same uniform grid as the stream tracer.
-#include "host/trace/cpu_tracer.h"
+#include "host/trace/cpu/cpu_tracer.h"
 
 #include <algorithm>
 #include <chrono>
@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "host/common/parallel.h"
-#include "host/trace/optics.h"
+#include "host/trace/cpu/optics.h"
 #include "host/trace/sampling.h"
 #include "host/trace/textures.h"
 #include "kernels/kernels.h"
@@ -603,7 +603,7 @@ class Tracer {
   double spread_ = 0;             // angle between neighbouring pixels' rays (base_texel)
 };
 
-// --aa adaptive as the stream tracer runs it (host/trace/stream_tracer.cpp, render_adaptive):
+// --aa adaptive as the stream tracer runs it (host/trace/stream/stream_tracer.cpp, render_adaptive):
 // the centre ray, then levels of n x n samples where marcarPixeles' rule marks the pixel (a
 // neighbour's surface key differs, or the colour's second difference exceeds the threshold),
 // each level's samples replacing the pixel's earlier ones.

@@ -1,6 +1,6 @@
-// What the walks share (host/trace/accel_walk.h): the formats' checks, the static textures'
+// What the walks share (host/trace/walks/accel_walk.h): the formats' checks, the static textures'
 // rewrite between frames, the per-pixel state, and the looping variant's host loop.
-#include "host/trace/accel_walk.h"
+#include "host/trace/walks/accel_walk.h"
 
 namespace host {
 

@@ -1,6 +1,6 @@
 // The stream ray tracer's host loop, the paper's pipeline: rays, the walk through the grid,
-// shading with shadow rays, reflections; the walk itself is host/trace/grid_walk.cpp.
-#include "host/trace/stream_tracer.h"
+// shading with shadow rays, reflections; the walk itself is host/trace/walks/grid_walk.cpp.
+#include "host/trace/stream/stream_tracer.h"
 
 #include <algorithm>
 #include <array>
@@ -13,12 +13,12 @@
 #include <stdexcept>
 
 #include "host/common/parallel.h"
-#include "host/trace/bvh_walk.h"
-#include "host/trace/devices.h"
-#include "host/trace/grid2_walk.h"
-#include "host/trace/kd_walk.h"
+#include "host/trace/walks/bvh_walk.h"
+#include "host/trace/stream/devices.h"
+#include "host/trace/walks/grid2_walk.h"
+#include "host/trace/walks/kd_walk.h"
 #include "host/trace/passes.h"
-#include "host/trace/ray_streams.h"
+#include "host/trace/stream/ray_streams.h"
 #include "host/trace/sampling.h"
 #include "host/trace/textures.h"
 
@@ -68,7 +68,7 @@ struct StreamTracer::State {
   // The walk through the acceleration structure, and how passes are issued.
   std::unique_ptr<AccelWalk> walk;
   std::unique_ptr<PassRunner> runner;
-  // Glass (or --ray-streams on): the frame as ray streams (host/trace/ray_streams.h).
+  // Glass (or --ray-streams on): the frame as ray streams (host/trace/stream/ray_streams.h).
   std::unique_ptr<RayStreams> streams;
 };
 
@@ -180,7 +180,7 @@ StreamTracer::StreamTracer(const Scene& scene, const Accel& accel, const RenderO
     for (const Texture* t : {&s.uvs01, &s.uvs2, &s.texture_table, &s.atlas}) gpu.upload(*t);
   }
 
-  // The acceleration structure's textures and walk (host/trace/grid_walk.h, bvh_walk.h,
+  // The acceleration structure's textures and walk (host/trace/walks/grid_walk.h, bvh_walk.h,
   // kd_walk.h).
   if (accel.kind == AccelKind::bvh)
     s.walk = std::make_unique<BvhWalk>(gpu, *accel.bvh, opt_, float(s.v[0].width()));

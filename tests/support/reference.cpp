@@ -1,6 +1,6 @@
 // Test references (see reference.h): voxel walks from sorted plane crossings and brute-force
 // ray/triangle intersection in double precision.
-#include "host/trace/reference.h"
+#include "tests/support/reference.h"
 
 #include <algorithm>
 #include <cmath>

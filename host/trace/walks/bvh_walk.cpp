@@ -1,11 +1,11 @@
-// The stackless BVH walk (host/trace/bvh_walk.h): its textures, its pass sequence
-// (multipass and looping, on the parts every walk shares: ListWalk, host/trace/accel_walk.h)
+// The stackless BVH walk (host/trace/walks/bvh_walk.h): its textures, its pass sequence
+// (multipass and looping, on the parts every walk shares: ListWalk, host/trace/walks/accel_walk.h)
 // and the walkers instantiated for it.
-#include "host/trace/bvh_walk.h"
+#include "host/trace/walks/bvh_walk.h"
 
 #include <algorithm>
 
-#include "host/trace/walk.h"
+#include "host/trace/walks/walk.h"
 
 namespace host {
 

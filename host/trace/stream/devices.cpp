@@ -1,5 +1,5 @@
 // Device construction by name.
-#include "host/trace/devices.h"
+#include "host/trace/stream/devices.h"
 
 #include "host/model/formats.h"
 #include "host/trace/render_options.h"

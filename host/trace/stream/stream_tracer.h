@@ -12,7 +12,7 @@
 #include "host/accel/grid.h"
 #include "host/model/formats.h"
 #include "host/scene/scene.h"
-#include "host/trace/grid_walk.h"
+#include "host/trace/walks/grid_walk.h"
 #include "host/trace/render_options.h"
 #include "kernels/kernels.h"
 #include "vgpu/vgpu.h"
@@ -53,7 +53,7 @@ class StreamTracer {
  private:
   struct State;
   // One ray stream (primary, shadow or reflected) through the grid: the walk of
-  // host/trace/grid_walk.h.
+  // host/trace/walks/grid_walk.h.
   void trace(vgpu::Texture& origins, vgpu::Texture& rays, bool primary, const Camera& cam);
   // One frame of the paper's pipeline with the rays `generate` makes: trace, shade, reflect,
   // up to 1 + bounces iterations (iteration_number counts them over the sample frames, for the
@@ -64,7 +64,7 @@ class StreamTracer {
   void frame(const Camera& cam, const vgpu::Program& generate, RenderResult& res, bool aovs,
              int& iteration_number, const vgpu::Texture* marks = nullptr, bool keep_hits = false);
   // frame() as ray streams (a glass scene, or RenderOptions::ray_streams;
-  // host/trace/ray_streams.h): level 0 is the primary frame; each later level traces and
+  // host/trace/stream/ray_streams.h): level 0 is the primary frame; each later level traces and
   // shades, chunk by chunk, the rays the level before spawned (compacted), and the colours
   // return to the pixels level by level. Same arguments and results as frame().
   void stream_frame(const Camera& cam, const vgpu::Program& generate, RenderResult& res,

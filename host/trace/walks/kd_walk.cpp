@@ -1,12 +1,12 @@
-// The kd-restart walk (host/trace/kd_walk.h): its textures, its pass sequence
-// (multipass and looping, on the parts every walk shares: ListWalk, host/trace/accel_walk.h)
+// The kd-restart walk (host/trace/walks/kd_walk.h): its textures, its pass sequence
+// (multipass and looping, on the parts every walk shares: ListWalk, host/trace/walks/accel_walk.h)
 // and the walkers instantiated for it.
-#include "host/trace/kd_walk.h"
+#include "host/trace/walks/kd_walk.h"
 
 #include <algorithm>
 
-#include "host/trace/grid_walk.h"  // kSlackOfDiagonal
-#include "host/trace/walk.h"
+#include "host/trace/walks/grid_walk.h"  // kSlackOfDiagonal
+#include "host/trace/walks/walk.h"
 
 namespace host {
 

@@ -1,5 +1,5 @@
 // How a walk's pass sequence runs, apart from which passes it issues. A walk (the grid's in
-// host/trace/grid_walk.h) is written once as a template over X and runs three ways:
+// host/trace/walks/grid_walk.h) is written once as a template over X and runs three ways:
 //   DeviceWalker  pass by pass on the device (the emulator or the GL device), or as the replay
 //                 of a batch walk's tallies (the emulator's statistics, loads and read-backs);
 //   BatchWalker   one batch of 8 neighbouring pixels through every pass, its ray state in
