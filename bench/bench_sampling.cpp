@@ -1,7 +1,7 @@
 // Benchmark: the sampling modes (--spp, --aa adaptive, --aa undersample) on bundled scenes, in
 // one run: primary rays per pixel (mean, max), passes, the cost model's ms on gf5700 / gf6600 /
 // h200, the emulator's render ms (median of runs), and the error against the CPU tracer's
-// 256-sample image. scripts/sampling.py runs it (--json) to write docs/sampling.md.
+// 256-sample image. scripts/docs/sampling.py runs it (--json) to write docs/sampling.md.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>

@@ -9,7 +9,7 @@
 //     marks, which catch silhouettes);
 //   - marcarHuecos' own rule at T (keys, or colour spread > T), and its ranking (keys first, then
 //     spread, largest first) cut at exactly a third of the rays.
-// scripts/sampling.py runs it (--json) for docs/sampling.md's section on these bounds.
+// scripts/docs/sampling.py runs it (--json) for docs/sampling.md's section on these bounds.
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cmath>

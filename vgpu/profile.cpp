@@ -23,7 +23,7 @@ const std::vector<Profile>& profiles() {
     fx.precision = Format::fp32;  // fp30 "float" is IEEE single; "half" is fp16
     fx.bus_mbps = 2112;           // AGP 8x: 264 MB/s x 8 (GPU Gems 2, ch. 30)
     // Fixed costs: no public figure; one unit u fitted on Table 1 Bunny3 on this card (5075 ms,
-    // scripts/table1.py --fit), split pass : load : read-back = u : u : 2u (docs/table1.md).
+    // scripts/docs/table1.py --fit), split pass : load : read-back = u : u : 2u (docs/table1.md).
     fx.program_load_us = 651;  // fitted (Table 1 Bunny3), driver cost of a program switch
     fx.readback_us = 1301;     // fitted (Table 1 Bunny3); GPU Gems 2 ch. 6: a stall
     fx.pass_us = 651;          // fitted (Table 1 Bunny3)
@@ -166,13 +166,13 @@ const std::vector<Profile>& profiles() {
     // frames it predicts.
     m.output_bytes_per_clock = 28;  // model parameter (measured by bench_gl's copy pass)
     // A glGetTexImage of one RGBA32F texture to the host: 330 us for 1 MB, 5.43 ms for 16 MB,
-    // 28.1 ms for 64 MB (bench_gl, docs/real_gpu_h200_texture_io.json): 3.1 GB/s, no fixed part.
+    // 28.1 ms for 64 MB (bench_gl, results/real_gpu/real_gpu_h200_texture_io.json): 3.1 GB/s, no fixed part.
     m.download_us = 0;      // measured (bench_gl: within noise of 0)
     m.download_gbps = 3.1;  // measured (bench_gl, 16 MB read-back)
 
     m.max_loop_iterations = 1 << 20;  // model parameter: no loop count limit
     m.loop_overhead_clocks = 1;       // model parameter (assumed: a compare and a branch)
-    // One fragment on this H200 (bench_gl --latency, docs/structures_h200_latency.json, GPU
+    // One fragment on this H200 (bench_gl --latency, results/structures/structures_h200_latency.json, GPU
     // timer queries, 1024 against 8192 iterations): following links through RGBA32F textures
     // of 512x512 and 2048x2048 texels, 235.4 and 238.8 ns an iteration (473 clocks at 1980 MHz
     // for the larger; 212 where the 16x16 texture stays in the first-level cache); 16 dependent

@@ -269,10 +269,10 @@ TEST_CASE("the frame table lists each frame's update, its passes and the nodes i
 }
 
 TEST_CASE("the scatter scene's refitted BVH hits what a rebuild hits while its SAH cost grows") {
-  // scripts/scatter_scene.py writes the larger animation of docs/animation.md: ten full bunnies
+  // scripts/scenes/scatter_scene.py writes the larger animation of docs/animation.md: ten full bunnies
   // that start inside one another and hop apart.
   const fs::path dir = fresh_dir("scatter");
-  const std::string script = std::string(VGPU_TEST_DATA) + "/../../scripts/scatter_scene.py";
+  const std::string script = std::string(VGPU_TEST_DATA) + "/../../scripts/scenes/scatter_scene.py";
   REQUIRE(std::system(("python3 " + script + " " + dir.string() + " >/dev/null").c_str()) == 0);
   const std::string common = "render " + (dir / "scatter.gltf").string() +
                              " --accel bvh --frames 0:0.5:3 --size 16x12 -q --stats none";

@@ -1,7 +1,7 @@
 // libFuzzer target: every input is written to a file and loaded with host::load_scene, then as a
 // host::AnimatedScene posed at two times of each of its first animations. InputError
 // is the only acceptable failure; any other exception, crash, sanitizer report, hang or runaway
-// allocation is a loader bug. Build and run with scripts/fuzz.sh.
+// allocation is a loader bug. Build and run with scripts/ci/fuzz.sh.
 #include <unistd.h>
 
 #include <cctype>

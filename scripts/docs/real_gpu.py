@@ -3,17 +3,17 @@
 
 Writes docs/real_gpu.md and its chart docs/real_gpu.png (matplotlib) from JSON that
 bench/bench_gl wrote:
-  docs/real_gpu_llvmpipe.json     this machine's EGL device (Mesa llvmpipe); measured again
+  results/real_gpu/real_gpu_llvmpipe.json     this machine's EGL device (Mesa llvmpipe); measured again
                                   unless --reuse
-  docs/real_gpu_predictions.json  the emulator's counts and the cost model's predictions
+  results/real_gpu/real_gpu_predictions.json  the emulator's counts and the cost model's predictions
                                   (bench_gl --readback-wait none); computed again unless --reuse
   --add NAME=FILE.json            figures measured on another machine (the H200:
-                                  scripts/h200_bench.sh), with NAME_clocks.csv beside it if
+                                  scripts/h200/real_gpu.sh), with NAME_clocks.csv beside it if
                                   nvidia-smi sampled the clocks there
   --add-run NAME=FILE.json        an earlier run on that machine, shown for its clocks only
 
-Usage: /usr/bin/python3 scripts/real_gpu.py [--bench build/bench/bench_gl] [--runs 3] [--reuse]
-         [--add h200=docs/real_gpu_h200.json] [--add-run h200-run1=docs/real_gpu_h200_run1.json]
+Usage: /usr/bin/python3 scripts/docs/real_gpu.py [--bench build/bench/bench_gl] [--runs 3] [--reuse]
+         [--add h200=results/real_gpu/real_gpu_h200.json] [--add-run h200-run1=results/real_gpu/real_gpu_h200_run1.json]
 """
 import argparse
 import csv
@@ -28,8 +28,9 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 DOCS = os.path.join(ROOT, "docs")
+RESULTS = os.path.join(ROOT, "results", "real_gpu")  # the measurements (results/real_gpu/README.md)
 
 
 def run(cmd):
@@ -97,14 +98,14 @@ def main():
                     help="NAME=FILE.json: an earlier run there, for its frame times and clocks")
     args = ap.parse_args()
 
-    local = os.path.join(DOCS, "real_gpu_llvmpipe.json")
-    preds = os.path.join(DOCS, "real_gpu_predictions.json")
+    local = os.path.join(RESULTS, "real_gpu_llvmpipe.json")
+    preds = os.path.join(RESULTS, "real_gpu_predictions.json")
     if not args.reuse or not os.path.exists(local):
         run([args.bench, "--runs", str(args.runs), "--json", local])
     if not args.reuse or not os.path.exists(preds):
         run([args.bench, "--runs", "1", "--sizes", "256", "1024", "--readback-wait", "none",
              "--json", preds])
-    preds_var = os.path.join(DOCS, "real_gpu_predictions_variants.json")
+    preds_var = os.path.join(RESULTS, "real_gpu_predictions_variants.json")
     if args.add_variants and (not args.reuse or not os.path.exists(preds_var)):
         run([args.bench, "--runs", "1", "--sizes", "256", "1024", "--readback-wait", "none",
              "--variants", "mrt", "looping", "--json", preds_var])
@@ -126,7 +127,7 @@ def main():
 
     lines = ["# The paper's passes on real OpenGL drivers",
              "",
-             "Written by `scripts/real_gpu.py` from `bench/bench_gl` (do not edit by hand). The GL",
+             "Written by `scripts/docs/real_gpu.py` from `bench/bench_gl` (do not edit by hand). The GL",
              "device (`gl/`) runs the stream tracer's host loop unchanged, with fragment shaders",
              "generated from the same C++ kernels the emulator runs. Frames use `docs/table1.md`'s",
              "settings (3 iterations, phong, no shadow rays, a 15³ grid); every figure is the median",
@@ -189,7 +190,7 @@ def main():
                   "The same frames with the fused two-output passes (`--mrt on`) and with the "
                   "looping kernels (`--kernels looping`, 32 steps a pass), on the `h200` profile, "
                   "polled read-backs, measured in one run beside the multipass pipeline "
-                  f"(`docs/{os.path.basename(args.add_variants[0].partition('=')[2])}`)."]
+                  f"(`{os.path.relpath(os.path.abspath(args.add_variants[0].partition('=')[2]), ROOT)}`)."]
         if clk:
             lines[-1] += (f" SM clock while busy: median {statistics.median(clk):.0f} MHz, "
                           f"{min(clk):.0f}–{max(clk):.0f} MHz.")

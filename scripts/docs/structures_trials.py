@@ -1,4 +1,4 @@
-"""The H200 trials of docs/structures.md's looping frames, for scripts/structures.py: a second
+"""The H200 trials of docs/structures.md's looping frames, for scripts/docs/structures.py: a second
 warmed run beside the first, the traversal kernels' GPU time against their modeled work, the
 texture-layout trial, the kernels as the driver compiled them and the GLSL without `precise`.
 Each function returns the Markdown it adds (empty where its files were not given)."""
@@ -7,7 +7,7 @@ import os
 import statistics
 import tempfile
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 
 def fmt_ms(v):
@@ -64,15 +64,15 @@ def layout_trial(files):
             "power-of-two width whose square holds them instead (`host/trace/passes.cpp`, "
             "`entry_texture`; the kernels read the width from a uniform, so images and counts "
             "are unchanged, and so are the predictions), the same looping frames "
-            "(`docs/structures_h200_looping_square.json`, a third device session) show each "
+            "(`results/structures/structures_h200_looping_square.json`) show each "
             f"traversal kernel's GPU time within {100 * max(abs(x) for x in loop):.1f}% of the "
             f"wide layout's, and {len(multi)} multipass frames measured with both layouts in one "
             f"run within {100 * max(abs(x) for x in multi):.2f}%: the layout is not the grid2 "
             "shortfall. The square layout is kept: it changes nothing on the H200, and a GL "
             "driver whose textures stop at 16384 texels (llvmpipe) can now run the two-level "
             "grid of the bunny, whose 32768-wide sub-cell texture it refused. The wall times of "
-            f"that third session moved by {100 * min(walls):+.0f}% to {100 * max(walls):+.0f}% "
-            "against the second's, with the GPU time unchanged; " + str(len(out)) + " of its "
+            f"the square layout's run moved by {100 * min(walls):+.0f}% to {100 * max(walls):+.0f}% "
+            "against the wide layout's, with the GPU time unchanged; " + str(len(out)) + " of its "
             f"{len(cells)} looping cells are outside 35% ("
             + ", ".join(f"{g['scene']} / {g['accel']} {100 * (p / g['wall_ms'] - 1):+.0f}%"
                         for g, p in out) + ").")
@@ -85,7 +85,7 @@ def compiled_bodies(a):
     if not a.h200_programs:
         return ""
     L = ["", "", "The same kernels as the H200's driver compiled them (`bench_gl --dump-programs`, "
-         "the program binary's NV_gpu_program5 assembly, in `docs/h200_programs/`; the "
+         "the program binary's NV_gpu_program5 assembly, in `results/structures/h200_programs/`; the "
          "bunny's frames), one loop iteration: the driver turns each of the GLSL's selects "
          "into an IF / ELSE block, and each division into a DIV.", "",
          "| structure | assembly lines | DIV | TXF (fetches) | IF blocks | vgpu's scalar "
@@ -138,7 +138,7 @@ def precise_trial(files):
     return ("\n\nTried: the GLSL without `precise`. The generated shaders mark every "
             "arithmetic statement `precise` (no fused or reordered operations, so that the GL "
             "device gives the emulator's bits). The same looping frames (bunny, bunny-refl, "
-            "classic, scales; `docs/structures_h200_precise_{on,off}.json`, one run, an "
+            "classic, scales; `results/structures/structures_h200_precise_{on,off}.json`, one run, an "
             "experiment binary without the qualifier) change each traversal kernel's GPU time "
             "by " + ", ".join(f"{acc} {100 * min(v):+.0f} to {100 * max(v):+.0f}%"
                               for acc, v in sorted(by.items())) +
@@ -161,8 +161,8 @@ def looping_second(a):
     first_within = sum(abs(r["predicted_ms"] / r["wall_ms"] - 1) <= 0.35 for r, _ in pairs)
     runs = len(pairs[0][1]["wall_runs_ms"])
     mv = max(pairs, key=lambda p: abs(p[1]["wall_ms"] / p[0]["wall_ms"] - 1))
-    L = ["", "", f"A second warmed run (`LOOPING=1 RUNS={runs} scripts/structures_h200.sh`, "
-         "`docs/structures_h200_looping_warm2.json`, another device session) timed "
+    L = ["", "", f"A second warmed run (`LOOPING=1 RUNS={runs} scripts/h200/structures.sh`, "
+         "`results/structures/structures_h200_looping_warm2.json`) timed "
          f"{runs} frames of each configuration instead of 5, and keeps every frame's time: within "
          "a configuration the frames agree closely (the quartiles below), but between the two "
          f"runs the same frame moved by up to {100 * abs(mv[1]['wall_ms'] / mv[0]['wall_ms'] - 1):.0f}% "
@@ -254,7 +254,7 @@ def ablation_trial(files):
          "images are wrong) ran the same looping frames with the triangle test taken out of the "
          "loop (the step alone: the nested DDA, climbing to the coarse cell and descending into "
          "the next) and with the step taken out (the triangle test alone: rays stay in their "
-         "sub-cell until the pass cap), `docs/structures_h200_grid2_ablation_{full,step,test}"
+         "sub-cell until the pass cap), `results/structures/structures_h200_grid2_ablation_{full,step,test}"
          ".json`, one run:", "",
          "| body | scene | passes | traversal GPU ms | modeled work ms | GPU / modeled | frame's "
          "modeled arithmetic / texture demand ms |", "|---|---|---:|---:|---:|---:|---|"]
@@ -346,7 +346,7 @@ def latency_term(a):
          "(`vgpu/span.h`: one iteration issued in order, one operation unit each, a fetched "
          "texel ready a fetch latency after its fetch issued), priced at two latencies the "
          "`h200` profile takes from the H200 itself. `bench_gl --latency` "
-         "(`docs/structures_h200_latency.json`) runs one fragment through 1,024 and 8,192 "
+         "(`results/structures/structures_h200_latency.json`) runs one fragment through 1,024 and 8,192 "
          "iterations of a chain and divides the difference:", "",
          "| probe | texture | ns an iteration | clocks at 1980 MHz | the model's chain: fetches, "
          "operation units |", "|---|---|---:|---:|---|"]
@@ -372,7 +372,7 @@ def latency_term(a):
     ch, per = looping_8x8(a, a.h200_sizes + a.h200_sizes_grid)
     if ch:
         L += ["", "Each looping walk's iteration as the model counts it, priced, against the H200's "
-              "8x8 frames (`SIZES=1 scripts/structures_h200.sh`; two warps, so the traversal "
+              "8x8 frames (`SIZES=1 scripts/h200/structures.sh`; two warps, so the traversal "
               "kernel's GPU time is its longest lanes: GPU ms over the emulator's "
               "`loop_span_iterations` of the same frame, least squares through zero over the "
               "six scenes but scales, whose first frames also fetch 58 MB of textures cold):", "",
@@ -406,12 +406,11 @@ def latency_term(a):
     if third:
         within = sum(abs(w["predicted_ms"] / w["wall_ms"] - 1) <= 0.35 for w in third)
         e = [100 * (w["predicted_ms"] / w["wall_ms"] - 1) for w in third]
-        L += ["", "The stored runs' predictions were brought up to date with the term "
-              "(`scripts/h200_repredict.py`: the emulator's half of each stored frame run "
-              "again here; the measurements are untouched; every H200 table in the docs shows "
-              "the new figures). Then one more device session measured the 28 looping frames "
-              "with the binary that carries the term (`docs/structures_h200_looping_warm3.json`, "
-              "2 s of warm-up, 5 frames each), its predictions written before the frames ran: "
+        L += ["", "Every H200 table in the docs prices its frames with the term (the stored "
+              "runs' predictions were brought up to date, their measurements untouched: "
+              "`results/structures/README.md`). The 28 looping frames measured again with the "
+              "binary that carries the term (`results/structures/structures_h200_looping_warm3.json`, "
+              "2 s of warm-up, 5 frames each, predicted before they ran): "
               f"{within} of {len(third)} cells within 35%, from {min(e):+.0f}% to "
               f"{max(e):+.0f}%:", "",
               "| scene | structure | wall ms | GPU ms | predicted ms | of it, longest lanes | "

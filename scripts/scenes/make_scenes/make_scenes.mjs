@@ -1,6 +1,6 @@
-// Generates the paper's test scenes (Fal, Vasconcelos & Delrieux) as glTF 2.0 files in ../../scenes/.
+// Generates the paper's test scenes (Fal, Vasconcelos & Delrieux) as glTF 2.0 files in ../../../scenes/.
 //
-//   cd scripts/make_scenes && npm ci && node make_scenes.mjs
+//   cd scripts/scenes/make_scenes && npm ci && node make_scenes.mjs
 //
 // Every file is a single .gltf with its buffer embedded as a base64 data URI. Conventions shared by
 // all scenes (what host/scene/gltf_loader.cpp reads):
@@ -28,7 +28,7 @@ const bunny = require('bunny');
 const teapot = require('teapot');
 const HERE = dirname(fileURLToPath(import.meta.url));
 const pkgVersion = (name) => JSON.parse(readFileSync(join(HERE, 'node_modules', name, 'package.json'), 'utf8')).version;
-const OUT_DIR = join(HERE, '..', '..', 'scenes');
+const OUT_DIR = join(HERE, '..', '..', '..', 'scenes');
 
 // ---------------------------------------------------------------------------------------------
 // Small vector helpers
@@ -375,7 +375,7 @@ class Gltf {
     this.description = description;
     this.source = source;
     this.json = {
-      asset: { version: '2.0', generator: 'vgpu-rt scripts/make_scenes/make_scenes.mjs', extras: { description, source } },
+      asset: { version: '2.0', generator: 'vgpu-rt scripts/scenes/make_scenes/make_scenes.mjs', extras: { description, source } },
       extensionsUsed: ['KHR_lights_punctual'],
       extensions: { KHR_lights_punctual: { lights: [] } },
       scene: 0,
@@ -684,7 +684,7 @@ for (const [file, mesh, what, src] of [
 // "BunnyRefl" (docs/table1.md): the object alone, and the bunny on a mirror floor only.
 // ---------------------------------------------------------------------------------------------
 {
-  const g = new Gltf('sphere-alone', 'Table 1 "Sphere" (the reading scripts/table1.py uses): the UV sphere of sphere.gltf alone, no floor; same camera and light', SRC_PROC);
+  const g = new Gltf('sphere-alone', 'Table 1 "Sphere" (the reading scripts/docs/table1.py uses): the UV sphere of sphere.gltf alone, no floor; same camera and light', SRC_PROC);
   const mSphere = g.material('red', [0.8, 0.12, 0.08], 0.3, 0.2);
   const sphere = uvSphere(1.5, 32, 24); // 1472 faces
   const c = [0, 2.0, 0];
@@ -694,7 +694,7 @@ for (const [file, mesh, what, src] of [
   summary.push(g.write('sphere-alone.gltf'));
 }
 {
-  const g = new Gltf('bunny-mirror', 'Table 1 "BunnyRefl" (the reading scripts/table1.py uses): the full bunny of bunny-refl.gltf on a reflective 6 x 6 floor (about twice its footprint), no walls; same camera and light', `${SRC_BUNNY}; floor procedural`);
+  const g = new Gltf('bunny-mirror', 'Table 1 "BunnyRefl" (the reading scripts/docs/table1.py uses): the full bunny of bunny-refl.gltf on a reflective 6 x 6 floor (about twice its footprint), no walls; same camera and light', `${SRC_BUNNY}; floor procedural`);
   const mBunny = g.material('bunny', [0.85, 0.72, 0.55], 0.0, 0.6);
   const mFloor = g.material('floor', [0.55, 0.6, 0.7], 0.5, 0.3);
   const t = [-0.4, bunnyBase, 0];
@@ -886,7 +886,7 @@ const lines = [
   'Regenerate (deterministic, byte-identical output):',
   '',
   '```sh',
-  'cd scripts/make_scenes && npm ci && node make_scenes.mjs',
+  'cd scripts/scenes/make_scenes && npm ci && node make_scenes.mjs',
   '```',
   '',
   'Conventions: world units, +Y up, floors at y = 0; indexed TRIANGLES (u16) with float POSITION and',

@@ -7,16 +7,15 @@
   scales.gltf   25 bunnies from 5% to 15x the bunny's size (log-spaced) on a floor, the same
                 mesh instanced by 25 nodes (92k triangles)
 
-Usage: scripts/uneven_scenes.py OUTDIR
+Usage: scripts/scenes/uneven_scenes.py OUTDIR
 """
 import base64
 import json
-import math
 import struct
 import sys
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def floor_buffers(half, y):
@@ -72,12 +71,12 @@ def main():
     width = (hi[0] - lo[0]) * s  # world width of the bunny
 
     g = json.loads(json.dumps(base))
-    g["asset"]["generator"] = "vgpu-rt scripts/uneven_scenes.py"
+    g["asset"]["generator"] = "vgpu-rt scripts/scenes/uneven_scenes.py"
     with_floor(g, 270 * width / 2, 0.0, [0.6, 0.6, 0.62])
     (out / "stadium.gltf").write_text(json.dumps(g))
 
     g = json.loads(json.dumps(base))
-    g["asset"]["generator"] = "vgpu-rt scripts/uneven_scenes.py"
+    g["asset"]["generator"] = "vgpu-rt scripts/scenes/uneven_scenes.py"
     g["nodes"] = [n for n in g["nodes"] if n.get("name") in ("light",)]
     g["cameras"] = []
     g["scenes"] = [{"nodes": [0]}]

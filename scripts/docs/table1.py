@@ -3,7 +3,7 @@
 the statistics and the cost model's predictions (host/model/cost_model.h) from --stats-json, and writes
 docs/table1.md and docs/table1_breakdown.png (matplotlib).
 
-Usage: /usr/bin/python3 scripts/table1.py [--vgpu-rt build/host/vgpu-rt] [--reuse] [--fit]
+Usage: /usr/bin/python3 scripts/docs/table1.py [--vgpu-rt build/host/vgpu-rt] [--reuse] [--fit]
   --reuse  keep the JSON of earlier renders (build/table1/*.json) instead of rendering again
   --fit    print the fixed costs fitted on the calibration cells (for vgpu/profile.cpp) and stop
 """
@@ -14,7 +14,10 @@ import re
 import subprocess
 import sys
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "lib"))
+import vgpurt  # noqa: E402
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 # Fal, Vasconcelos & Delrieux, Table 1: 256x256, ms.
 PAPER = {
@@ -58,13 +61,10 @@ def run(exe, scene, profile, work, reuse, masks="off", engine=None, extra=(), ta
         return json.load(open(path))
     opts = dict(zip(SETTINGS[::2], SETTINGS[1::2]))
     opts.update(zip(extra[::2], extra[1::2]))
-    cmd = [exe, "render", scene, *[x for kv in opts.items() for x in kv], "--profile", profile,
-           "--masks", masks, "--stats", "none", "-q", "--stats-json", path]
+    args = [*[x for kv in opts.items() for x in kv], "--profile", profile, "--masks", masks]
     if engine:
-        cmd += ["--engine", engine]
-    print("+", " ".join(cmd), file=sys.stderr, flush=True)
-    subprocess.run(cmd, check=True, cwd=ROOT)
-    return json.load(open(path))
+        args += ["--engine", engine]
+    return vgpurt.render(exe, scene, args, stats_json=path, cwd=ROOT, echo=True)
 
 
 def has_engine(exe):
@@ -256,7 +256,7 @@ def write_doc(data, masks, cpu, figures, readings, mrt, mrt_masks):
     w = L.append
     j0 = data[("Sphere", "gf5700")]
     w("# Table 1: the paper's times, our measurements and the cost model's predictions\n")
-    w("Written by `/usr/bin/python3 scripts/table1.py` (do not edit by hand). It renders every scene "
+    w("Written by `/usr/bin/python3 scripts/docs/table1.py` (do not edit by hand). It renders every scene "
       "on every profile with `vgpu-rt render --stats-json`, and reads the statistics and the cost "
       "model's predictions (`host/model/cost_model.h`, also printed by `vgpu-rt render --predict`).\n")
     w("Settings, the same for every cell: `" + " ".join(SETTINGS) + "`, masks off unless said. "

@@ -3,18 +3,18 @@
 --aa undersample) on the bundled scenes, error against a 256-sample reference beside rays,
 passes and modeled time.
 
-Usage: /usr/bin/python3 scripts/sampling.py [--bench build/bench/bench_sampling] [--size 128]
+Usage: /usr/bin/python3 scripts/docs/sampling.py [--bench build/bench/bench_sampling] [--size 128]
     [--reps 3] [--scenes sphere,bunny,...] [--other-scenes hop,teapot,...] [--changed-size 256]
-       /usr/bin/python3 scripts/sampling.py --h200 FILE... [--h200-clocks CSV]
+       /usr/bin/python3 scripts/docs/sampling.py --h200 FILE... [--h200-clocks CSV]
            [--h200-looping FILE... [--h200-looping-control FILE...] [--h200-looping-clocks CSV]]
-       /usr/bin/python3 scripts/sampling.py --bounds-only [--bounds-bench FILE]
+       /usr/bin/python3 scripts/docs/sampling.py --bounds-only [--bounds-bench FILE]
 --bounds-only rewrites only the section on how far any choice of traced gaps can go (between
 the undersample-bounds markers; bench/bench_undersample_bounds.cpp, a few seconds), which a
 full regeneration writes too.
---h200 runs nothing: it reads bench_gl's JSON from an H200 (scripts/streams_sampling_h200.sh) and
+--h200 runs nothing: it reads bench_gl's JSON from an H200 (scripts/h200/streams_sampling.sh) and
 rewrites only docs/sampling.md's H200 section (between the h200-measured markers), which a full
 regeneration keeps as it is. --h200-looping takes the looping rows from a second run with a warm-up
-before timing (scripts/sampling_looping_h200.sh), --h200-looping-control its run without one.
+before timing (scripts/h200/sampling_looping.sh), --h200-looping-control its run without one.
 
 The figures are bench_sampling's (bench/bench_sampling.cpp), which this script runs with --json:
 every image is the stream engine's (the emulator) on gf6600, the reference the CPU tracer at
@@ -31,13 +31,15 @@ import subprocess
 import sys
 import tempfile
 
-import h200_frames as hf
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "lib"))
+import h200_frames as hf  # noqa: E402
 import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 MAIN = "sphere,bunny,bunny-refl,classic"
 OTHERS = "bunny-low,bunny-mirror,hop,sphere-alone,teapot,textured"
 
@@ -266,7 +268,7 @@ like a curve)."""
 
 H200_BEGIN, H200_END = "<!-- h200-measured:begin -->", "<!-- h200-measured:end -->"
 DOC = os.path.join(ROOT, "docs", "sampling.md")
-# What the measured tables say (docs/sampling_h200*.json and the clock log, one device run; kept
+# What the measured tables say (results/sampling/sampling_h200*.json and the clock log, one device run; kept
 # with the script so that a rewrite of the section keeps it).
 H200_PROSE = """**What the differences say about the model's pricing of sampling passes.**
 
@@ -343,7 +345,8 @@ def h200(paths, clocks, looping=None, control=None, looping_clocks=None):
     out = ["## Measured on an H200 through the GL device", ""]
     out.append(
         f"The sampling modes on an NVIDIA H200 through the GL device (`bench/bench_gl.cpp "
-        f"--sampling`, run by `scripts/streams_sampling_h200.sh`; {r0['renderer']}, OpenGL "
+        f"--sampling`; the files and how they were run: `results/sampling/README.md`; "
+        f"{r0['renderer']}, OpenGL "
         f"{r0['gl_version']}), {r0['size']}x{r0['size']}, the CLI's defaults ({r0['bounces']} "
         "bounces, Phong, shadows, the paper's grid at `--grid auto`, `--aa-threshold` 0.1), "
         f"polled read-backs: the median of {r0['runs']} warm frames after one warm-up frame, "
@@ -357,8 +360,7 @@ def h200(paths, clocks, looping=None, control=None, looping_clocks=None):
     if again:
         a0 = again[0]
         out[-1] += (
-            f" The looping rows come from a second run (`scripts/sampling_looping_h200.sh`, the "
-            f"same options, looping frames only): after the warm-up frame, frames of the same "
+            f" The looping rows come from a second run (the same options, looping frames only): after the warm-up frame, frames of the same "
             f"configuration for {a0['warmup_ms'] / 1e3:.1f} s (`bench_gl --warmup-ms`) before "
             f"the {a0['runs']} timed ones, so that the GPU clock is up when timing starts; the "
             "multipass rows from the first run (one warm-up frame).")
@@ -411,19 +413,19 @@ def main():
                     help="only rewrite docs/sampling.md's section on how far any choice of "
                     "traced gaps can go")
     ap.add_argument("--h200", nargs="+", metavar="FILE",
-                    help="bench_gl JSON measured on an H200 (docs/sampling_h200*.json): only "
+                    help="bench_gl JSON measured on an H200 (results/sampling/sampling_h200*.json): only "
                     "rewrite docs/sampling.md's H200 section")
     ap.add_argument("--h200-clocks", metavar="CSV",
-                    default=os.path.join(ROOT, "docs", "streams_sampling_h200_clocks.csv"),
+                    default=os.path.join(ROOT, "results", "sampling", "streams_sampling_h200_clocks.csv"),
                     help="nvidia-smi's clock log of the same run")
     ap.add_argument("--h200-looping", nargs="+", metavar="FILE",
                     help="bench_gl JSON of the looping frames run again with --warmup-ms "
-                    "(docs/sampling_h200_looping*.json): the section's looping rows")
+                    "(results/sampling/sampling_h200_looping*.json): the section's looping rows")
     ap.add_argument("--h200-looping-control", nargs="+", metavar="FILE",
                     help="the same run's frames without warm-up "
-                    "(docs/sampling_h200_looping_nowarm*.json)")
+                    "(results/sampling/sampling_h200_looping_nowarm*.json)")
     ap.add_argument("--h200-looping-clocks", metavar="CSV",
-                    default=os.path.join(ROOT, "docs", "sampling_h200_looping_clocks.csv"),
+                    default=os.path.join(ROOT, "results", "sampling", "sampling_h200_looping_clocks.csv"),
                     help="nvidia-smi's clock log of the looping run")
     args = ap.parse_args()
     if args.bounds_only:
@@ -494,7 +496,7 @@ def main():
     out = [
         "# Sampling: error against rays, passes and modeled time",
         "",
-        "Written by `scripts/sampling.py` from `bench_sampling`'s figures (do not edit by hand; "
+        "Written by `scripts/docs/sampling.py` from `bench_sampling`'s figures (do not edit by hand; "
         "the prose around the tables is in the script). Scenes at "
         f"{args.size}x{args.size}, the CLI's default options (2 bounces, Phong, shadows, grid), "
         "the stream engine on gf6600 (predictions for every profile come from the same "

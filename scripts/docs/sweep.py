@@ -17,10 +17,10 @@ wrong by three criteria (all through `vgpu-rt compare`, i.e. OpenImageIO):
 plus the PSNR of the colour image. A grid the profile refuses (the render fails) is recorded with
 its message and left out of the chart; a run over --timeout seconds likewise.
 
-Writes docs/sweep.csv, docs/speed_vs_accuracy.png and docs/accuracy.md.
-Usage: /usr/bin/python3 scripts/sweep.py [--grids auto,8,16,32] [--jobs 2] [--timeout 300]
+Writes results/sweep/sweep.csv, docs/speed_vs_accuracy.png and docs/accuracy.md.
+Usage: /usr/bin/python3 scripts/docs/sweep.py [--grids auto,8,16,32] [--jobs 2] [--timeout 300]
                                          [--reuse WORKDIR]
-       /usr/bin/python3 scripts/sweep.py --plot-only   (chart and report from docs/sweep.csv)
+       /usr/bin/python3 scripts/docs/sweep.py --plot-only   (chart and report from results/sweep/sweep.csv)
 """
 import argparse
 import concurrent.futures as cf
@@ -35,7 +35,10 @@ import sys
 import tempfile
 import time
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "lib"))
+import vgpurt  # noqa: E402
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 SCENES = ["sphere", "bunny", "bunny-refl", "classic"]
 PRECISIONS = ["fp32", "fp24", "fp16", "auto"]
 PARTS = ["gf5700", "r300", "gf6600"]  # the 2004 profiles, modeled time of each
@@ -54,34 +57,23 @@ def render(exe, work, scene, grid, engine, precision, bounces, size, timeout, re
     if reuse and all(os.path.exists(p) for p in out.values()):
         with open(out["json"]) as f:
             return tag, out, json.load(f), ""
-    cmd = [exe, "render", scene, "--engine", engine, "--grid", grid, "--bounces", str(bounces),
-           "--size", size, "--out", out["rgb"], "--aov", "hit=" + out["hit"], "depth=" + out["depth"],
-           "--stats-json", out["json"], "--quiet", "--stats", "none", "--threads", "1"]
-    if engine == "stream":
-        cmd += ["--precision", precision]
+    args = ["--engine", engine, "--grid", grid, "--bounces", str(bounces), "--size", size,
+            "--threads", "1"] + (["--precision", precision] if engine == "stream" else [])
     t0 = time.time()
     try:
-        p = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
+        stats = vgpurt.render(exe, scene, args, stats_json=out["json"], out=out["rgb"],
+                              aovs={"hit": out["hit"], "depth": out["depth"]}, timeout=timeout)
     except subprocess.TimeoutExpired:
         return tag, out, None, f"timeout after {timeout} s"
-    if p.returncode != 0:
-        msg = (p.stderr.strip() or p.stdout.strip()).splitlines()
-        return tag, out, None, "refused: " + (msg[-1] if msg else f"exit {p.returncode}")
-    with open(out["json"]) as f:
-        stats = json.load(f)
+    except vgpurt.Failed as e:
+        return tag, out, None, "refused: " + e.message
     stats["_wall_s"] = time.time() - t0
     return tag, out, stats, ""
 
 
 def compare(exe, a, b, threshold=None):
-    cmd = [exe, "compare", a, b] + (["--threshold", str(threshold)] if threshold else [])
-    p = subprocess.run(cmd, capture_output=True, text=True)
-    text = p.stdout + p.stderr
-    share = re.search(r"([0-9.eE+-]+)% of pixels differ", text)
-    psnr = re.search(r"PSNR ([0-9.eE+-]+|inf)", text)
-    if not share:
-        raise RuntimeError(f"cannot parse compare output: {text!r}")
-    return float(share.group(1)) / 100.0, (float(psnr.group(1)) if psnr else math.inf)
+    share, psnr, _, _ = vgpurt.compare(exe, a, b, threshold if threshold else None)
+    return share, psnr
 
 
 def main():
@@ -93,14 +85,16 @@ def main():
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--timeout", type=float, default=300)
     ap.add_argument("--size", default="128x128")
+    ap.add_argument("--results-dir", default=os.path.join(ROOT, "results", "sweep"),
+                    help="where sweep.csv, the raw figures, goes")
     ap.add_argument("--build", default=os.path.join(ROOT, "build-stab"))
-    ap.add_argument("--plot-only", action="store_true", help="redraw the chart from docs/sweep.csv")
+    ap.add_argument("--plot-only", action="store_true", help="redraw the chart from results/sweep/sweep.csv")
     ap.add_argument("--reuse", metavar="DIR",
                     help="work directory of an earlier sweep: keep the renders it finished")
     args = ap.parse_args()
     SCENES[:] = args.scenes.split(",")
     if args.plot_only:
-        with open(os.path.join(args.out_dir, "sweep.csv")) as f:
+        with open(os.path.join(args.results_dir, "sweep.csv")) as f:
             rows = [dict(r, bounces=int(r["bounces"])) for r in csv.DictReader(f)]
         plot(rows, os.path.join(args.out_dir, "speed_vs_accuracy.png"), args.size)
         report(rows, os.path.join(args.out_dir, "accuracy.md"), args.size)
@@ -171,7 +165,8 @@ def main():
         rows.append(row)
 
     os.makedirs(args.out_dir, exist_ok=True)
-    csv_path = os.path.join(args.out_dir, "sweep.csv")
+    os.makedirs(args.results_dir, exist_ok=True)
+    csv_path = os.path.join(args.results_dir, "sweep.csv")
     with open(csv_path, "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=list(rows[0].keys()))
         w.writeheader()
@@ -275,8 +270,8 @@ def report(rows, path, size):
     pixels = int(ok[0]["pixels"]) if ok else 0
     L = []
     L.append("# Accuracy per precision mode: wrong pixels against the CPU reference\n")
-    L.append("Written by `/usr/bin/python3 scripts/sweep.py` (do not edit by hand; the same runs "
-             "as `docs/sweep.csv` and `docs/speed_vs_accuracy.png`).\n")
+    L.append("Written by `/usr/bin/python3 scripts/docs/sweep.py` (do not edit by hand; the same runs "
+             "as `results/sweep/sweep.csv` and `docs/speed_vs_accuracy.png`).\n")
     L.append(f"Every stream render (`--engine stream --precision P`) is compared with the CPU "
              f"tracer (`--engine cpu`, double precision) at the same scene, grid and bounce "
              f"count, {size} ({pixels} pixels), through `vgpu-rt compare` (OpenImageIO). A pixel "

@@ -1,4 +1,4 @@
-# Sourced by the H200 measurement scripts (scripts/*_h200.sh) on the GPU host, from the
+# Sourced by the H200 measurement scripts (scripts/h200/*.sh) on the GPU host, from the
 # repository's root, after `out` is set: installs the carried glvnd GL libraries (.gl/*.deb,
 # the device has no Debian packages), points EGL at NVIDIA's vendor file, and logs the SM clock
 # to $out/clocks.csv in the background every CLOCK_MS ms (default 500; 500 where nvidia-smi

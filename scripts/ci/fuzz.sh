@@ -2,11 +2,11 @@
 # Fuzzes the glTF loader: builds tests/fuzz (clang, libFuzzer + ASan + UBSan) in build-fuzz and
 # runs it for DURATION seconds (default 60) on a scratch copy of tests/fuzz/corpus, so the
 # committed seeds stay as they are. Crash inputs are written to build-fuzz/artifacts/.
-# Usage: scripts/fuzz.sh [DURATION]
+# Usage: scripts/ci/fuzz.sh [DURATION]
 set -euo pipefail
 
 duration=${1:-60}
-root=$(cd "$(dirname "$0")/.." && pwd)
+root=$(cd "$(dirname "$0")/../.." && pwd)
 build=$root/build-fuzz
 
 CC=clang CXX=clang++ cmake -S "$root" -B "$build" -DVGPU_FUZZ=ON -DVGPU_BENCH=OFF \

@@ -3,10 +3,10 @@
 table (markdown) on stdout; with --glass, measures the bundled `glass` scene instead and writes
 its tables into docs/materials.md between the glass-measured markers.
 
-Usage: /usr/bin/python3 scripts/materials.py [--vgpu-rt build/host/vgpu-rt] [--size 256] [--glass]
-       /usr/bin/python3 scripts/materials.py --h200 FILE... [--h200-clocks CSV]
-       /usr/bin/python3 scripts/materials.py --opaque-copy PATH
---h200 measures nothing: it reads bench_gl's JSON from an H200 (scripts/streams_sampling_h200.sh)
+Usage: /usr/bin/python3 scripts/docs/materials.py [--vgpu-rt build/host/vgpu-rt] [--size 256] [--glass]
+       /usr/bin/python3 scripts/docs/materials.py --h200 FILE... [--h200-clocks CSV]
+       /usr/bin/python3 scripts/docs/materials.py --opaque-copy PATH
+--h200 measures nothing: it reads bench_gl's JSON from an H200 (scripts/h200/streams_sampling.sh)
 and writes docs/materials.md's H200 section between the h200-measured markers.
 Each filter renders once on the stream engine (the emulator, gf5700: every fragment runs every
 pass, as on the paper's card) with --predict: the shader's texture fetches, the frame's, and
@@ -18,26 +18,25 @@ a supersampled reference of the textures' footprint in each pixel.
 import argparse
 import json
 import os
-import subprocess
+import sys
 import tempfile
 
-import h200_frames as hf
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "lib"))
+import h200_frames as hf  # noqa: E402
+import vgpurt  # noqa: E402
 
 import matplotlib.image as mpimg
 import numpy as np
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 PROFILES = ["gf5700", "gf6600", "h200"]
 
 
 def render(exe, scene, size, opts, png, js=None, predict=True):
-    cmd = [exe, "render", scene, "--size", f"{size}x{size}", "--out", png, "--stats", "none", "-q",
-           *opts]
-    if js:
-        cmd += ["--stats-json", js] + (["--predict"] if predict else [])
-    subprocess.run(cmd, check=True)
+    opts = ["--size", f"{size}x{size}", *opts] + (["--predict"] if js and predict else [])
+    vgpurt.run(vgpurt.render_command(exe, scene, opts, stats_json=js, out=png))
     img = mpimg.imread(png)[..., :3].astype(np.float64)
-    return img, (json.load(open(js)) if js else None)
+    return img, (vgpurt.read_stats(js) if js else None)
 
 
 def shader(stats):
@@ -75,7 +74,7 @@ def glass(exe, size):
                 runs[label, engine] = js
     g, c = runs["glass", "stream"], runs["glass", "cpu"]
     out.append(f"`glass` at {size}x{size}, gf5700 defaults (phong, shadows, 2 bounces), one run "
-               f"per engine (`/usr/bin/python3 scripts/materials.py --glass`).\n")
+               f"per engine (`/usr/bin/python3 scripts/docs/materials.py --glass`).\n")
     out.append("Rays per level by kind (spawned by the level for the next), stream engine / CPU "
                "tracer:\n")
     out.append("| level | stream length | chunks | reflected | refracted | of the reflected, "
@@ -110,7 +109,7 @@ def glass(exe, size):
 
 H200_BEGIN, H200_END = "<!-- h200-measured:begin -->", "<!-- h200-measured:end -->"
 
-# What the measured tables say (docs/materials_h200_*.json, one device run; kept with the script
+# What the measured tables say (results/materials/materials_h200_*.json, one device run; kept with the script
 # so that a rewrite of the section keeps it).
 H200_PROSE = """**What the differences say about the model's pricing of stream passes.**
 
@@ -150,8 +149,8 @@ def h200(paths, clocks):
     clk = hf.sm_clock(clocks)
     out = ["## Measured on an H200 through the GL device", ""]
     out.append(
-        f"The glass frames on an NVIDIA H200 through the GL device (`bench/bench_gl.cpp`, run by "
-        f"`scripts/streams_sampling_h200.sh`; {r0['renderer']}, OpenGL {r0['gl_version']}), "
+        f"The glass frames on an NVIDIA H200 through the GL device (`bench/bench_gl.cpp`; the "
+        f"files and how they were run: `results/materials/README.md`; {r0['renderer']}, OpenGL {r0['gl_version']}), "
         f"{r0['size']}x{r0['size']}, "
         f"the CLI's defaults ({r0['bounces']} bounces, Phong, shadows, the paper's grid at "
         f"`--grid auto`), polled read-backs: the median of {r0['runs']} warm frames after one "
@@ -223,10 +222,10 @@ def main():
     ap.add_argument("--opaque-copy", metavar="PATH",
                     help="only write the glass scene's opaque copy to PATH (for bench_gl)")
     ap.add_argument("--h200", nargs="+", metavar="FILE",
-                    help="bench_gl JSON measured on an H200 (docs/materials_h200_*.json): only "
+                    help="bench_gl JSON measured on an H200 (results/materials/materials_h200_*.json): only "
                     "write docs/materials.md's H200 section")
     ap.add_argument("--h200-clocks", metavar="CSV",
-                    default=os.path.join(ROOT, "docs", "streams_sampling_h200_clocks.csv"),
+                    default=os.path.join(ROOT, "results", "sampling", "streams_sampling_h200_clocks.csv"),
                     help="nvidia-smi's clock log of the same run")
     args = ap.parse_args()
     exe, size = args.vgpu_rt, args.size
@@ -262,7 +261,7 @@ def main():
                          sh["bytes_read"], js["totals"]["texture_fetches"],
                          [js["predicted_ms"][p] for p in PROFILES], rms))
     print(f"`textured` at {size}x{size}, gf5700 defaults (phong, shadows, 2 bounces), stream "
-          f"engine; `scripts/materials.py`.\n")
+          f"engine; `scripts/docs/materials.py`.\n")
     print("| filter | shader fetches / fragment | shader fetches | shader bytes read | frame "
           "fetches | predicted gf5700 ms | predicted gf6600 ms | predicted h200 ms | RMS vs "
           "reference |")

@@ -1,7 +1,7 @@
 """Frames measured on an H200 through the GL device (bench_gl JSON from
-scripts/streams_sampling_h200.sh) beside the cost model's h200 prediction from the emulator's
+scripts/h200/streams_sampling.sh) beside the cost model's h200 prediction from the emulator's
 statistics of the same frame: the tables of docs/materials.md's and docs/sampling.md's H200
-sections (scripts/materials.py --h200, scripts/sampling.py --h200), and the marked section they
+sections (scripts/docs/materials.py --h200, scripts/docs/sampling.py --h200), and the marked section they
 replace. Times are ms; "vs" columns are (predicted - measured) / measured.
 """
 import csv

@@ -1,9 +1,9 @@
 #!/usr/bin/env python3
 """Writes docs/structures.md and docs/structures.png: the uniform grid (the paper's), the
 two-level grid, the BVH, the kd-tree and --accel auto on the bundled scenes and on uneven scenes
-(scripts/uneven_scenes.py), side by side in one run.
+(scripts/scenes/uneven_scenes.py), side by side in one run.
 
-Usage: /usr/bin/python3 scripts/structures.py [--vgpu-rt build/host/vgpu-rt] [--size 256]
+Usage: /usr/bin/python3 scripts/docs/structures.py [--vgpu-rt build/host/vgpu-rt] [--size 256]
                                               [--runs 3] [--h200 FILE ...]
                                               [--h200-looping FILE ...] [--h200-looping-again FILE ...]
                                               [--h200-layout SQUARE MULTI_WIDE MULTI_SQUARE WIDE]
@@ -20,10 +20,10 @@ statistics do not change between runs), emulator ms and CPU tracer ms (medians o
 2 host threads). --accel auto chooses per profile: it is run with --profile gf6600 and with
 --profile h200. --h200 FILE... adds frames measured on an H200 through the GL device: bench_gl JSON files
 (bench/bench_gl.cpp with --accel, warm frames after one warm-up, polled read-backs; made by
-scripts/structures_h200.sh), each GL frame set beside the cost model's prediction from the
+scripts/h200/structures.sh), each GL frame set beside the cost model's prediction from the
 same frame's emulator statistics in the same file. --reuse --only grid2 "auto gf6600" "auto h200"
-renders only those rows again and keeps the others from OUT/structures.json (rows of one size).
---h200-sizes FILE... (scripts/structures_h200.sh with SIZES=1: the same walks from 8x8 to
+renders only those rows again and keeps the others from results/structures/structures.json (rows of one size).
+--h200-sizes FILE... (scripts/h200/structures.sh with SIZES=1: the same walks from 8x8 to
 512x512) tests whether what the model lacks in the H200's looping frames is a cost per frame or
 one that grows with the image, and writes what it finds under "Left out".
 """
@@ -38,13 +38,16 @@ import tempfile
 import textwrap
 
 import matplotlib
-import structures_trials as st
 import numpy as np
+import structures_trials as st
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "lib"))
+import vgpurt  # noqa: E402
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 BUNDLED = ["sphere", "bunny", "bunny-refl", "classic", "teapot"]
 UNEVEN = ["stadium", "scales"]
 MODES = {"primary": ["--bounces", "0", "--shadows", "off"], "full": []}
@@ -52,9 +55,7 @@ COLOURS = {"grid": "C0", "grid2": "C1", "bvh": "C2", "kdtree": "C3"}  # the same
 
 
 def run(exe, scene, opts, js):
-    cmd = [exe, "render", scene, "--stats", "none", "-q", "--stats-json", js, *opts]
-    subprocess.run(cmd, check=True)
-    return json.load(open(js))
+    return vgpurt.render(exe, scene, opts, stats_json=js)
 
 
 def main():
@@ -63,47 +64,50 @@ def main():
     ap.add_argument("--size", type=int, default=256)
     ap.add_argument("--runs", type=int, default=3)
     ap.add_argument("--h200", nargs="*", default=[],
-                    help="bench_gl JSON files measured on an H200 (docs/structures_h200_*.json)")
+                    help="bench_gl JSON files measured on an H200 (results/structures/structures_h200_*.json)")
     ap.add_argument("--h200-looping", nargs="*", default=[],
                     help="bench_gl JSON of the looping frames measured again with a warm-up "
-                    "(docs/structures_h200_looping_warm.json): they replace the looping cells")
+                    "(results/structures/structures_h200_looping_warm.json): they replace the looping cells")
     ap.add_argument("--h200-looping-again", nargs="*", default=[],
                     help="bench_gl JSON of a second warmed run of the looping frames, with every "
-                    "frame's time (docs/structures_h200_looping_warm2.json, RUNS=15): shown beside "
+                    "frame's time (results/structures/structures_h200_looping_warm2.json, RUNS=15): shown beside "
                     "the first, with the traversal kernels' GPU time against their modeled work")
     ap.add_argument("--h200-layout", nargs=4, default=[], metavar="FILE",
                     help="the texture-layout trial: looping frames with the structures' textures "
-                    "laid out square (docs/structures_h200_looping_square.json), then multipass "
+                    "laid out square (results/structures/structures_h200_looping_square.json), then multipass "
                     "frames with the old (wide) and the square layout in one run "
-                    "(docs/structures_h200_layout_multipass_{wide,square}.json), then the same "
-                    "looping frames wide (docs/structures_h200_looping_warm2.json)")
+                    "(results/structures/structures_h200_layout_multipass_{wide,square}.json), then the same "
+                    "looping frames wide (results/structures/structures_h200_looping_warm2.json)")
     ap.add_argument("--h200-precise", nargs=2, default=[], metavar="FILE",
                     help="the same looping frames with the GLSL's `precise` qualifiers, then "
-                    "with them removed (an experiment binary; docs/structures_h200_precise_"
+                    "with them removed (an experiment binary; results/structures/structures_h200_precise_"
                     "{on,off}.json)")
     ap.add_argument("--h200-ablation", nargs=3, default=[], metavar="FILE",
                     help="grid2's looping frames whole, with the step alone and with the "
                     "triangle test alone (experiment binaries; "
-                    "docs/structures_h200_grid2_ablation_{full,step,test}.json)")
+                    "results/structures/structures_h200_grid2_ablation_{full,step,test}.json)")
     ap.add_argument("--h200-programs", metavar="DIR",
                     help="NVIDIA's compiled assembly of the looping traversal kernels, from "
-                    "bench_gl --dump-programs on the H200 (docs/h200_programs/*.nvfp): their "
+                    "bench_gl --dump-programs on the H200 (results/structures/h200_programs/*.nvfp): their "
                     "loop bodies beside the vgpu's counts")
     ap.add_argument("--h200-latency", metavar="FILE",
-                    help="bench_gl --latency JSON from the H200 (docs/structures_h200_latency.json):"
+                    help="bench_gl --latency JSON from the H200 (results/structures/structures_h200_latency.json):"
                     " the latency term's section")
     ap.add_argument("--h200-looping-third", nargs="*", default=[],
                     help="bench_gl JSON of the looping frames measured with the latency term "
-                    "(docs/structures_h200_looping_warm3.json)")
+                    "(results/structures/structures_h200_looping_warm3.json)")
     ap.add_argument("--h200-sizes-grid", nargs="*", default=[],
                     help="the grid's looping frames at 8x8, 64x64 and 512x512 "
-                    "(docs/structures_h200_sizes_looping_grid.json), for the latency term")
+                    "(results/structures/structures_h200_sizes_looping_grid.json), for the latency term")
     ap.add_argument("--h200-sizes", nargs="*", default=[],
                     help="bench_gl JSON files of the same frames at several sizes "
-                    "(docs/structures_h200_sizes_*.json)")
-    ap.add_argument("--out", default=os.path.join(ROOT, "docs"))
+                    "(results/structures/structures_h200_sizes_*.json)")
+    ap.add_argument("--out", default=os.path.join(ROOT, "docs"),
+                    help="where structures.md and structures.png go")
+    ap.add_argument("--results", default=os.path.join(ROOT, "results", "structures"),
+                    help="where structures.json, the raw figures, goes")
     ap.add_argument("--reuse", action="store_true",
-                    help="take the emulator and CPU rows from OUT/structures.json instead of "
+                    help="take the emulator and CPU rows from RESULTS/structures.json instead of "
                     "rendering them again (the H200 files are read again)")
     ap.add_argument("--only", nargs="*", default=[],
                     help="with --reuse: render these rows (grid, grid2, bvh, kdtree, 'auto "
@@ -111,14 +115,14 @@ def main():
                     "replacing the stored ones")
     a = ap.parse_args()
     tmp = tempfile.mkdtemp(prefix="structures_")
-    subprocess.run([sys.executable, os.path.join(ROOT, "scripts", "uneven_scenes.py"), tmp],
+    subprocess.run([sys.executable, os.path.join(ROOT, "scripts", "scenes", "uneven_scenes.py"), tmp],
                    check=True, stdout=subprocess.DEVNULL)
     scenes = [(s, s) for s in BUNDLED] + [(s, os.path.join(tmp, s + ".gltf")) for s in UNEVEN]
     size = ["--size", f"{a.size}x{a.size}", "--threads", "2"]
     rows = []
     js = os.path.join(tmp, "r.json")
     if a.reuse:
-        rows = [r for r in json.load(open(os.path.join(a.out, "structures.json")))["rows"]
+        rows = [r for r in json.load(open(os.path.join(a.results, "structures.json")))["rows"]
                 if not wanted(a.only, r["scene"], r["accel"])]
     for name, path in ([] if a.reuse and not a.only else scenes):
         for mode, mopts in MODES.items():
@@ -159,7 +163,7 @@ def main():
                       f"{row['passes']:7d} gf6600 {row['gf6600']:10.1f} ms h200 {row['h200']:8.1f}"
                       f" ms emulator {row['emu_ms']:8.1f} ms", file=sys.stderr)
     h200 = gl_cells(a.h200)
-    # The looping cells measured again with a warm-up (LOOPING=1 scripts/structures_h200.sh)
+    # The looping cells measured again with a warm-up (LOOPING=1 scripts/h200/structures.sh)
     # replace the first runs' and are shown beside them.
     a.looping_first = []
     for w in gl_cells(a.h200_looping):
@@ -176,7 +180,7 @@ def main():
     a.kernel_ratios = st.traversal_ratios(a.h200_looping_again)
     a.looping_third = gl_cells(a.h200_looping_third)
     a.run = run
-    json.dump({"rows": rows, "h200": h200}, open(os.path.join(a.out, "structures.json"), "w"),
+    json.dump({"rows": rows, "h200": h200}, open(os.path.join(a.results, "structures.json"), "w"),
               indent=1)
     write_doc(a, rows, h200)
     chart(a, rows, h200)
@@ -294,7 +298,7 @@ def looping_again(pairs):
     within = sum(abs(w["predicted_ms"] / w["wall_ms"] - 1) <= 0.35 for _, w in pairs)
     warm_s = sorted(w["warmup_ms"] for _, w in pairs)[len(pairs) // 2] / 1000
     L = ["", "", f"The looping rows above come from a later run (`LOOPING=1 "
-         "scripts/structures_h200.sh`, `docs/structures_h200_looping_warm.json`): the same frames, "
+         "scripts/h200/structures.sh`, `results/structures/structures_h200_looping_warm.json`): the same frames, "
          f"each configuration's GL frames run for about {warm_s:.1f} s (`bench_gl --warmup-ms`) "
          "before the timed ones, since a GPU left idle while the emulator computes the frame's "
          "prediction lowers its clock (docs/sampling.md's H200 section measured it: 345 MHz, and "
@@ -452,7 +456,7 @@ def frame_cost(h200_files, sizes_files):
         f"{mean_err(loop):+.0f}% to {mean_err(loop, best):+.0f}%, the multipass cells' from "
         f"{mean_err(multi):+.1f}% to {mean_err(multi, best):+.1f}%). But every cell is 256x256, "
         "where a cost per frame and a cost per pixel look the same. One more run "
-        "(`SIZES=1 scripts/structures_h200.sh`, `docs/structures_h200_sizes_*.json`: the looping "
+        "(`SIZES=1 scripts/h200/structures.sh`, `results/structures/structures_h200_sizes_*.json`: the looping "
         "walks of grid2, bvh and kdtree on the seven scenes at "
         f"{', '.join(f'{s}x{s}' for s in sizes)}, medians of 5 frames) tells them apart: an "
         f"{sizes[0]}x{sizes[0]} frame takes {med([c['wall'] for c in small]):.2f} ms in all "
@@ -497,8 +501,8 @@ def write_doc(a, rows, h200):
              1.10 * get(rows, sc, mode, "grid")["gf6600"]]
     doc = f"""# Acceleration structures: the grid, a two-level grid, a BVH, a kd-tree, and `--accel auto`
 
-Written by `scripts/structures.py` (run it again to refresh every figure here); the chart is
-`docs/structures.png`, the raw figures `docs/structures.json`.
+Written by `scripts/docs/structures.py` (run it again to refresh every figure here); the chart is
+`docs/structures.png`, the raw figures `results/structures/structures.json`.
 
 The paper walks one uniform grid. A grid fits an object that fills its box; it fails where the
 scene is uneven: a small detailed object on a large floor puts the object in a few voxels of a
@@ -548,7 +552,7 @@ default frame (2 bounces, shadows). Steps: voxels stepped (grid) or nodes visite
 by the step passes' working fragments; tests: triangle tests. The modeled ms come from the same
 statistics (cost model, `docs/table1.md`); the scenes "stadium" (the bunny on a floor 270 times
 its width) and "scales" (25 bunnies from 5% to 15 times its size, 92k triangles) are written by
-`scripts/uneven_scenes.py`.
+`scripts/scenes/uneven_scenes.py`.
 
 {main_table(rows)}
 
@@ -578,7 +582,7 @@ follows more closely than a modeled GPU's pass-bound time does.
 ## Measured on an H200 through the GL device
 
 The same frames on an NVIDIA H200 through the GL device (`bench/bench_gl.cpp --accel grid bvh
-kdtree`, and in a later session's run `--accel grid2`: `scripts/structures_h200.sh`, driver 580.159.04, 256x256, polled read-backs, SM clock 1980 MHz while busy): the
+kdtree grid2`, 256x256, polled read-backs, SM clock 1980 MHz while busy; how they were run: `results/structures/README.md`): the
 median of 3 frames after one warm-up frame, beside the cost model's prediction (`h200`
 profile) from the emulator's statistics of the same frame. "primary" is `--bounces 0`, "2
 bounces" Table 1's setting (no shadows); multipass frames use the paper's kernels, "looping"

@@ -4,15 +4,15 @@
 #   cmake --build build --target bench_gl && mkdir -p .bin && cp build/bench/bench_gl .bin/
 #   mkdir -p .gl && (cd .gl && apt-get download libegl1 libglvnd0 libopengl0 libgl1 libglx0)
 # copy the repository with .bin and .gl to the GPU host and run there, from its root:
-#   scripts/h200_bench.sh OUTPUT_DIR
-# then copy OUTPUT_DIR's real_gpu_h200.json and gpu_clocks.csv to docs/ (the clocks as
+#   scripts/h200/real_gpu.sh OUTPUT_DIR
+# then copy OUTPUT_DIR's real_gpu_h200.json and gpu_clocks.csv to results/real_gpu/ (the clocks as
 # real_gpu_h200_clocks.csv) and run here:
-#   /usr/bin/python3 scripts/real_gpu.py --reuse --add h200=docs/real_gpu_h200.json \
-#     --add-variants h200=docs/real_gpu_h200_variants.json --add-run h200-run1=docs/real_gpu_h200_run1.json
+#   /usr/bin/python3 scripts/docs/real_gpu.py --reuse --add h200=results/real_gpu/real_gpu_h200.json \
+#     --add-variants h200=results/real_gpu/real_gpu_h200_variants.json --add-run h200-run1=results/real_gpu/real_gpu_h200_run1.json
 set -euo pipefail
-out="${1:?usage: scripts/h200_bench.sh OUTPUT_DIR [all|frames|variants|texture-io]}"
+out="${1:?usage: scripts/h200/real_gpu.sh OUTPUT_DIR [all|frames|variants|texture-io]}"
 phase="${2:-all}"
-cd "$(dirname "$0")/.."
+cd "$(dirname "$0")/../.."
 if [ -d .gl ]; then
   for f in .gl/*.deb; do dpkg -x "$f" /; done
   ldconfig
@@ -29,7 +29,7 @@ sampler=$!
 trap 'kill $sampler 2>/dev/null || true' EXIT
 if [ "$phase" = all ] || [ "$phase" = frames ]; then
 # Frames with both read-back waits (the emulator's counts and the predictions are the same on
-# every machine: scripts/real_gpu.py computes them here with --readback-wait none).
+# every machine: scripts/docs/real_gpu.py computes them here with --readback-wait none).
 .bin/bench_gl --runs 5 --sizes 256 1024 --threads 16 --no-stream --readback-wait both \
   --scenes scenes/sphere-alone.gltf scenes/bunny.gltf scenes/bunny-mirror.gltf \
   --json "$out/real_gpu_h200.json" 2>&1 | tee "$out/bench_gl.log"

@@ -5,27 +5,28 @@ every bundled scene at 256x256, on the GeForce 6600 (fp40) and a modern profile 
 
 Renders each cell with vgpu-rt (--stats-json, --aov hit=...), compares every variant's hit ids
 with the multipass run of the same scene and profile (vgpu-rt compare, OpenImageIO, threshold 0),
-and writes docs/variants.md, docs/variants.csv and docs/variants.png (matplotlib).
+and writes docs/variants.md, results/variants/variants.csv and docs/variants.png (matplotlib).
 
-Usage: /usr/bin/python3 scripts/variants.py [--vgpu-rt build/host/vgpu-rt] [--size 256]
+Usage: /usr/bin/python3 scripts/docs/variants.py [--vgpu-rt build/host/vgpu-rt] [--size 256]
          [--threads 1] [--reuse] [--scenes NAME ...]
   --reuse  keep the JSON and EXR of earlier renders (build/variants/) instead of rendering again
 """
 import argparse
 import csv
-import json
 import os
 import re
 import subprocess
 import sys
 import time
 
-import matplotlib
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "lib"))
+import vgpurt  # noqa: E402
+import matplotlib  # noqa: E402
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 DOCS = os.path.join(ROOT, "docs")
 PROFILES = [("gf6600", "GeForce 6600 (fp40)"), ("rtx4090", "RTX 4090")]
 # name, extra vgpu-rt arguments
@@ -55,26 +56,22 @@ def render(exe, work, scene, profile, variant, args, opts):
     base = os.path.join(work, f"{scene}_{profile}_{slug(variant)}")
     js, hit = base + ".json", base + "_hit.exr"
     if not (opts.reuse and os.path.exists(js) and os.path.exists(hit)):
-        cmd = [exe, "render", scene, "--size", f"{opts.size}x{opts.size}", "--profile", profile,
-               "--threads", str(opts.threads), "-q", "--stats", "none", "--stats-json", js,
-               "--aov", f"hit={hit}"] + args
-        r = subprocess.run(cmd, capture_output=True, text=True)
-        if r.returncode != 0:
-            return {"refused": r.stderr.strip().splitlines()[-1] if r.stderr.strip() else
-                    f"exit {r.returncode}"}
-    with open(js) as f:
-        d = json.load(f)
+        try:
+            vgpurt.render(exe, scene, ["--size", f"{opts.size}x{opts.size}", "--profile", profile,
+                                       "--threads", str(opts.threads)] + args,
+                          stats_json=js, aovs={"hit": hit})
+        except vgpurt.Failed as e:
+            return {"refused": e.message}
+    d = vgpurt.read_stats(js)
     d["hit_path"] = hit
     return d
 
 
 def differing(exe, a, b):
-    r = subprocess.run([exe, "compare", a, b, "--threshold", "0"], capture_output=True,
-                       text=True)
-    m = re.search(r"([0-9.]+)% of pixels differ", r.stdout)
-    if r.returncode != 0 or not m:
-        sys.exit(f"variants: vgpu-rt compare {a} {b} failed: {r.stderr.strip()}")
-    return float(m.group(1))
+    try:
+        return 100.0 * vgpurt.compare(exe, a, b, threshold=0)[0]
+    except vgpurt.Failed as e:
+        sys.exit(f"variants: {e}")
 
 
 def main():
@@ -135,7 +132,7 @@ def main():
     keys = ["scene", "profile", "variant", "passes", "program_loads", "query_readbacks",
             "fragments_shaded", "fragments_masked", "loop_lane_slots", "idle_share", "bytes",
             "predicted_ms", "host_ms", "hit_differ_pct", "refused"]
-    with open(os.path.join(DOCS, "variants.csv"), "w", newline="") as f:
+    with open(os.path.join(ROOT, "results", "variants", "variants.csv"), "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=keys)
         w.writeheader()
         for r in rows:
@@ -152,7 +149,7 @@ def main():
 
     lines = ["# Pipeline variants: multipass, masks, MRT, looping",
              "",
-             "Written by `scripts/variants.py` (do not edit by hand): every bundled scene at "
+             "Written by `scripts/docs/variants.py` (do not edit by hand): every bundled scene at "
              f"{opts.size}x{opts.size} with the default settings (3 ray-tracing iterations, phong, "
              "shadow rays), rendered by the emulator with each variant of the pipeline's structure "
              f"on two profiles, {opts.threads} host thread(s). *Predicted* is the cost model's "
@@ -273,7 +270,7 @@ def main():
             lines += [f.read().rstrip(), ""]
     with open(os.path.join(DOCS, "variants.md"), "w") as f:
         f.write("\n".join(lines))
-    print(f"variants: wrote docs/variants.md, docs/variants.csv, docs/variants.png "
+    print(f"variants: wrote docs/variants.md, results/variants/variants.csv, docs/variants.png "
           f"({time.time() - t0:.0f} s)", file=sys.stderr)
 
 

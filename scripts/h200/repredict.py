@@ -9,10 +9,10 @@ variant, and replaces that frame's predicted fields (predicted_ms, predicted_h20
 kernel's predicted_h200_*). Wall times, GPU times and the emulator's own timings are kept. The
 file records when and why under "predictions_updated".
 
-  /usr/bin/python3 scripts/h200_repredict.py --why "..." docs/structures_h200_looping_warm2.json
+  /usr/bin/python3 scripts/h200/repredict.py --why "..." results/structures/structures_h200_looping_warm2.json
 
 Scenes are found in scenes/ or in --scene-dir (.h200: the uneven scenes of
-scripts/uneven_scenes.py, glass-opaque of scripts/materials.py --opaque-copy)."""
+scripts/scenes/uneven_scenes.py, glass-opaque of scripts/docs/materials.py --opaque-copy)."""
 import argparse
 import datetime
 import json
@@ -21,7 +21,7 @@ import subprocess
 import sys
 import tempfile
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 KEY = ("scene", "accel", "variant", "bounces", "shadows", "ray_streams", "sampling", "size")
 # What bench_gl did before a frame recorded the option (its defaults then).
 DEFAULTS = {"accel": "grid", "bounces": 2, "shadows": False, "ray_streams": "off",

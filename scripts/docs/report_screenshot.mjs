@@ -1,5 +1,5 @@
 // A screenshot of a vgpu-rt HTML report in headless chromium (the one in docs/ comes from here):
-//   node scripts/report_screenshot.mjs REPORT.html OUT.png [--pixel X,Y] [--trace N] [--hide-idle] [--height PX]
+//   node scripts/docs/report_screenshot.mjs REPORT.html OUT.png [--pixel X,Y] [--trace N] [--hide-idle] [--height PX]
 // --trace N zooms the timeline to trace N (0-based), --hide-idle hides the idle bars, --height
 // cuts the page to its first PX pixels (default: the whole page). Needs scripts/setup.sh's JS.
 import path from "node:path";
@@ -10,7 +10,7 @@ const { chromium } = createRequire(import.meta.url)(path.join(here, "../host/rep
 const args = process.argv.slice(2);
 const opt = name => { const i = args.indexOf(name); return i >= 0 ? args[i + 1] : undefined; };
 const [file, out] = args;
-if (!file || !out) { console.error("usage: node scripts/report_screenshot.mjs REPORT.html OUT.png [options]"); process.exit(2); }
+if (!file || !out) { console.error("usage: node scripts/docs/report_screenshot.mjs REPORT.html OUT.png [options]"); process.exit(2); }
 const browser = await chromium.launch({ executablePath: "/usr/bin/chromium", args: ["--no-sandbox", "--disable-gpu"] });
 try {
   const page = await browser.newPage({ viewport: { width: 1320, height: 1000 } });

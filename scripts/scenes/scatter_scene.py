@@ -14,7 +14,7 @@ refit keeps that grouping, and its boxes grow frame after frame (what the issue 
 The file reuses scenes/hop.gltf (board, sphere, camera, light, the sphere's turn) and the bunny
 mesh of scenes/bunny.gltf, once, instanced by ten nodes at hop's scale (0.22): about 170 KB.
 
-Usage: scripts/scatter_scene.py OUTDIR      (writes OUTDIR/scatter.gltf)
+Usage: scripts/scenes/scatter_scene.py OUTDIR      (writes OUTDIR/scatter.gltf)
 """
 import base64
 import json
@@ -23,7 +23,7 @@ import struct
 import sys
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 BUNNIES = 10
 SCALE = 0.22  # hop's bunny scale: 2.2 units wide, 2.1 high
 DURATION = 2.0  # s
@@ -61,7 +61,7 @@ def main():
     out.mkdir(parents=True, exist_ok=True)
     g = json.loads((ROOT / "scenes" / "hop.gltf").read_text())
     src = json.loads((ROOT / "scenes" / "bunny.gltf").read_text())
-    g["asset"]["generator"] = "vgpu-rt scripts/scatter_scene.py"
+    g["asset"]["generator"] = "vgpu-rt scripts/scenes/scatter_scene.py"
 
     # The full bunny mesh: bunny.gltf's buffer, views and accessors appended; hop's bunny mesh
     # (the simplified one) is pointed at them, so every node naming it draws the full bunny.

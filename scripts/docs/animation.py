@@ -3,7 +3,7 @@
 moving scene costs per frame, per structure and update mode, on the emulator and modeled.
 
 For each scene (default: the bundled `hop`, 1,436 triangles, and `scatter`, 37,228 triangles,
-which scripts/scatter_scene.py writes into build/scenes/ when it is missing), each structure of
+which scripts/scenes/scatter_scene.py writes into build/scenes/ when it is missing), each structure of
 --structures, and each update mode the structure has (rebuild for all; refit and auto for those
 of --refit, the BVH), vgpu-rt renders --frames with --stats-json, one run each. From the
 per-frame records it charts and tabulates, per frame:
@@ -15,7 +15,7 @@ per-frame records it charts and tabulates, per frame:
   quality    a refitted BVH's SAH cost over the cost of a BVH built for the same frame (the
              rebuild run's), and its node visits over the rebuilt tree's
 
-Usage: /usr/bin/python3 scripts/animation.py [--vgpu-rt build/host/vgpu-rt] [--scenes hop,scatter]
+Usage: /usr/bin/python3 scripts/docs/animation.py [--vgpu-rt build/host/vgpu-rt] [--scenes hop,scatter]
          [--structures grid,bvh,kdtree] [--refit bvh] [--kernels multipass,looping]
          [--frames 0:2:25] [--size 128] [--probe-sizes 256,512] [--probe-time 1] [--threads 0]
          [--runs build/animation_runs] [--reuse] [--doc docs/animation.md]
@@ -29,13 +29,15 @@ Usage: /usr/bin/python3 scripts/animation.py [--vgpu-rt build/host/vgpu-rt] [--s
             tables ('-' prints them instead)
 """
 import argparse
-import json
 import os
 import statistics
 import subprocess
 import sys
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "lib"))
+import vgpurt  # noqa: E402
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 PROFILES = ["gf6600", "h200"]
 BEGIN, END = "<!-- animation.py: begin -->", "<!-- animation.py: end -->"
 INTERACTIVE_MS = 100.0  # 10 frames per second
@@ -47,7 +49,7 @@ def scene_path(name):
     if name == "scatter":
         path = os.path.join(ROOT, "build", "scenes", "scatter.gltf")
         if not os.path.exists(path):
-            subprocess.run([sys.executable, os.path.join(ROOT, "scripts", "scatter_scene.py"),
+            subprocess.run([sys.executable, os.path.join(ROOT, "scripts", "scenes", "scatter_scene.py"),
                             os.path.dirname(path)], check=True, stdout=subprocess.DEVNULL)
         return path
     return name
@@ -67,13 +69,11 @@ def run(a, scene, structure, mode, variant, when=None, size=None):
     tag = f"t{when}" if when else a.frames.replace(":", "-")
     path = os.path.join(a.runs, f"{scene}_{structure}_{mode}_{variant}_{size}_{tag}.json")
     if not (a.reuse and os.path.exists(path)):
-        cmd = [a.vgpu_rt, "render", scene_path(scene), *what, "--size", f"{size}x{size}",
-               "--threads", str(a.threads), "--accel", structure, "--update", mode,
-               *kernel_options(variant), "-q", "--stats", "none", "--stats-json", path]
-        print("running", " ".join(cmd), file=sys.stderr)
-        subprocess.run(cmd, check=True)
-    with open(path) as f:
-        return json.load(f)
+        return vgpurt.render(a.vgpu_rt, scene_path(scene),
+                             [*what, "--size", f"{size}x{size}", "--threads", str(a.threads),
+                              "--accel", structure, "--update", mode, *kernel_options(variant)],
+                             stats_json=path, echo=True)
+    return vgpurt.read_stats(path)
 
 
 def update_ms(r):
@@ -135,7 +135,7 @@ def pct(x):
 def tables(a, runs, probes):
     """The Markdown tables of docs/animation.md."""
     n = len(next(iter(runs.values()))["time"])
-    lines = [f"Measured by `scripts/animation.py --size {a.size} --frames {a.frames} "
+    lines = [f"Measured by `scripts/docs/animation.py --size {a.size} --frames {a.frames} "
              f"--structures {','.join(a.structures)}`: one run per scene, structure, update mode "
              f"and kernels, {a.size}x{a.size}, 2 bounces, shadows, phong, --threads {a.threads} "
              "(0: every host thread); multipass kernels on gf5700 (the paper's), looping kernels "
