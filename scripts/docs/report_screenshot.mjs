@@ -6,7 +6,7 @@ import path from "node:path";
 import { createRequire } from "node:module";
 
 const here = path.dirname(new URL(import.meta.url).pathname);
-const { chromium } = createRequire(import.meta.url)(path.join(here, "../host/report/node_modules/playwright-core"));
+const { chromium } = createRequire(import.meta.url)(path.join(here, "../../host/report/node_modules/playwright-core"));
 const args = process.argv.slice(2);
 const opt = name => { const i = args.indexOf(name); return i >= 0 ? args[i + 1] : undefined; };
 const [file, out] = args;
