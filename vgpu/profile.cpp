@@ -166,18 +166,20 @@ const std::vector<Profile>& profiles() {
     // frames it predicts.
     m.output_bytes_per_clock = 28;  // model parameter (measured by bench_gl's copy pass)
     // A glGetTexImage of one RGBA32F texture to the host: 330 us for 1 MB, 5.43 ms for 16 MB,
-    // 28.1 ms for 64 MB (bench_gl, results/real_gpu/real_gpu_h200_texture_io.json): 3.1 GB/s, no fixed part.
+    // 28.1 ms for 64 MB (bench_gl, results/real_gpu/real_gpu_h200_texture_io.json): 3.1 GB/s, no
+    // fixed part.
     m.download_us = 0;      // measured (bench_gl: within noise of 0)
     m.download_gbps = 3.1;  // measured (bench_gl, 16 MB read-back)
 
     m.max_loop_iterations = 1 << 20;  // model parameter: no loop count limit
     m.loop_overhead_clocks = 1;       // model parameter (assumed: a compare and a branch)
-    // One fragment on this H200 (bench_gl --latency, results/structures/structures_h200_latency.json, GPU
-    // timer queries, 1024 against 8192 iterations): following links through RGBA32F textures
-    // of 512x512 and 2048x2048 texels, 235.4 and 238.8 ns an iteration (473 clocks at 1980 MHz
-    // for the larger; 212 where the 16x16 texture stays in the first-level cache); 16 dependent
-    // multiply-adds, 77.3 ns (153 clocks). Priced as the model counts those loops (vgpu/span.h:
-    // the multiply-adds' iteration is 35 operation units, the chase's one fetch and 6 units):
+    // One fragment on this H200 (bench_gl --latency,
+    // results/structures/structures_h200_latency.json, GPU timer queries, 1024 against 8192
+    // iterations): following links through RGBA32F textures of 512x512 and 2048x2048 texels, 235.4
+    // and 238.8 ns an iteration (473 clocks at 1980 MHz for the larger; 212 where the 16x16 texture
+    // stays in the first-level cache); 16 dependent multiply-adds, 77.3 ns (153 clocks). Priced as
+    // the model counts those loops (vgpu/span.h: the multiply-adds' iteration is 35 operation
+    // units, the chase's one fetch and 6 units):
     m.operation_latency_clocks = 4.37;  // measured: 153 clocks / 35
     m.fetch_latency_clocks = 447;       // measured: 473 clocks - 6 x 4.37
     t.push_back(m);

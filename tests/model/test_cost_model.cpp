@@ -208,8 +208,8 @@ TEST_CASE("Merging a pair of kernels into one MRT pass drops passes and loads, k
 
 TEST_CASE(
     "the fitted fixed costs reproduce Table 1's Bunny3 on both cards at the Table 1 settings") {
-  // scripts/docs/table1.py's settings: 256x256, 2 bounces, phong, no shadow rays, a 15^3 grid. If the
-  // kernels or the host loop change their counts, this fails: refit (table1.py --fit).
+  // scripts/docs/table1.py's settings: 256x256, 2 bounces, phong, no shadow rays, a 15^3 grid. If
+  // the kernels or the host loop change their counts, this fails: refit (table1.py --fit).
   const host::Scene scene = host::load_scene(VGPU_SCENES_DIR "/bunny.gltf");
   REQUIRE(scene.camera.has_value());
   const host::Grid grid = host::build_grid(scene, host::parse_grid_spec("15"));
