@@ -12,14 +12,9 @@ and returns the JSON as a dict. A refused option or a failed render raises Faile
 vgpu-rt's last line on stderr (the one line a refusal prints) and its exit status (2 for a refusal).
 """
 import json
-import os
 import re
 import subprocess
 import sys
-
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-VGPU_RT = os.path.join(ROOT, "build", "host", "vgpu-rt")  # where the README's build puts it
-RESULTS = os.path.join(ROOT, "results")  # measurements, one folder per study
 
 
 class Failed(RuntimeError):
