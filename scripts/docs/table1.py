@@ -11,7 +11,6 @@ import argparse
 import json
 import os
 import re
-import subprocess
 import sys
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "lib"))
@@ -68,8 +67,7 @@ def run(exe, scene, profile, work, reuse, masks="off", engine=None, extra=(), ta
 
 
 def has_engine(exe):
-    out = subprocess.run([exe, "render", "--help"], capture_output=True, text=True, cwd=ROOT)
-    return "--engine" in out.stdout
+    return "--engine" in vgpurt.run([exe, "render", "--help"], cwd=ROOT)
 
 
 def err(pred, paper):
