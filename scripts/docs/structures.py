@@ -536,7 +536,7 @@ functors) and in the CPU tracer (double precision). On every bundled scene the B
 kd-tree give the grid's hit ids, depths and colours, bit for bit, on the emulator and on
 llvmpipe; the two-level grid gives the grid's primary hit ids on every bundled scene at 48x48
 and on every stability case but for 3 pixels of the triangle fan, exact ties on a shared spoke
-checked in double (`tests/trace/test_grid2_walk.cpp`), and llvmpipe gives the emulator's.
+checked in double (`tests/trace/test_structure_walks.cpp`), and llvmpipe gives the emulator's.
 
 ## The figures
 

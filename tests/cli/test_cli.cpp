@@ -300,7 +300,7 @@ TEST_CASE("a render writes the image, the AOVs and the statistics asked for, and
   fs::remove_all(dir);
 }
 
-// --accel kdtree and --accel auto (tests/trace/test_kd_walk.cpp tests the walk itself).
+// --accel kdtree and --accel auto (tests/trace/test_structure_walks.cpp tests the walk itself).
 namespace {
 
 // A render of bunny-low at 32x32 with the statistics JSON read back; "" args added.

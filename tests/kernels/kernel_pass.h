@@ -181,3 +181,33 @@ inline kernels::GridUniforms grid_uniforms(glm::vec3 lo, glm::vec3 cell, glm::ve
       CHECK(got_[c_] == doctest::Approx(expected_[c_]).epsilon(eps)); \
     }                                                                 \
   } while (0)
+
+namespace ktest {
+
+// Two textures of one shape, every channel of every texel equal.
+inline void check_same(const Texture& a, const Texture& b) {
+  REQUIRE(a.width() == b.width());
+  REQUIRE(a.height() == b.height());
+  for (int y = 0; y < a.height(); ++y)
+    for (int x = 0; x < a.width(); ++x) CHECK_TEXEL(a, x, y, ktest::at(b, x, y));
+}
+
+// The first n texels of row 0 (one per ray) equal in every channel.
+inline void check_same(const Texture& a, const Texture& b, int n) {
+  for (int i = 0; i < n; ++i) CHECK_TEXEL(a, i, 0, ktest::at(b, i, 0));
+}
+
+// Whether any of the first n texels of row 0 has x (or w) at least v: a walk's loop conditions
+// ("some ray still walks", "some ray still has triangles to test").
+inline bool any_x_at_least(const Texture& t, int n, float v) {
+  for (int i = 0; i < n; ++i)
+    if (at(t, i, 0).x >= v) return true;
+  return false;
+}
+inline bool any_w_at_least(const Texture& t, int n, float v) {
+  for (int i = 0; i < n; ++i)
+    if (at(t, i, 0).w >= v) return true;
+  return false;
+}
+
+}  // namespace ktest

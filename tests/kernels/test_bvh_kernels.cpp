@@ -3,8 +3,8 @@
 // hand-made texels, every channel of every output checked against values worked out here. Built
 // into test_gl (KTEST_GL), every pass is made again on the GL device from the same texels.
 //
-// The hand-made hierarchy (texture layouts of kernels/bvh.h and host/trace/walks/bvh_walk.cpp), node
-// textures 2 texels wide (nodes 2 to 4 sit on the second and third rows):
+// The hand-made hierarchy (texture layouts of kernels/bvh.h and host/trace/walks/bvh_walk.cpp),
+// node textures 2 texels wide (nodes 2 to 4 sit on the second and third rows):
 //   node 0  root, inner  box [0, 4]^3                     escape -1
 //   node 1  inner L      box [1, 2] x [0, 1] x [0, 1]     escape 4 (past its subtree)
 //   node 2  leaf A       box [1, 1.6] x [0, 1] x [0, 1]   escape 3    list at 1: {0}
@@ -25,6 +25,7 @@
 
 using kernels::kFar;
 using kernels::kNone;
+using ktest::check_same;
 using ktest::scalars;
 using ktest::texels;
 using ktest::Texture;
@@ -53,14 +54,6 @@ kernels::BvhUniforms uniforms() {
 
 const glm::vec4 kPx(1, 0, 0, kFar), kMx(-1, 0, 0, kFar), kNoHit(kFar, 0, 0, kNone);
 const glm::vec4 kEmpty(0, 0, 0, kNone);  // voxel state: nothing to test
-
-// Every channel of two textures equal, texel by texel.
-void check_same(const Texture& a, const Texture& b) {
-  REQUIRE(a.width() == b.width());
-  REQUIRE(a.height() == b.height());
-  for (int y = 0; y < a.height(); ++y)
-    for (int x = 0; x < a.width(); ++x) CHECK_TEXEL(a, x, y, ktest::at(b, x, y));
-}
 
 // The step cases: origin, ray, traversal, intersection, and the traversal expected after one
 // recorridoBVH pass.

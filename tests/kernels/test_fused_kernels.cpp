@@ -10,6 +10,7 @@
 
 using kernels::kFar;
 using kernels::kNone;
+using ktest::check_same;
 using ktest::grid_uniforms;
 using ktest::scalars;
 using ktest::texels;
@@ -21,12 +22,6 @@ namespace {
 // Triangle lists, 4 entries per row: entry 0 is the shared empty list; {1, 0} starts at 1,
 // {0} at 4.
 const std::vector<float> kLists = {kNone, 1, 0, kNone, 0, kNone, 0, 0};
-
-// Every channel of two textures equal.
-void check_same(const Texture& a, const Texture& b) {
-  REQUIRE(a.width() == b.width());
-  for (int x = 0; x < a.width(); ++x) CHECK_TEXEL(a, x, 0, ktest::at(b, x, 0));
-}
 
 }  // namespace
 

@@ -21,6 +21,9 @@ namespace {
 
 using kernels::kFar;
 using kernels::kNone;
+using ktest::any_w_at_least;
+using ktest::any_x_at_least;
+using ktest::check_same;
 using ktest::scalars;
 using ktest::texels;
 using ktest::Texture;
@@ -111,21 +114,6 @@ void check_hits(const Texture& isect) {
   CHECK_TEXEL(isect, 4, 0, kNoHit);
   CHECK_TEXEL_NEAR(isect, 5, 0, 1e-6, kHit5);
   CHECK_TEXEL_NEAR(isect, 6, 0, 1e-6, kHit6);
-}
-
-bool any_x_at_least(const Texture& t, int n, float v) {
-  for (int i = 0; i < n; ++i)
-    if (ktest::at(t, i, 0).x >= v) return true;
-  return false;
-}
-bool any_w_at_least(const Texture& t, int n, float v) {
-  for (int i = 0; i < n; ++i)
-    if (ktest::at(t, i, 0).w >= v) return true;
-  return false;
-}
-
-void check_same(const Texture& a, const Texture& b, int n) {
-  for (int i = 0; i < n; ++i) CHECK_TEXEL(a, i, 0, ktest::at(b, i, 0));
 }
 
 Texture enter(const Structure& s, const Rays& r) {

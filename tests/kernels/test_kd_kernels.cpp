@@ -22,6 +22,9 @@ namespace {
 
 using kernels::kFar;
 using kernels::kNone;
+using ktest::any_w_at_least;
+using ktest::any_x_at_least;
+using ktest::check_same;
 using ktest::scalars;
 using ktest::texels;
 using ktest::Texture;
@@ -271,17 +274,6 @@ struct Walk {
 const glm::vec4 kHitA(2.5f, 0.25f, 0.25f, 1), kHitB(0.5f, 0.25f, 0.125f, 0),
     kHitC(2.5f, 0.25f, 0.25f, 0);
 
-bool any_x_at_least(const Texture& t, int n, float v) {
-  for (int i = 0; i < n; ++i)
-    if (ktest::at(t, i, 0).x >= v) return true;
-  return false;
-}
-bool any_w_at_least(const Texture& t, int n, float v) {
-  for (int i = 0; i < n; ++i)
-    if (ktest::at(t, i, 0).w >= v) return true;
-  return false;
-}
-
 struct State {
   Texture trav, vs, isect;
   int steps = 0;
@@ -344,11 +336,6 @@ void check_hits(const Texture& isect) {
   CHECK_TEXEL_NEAR(isect, 2, 0, 1e-6, kHitC);
   CHECK_TEXEL(isect, 3, 0, kNoHit);
   CHECK_TEXEL(isect, 4, 0, kNoHit);
-}
-
-// Every channel of every texel the same.
-void check_same(const Texture& a, const Texture& b, int n) {
-  for (int i = 0; i < n; ++i) CHECK_TEXEL(a, i, 0, ktest::at(b, i, 0));
 }
 
 struct LoopOut {

@@ -21,14 +21,16 @@
 #include "host/scene/gltf_loader.h"
 #include "host/trace/stream/stream_tracer.h"
 #include "stability_cases.h"
+#include "tests/support/bits.h"
+#include "tests/support/stats_json.h"
+
+using test_support::same_bits;
+
+using test_support::without_times;
 
 namespace {
 
 using Json = nlohmann::ordered_json;
-
-bool same_bits(const std::vector<float>& a, const std::vector<float>& b) {
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0;
-}
 
 // The first pixel where two buffers differ (bits), as "i: a vs b", or "" when none does.
 std::string first_difference(const std::vector<float>& a, const std::vector<float>& b) {
@@ -38,22 +40,6 @@ std::string first_difference(const std::vector<float>& a, const std::vector<floa
     if (std::memcmp(&a[i], &b[i], sizeof(float)) != 0)
       return std::to_string(i) + ": " + std::to_string(a[i]) + " vs " + std::to_string(b[i]);
   return "";
-}
-
-// A statistics JSON without its wall-clock fields (host_ms, device_ms: every "*_ms" key).
-Json without_times(Json j) {
-  if (j.is_object()) {
-    Json out = Json::object();
-    for (auto& [k, v] : j.items())
-      if (!(k.size() > 3 && k.compare(k.size() - 3, 3, "_ms") == 0)) out[k] = without_times(v);
-    return out;
-  }
-  if (j.is_array()) {
-    Json out = Json::array();
-    for (auto& v : j) out.push_back(without_times(v));
-    return out;
-  }
-  return j;
 }
 
 // Every pass record as JSON: program, rectangle, every integer counter, query result, loops.

@@ -1,6 +1,7 @@
 // The BVH walk (--accel bvh, host/trace/walks/bvh_walk.h) against the paper's grid walk and against
 // itself: the same primary hit ids as the grid on every bundled scene and every stability case;
-// batches equal to pass by pass; --mrt on and the looping kernel equal to the multipass walk;
+// batches equal to pass by pass; the looping kernel equal to the multipass walk (--mrt on is in
+// test_structure_walks.cpp, with the kd-tree's and the two-level grid's);
 // the CPU tracer's BVH walk equal to its grid walk and to the stream tracer's BVH walk; fp16
 // state refused where it cannot address the nodes or lists, exact where it can; and
 // --precision auto keeping fp32's hit ids.
@@ -23,34 +24,27 @@
 #include "host/trace/cpu/cpu_tracer.h"
 #include "host/trace/stream/stream_tracer.h"
 #include "stability_cases.h"
+#include "tests/support/bits.h"
+#include "tests/support/hit_compare.h"
+#include "tests/support/stats_json.h"
+#include "tests/support/structures.h"
 
 using host::RenderOptions;
 using host::RenderResult;
+using test_support::hit_t;
+using test_support::internal_of;
+using test_support::same_bits;
+using test_support::Structures;
 
 namespace {
 
 using Json = nlohmann::ordered_json;
 
-bool same_bits(const std::vector<float>& a, const std::vector<float>& b) {
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0;
-}
-
 // A bundled scene with the grid the CLI builds for the profile, the BVH and the one-voxel grid
-// the CLI builds beside it (the scene box).
-struct Bundled {
-  host::Scene scene;
-  host::Grid grid, box;
-  host::Bvh bvh;
-  host::Camera camera;
-  Bundled(const std::string& name, const std::string& profile = "gf5700")
-      : scene(host::load_scene(host::resolve_scene(name), host::with_images())),
-        grid(host::build_grid(scene, host::grid_spec_for({}, scene, vgpu::profile(profile)))),
-        box(host::build_grid(scene, host::GridSpec{glm::ivec3(1)})),
-        bvh(host::build_bvh(scene)),
-        camera(host::scene_camera(scene)) {}
-  host::Accel grid_accel() const { return {host::AccelKind::grid, &grid, nullptr}; }
-  host::Accel bvh_accel() const { return {host::AccelKind::bvh, &box, &bvh}; }
-};
+// the CLI builds beside it (the scene box); the camera for a square image.
+Structures bundled(const std::string& name, const std::string& profile = "gf5700") {
+  return test_support::bundled_structures(host::AccelKind::bvh, name, 1, 1, profile);
+}
 
 RenderOptions options(int w, int h, const std::string& profile = "gf5700") {
   RenderOptions opt;
@@ -70,27 +64,6 @@ RenderResult render(const host::Scene& scene, const host::Accel& accel, const ho
 uint64_t passes_of(const RenderResult& r, const std::string& program) {
   const auto* p = r.stats.find(program);
   return p ? p->counters.passes : 0;
-}
-
-// Moller-Trumbore in double, no culling, no edge widening: the parameter t of the ray's hit on
-// internal triangle i, or infinity.
-double hit_t(const host::Scene& s, size_t i, glm::dvec3 o, glm::dvec3 d) {
-  const glm::dvec3 p0(s.p0[i]), e1 = glm::dvec3(s.p1[i]) - p0, e2 = glm::dvec3(s.p2[i]) - p0;
-  const glm::dvec3 p = glm::cross(d, e2);
-  const double det = glm::dot(e1, p);
-  if (det == 0) return INFINITY;
-  const glm::dvec3 q = glm::cross(o - p0, e1);
-  const double u = glm::dot(o - p0, p) / det, v = glm::dot(d, q) / det;
-  const double eps = 1e-4;  // near an edge counts: the tie we look for is a shared edge
-  if (u < -eps || v < -eps || u + v > 1 + eps) return INFINITY;
-  return glm::dot(e2, q) / det;
-}
-
-size_t internal_of(const host::Scene& s, float input_id) {
-  for (size_t i = 0; i < s.id.size(); ++i)
-    if (float(s.id[i]) == input_id) return i;
-  FAIL("no triangle with input id " << input_id);
-  return 0;
 }
 
 // Primary hit ids of the grid and the BVH compared: coverage must be identical, and a pixel
@@ -122,22 +95,6 @@ size_t covered(const std::vector<float>& ids) {
   return size_t(std::count_if(ids.begin(), ids.end(), [](float id) { return id >= 0; }));
 }
 
-// A statistics JSON without its wall-clock fields (every "*_ms" key).
-Json without_times(Json j) {
-  if (j.is_object()) {
-    Json out = Json::object();
-    for (auto& [k, v] : j.items())
-      if (!(k.size() > 3 && k.compare(k.size() - 3, 3, "_ms") == 0)) out[k] = without_times(v);
-    return out;
-  }
-  if (j.is_array()) {
-    Json out = Json::array();
-    for (auto& v : j) out.push_back(without_times(v));
-    return out;
-  }
-  return j;
-}
-
 // Two frames alike in everything but wall-clock time.
 void check_same_frame(const RenderResult& a, const RenderResult& b) {
   CHECK(same_bits(a.rgb, b.rgb));
@@ -146,7 +103,8 @@ void check_same_frame(const RenderResult& a, const RenderResult& b) {
   CHECK(a.iterations == b.iterations);
   CHECK(a.rays_traced == b.rays_traced);
   CHECK(a.rays_unfinished == b.rays_unfinished);
-  const Json ja = without_times(a.stats.json()), jb = without_times(b.stats.json());
+  const Json ja = test_support::without_times(a.stats.json());
+  const Json jb = test_support::without_times(b.stats.json());
   std::string diff = Json::diff(ja, jb).dump();
   if (diff.size() > 1500) diff = diff.substr(0, 1500) + "...";
   CHECK_MESSAGE(ja == jb, "statistics differ: ", diff);
@@ -162,12 +120,12 @@ TEST_CASE("every bundled scene gives the grid's primary hit ids and coverage wit
   REQUIRE(scenes.size() >= 8);
   for (const auto& [name, path] : scenes) {
     CAPTURE(name);
-    const Bundled b(name);
+    const Structures b = bundled(name);
     RenderOptions opt = options(64, 64);
     opt.bounces = 0;
     opt.shadows = false;
     const RenderResult g = render(b.scene, b.grid_accel(), b.camera, opt);
-    const RenderResult v = render(b.scene, b.bvh_accel(), b.camera, opt);
+    const RenderResult v = render(b.scene, b.accel(), b.camera, opt);
     CHECK(covered(v.hit_id) * 20 >= v.hit_id.size());  // not an empty frame
     CHECK(compare_hits(b.scene, b.camera, 64, 64, g.hit_id, v.hit_id) == 0);
     CHECK(v.rays_unfinished == 0);
@@ -210,18 +168,18 @@ TEST_CASE(
     for (bool masks : {false, true}) {
       CAPTURE(std::string(name));
       CAPTURE(masks);
-      const Bundled b(name);
+      const Structures b = bundled(name);
       RenderOptions opt = options(40, 32);
       opt.masks = masks;
       opt.bounces = 2;
       opt.threads = 1;
       opt.batch_walk = false;
-      const RenderResult passes = render(b.scene, b.bvh_accel(), b.camera, opt);
+      const RenderResult passes = render(b.scene, b.accel(), b.camera, opt);
       CHECK_FALSE(passes.batch_walk);
       opt.batch_walk = true;
-      const RenderResult one = render(b.scene, b.bvh_accel(), b.camera, opt);
+      const RenderResult one = render(b.scene, b.accel(), b.camera, opt);
       opt.threads = 2;
-      const RenderResult two = render(b.scene, b.bvh_accel(), b.camera, opt);
+      const RenderResult two = render(b.scene, b.accel(), b.camera, opt);
       CHECK(one.batch_walk);
       CHECK(two.batch_walk);
       check_same_frame(passes, one);
@@ -231,36 +189,17 @@ TEST_CASE(
     }
 }
 
-TEST_CASE("mrt on gives the multipass bvh walk's hit ids, depths and images on gf6600") {
-  for (const char* name : {"bunny-refl", "classic", "teapot"}) {
-    CAPTURE(std::string(name));
-    const Bundled b(name, "gf6600");
-    RenderOptions opt = options(48, 48, "gf6600");
-    const RenderResult multi = render(b.scene, b.bvh_accel(), b.camera, opt);
-    opt.mrt = true;
-    const RenderResult mrt = render(b.scene, b.bvh_accel(), b.camera, opt);
-    CHECK(same_bits(multi.hit_id, mrt.hit_id));
-    CHECK(same_bits(multi.depth, mrt.depth));
-    CHECK(same_bits(multi.rgb, mrt.rgb));
-    CHECK(mrt.rays_traced == multi.rays_traced);
-    CHECK(passes_of(mrt, "bvh step + load leaf") > 0);
-    CHECK(passes_of(mrt, "bvh intersections + next triangle") > 0);
-    CHECK(passes_of(mrt, "bvh step") == 0);
-    CHECK(mrt.stats.totals.passes < multi.stats.totals.passes);
-  }
-}
-
 TEST_CASE("the bvh looping kernel gives the multipass hit ids and depths on gf6600") {
   for (const char* name : {"bunny-refl", "classic", "teapot"})
     for (int steps : {7, 64}) {
       CAPTURE(std::string(name));
       CAPTURE(steps);
-      const Bundled b(name, "gf6600");
+      const Structures b = bundled(name, "gf6600");
       RenderOptions opt = options(48, 48, "gf6600");
-      const RenderResult multi = render(b.scene, b.bvh_accel(), b.camera, opt);
+      const RenderResult multi = render(b.scene, b.accel(), b.camera, opt);
       opt.looping = true;
       opt.steps_per_pass = steps;
-      const RenderResult loop = render(b.scene, b.bvh_accel(), b.camera, opt);
+      const RenderResult loop = render(b.scene, b.accel(), b.camera, opt);
       CHECK(same_bits(multi.hit_id, loop.hit_id));
       CHECK(same_bits(multi.depth, loop.depth));
       CHECK(same_bits(multi.rgb, loop.rgb));
@@ -275,19 +214,19 @@ TEST_CASE("the bvh looping kernel gives the multipass hit ids and depths on gf66
 TEST_CASE("the cpu tracer's bvh walk gives its grid walk's hit ids and the stream bvh walk's") {
   for (const char* name : {"bunny", "bunny-refl", "classic", "teapot"}) {
     CAPTURE(std::string(name));
-    const Bundled b(name);
+    const Structures b = bundled(name);
     RenderOptions opt = options(64, 64);
     opt.bounces = 2;
     host::CpuStats gs, vs;
     const RenderResult cg = host::render_cpu(b.scene, b.grid_accel(), b.camera, opt, &gs);
-    const RenderResult cv = host::render_cpu(b.scene, b.bvh_accel(), b.camera, opt, &vs);
+    const RenderResult cv = host::render_cpu(b.scene, b.accel(), b.camera, opt, &vs);
     CHECK(compare_hits(b.scene, b.camera, 64, 64, cg.hit_id, cv.hit_id) == 0);
     CHECK(gs.nodes_visited == 0);
     CHECK(vs.nodes_visited > 0);
     CHECK(vs.voxel_steps == 0);
     CHECK(vs.rays == gs.rays);
     // The stream tracer's bvh walk in fp32 against the cpu's in double: the same ids.
-    const RenderResult sv = render(b.scene, b.bvh_accel(), b.camera, opt);
+    const RenderResult sv = render(b.scene, b.accel(), b.camera, opt);
     CHECK(compare_hits(b.scene, b.camera, 64, 64, cv.hit_id, sv.hit_id) == 0);
     CHECK(sv.rays_traced == cv.rays_traced);
   }
@@ -300,7 +239,7 @@ TEST_CASE("fp16 traversal or voxel state past 1023 node indices or list position
   // (fp16 arithmetic) or all 1024 (fp32 arithmetic: the end marker 5433 written as 5432, the
   // last leaf, whose escape is the end marker again) rays stopped by the step cap, and 218 or
   // 212 wrong pixels. The tracer now refuses at initialization, naming the group and the limit.
-  const Bundled b("teapot");
+  const Structures b = bundled("teapot");
   REQUIRE(b.bvh.nodes.size() == 5433);
   RenderOptions opt = options(32, 32);
   opt.bounces = 0;
@@ -309,7 +248,7 @@ TEST_CASE("fp16 traversal or voxel state past 1023 node indices or list position
     CAPTURE(vgpu::format_name(arith));
     opt.formats = host::Formats::all(vgpu::Format::fp32);
     opt.formats.set(host::Group::traversal, vgpu::Format::fp16, arith);
-    CHECK_THROWS_WITH_AS(host::StreamTracer(b.scene, b.bvh_accel(), opt),
+    CHECK_THROWS_WITH_AS(host::StreamTracer(b.scene, b.accel(), opt),
                          doctest::Contains("bvh: node indices reach 5432; the traversal group's "
                                            "fp16 addresses texels exactly only to 1023"),
                          vgpu::Error);
@@ -318,20 +257,20 @@ TEST_CASE("fp16 traversal or voxel state past 1023 node indices or list position
   opt.formats.set(host::Group::voxel, vgpu::Format::fp16, vgpu::Format::fp16);
   const std::string lists = "bvh: list positions reach " + std::to_string(b.bvh.lists.size() - 1) +
                             "; the voxel group's fp16";
-  CHECK_THROWS_WITH_AS(host::StreamTracer(b.scene, b.bvh_accel(), opt),
+  CHECK_THROWS_WITH_AS(host::StreamTracer(b.scene, b.accel(), opt),
                        doctest::Contains(lists.c_str()), vgpu::Error);
 }
 
 TEST_CASE("fp16 traversal texels on a bvh of fewer than 1024 nodes give fp32's hit ids") {
   // classic: 829 nodes, every index an exact fp16 address; the box tests still compute in fp32.
-  const Bundled b("classic");
+  const Structures b = bundled("classic");
   REQUIRE(b.bvh.nodes.size() <= 1024);
   RenderOptions opt = options(48, 48);
   opt.bounces = 0;
   opt.shadows = false;
-  const RenderResult ref = render(b.scene, b.bvh_accel(), b.camera, opt);
+  const RenderResult ref = render(b.scene, b.accel(), b.camera, opt);
   opt.formats.set(host::Group::traversal, vgpu::Format::fp16, vgpu::Format::fp32);
-  const RenderResult r = render(b.scene, b.bvh_accel(), b.camera, opt);
+  const RenderResult r = render(b.scene, b.accel(), b.camera, opt);
   CHECK(r.rays_unfinished == 0);
   CHECK(same_bits(ref.hit_id, r.hit_id));
   CHECK(same_bits(ref.depth, r.depth));
@@ -342,15 +281,15 @@ TEST_CASE("automatic formats keep fp32's hit ids with the bvh on every bundled s
   // state holds positions in the BVH's lists, which are longer than one voxel's list.
   for (const auto& [name, path] : host::list_scenes()) {
     CAPTURE(name);
-    const Bundled b(name);
+    const Structures b = bundled(name);
     RenderOptions opt = options(48, 48);
     opt.bounces = 0;
     opt.shadows = false;
-    const RenderResult ref = render(b.scene, b.bvh_accel(), b.camera, opt);
+    const RenderResult ref = render(b.scene, b.accel(), b.camera, opt);
     opt.formats = host::resolve(host::parse_format_request("auto", ""), b.scene, b.box,
                                 vgpu::profile("gf5700"), b.bvh.lists.size());
     CAPTURE(host::describe(opt.formats));
-    const RenderResult r = render(b.scene, b.bvh_accel(), b.camera, opt);
+    const RenderResult r = render(b.scene, b.accel(), b.camera, opt);
     CHECK(r.rays_unfinished == 0);
     CHECK(same_bits(ref.hit_id, r.hit_id));
   }

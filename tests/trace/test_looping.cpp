@@ -17,15 +17,14 @@
 #include "host/scene/gltf_loader.h"
 #include "host/trace/stream/stream_tracer.h"
 #include "stability_cases.h"
+#include "tests/support/bits.h"
 
 using host::RenderOptions;
 using host::RenderResult;
 
-namespace {
+using test_support::same_bits;
 
-bool same_bits(const std::vector<float>& a, const std::vector<float>& b) {
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0;
-}
+namespace {
 
 RenderResult render(const host::Scene& scene, const host::Grid& grid, const host::Camera& cam,
                     const RenderOptions& opt) {

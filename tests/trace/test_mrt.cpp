@@ -14,12 +14,11 @@
 #include "host/scene/gltf_loader.h"
 #include "host/trace/stream/stream_tracer.h"
 #include "stability_cases.h"
+#include "tests/support/bits.h"
+
+using test_support::same_bits;
 
 namespace {
-
-bool same_bits(const std::vector<float>& a, const std::vector<float>& b) {
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0;
-}
 
 uint64_t passes_of(const vgpu::FrameStats& s, const std::string& program) {
   const auto* p = s.find(program);

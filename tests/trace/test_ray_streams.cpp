@@ -1,5 +1,5 @@
-// Glass on the virtual GPU (issue 25): the ray streams of host/trace/stream/ray_streams.h end to end.
-// A glass slab in front of a wall, seen along its axis, against Whitted's recursion in double
+// Glass on the virtual GPU (issue 25): the ray streams of host/trace/stream/ray_streams.h end to
+// end. A glass slab in front of a wall, seen along its axis, against Whitted's recursion in double
 // written out here (every hit on the axis is at normal incidence); levels longer than one
 // chunk; shadow rays through glass; the paper's reflections through the streams; and the same
 // images and statistics for any thread count, lane width and walk.
@@ -12,10 +12,13 @@
 #include "host/accel/grid.h"
 #include "host/scene/gltf_loader.h"
 #include "host/trace/stream/stream_tracer.h"
+#include "tests/support/bits.h"
 
 using host::RenderOptions;
 using host::RenderResult;
 using host::Scene;
+
+using test_support::same_bits;
 
 namespace {
 
@@ -96,10 +99,6 @@ RenderResult render(const Scene& scene, RenderOptions opt) {
 glm::dvec3 centre(const RenderResult& r) {
   const size_t i = (size_t(kSize / 2) * kSize + kSize / 2) * 3;
   return {r.rgb[i], r.rgb[i + 1], r.rgb[i + 2]};
-}
-
-bool same_bits(const std::vector<float>& a, const std::vector<float>& b) {
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0;
 }
 
 }  // namespace

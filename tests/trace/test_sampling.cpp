@@ -18,6 +18,9 @@
 #include "host/trace/cpu/cpu_tracer.h"
 #include "host/trace/sampling.h"
 #include "host/trace/stream/stream_tracer.h"
+#include "tests/support/bits.h"
+
+using test_support::same_bits;
 
 namespace {
 
@@ -152,10 +155,6 @@ host::RenderOptions adaptive_options(int spp, float threshold) {
   opt.adaptive = true;
   opt.aa_threshold = threshold;
   return opt;
-}
-
-bool same_bits(const std::vector<float>& a, const std::vector<float>& b) {
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0;
 }
 
 }  // namespace

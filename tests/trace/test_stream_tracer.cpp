@@ -15,13 +15,16 @@
 #include "host/accel/grid.h"
 #include "host/scene/camera.h"
 #include "host/scene/gltf_loader.h"
-#include "tests/support/reference.h"
 #include "host/trace/stream/stream_tracer.h"
+#include "tests/support/bits.h"
+#include "tests/support/reference.h"
 
 using host::RefHit;
 using host::RenderOptions;
 using host::RenderResult;
 using host::Scene;
+
+using test_support::same_bits;
 
 namespace {
 
@@ -160,10 +163,6 @@ Comparison compare_primary(const Scene& scene, const host::Camera& cam, const Re
       if (std::abs(r.depth[i] - depth) > 1e-4 * depth) ++c.depth_errors;
     }
   return c;
-}
-
-bool same_bits(const std::vector<float>& a, const std::vector<float>& b) {
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0;
 }
 
 // Same image, depth and hit buffers bit for bit, and every integer statistic equal, in total and

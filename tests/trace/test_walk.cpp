@@ -1,7 +1,7 @@
-// The walk machinery of host/trace/walks/walk.h on a walk that is not the grid's: a toy pass sequence
-// (count each pixel's counter down to zero, one step per pass, steered by a query) with its own
-// sites gets batch walks and their replay from run_walk, with the textures, query counts and
-// statistics of the same walk run pass by pass.
+// The walk machinery of host/trace/walks/walk.h on a walk that is not the grid's: a toy pass
+// sequence (count each pixel's counter down to zero, one step per pass, steered by a query) with
+// its own sites gets batch walks and their replay from run_walk, with the textures, query counts
+// and statistics of the same walk run pass by pass.
 #include <doctest/doctest.h>
 
 #include <cstring>
@@ -11,6 +11,7 @@
 
 #include "host/trace/walks/walk.h"
 #include "kernels/common.h"
+#include "tests/support/stats_json.h"
 
 namespace {
 
@@ -94,24 +95,6 @@ struct Run {
   std::string stats;  // the frame's statistics JSON without wall-clock fields
 };
 
-std::string without_times(nlohmann::ordered_json j) {
-  std::function<void(nlohmann::ordered_json&)> strip = [&](nlohmann::ordered_json& v) {
-    if (v.is_object()) {
-      nlohmann::ordered_json out = nlohmann::ordered_json::object();
-      for (auto& [k, e] : v.items())
-        if (!(k.size() > 3 && k.compare(k.size() - 3, 3, "_ms") == 0)) {
-          strip(e);
-          out[k] = e;
-        }
-      v = out;
-    } else if (v.is_array()) {
-      for (auto& e : v) strip(e);
-    }
-  };
-  strip(j);
-  return j.dump();
-}
-
 // 37x21 pixels (partial batches and tiles), counters from 0 to 12 in a pattern no tile repeats.
 Run run_countdown(bool batches, int threads, bool masks) {
   host::RenderOptions opt;
@@ -131,7 +114,7 @@ Run run_countdown(bool batches, int threads, bool masks) {
   host::PassRunner r(gpu, opt, target);
   CountdownWalk::Cursor c{0};
   host::walk::run_walk(r, w, c);
-  return {w.counter[c.cur], r.counts, without_times(gpu.stats().json())};
+  return {w.counter[c.cur], r.counts, test_support::without_times(gpu.stats().json()).dump()};
 }
 
 }  // namespace

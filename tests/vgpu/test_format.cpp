@@ -7,11 +7,14 @@
 #include <ios>
 #include <limits>
 
+#include "tests/support/bits.h"
 #include "vgpu/format.h"
 
 using vgpu::Format;
 using vgpu::round_fp16;
 using vgpu::round_fp24;
+
+using test_support::same_bits;
 
 namespace {
 
@@ -19,10 +22,6 @@ const float kInf = std::numeric_limits<float>::infinity();
 const float kNaN = std::numeric_limits<float>::quiet_NaN();
 
 // Exact equality of bits: tells +0 from -0, which == does not.
-bool same_bits(float a, float b) {
-  return std::bit_cast<uint32_t>(a) == std::bit_cast<uint32_t>(b);
-}
-
 }  // namespace
 
 TEST_CASE("fp16 stores round to the nearest binary16, ties to even") {
