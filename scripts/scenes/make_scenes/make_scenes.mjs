@@ -15,6 +15,7 @@
 //   - KHR_lights_punctual point lights with intensity 1.0 (the renderer multiplies colour by
 //     intensity and applies no physical falloff).
 // The output is deterministic: no randomness, no timestamps, fixed iteration orders.
+// This file holds the glTF writer and the scenes; the vector and mesh helpers are in geometry.mjs.
 
 import { readFileSync, writeFileSync, mkdirSync } from 'node:fs';
 import { createRequire } from 'node:module';
