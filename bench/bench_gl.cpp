@@ -337,10 +337,8 @@ FrameRun run_frames(const host::Scene& scene, const host::Accel& accel, const ho
   return fr;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  CLI::App app{"bench_gl: the stream ray tracer's passes on the GL device beside the vgpu"};
+// The command line.
+struct Args {
   std::string device = "auto", json_path, grid_text = "15";
   std::vector<std::string> scenes = {"sphere-alone", "bunny", "bunny-mirror"};
   std::vector<int> sizes = {256};
@@ -353,59 +351,63 @@ int main(int argc, char** argv) {
   int bounces = 2;
   std::vector<std::string> ray_streams = {"off"}, sampling = {"spp:1"};
   bool shadows = false, no_fixed = false, latency = false;
-  app.add_option("--gl-device", device, "auto, or an EGL device index")->capture_default_str();
-  app.add_option("--scenes", scenes, "Scene names or .gltf paths")->capture_default_str();
-  app.add_option("--sizes", sizes, "Image sizes (square)")
+};
+
+// Declares every option of bench_gl on app, bound to a.
+void add_options(CLI::App& app, Args& a) {
+  app.add_option("--gl-device", a.device, "auto, or an EGL device index")->capture_default_str();
+  app.add_option("--scenes", a.scenes, "Scene names or .gltf paths")->capture_default_str();
+  app.add_option("--sizes", a.sizes, "Image sizes (square)")
       ->capture_default_str()
       ->check(CLI::Range(8, 4096));
-  app.add_option("--grid", grid_text, "Grid: auto, N or AxBxC")->capture_default_str();
-  app.add_option("--runs", runs, "Timed runs per figure (after one warm-up)")
+  app.add_option("--grid", a.grid_text, "Grid: auto, N or AxBxC")->capture_default_str();
+  app.add_option("--runs", a.runs, "Timed runs per figure (after one warm-up)")
       ->capture_default_str()
       ->check(CLI::Range(1, 100));
-  app.add_option("--dump-programs", dump_programs,
+  app.add_option("--dump-programs", a.dump_programs,
                  "GL frames: write every program the driver links, GLSL and program binary "
                  "(NVIDIA's holds its compiled assembly as text), under DIR/scene_accel_variant/");
-  app.add_option("--warmup-ms", warmup_ms,
+  app.add_option("--warmup-ms", a.warmup_ms,
                  "GL frames: after the warm-up frame, run frames of the same configuration until "
                  "this many ms have passed before timing (a GPU idle before them has lowered its "
                  "clock); 0: none")
       ->capture_default_str()
       ->check(CLI::Range(0, 600000));
-  app.add_option("--micro-passes", micro_passes, "Passes per fixed-cost measurement")
+  app.add_option("--micro-passes", a.micro_passes, "Passes per fixed-cost measurement")
       ->capture_default_str()
       ->check(CLI::Range(10, 100000));
-  app.add_option("--threads", threads, "Host threads of the vgpu runs (0: all cores)")
+  app.add_option("--threads", a.threads, "Host threads of the vgpu runs (0: all cores)")
       ->capture_default_str()
       ->check(CLI::Range(0, 256));
-  app.add_flag("--no-stream", no_stream, "Skip the vgpu (emulator) runs");
-  app.add_option("--variants", variants,
+  app.add_flag("--no-stream", a.no_stream, "Skip the vgpu (emulator) runs");
+  app.add_option("--variants", a.variants,
                  "Pipelines per frame: multipass (the paper's, Table 1's gf5700 profile), mrt "
                  "(fused two-output passes) and looping (the looping kernels), both on the h200 "
                  "profile")
       ->check(CLI::IsMember({"multipass", "mrt", "looping"}))
       ->capture_default_str();
-  app.add_option("--readback-wait", wait_mode,
+  app.add_option("--readback-wait", a.wait_mode,
                  "GL frames: block (GL_QUERY_RESULT), poll (spin on GL_QUERY_RESULT_AVAILABLE), "
                  "both, or none (no GL frames: the emulator's counts and predictions only)")
       ->check(CLI::IsMember({"block", "poll", "both", "none"}))
       ->capture_default_str();
   app.add_option(
-         "--accel", accels,
+         "--accel", a.accels,
          "Acceleration structures per frame: grid (the paper's, --grid), grid2 (two-level), "
          "bvh, kdtree")
       ->check(CLI::IsMember({"grid", "grid2", "bvh", "kdtree"}))
       ->capture_default_str();
-  app.add_option("--bounces", bounces,
+  app.add_option("--bounces", a.bounces,
                  "Reflection iterations after the primary one (0: primary "
                  "rays only)")
       ->capture_default_str()
       ->check(CLI::Range(0, 16));
-  app.add_option("--ray-streams", ray_streams,
+  app.add_option("--ray-streams", a.ray_streams,
                  "Per frame: off (the paper's reflections), on (reflections through glass's ray "
                  "streams: split, compaction, gather); a scene with glass always runs them")
       ->check(CLI::IsMember({"off", "on"}))
       ->capture_default_str();
-  app.add_option("--sampling", sampling,
+  app.add_option("--sampling", a.sampling,
                  "Sampling modes per frame: spp:N (N a square, 1 to 256), adaptive:N (--aa "
                  "adaptive up to N), undersample:K (--aa undersample:K, K 1 to 64)")
       ->check(CLI::Validator(
@@ -419,20 +421,251 @@ int main(int argc, char** argv) {
           },
           "MODE", "sampling"))
       ->capture_default_str();
-  app.add_flag("--shadows", shadows, "Shadow rays in the frames (off: Table 1's setting)");
-  app.add_flag("--no-fixed", no_fixed, "Skip the fixed-cost passes (frames only)");
-  app.add_flag("--no-frames", no_frames, "Only the fixed costs");
-  app.add_flag("--latency", latency,
+  app.add_flag("--shadows", a.shadows, "Shadow rays in the frames (off: Table 1's setting)");
+  app.add_flag("--no-fixed", a.no_fixed, "Skip the fixed-cost passes (frames only)");
+  app.add_flag("--no-frames", a.no_frames, "Only the fixed costs");
+  app.add_flag("--latency", a.latency,
                "Also measure latencies: one fragment following a chain of dependent texel "
                "fetches (RGBA32F textures of 16x16, 512x512 and 2048x2048 texels) and of "
                "dependent multiply-adds, GPU time per iteration (needs a GL device)");
-  app.add_option("--json", json_path, "Also write every figure as JSON to this file");
+  app.add_option("--json", a.json_path, "Also write every figure as JSON to this file");
+}
+
+// The fixed costs, on a device of its own (gf6600: two outputs for the MRT pass): one pass, one
+// query read-back and one program switch on tiny passes, then texture clears and downloads and
+// passes over large targets. Adds pass_us, readback_us, program_switch_us and fixed to out.
+void measure_fixed_costs(const Args& a, json& out) {
+  const int runs = a.runs, micro_passes = a.micro_passes;
+  gl::GlDevice d(vgpu::profile("gf6600"), a.device, gl::GlDevice::ReadbackWait::block);
+  vgpu::KernelProgram<CopyTexel> copy;
+  vgpu::KernelProgram<ScaleTexel> scale;
+  vgpu::KernelProgram<CopyTwice> twice;
+  json fixed = json::array();
+  auto row = [&](const std::string& what, int size, const Fixed& f) {
+    std::printf("  %-46s %5dx%-5d wall %9.2f us  gpu %9.2f us\n", what.c_str(), size, size,
+                f.wall_us, f.gpu_us);
+    fixed.push_back({{"what", what}, {"size", size}, {"wall_us", f.wall_us}, {"gpu_us", f.gpu_us}});
+  };
+  std::printf("fixed costs, per pass (medians of %d runs of %d passes):\n", runs, micro_passes);
+  for (int size : {1, 64, 256}) {
+    const Fixed pass = time_passes(d, size, micro_passes, runs, false, copy, nullptr);
+    const Fixed rb = time_passes(d, size, micro_passes, runs, true, copy, nullptr);
+    const Fixed sw = time_passes(d, size, micro_passes, runs, false, copy, &scale);
+    row("pass", size, pass);
+    row("pass + blocking query read-back", size, rb);
+    row("pass, program switched every pass", size, sw);
+    if (size == 1) {
+      out["pass_us"] = pass.wall_us;
+      out["readback_us"] = rb.wall_us - pass.wall_us;
+      out["program_switch_us"] = sw.wall_us - pass.wall_us;
+    }
+  }
+  gl::GlDevice dp(vgpu::profile("gf6600"), a.device, gl::GlDevice::ReadbackWait::poll);
+  for (int size : {1, 256})
+    row("pass + polled query read-back", size,
+        time_passes(dp, size, micro_passes, runs, true, copy, nullptr));
+  // Texture work outside passes: a clear, and a read-back of one RGBA32F texture to the host
+  // (glGetTexImage; the image at the end of a frame), each after a glFinish.
+  for (int size : {256, 1024, 2048}) {
+    vgpu::Texture t = d.make_texture("readback", size, size, 4);
+    d.upload(t);
+    std::vector<double> clear_us, down_us;
+    for (int r = 0; r <= runs; ++r) {
+      d.finish();
+      auto t0 = Clock::now();
+      d.clear(t, {0.f, 0.f, 0.f, 0.f});
+      d.finish();
+      const double c = 1e3 * ms_since(t0);
+      t0 = Clock::now();
+      d.download(t);
+      const double w = 1e3 * ms_since(t0);
+      if (r == 0) continue;
+      clear_us.push_back(c);
+      down_us.push_back(w);
+    }
+    row("clear one RGBA32F texture", size, {median(clear_us), 0});
+    row("download one RGBA32F texture", size, {median(down_us), 0});
+  }
+  for (int size : {1024, 2048}) {
+    const int n = std::max(10, micro_passes / 10);
+    row("pass, one RGBA32F target", size, time_passes(d, size, n, runs, false, copy, nullptr));
+    row("pass + blocking query read-back", size,
+        time_passes(d, size, n, runs, true, copy, nullptr));
+    row("pass + polled query read-back", size, time_passes(dp, size, n, runs, true, copy, nullptr));
+    row("pass, two RGBA32F targets (MRT)", size,
+        time_passes(d, size, std::max(10, micro_passes / 10), runs, false, twice, nullptr, 2));
+  }
+  std::printf(
+      "  => one pass %.2f us, one query read-back %.2f us, one program switch %.2f us "
+      "(1x1 passes, wall)\n",
+      out["pass_us"].get<double>(), out["readback_us"].get<double>(),
+      out["program_switch_us"].get<double>());
+  out["fixed"] = fixed;
+}
+
+// One kernel's figures in a frame; for an emulator frame (!gl) the cost model's prediction of
+// its passes' work and fixed costs on the h200.
+json kernel_json(const FrameRun& fr, const vgpu::FrameStats::ProgramTotals& p, bool gl) {
+  json k = {{"name", p.name},
+            {"paper_name", p.paper_name},
+            {"passes", p.counters.passes},
+            {"gpu_ms", gl ? json(median(fr.kernel_gpu.at(p.name))) : json()},
+            {"host_ms", median(fr.kernel_host.at(p.name))}};
+  if (!gl) {
+    vgpu::FrameStats one;
+    one.programs = {p};
+    one.totals = p.counters;
+    const vgpu::Profile& hp = vgpu::profile("h200");
+    const host::CostBreakdown b = host::predict(one, hp, params_for(hp));
+    k["predicted_h200_ms"] = b.total_ms;
+    k["predicted_h200_work_ms"] = b.arithmetic_ms + b.texture_ms + b.memory_ms;
+    k["predicted_h200_latency_ms"] = b.latency_ms;
+  }
+  return k;
+}
+
+// What one frame configuration names, beside its measurements.
+struct FrameKey {
+  std::string scene, accel, variant, streams, mode, engine;
+  int size = 0;
+};
+
+// One frame configuration's figures as JSON, and its line on stdout.
+json frame_json(const FrameKey& key, const host::RenderOptions& opt, const FrameRun& fr, int runs) {
+  const bool gl = key.engine != "stream";
+  json f = {{"scene", key.scene},
+            {"accel", key.accel},
+            {"bounces", opt.bounces},
+            {"variant", key.variant},
+            {"shadows", opt.shadows},
+            {"ray_streams", key.streams},
+            {"streams_ran", fr.streams},
+            {"sampling", key.mode},
+            {"size", key.size},
+            {"engine", key.engine},
+            {"device", fr.device},
+            {"runs", runs},
+            {"warmup_frames", fr.warmup_frames},
+            {"warmup_ms", fr.warmup_ms},
+            {"timed_from_s", fr.timed_from_s},
+            {"timed_to_s", fr.timed_to_s},
+            {"wall_ms", median(fr.wall)},
+            {"wall_runs_ms", fr.wall},  // every timed frame, in order
+            {"gpu_ms", gl ? json(median(fr.gpu)) : json()},
+            {"readback_wait_ms", gl ? json(median(fr.wait)) : json()},
+            {"gpu_runs_ms", gl ? json(fr.gpu) : json()},
+            {"passes", fr.stats.totals.passes},
+            {"query_readbacks", fr.stats.totals.query_readbacks},
+            {"program_loads", fr.stats.totals.program_loads},
+            {"fragments_shaded", fr.stats.totals.fragments_shaded},
+            {"rays_traced", fr.rays_traced}};
+  json kernels = json::array();
+  for (const auto& p : fr.stats.programs) kernels.push_back(kernel_json(fr, p, gl));
+  f["kernels"] = kernels;
+  if (!gl) {
+    json pred;
+    for (const vgpu::Profile& p : vgpu::profiles())
+      pred[p.name] = host::predict(fr.stats, p, params_for(p)).total_ms;
+    f["predicted_ms"] = pred;
+    json h200 = json::object();
+    const vgpu::Profile& hp = vgpu::profile("h200");
+    for (const auto& [k, v] : host::predict(fr.stats, hp, params_for(hp)).items()) h200[k] = v;
+    f["predicted_h200"] = h200;
+  }
+  std::printf("%-14s %4dx%-4d %-6s %-9s %-7s streams %-3s %-13s wall %9.1f ms", key.scene.c_str(),
+              key.size, key.size, key.accel.c_str(), key.variant.c_str(), key.engine.c_str(),
+              key.streams.c_str(), key.mode.c_str(), median(fr.wall));
+  if (gl)
+    std::printf("  gpu %9.1f ms  wait %8.1f ms  warm-up %d frames", median(fr.gpu), median(fr.wait),
+                fr.warmup_frames);
+  else
+    std::printf("  h200 predicted %8.1f ms", f["predicted_ms"]["h200"].get<double>());
+  std::printf("  passes %6llu  read-backs %5llu\n",
+              static_cast<unsigned long long>(fr.stats.totals.passes),
+              static_cast<unsigned long long>(fr.stats.totals.query_readbacks));
+  std::fflush(stdout);
+  return f;
+}
+
+// The frames of one scene at one size: every structure, variant, ray-stream setting, sampling
+// mode and engine, appended to frames.
+void scene_frames(const Args& a, const host::Scene& scene, int size,
+                  const std::vector<std::string>& engines, json& frames) {
+  host::RenderOptions opt;  // docs/table1.md's settings
+  opt.width = opt.height = size;
+  opt.bounces = a.bounces;
+  opt.shading = kernels::ShadingModel::phong;
+  opt.shadows = a.shadows;
+  opt.threads = a.threads;
+  opt.gl_device = a.device;
+  const host::Grid grid = host::build_grid(
+      scene,
+      host::grid_spec_for(host::parse_grid_spec(a.grid_text), scene, vgpu::profile(opt.profile)));
+  const host::Grid box = host::build_grid(scene, host::GridSpec{glm::ivec3(1)});
+  std::optional<host::Bvh> bvh;
+  std::optional<host::KdTree> kd;
+  std::optional<host::Grid2> grid2;
+  for (const std::string& name : a.accels) {
+    if (name == "bvh" && !bvh) bvh = host::build_bvh(scene);
+    if (name == "kdtree" && !kd) kd = host::build_kdtree(scene, box.lo, box.hi);
+    if (name == "grid2" && !grid2) grid2 = host::build_grid2(scene);
+  }
+  const host::Camera cam = host::scene_camera(scene);
+  for (const std::string& accel_name : a.accels)
+    for (const std::string& variant : a.variants) {
+      const host::AccelKind kind = host::parse_accel_kind(accel_name);
+      const host::Accel accel{kind, kind == host::AccelKind::grid ? &grid : &box,
+                              bvh ? &*bvh : nullptr, kd ? &*kd : nullptr,
+                              grid2 ? &*grid2 : nullptr};
+      // The paper's pipeline at Table 1's profile; its future work (MRT fused passes, the
+      // looping kernels) needs a profile with several outputs and loops: the h200's.
+      opt.mrt = variant == "mrt";
+      opt.looping = variant == "looping";
+      opt.profile = variant == "multipass" ? "gf5700" : "h200";
+      for (const std::string& streams : a.ray_streams)
+        for (const std::string& mode : a.sampling)
+          for (const std::string& engine : engines) {
+            opt.ray_streams = streams == "on";
+            parse_sampling(mode, opt);  // checked when parsed
+            const bool gl = engine != "stream";
+            opt.device = gl ? "gl" : "vgpu";
+            opt.gl_readback = engine == "gl-poll" ? "poll" : "block";
+            const std::string dump = a.dump_programs.empty() ? ""
+                                                             : a.dump_programs + "/" + scene.name +
+                                                                   "_" + accel_name + "_" + variant;
+            const FrameRun fr = run_frames(scene, accel, cam, opt, a.runs, a.warmup_ms, dump);
+            const FrameKey key{scene.name, accel_name, variant, streams, mode, engine, size};
+            frames.push_back(frame_json(key, opt, fr, a.runs));
+          }
+    }
+}
+
+// Every frame: the scenes by the sizes, on the engines --readback-wait and --no-stream ask for.
+json measure_frames(const Args& a) {
+  std::vector<std::string> engines;
+  if (a.wait_mode == "block" || a.wait_mode == "both") engines.push_back("gl");
+  if (a.wait_mode == "poll" || a.wait_mode == "both") engines.push_back("gl-poll");
+  if (!a.no_stream) engines.push_back("stream");
+  json frames = json::array();
+  for (const std::string& name : a.scenes) {
+    const host::Scene scene = host::load_scene(host::resolve_scene(name), host::with_images());
+    for (int size : a.sizes) scene_frames(a, scene, size, engines, frames);
+  }
+  return frames;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"bench_gl: the stream ray tracer's passes on the GL device beside the vgpu"};
+  Args a;
+  add_options(app, a);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {  // --help exits 0; a bad option 2, as vgpu-rt does
     return app.exit(e) == 0 ? 0 : 2;
   }
-  if (latency && wait_mode == "none") {
+  if (a.latency && a.wait_mode == "none") {
     std::fprintf(stderr,
                  "bench_gl: --latency needs a GL device (--readback-wait block, poll or "
                  "both)\n");
@@ -441,221 +674,23 @@ int main(int argc, char** argv) {
 
   try {
     json out;
-    // Fixed costs first, on a device of its own (gf6600: two outputs for the MRT pass).
-    if (wait_mode != "none") {
-      gl::GlDevice d(vgpu::profile("gf6600"), device, gl::GlDevice::ReadbackWait::block);
+    if (a.wait_mode != "none") {
+      gl::GlDevice d(vgpu::profile("gf6600"), a.device, gl::GlDevice::ReadbackWait::block);
       out["device"] = d.description();
       out["renderer"] = d.context().renderer();
       out["gl_version"] = d.context().version();
       std::printf("device: %s\n", d.description().c_str());
     }
-    if (wait_mode != "none" && !no_fixed) {
-      gl::GlDevice d(vgpu::profile("gf6600"), device, gl::GlDevice::ReadbackWait::block);
-      vgpu::KernelProgram<CopyTexel> copy;
-      vgpu::KernelProgram<ScaleTexel> scale;
-      vgpu::KernelProgram<CopyTwice> twice;
-      json fixed = json::array();
-      auto row = [&](const std::string& what, int size, const Fixed& f) {
-        std::printf("  %-46s %5dx%-5d wall %9.2f us  gpu %9.2f us\n", what.c_str(), size, size,
-                    f.wall_us, f.gpu_us);
-        fixed.push_back(
-            {{"what", what}, {"size", size}, {"wall_us", f.wall_us}, {"gpu_us", f.gpu_us}});
-      };
-      std::printf("fixed costs, per pass (medians of %d runs of %d passes):\n", runs, micro_passes);
-      for (int size : {1, 64, 256}) {
-        const Fixed pass = time_passes(d, size, micro_passes, runs, false, copy, nullptr);
-        const Fixed rb = time_passes(d, size, micro_passes, runs, true, copy, nullptr);
-        const Fixed sw = time_passes(d, size, micro_passes, runs, false, copy, &scale);
-        row("pass", size, pass);
-        row("pass + blocking query read-back", size, rb);
-        row("pass, program switched every pass", size, sw);
-        if (size == 1) {
-          out["pass_us"] = pass.wall_us;
-          out["readback_us"] = rb.wall_us - pass.wall_us;
-          out["program_switch_us"] = sw.wall_us - pass.wall_us;
-        }
-      }
-      gl::GlDevice dp(vgpu::profile("gf6600"), device, gl::GlDevice::ReadbackWait::poll);
-      for (int size : {1, 256})
-        row("pass + polled query read-back", size,
-            time_passes(dp, size, micro_passes, runs, true, copy, nullptr));
-      // Texture work outside passes: a clear, and a read-back of one RGBA32F texture to the host
-      // (glGetTexImage; the image at the end of a frame), each after a glFinish.
-      for (int size : {256, 1024, 2048}) {
-        vgpu::Texture t = d.make_texture("readback", size, size, 4);
-        d.upload(t);
-        std::vector<double> clear_us, down_us;
-        for (int r = 0; r <= runs; ++r) {
-          d.finish();
-          auto t0 = Clock::now();
-          d.clear(t, {0.f, 0.f, 0.f, 0.f});
-          d.finish();
-          const double c = 1e3 * ms_since(t0);
-          t0 = Clock::now();
-          d.download(t);
-          const double w = 1e3 * ms_since(t0);
-          if (r == 0) continue;
-          clear_us.push_back(c);
-          down_us.push_back(w);
-        }
-        row("clear one RGBA32F texture", size, {median(clear_us), 0});
-        row("download one RGBA32F texture", size, {median(down_us), 0});
-      }
-      for (int size : {1024, 2048}) {
-        const int n = std::max(10, micro_passes / 10);
-        row("pass, one RGBA32F target", size, time_passes(d, size, n, runs, false, copy, nullptr));
-        row("pass + blocking query read-back", size,
-            time_passes(d, size, n, runs, true, copy, nullptr));
-        row("pass + polled query read-back", size,
-            time_passes(dp, size, n, runs, true, copy, nullptr));
-        row("pass, two RGBA32F targets (MRT)", size,
-            time_passes(d, size, std::max(10, micro_passes / 10), runs, false, twice, nullptr, 2));
-      }
-      std::printf(
-          "  => one pass %.2f us, one query read-back %.2f us, one program switch %.2f us "
-          "(1x1 passes, wall)\n",
-          out["pass_us"].get<double>(), out["readback_us"].get<double>(),
-          out["program_switch_us"].get<double>());
-      out["fixed"] = fixed;
+    if (a.wait_mode != "none" && !a.no_fixed) measure_fixed_costs(a, out);
+    if (a.latency) {
+      gl::GlDevice d(vgpu::profile("h200"), a.device, gl::GlDevice::ReadbackWait::poll);
+      out["latency"] = measure_latencies(d, a.runs, std::max(a.warmup_ms, 200));
     }
-    if (latency) {
-      gl::GlDevice d(vgpu::profile("h200"), device, gl::GlDevice::ReadbackWait::poll);
-      out["latency"] = measure_latencies(d, runs, std::max(warmup_ms, 200));
-    }
-    std::vector<std::string> engines;
-    if (wait_mode == "block" || wait_mode == "both") engines.push_back("gl");
-    if (wait_mode == "poll" || wait_mode == "both") engines.push_back("gl-poll");
-    if (!no_stream) engines.push_back("stream");
-    if (!no_frames) {
-      json frames = json::array();
-      for (const std::string& name : scenes) {
-        const host::Scene scene = host::load_scene(host::resolve_scene(name), host::with_images());
-        for (int size : sizes) {
-          host::RenderOptions opt;  // docs/table1.md's settings
-          opt.width = opt.height = size;
-          opt.bounces = bounces;
-          opt.shading = kernels::ShadingModel::phong;
-          opt.shadows = shadows;
-          opt.threads = threads;
-          opt.gl_device = device;
-          const host::Grid grid =
-              host::build_grid(scene, host::grid_spec_for(host::parse_grid_spec(grid_text), scene,
-                                                          vgpu::profile(opt.profile)));
-          const host::Grid box = host::build_grid(scene, host::GridSpec{glm::ivec3(1)});
-          std::optional<host::Bvh> bvh;
-          std::optional<host::KdTree> kd;
-          std::optional<host::Grid2> grid2;
-          for (const std::string& a : accels) {
-            if (a == "bvh" && !bvh) bvh = host::build_bvh(scene);
-            if (a == "kdtree" && !kd) kd = host::build_kdtree(scene, box.lo, box.hi);
-            if (a == "grid2" && !grid2) grid2 = host::build_grid2(scene);
-          }
-          const host::Camera cam = host::scene_camera(scene);
-          for (const std::string& accel_name : accels)
-            for (const std::string& variant : variants) {
-              const host::AccelKind kind = host::parse_accel_kind(accel_name);
-              const host::Accel accel{kind, kind == host::AccelKind::grid ? &grid : &box,
-                                      bvh ? &*bvh : nullptr, kd ? &*kd : nullptr,
-                                      grid2 ? &*grid2 : nullptr};
-              // The paper's pipeline at Table 1's profile; its future work (MRT fused passes, the
-              // looping kernels) needs a profile with several outputs and loops: the h200's.
-              opt.mrt = variant == "mrt";
-              opt.looping = variant == "looping";
-              opt.profile = variant == "multipass" ? "gf5700" : "h200";
-              for (const std::string& streams : ray_streams)
-                for (const std::string& mode : sampling)
-                  for (const std::string& engine : engines) {
-                    opt.ray_streams = streams == "on";
-                    parse_sampling(mode, opt);  // checked when parsed
-                    const bool gl = engine != "stream";
-                    opt.device = gl ? "gl" : "vgpu";
-                    opt.gl_readback = engine == "gl-poll" ? "poll" : "block";
-                    const std::string dump =
-                        dump_programs.empty()
-                            ? ""
-                            : dump_programs + "/" + scene.name + "_" + accel_name + "_" + variant;
-                    const FrameRun fr = run_frames(scene, accel, cam, opt, runs, warmup_ms, dump);
-                    json f = {{"scene", scene.name},
-                              {"accel", accel_name},
-                              {"bounces", opt.bounces},
-                              {"variant", variant},
-                              {"shadows", opt.shadows},
-                              {"ray_streams", streams},
-                              {"streams_ran", fr.streams},
-                              {"sampling", mode},
-                              {"size", size},
-                              {"engine", engine},
-                              {"device", fr.device},
-                              {"runs", runs},
-                              {"warmup_frames", fr.warmup_frames},
-                              {"warmup_ms", fr.warmup_ms},
-                              {"timed_from_s", fr.timed_from_s},
-                              {"timed_to_s", fr.timed_to_s},
-                              {"wall_ms", median(fr.wall)},
-                              {"wall_runs_ms", fr.wall},  // every timed frame, in order
-                              {"gpu_ms", gl ? json(median(fr.gpu)) : json()},
-                              {"readback_wait_ms", gl ? json(median(fr.wait)) : json()},
-                              {"gpu_runs_ms", gl ? json(fr.gpu) : json()},
-                              {"passes", fr.stats.totals.passes},
-                              {"query_readbacks", fr.stats.totals.query_readbacks},
-                              {"program_loads", fr.stats.totals.program_loads},
-                              {"fragments_shaded", fr.stats.totals.fragments_shaded},
-                              {"rays_traced", fr.rays_traced}};
-                    json kernels = json::array();
-                    for (const auto& p : fr.stats.programs) {
-                      json k = {{"name", p.name},
-                                {"paper_name", p.paper_name},
-                                {"passes", p.counters.passes},
-                                {"gpu_ms", gl ? json(median(fr.kernel_gpu.at(p.name))) : json()},
-                                {"host_ms", median(fr.kernel_host.at(p.name))}};
-                      if (!gl) {  // the cost model per kernel: its passes' work and fixed costs
-                        vgpu::FrameStats one;
-                        one.programs = {p};
-                        one.totals = p.counters;
-                        const vgpu::Profile& hp = vgpu::profile("h200");
-                        const host::CostBreakdown b = host::predict(one, hp, params_for(hp));
-                        k["predicted_h200_ms"] = b.total_ms;
-                        k["predicted_h200_work_ms"] = b.arithmetic_ms + b.texture_ms + b.memory_ms;
-                        k["predicted_h200_latency_ms"] = b.latency_ms;
-                      }
-                      kernels.push_back(k);
-                    }
-                    f["kernels"] = kernels;
-                    if (!gl) {
-                      json pred;
-                      for (const vgpu::Profile& p : vgpu::profiles())
-                        pred[p.name] = host::predict(fr.stats, p, params_for(p)).total_ms;
-                      f["predicted_ms"] = pred;
-                      json h200 = json::object();
-                      const vgpu::Profile& hp = vgpu::profile("h200");
-                      for (const auto& [k, v] : host::predict(fr.stats, hp, params_for(hp)).items())
-                        h200[k] = v;
-                      f["predicted_h200"] = h200;
-                    }
-                    std::printf("%-14s %4dx%-4d %-6s %-9s %-7s streams %-3s %-13s wall %9.1f ms",
-                                scene.name.c_str(), size, size, accel_name.c_str(), variant.c_str(),
-                                engine.c_str(), streams.c_str(), mode.c_str(), median(fr.wall));
-                    if (gl)
-                      std::printf("  gpu %9.1f ms  wait %8.1f ms  warm-up %d frames",
-                                  median(fr.gpu), median(fr.wait), fr.warmup_frames);
-                    else
-                      std::printf("  h200 predicted %8.1f ms",
-                                  f["predicted_ms"]["h200"].get<double>());
-                    std::printf("  passes %6llu  read-backs %5llu\n",
-                                static_cast<unsigned long long>(fr.stats.totals.passes),
-                                static_cast<unsigned long long>(fr.stats.totals.query_readbacks));
-                    std::fflush(stdout);
-                    frames.push_back(f);
-                  }
-            }
-        }
-      }
-      out["frames"] = frames;
-    }
-    if (!json_path.empty()) {
-      std::ofstream f(json_path);
+    if (!a.no_frames) out["frames"] = measure_frames(a);
+    if (!a.json_path.empty()) {
+      std::ofstream f(a.json_path);
       f << out.dump(2) << "\n";
-      if (!f) throw std::runtime_error(json_path + ": cannot write");
+      if (!f) throw std::runtime_error(a.json_path + ": cannot write");
     }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "bench_gl: %s\n", e.what());
