@@ -30,11 +30,11 @@
 #include "host/scene/animation.h"
 #include "host/scene/camera.h"
 #include "host/scene/gltf_loader.h"
-#include "host/trace/stream/accel_choice.h"
 #include "host/trace/cpu/cpu_tracer.h"
+#include "host/trace/sampling.h"
+#include "host/trace/stream/accel_choice.h"
 #include "host/trace/stream/devices.h"
 #include "host/trace/stream/ray_streams.h"
-#include "host/trace/sampling.h"
 #include "host/trace/stream/stream_tracer.h"
 #include "kernels/registry.h"
 #include "vgpu/glsl.h"
@@ -104,14 +104,7 @@ int run_render(const RenderArgs& a, bool lanes_given) {
   opt.spp = a.spp;
   opt.adaptive = a.aa == "adaptive";
   opt.undersample = a.aa == "adaptive" || a.aa == "none" ? 0 : *parse_aa(a.aa);
-  if (opt.undersample > 0 && opt.spp > 1)
-    throw UsageError("--aa " + a.aa + " traces one ray per traced pixel; drop --spp " +
-                     std::to_string(opt.spp));
   opt.aa_threshold = a.aa_threshold;
-  if (opt.mrt && opt.looping)
-    throw UsageError(
-        "--mrt on with --kernels looping: the looping program already writes the traversal, "
-        "voxel and hit targets in one pass; there are no separate passes left to fuse");
   opt.profile = vgpu::profile(a.profile).name;
   opt.threads = a.threads;
   opt.lanes = a.lanes;
@@ -210,12 +203,11 @@ int run_render(const RenderArgs& a, bool lanes_given) {
   if (reduced && opt.lanes != 1 && opt.lanes != 8)
     throw UsageError("--lanes " + std::to_string(opt.lanes) + ": --precision " + a.precision +
                      " runs at 1 or 8 lanes");
-  // The profile's output limit, before any work (the formats are checked once resolved).
-  if (opt.mrt) {
-    const std::string why =
-        host::mrt_refusal(vgpu::profile(opt.profile), host::Formats::all(vgpu::Format::fp32));
-    if (!why.empty()) throw UsageError(why);
-  }
+  // The combinations the tracer cannot run, before any work (with fp32 formats: MRT's formats
+  // are checked again once resolved).
+  opt.formats = host::Formats::all(vgpu::Format::fp32);
+  if (const std::string why = opt.refusal(vgpu::profile(opt.profile)); !why.empty())
+    throw UsageError(why);
   if (a.engine != "stream" && (!a.report.empty() || !a.stats_csv.empty()))
     throw UsageError(
         "--report and --stats-csv need --engine stream (the report reads the "
@@ -322,10 +314,8 @@ int run_render(const RenderArgs& a, bool lanes_given) {
                : host::resolve(formats, scene, *box, p, kd->lists.size());
   };
   opt.formats = formats_for(accel_kind);
-  if (opt.mrt) {
-    const std::string why = host::mrt_refusal(vgpu::profile(opt.profile), opt.formats);
-    if (!why.empty()) throw UsageError(why);
-  }
+  if (const std::string why = opt.refusal(vgpu::profile(opt.profile)); !why.empty())
+    throw UsageError(why);
   const float aspect = float(opt.width) / float(opt.height);
   // A frame's camera: the file's (moving with its node), else the rest scene's framing.
   auto camera_for = [&](const host::Scene& s) {
