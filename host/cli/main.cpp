@@ -27,6 +27,7 @@
 #include "host/model/cost_model.h"
 #include "host/model/formats.h"
 #include "host/report/report.h"
+#include "host/report/stats_json.h"
 #include "host/scene/animation.h"
 #include "host/scene/camera.h"
 #include "host/scene/gltf_loader.h"
@@ -354,170 +355,9 @@ int run_render(const RenderArgs& a, bool lanes_given) {
   host::RenderResult r;
   // One frame's statistics object (the whole --stats-json of a render that is not animated).
   auto record = [&](double frame_init_ms) {
-    nlohmann::ordered_json j;
-    j["scene"] = scene.name;
-    j["scene_path"] = path;
-    j["engine"] = a.engine;
-    if (tracer) j["device"] = tracer->device().description();
-    j["triangles"] = scene.triangle_count();
-    j["input_triangles"] = scene.input_triangles;
-    j["dropped_degenerate"] = scene.dropped_degenerate;
-    j["grid"] = {walk_grid.res.x, walk_grid.res.y, walk_grid.res.z};
-    j["grid_references"] = walk_grid.references();
-    {
-      nlohmann::ordered_json acc;
-      acc["structure"] = host::accel_name(accel_kind);
-      if (accel_kind == host::AccelKind::bvh) {
-        acc["nodes"] = bvh->nodes.size();
-        acc["leaves"] = bvh->leaves;
-        acc["depth"] = bvh->depth;
-        acc["max_leaf"] = bvh->max_leaf;
-        acc["references"] = bvh->references();
-        acc["sah_cost"] = bvh->sah_cost;
-        acc["build_ms"] = bvh->build_ms;
-      } else if (accel_kind == host::AccelKind::kdtree) {
-        acc["nodes"] = kd->nodes.size();
-        acc["leaves"] = kd->leaves;
-        acc["empty_leaves"] = kd->empty_leaves;
-        acc["depth"] = kd->depth;
-        acc["max_leaf"] = kd->max_leaf;
-        acc["references"] = kd->references();
-        acc["sah_cost"] = kd->sah_cost;
-        acc["build_ms"] = kd->build_ms;
-      } else if (accel_kind == host::AccelKind::grid2) {
-        const host::Grid& c = grid2->coarse;
-        acc["coarse"] = {c.res.x, c.res.y, c.res.z};
-        acc["crowded_cells"] = grid2->crowded;
-        acc["sub_cells"] = grid2->sub_cells();
-        acc["list_entries"] = grid2->lists.size();
-        acc["references"] = grid2->references;
-        acc["max_list"] = grid2->max_list;
-        acc["build_ms"] = grid2->build_ms;
-      } else {
-        acc["voxels"] = {walk_grid.res.x, walk_grid.res.y, walk_grid.res.z};
-        acc["references"] = walk_grid.references();
-        acc["build_ms"] = walk_grid.build_ms;
-      }
-      if (!cpu) {
-        const host::WalkWork w = host::walk_work(r.stats, r.rays_traced);
-        acc["work"] = {{"voxel_steps", w.voxel_steps},
-                       {"nodes_visited", w.nodes_visited},
-                       {"triangle_tests", w.triangle_tests},
-                       {"loop_iterations", w.loop_iterations}};
-        // kd-restart's restarts, where the passes show them (WalkWork::restarts); else null.
-        acc["work"]["restarts"] =
-            w.restarts >= 0 ? nlohmann::ordered_json(w.restarts) : nlohmann::ordered_json();
-      }
-      if (choice) {
-        nlohmann::ordered_json au;
-        au["probe_size"] = {choice->probe_width, choice->probe_height};
-        au["profile"] = opt.profile;
-        au["predicted_ms"] = choice->predicted_ms;
-        au["probe_passes"] = choice->probe_passes;
-        au["probe_ms"] = choice->probe_ms;
-        au["why"] = choice->why;
-        acc["auto"] = au;
-      }
-      j["accel"] = acc;
-    }
-    j["profile"] = opt.profile;
-    j["size"] = {r.width, r.height};
-    j["bounces"] = opt.bounces;
-    j["iterations"] = r.iterations;
-    j["shading"] = a.shading;
-    j["shadows"] = opt.shadows;
-    if (!scene.textures.empty()) {  // base-colour textures (kernels/base_color.h)
-      j["textures"] = scene.textures.size();
-      j["texture_filter"] = a.texture_filter;
-    }
-    j["masks"] = opt.masks;
-    j["mrt"] = opt.mrt;  // fused two-output passes (kernels/fused.h)
-    j["fused_programs"] = opt.mrt ? host::mrt_programs() : std::vector<std::string>{};
-    j["kernel_variant"] = a.kernels;  // multipass | looping ("kernels" lists the programs)
-    if (opt.looping) j["steps_per_pass"] = opt.steps_per_pass;
-    j["threads"] = opt.threads;
-    j["lanes"] = opt.lanes;
-    // How the emulator ran the grid walks: in batches or pass by pass (same statistics).
-    if (!cpu && !gl) j["walk"] = r.batch_walk ? "batches" : "passes";
-    j["precision"] = a.precision;
-    if (!cpu) j["formats"] = host::to_json(opt.formats);
-    j["init_ms"] = frame_init_ms;
-    j["grid_build_ms"] = walk_grid.build_ms;
-    j["render_ms"] = r.render_ms;
-    if (tracer) j["texture_bytes"] = tracer->texture_bytes();
-    if (cpu)
-      j["cpu"] = {{"rays", cpu_stats.rays},
-                  {"voxel_steps", cpu_stats.voxel_steps},
-                  {"triangle_tests", cpu_stats.triangle_tests},
-                  {"nodes_visited", cpu_stats.nodes_visited},
-                  {"restarts", cpu_stats.restarts},
-                  {"reflected", cpu_stats.reflected},
-                  {"refracted", cpu_stats.refracted},
-                  {"total_internal", cpu_stats.total_internal},
-                  {"glass_shadow_crossings", cpu_stats.glass_shadow_crossings}};
-    j["rays_traced"] = r.rays_traced;
-    if (r.streams.on) j["streams"] = host::to_json(r.streams);  // glass's ray streams
-    j["rays_unfinished"] = r.rays_unfinished;
-    // Supersampling (--spp): samples per pixel and the passes it added to the first sample frame.
-    {
-      double mean = double(r.samples);
-      uint64_t most = uint64_t(r.samples);
-      if (!r.rays_per_pixel.empty()) {
-        uint64_t total = 0;
-        most = 0;
-        for (const uint32_t n : r.rays_per_pixel) total += n, most = std::max<uint64_t>(most, n);
-        mean = double(total) / double(r.rays_per_pixel.size());
-      }
-      j["sampling"] = {{"mode", opt.undersample > 0           ? "undersample"
-                                : opt.adaptive && opt.spp > 1 ? "adaptive"
-                                                              : "uniform"},
-                       {"spp", opt.spp},
-                       {"samples_per_pixel_mean", mean},
-                       {"samples_per_pixel_max", most},
-                       {"passes_added", cpu ? 0 : r.stats.totals.passes - r.first_frame_passes}};
-      if (opt.adaptive) j["sampling"]["threshold"] = opt.aa_threshold;
-      if (opt.undersample > 0) j["sampling"]["k"] = opt.undersample;
-    }
-    {
-      nlohmann::ordered_json stats = r.stats.json();
-      if (gl)  // the emulator's SIMD model: a driver does not show its lanes
-        for (const char* key :
-             {"lanes_idle", "idle_in_batch32", "idle_in_batch1024", "loop_iterations",
-              "loop_lane_slots", "loop_lanes_idle", "loop_batch_iterations",
-              "loop_idle_instructions", "loop_idle_fetches"}) {
-          stats["totals"][key] = nullptr;
-          for (auto& k : stats["programs"]) k[key] = nullptr;
-        }
-      j["totals"] = std::move(stats["totals"]);
-      j["downloads"] = stats["downloads"];
-      j["download_bytes"] = stats["download_bytes"];
-      j["kernels"] = std::move(stats["programs"]);
-    }
-    // The cost model's prediction for every built-in profile (the counters do not depend on it).
-    nlohmann::ordered_json predicted_ms, predicted_breakdown;
-    for (const vgpu::Profile& p : vgpu::profiles()) {
-      if (cpu || gl) break;  // no passes, or no SIMD counters to predict from
-      if (opt.looping && p.max_loop_iterations < opt.steps_per_pass) {
-        predicted_ms[p.name] = nullptr;  // the looping program cannot run there
-        continue;
-      }
-      const host::CostBreakdown c = host::predict(r.stats, p);
-      predicted_ms[p.name] = c.total_ms;
-      for (const auto& [key, v] : c.items()) predicted_breakdown[p.name][key] = v;
-    }
-    j["predicted_ms"] = predicted_ms;
-    j["predicted_breakdown"] = predicted_breakdown;
-    auto what_if = nlohmann::ordered_json::array();  // MRT and resident programs (docs/table1.md)
-    for (const auto& [name, s] :
-         cpu || gl ? decltype(host::what_ifs(r.stats)){} : host::what_ifs(r.stats)) {
-      nlohmann::ordered_json w = {{"name", name}, {"totals", vgpu::to_json(s.totals)}};
-      for (const vgpu::Profile& p : vgpu::profiles())
-        for (const auto& [key, v] : host::predict(s, p).items())
-          w["predicted_breakdown"][p.name][key] = v;
-      what_if.push_back(w);
-    }
-    j["predicted_what_if"] = what_if;
-    return j;
+    return host::frame_stats_json({scene, path, a.engine, tracer ? &*tracer : nullptr, accel,
+                                   choice ? &*choice : nullptr, opt, r, cpu_stats, a.shading,
+                                   a.texture_filter, a.kernels, a.precision, frame_init_ms});
   };
 
   // Frame by frame: the scene posed, the structure rebuilt, the static textures that changed
@@ -637,16 +477,7 @@ int run_render(const RenderArgs& a, bool lanes_given) {
   if (several)
     j = {{"scene", scene.name}, {"scene_path", path},          {"animation", animation_json},
          {"update", a.update},  {"frame_count", times.size()}, {"frames", frames_json}};
-  if (!a.stats_json.empty()) {
-    const std::string tmp = a.stats_json + ".tmp";
-    std::ofstream f(tmp);
-    f << j.dump(2) << "\n";
-    f.close();
-    if (!f || std::rename(tmp.c_str(), a.stats_json.c_str()) != 0) {
-      std::remove(tmp.c_str());
-      throw host::InputError(a.stats_json + ": cannot write the statistics");
-    }
-  }
+  if (!a.stats_json.empty()) host::write_stats_json(a.stats_json, j);
   if (!a.stats_csv.empty()) host::write_stats_csv(a.stats_csv, *recorder);
   if (!a.report.empty())
     host::write_report(a.report, *recorder, reported ? reported->first : r,
