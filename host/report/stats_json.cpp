@@ -190,6 +190,35 @@ nlohmann::ordered_json frame_stats_json(const FrameStatsInputs& in) {
   return j;
 }
 
+nlohmann::ordered_json animation_json(const Animation& animation, size_t index) {
+  return {{"name", animation.name},
+          {"index", index},
+          {"start", animation.start},
+          {"end", animation.end}};
+}
+
+nlohmann::ordered_json frame_update_json(const std::string& mode, double pose_ms,
+                                         AccelKind structure, double build_ms, double write_ms,
+                                         const StreamTracer::Upload& up, bool uploaded) {
+  nlohmann::ordered_json update = {
+      {"mode", mode},
+      {"pose_ms", pose_ms},
+      {"structure", accel_name(structure)},
+      {"build_ms", build_ms},
+      {"write_ms", write_ms},
+      {"uploaded_bytes", uploaded ? nlohmann::ordered_json(up.bytes) : nullptr},
+      {"uploaded_textures", up.textures}};
+  nlohmann::ordered_json charged;
+  for (const vgpu::Profile& p : vgpu::profiles()) {
+    if (!uploaded) break;
+    const UpdateCost c = predict_update(up.bytes, build_ms, p);
+    charged[p.name] = {
+        {"upload_ms", c.upload_ms}, {"build_ms", c.build_ms}, {"total_ms", c.total_ms}};
+  }
+  update["predicted"] = charged;
+  return update;
+}
+
 void write_stats_json(const std::string& path, const nlohmann::ordered_json& j) {
   const std::string tmp = path + ".tmp";
   std::ofstream f(tmp);
