@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <functional>
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -27,14 +28,15 @@
 #include "host/model/cost_model.h"
 #include "host/model/formats.h"
 #include "host/report/report.h"
+#include "host/report/stats_json.h"
 #include "host/scene/animation.h"
 #include "host/scene/camera.h"
 #include "host/scene/gltf_loader.h"
-#include "host/trace/stream/accel_choice.h"
 #include "host/trace/cpu/cpu_tracer.h"
+#include "host/trace/sampling.h"
+#include "host/trace/stream/accel_choice.h"
 #include "host/trace/stream/devices.h"
 #include "host/trace/stream/ray_streams.h"
-#include "host/trace/sampling.h"
 #include "host/trace/stream/stream_tracer.h"
 #include "kernels/registry.h"
 #include "vgpu/glsl.h"
@@ -83,9 +85,22 @@ class OneFrame final : public host::PassObserver {
   host::PassObserver& to_;
 };
 
-int run_render(const RenderArgs& a, bool lanes_given) {
-  // CLI11 checked each value; what is left are combinations of options.
+// What a render was asked for, once every option and every combination was checked: the tracer's
+// options, and what the command line keeps for itself.
+struct RenderPlan {
   host::RenderOptions opt;
+  host::FormatRequest formats;  // resolved once the scene and its structure are known
+  host::GridSpec grid_spec;
+  std::string aov_depth, aov_hit;  // --aov files (empty: not written)
+  std::vector<double> times;       // the frames' times (one frame: {0} or --time)
+  bool animating = false, cpu = false, gl = false;
+};
+
+// Parse: the options into a plan, refusing what cannot run before any work (UsageError, exit 2).
+RenderPlan parse_render(const RenderArgs& a, bool lanes_given) {
+  // CLI11 checked each value; what is left are combinations of options.
+  RenderPlan plan;
+  host::RenderOptions& opt = plan.opt;
   const glm::ivec2 size = *parse_size(a.size);
   opt.width = size.x;
   opt.height = size.y;
@@ -104,25 +119,18 @@ int run_render(const RenderArgs& a, bool lanes_given) {
   opt.spp = a.spp;
   opt.adaptive = a.aa == "adaptive";
   opt.undersample = a.aa == "adaptive" || a.aa == "none" ? 0 : *parse_aa(a.aa);
-  if (opt.undersample > 0 && opt.spp > 1)
-    throw UsageError("--aa " + a.aa + " traces one ray per traced pixel; drop --spp " +
-                     std::to_string(opt.spp));
   opt.aa_threshold = a.aa_threshold;
-  if (opt.mrt && opt.looping)
-    throw UsageError(
-        "--mrt on with --kernels looping: the looping program already writes the traversal, "
-        "voxel and hit targets in one pass; there are no separate passes left to fuse");
   opt.profile = vgpu::profile(a.profile).name;
   opt.threads = a.threads;
   opt.lanes = a.lanes;
-  host::FormatRequest formats;
   try {
-    formats = host::parse_format_request(a.precision, a.formats);
+    plan.formats = host::parse_format_request(a.precision, a.formats);
   } catch (const std::invalid_argument& e) {
     throw UsageError(e.what());
   }
-  const host::GridSpec grid_spec = host::parse_grid_spec(a.grid);
-  std::string aov_depth, aov_hit;
+  plan.grid_spec = host::parse_grid_spec(a.grid);
+  std::string& aov_depth = plan.aov_depth;
+  std::string& aov_hit = plan.aov_hit;
   for (const std::string& aov : a.aovs) {
     const auto eq = aov.find('=');
     (aov.compare(0, eq, "depth") == 0 ? aov_depth : aov_hit) = aov.substr(eq + 1);
@@ -137,8 +145,8 @@ int run_render(const RenderArgs& a, bool lanes_given) {
 
   if (a.engine != "stream" && a.engine != "cpu" && a.engine != "gl")
     throw UsageError("--engine: expected stream, cpu or gl, got '" + a.engine + "'");
-  const bool cpu = a.engine == "cpu";
-  const bool gl = a.engine == "gl";
+  const bool cpu = plan.cpu = a.engine == "cpu";
+  const bool gl = plan.gl = a.engine == "gl";
   // Settings the CPU reference does not use are refused rather than recorded as if they ran.
   if (cpu) {
     const char* unused = a.predict                ? "--predict"
@@ -158,7 +166,7 @@ int run_render(const RenderArgs& a, bool lanes_given) {
   }
   if (a.steps_given && !opt.looping) throw UsageError("--steps-per-pass needs --kernels looping");
   // Animation (issue 23): the frames' times, and what several frames need.
-  const bool animating = !a.time.empty() || !a.frames.empty();
+  const bool animating = plan.animating = !a.time.empty() || !a.frames.empty();
   if (!a.time.empty() && !a.frames.empty())
     throw UsageError("--time and --frames: give one (--frames A:A:1 is --time A)");
   if (!animating && (!a.animation.empty() || a.update_given))
@@ -168,7 +176,8 @@ int run_render(const RenderArgs& a, bool lanes_given) {
     throw UsageError("--update " + a.update +
                      ": only a BVH's boxes can be refitted (--accel bvh); the grid and the "
                      "kd-tree are rebuilt (--update rebuild)");
-  std::vector<double> times = {0.0};
+  std::vector<double>& times = plan.times;
+  times = {0.0};
   if (!a.time.empty()) times = {cli::parse_time(a.time)};
   if (!a.frames.empty()) {
     cli::FrameRange range;
@@ -210,12 +219,11 @@ int run_render(const RenderArgs& a, bool lanes_given) {
   if (reduced && opt.lanes != 1 && opt.lanes != 8)
     throw UsageError("--lanes " + std::to_string(opt.lanes) + ": --precision " + a.precision +
                      " runs at 1 or 8 lanes");
-  // The profile's output limit, before any work (the formats are checked once resolved).
-  if (opt.mrt) {
-    const std::string why =
-        host::mrt_refusal(vgpu::profile(opt.profile), host::Formats::all(vgpu::Format::fp32));
-    if (!why.empty()) throw UsageError(why);
-  }
+  // The combinations the tracer cannot run, before any work (with fp32 formats: MRT's formats
+  // are checked again once resolved).
+  opt.formats = host::Formats::all(vgpu::Format::fp32);
+  if (const std::string why = opt.refusal(vgpu::profile(opt.profile)); !why.empty())
+    throw UsageError(why);
   if (a.engine != "stream" && (!a.report.empty() || !a.stats_csv.empty()))
     throw UsageError(
         "--report and --stats-csv need --engine stream (the report reads the "
@@ -242,15 +250,199 @@ int run_render(const RenderArgs& a, bool lanes_given) {
                      " pixels (512x512); got " + a.size);
   if (!a.report.empty()) host::check_output_path(a.report, {".html"});
   if (!a.stats_csv.empty()) host::check_output_path(a.stats_csv, {".csv"});
+  return plan;
+}
+
+// Write (--stats table, one frame): the pass statistics, the scene and its structure, the options
+// and the times. `animation_text` names what --time posed (read only when animating).
+void print_table(const RenderArgs& a, const RenderPlan& plan, const host::Scene& scene,
+                 const host::Accel& accel, const host::AccelChoice* choice,
+                 const host::RenderResult& r, const host::CpuStats& cpu_stats, double init_ms,
+                 host::StreamTracer* tracer, const std::string& animation_text) {
+  const host::RenderOptions& opt = plan.opt;
+  const bool cpu = plan.cpu, gl = plan.gl, animating = plan.animating;
+  const host::Grid& walk_grid = *accel.grid;
+  if (cpu) {
+    std::printf(
+        "CPU reference (double precision, recursive Whitted): %llu rays, %llu voxel steps, %llu "
+        "triangle tests\n",
+        static_cast<unsigned long long>(cpu_stats.rays),
+        static_cast<unsigned long long>(cpu_stats.voxel_steps),
+        static_cast<unsigned long long>(cpu_stats.triangle_tests));
+    // Glass (docs/materials.md): the rays of each kind, summed over the iterations.
+    auto sum = [](const std::vector<uint64_t>& v) {
+      return static_cast<unsigned long long>(std::accumulate(v.begin(), v.end(), uint64_t(0)));
+    };
+    if (sum(cpu_stats.refracted) + sum(cpu_stats.total_internal) +
+            cpu_stats.glass_shadow_crossings >
+        0)
+      std::printf(
+          "glass: %llu reflected rays (%llu of them totally internally), %llu refracted; %llu "
+          "shadow-ray crossings\n",
+          sum(cpu_stats.reflected), sum(cpu_stats.total_internal), sum(cpu_stats.refracted),
+          static_cast<unsigned long long>(cpu_stats.glass_shadow_crossings));
+  } else
+    std::cout << r.stats.to_table();
+  std::printf(
+      "scene %s: %zu triangles (%u dropped as degenerate), grid %dx%dx%d (%llu references)\n",
+      scene.name.c_str(), scene.triangle_count(), scene.dropped_degenerate, walk_grid.res.x,
+      walk_grid.res.y, walk_grid.res.z, static_cast<unsigned long long>(walk_grid.references()));
+  if (accel.kind == host::AccelKind::bvh)
+    std::printf("%s (%.1f ms to build)\n", host::describe(*accel.bvh).c_str(), accel.bvh->build_ms);
+  if (accel.kind == host::AccelKind::kdtree)
+    std::printf("%s (%.1f ms to build)\n", host::describe(*accel.kd).c_str(), accel.kd->build_ms);
+  if (accel.kind == host::AccelKind::grid2)
+    std::printf(
+        "two-level grid: coarse %dx%dx%d, %d crowded cells, %zu sub-cells, %llu "
+        "references (%.1f ms to build)\n",
+        accel.grid2->coarse.res.x, accel.grid2->coarse.res.y, accel.grid2->coarse.res.z,
+        accel.grid2->crowded, accel.grid2->sub_cells(),
+        static_cast<unsigned long long>(accel.grid2->references), accel.grid2->build_ms);
+  if (choice)
+    std::printf("accel auto: %s (probes %.0f ms)\n", choice->why.c_str(), choice->probe_ms);
+  std::printf("%s %s, %dx%d, %d iteration(s), %s shading, shadows %s, masks %s, mrt %s\n",
+              cpu ? "engine" : "profile", cpu ? "cpu" : opt.profile.c_str(), r.width, r.height,
+              r.iterations, a.shading.c_str(), a.shadows.c_str(), a.masks.c_str(), a.mrt.c_str());
+  if (!cpu) std::cout << "formats (texture and arithmetic, per group):\n" << describe(opt.formats);
+  if (r.streams.on) std::cout << host::describe(r.streams);
+  std::printf("initialization %.1f ms (grid %.1f ms), render %.1f ms (%s)\n", init_ms,
+              walk_grid.build_ms, r.render_ms,
+              cpu            ? "host CPU"
+              : gl           ? "wall, GL device"
+              : r.batch_walk ? "host, emulated, walks in batches"
+                             : "host, emulated");
+  if (gl)
+    std::printf("device %s: passes %.2f ms of GPU time (timer queries)\n",
+                tracer->device().description().c_str(), r.stats.totals.device_ms);
+  if (animating) std::printf("time %g s of %s\n", plan.times[0], animation_text.c_str());
+}
+
+// One line of the frames table (--frames with --stats table).
+struct FrameLine {
+  double time, pose_ms, build_ms, write_ms, render_ms;
+  uint64_t uploaded, passes;
+  double predicted_ms;
+  std::string action;                   // initial, rebuild or refit
+  uint64_t nodes_visited, voxel_steps;  // the walk's work (a tree's nodes, the grid's voxels)
+};
+
+// Write (--stats table, several frames): one line per frame, then the initialization.
+void print_frames_table(const RenderArgs& a, const RenderPlan& plan, const host::Scene& scene,
+                        host::AccelKind accel, const host::RenderResult& r,
+                        const std::vector<FrameLine>& lines, double init_ms,
+                        const std::string& animation_text) {
+  const host::RenderOptions& opt = plan.opt;
+  const bool cpu = plan.cpu;
+  std::printf("scene %s, animation %s, %zu frames, %s, --update %s, %dx%d, %s %s\n",
+              scene.name.c_str(), animation_text.c_str(), lines.size(),
+              std::string(host::accel_name(accel)).c_str(), a.update.c_str(), r.width, r.height,
+              cpu ? "engine" : "profile", cpu ? "cpu" : opt.profile.c_str());
+  std::printf("%6s %9s %8s %9s %9s %11s %12s %10s %8s %12s %12s%s\n", "frame", "time s", "update",
+              "pose ms", "build ms", "textures ms", "uploaded B", "render ms", "passes", "nodes",
+              "voxels", a.predict ? "  predicted ms" : "");
+  for (size_t f = 0; f < lines.size(); ++f) {
+    const FrameLine& l = lines[f];
+    std::printf("%6zu %9.4g %8s %9.2f %9.2f %11.2f %12llu %10.1f %8llu %12llu %12llu", f + 1,
+                l.time, l.action.c_str(), l.pose_ms, l.build_ms, l.write_ms,
+                static_cast<unsigned long long>(l.uploaded), l.render_ms,
+                static_cast<unsigned long long>(l.passes),
+                static_cast<unsigned long long>(l.nodes_visited),
+                static_cast<unsigned long long>(l.voxel_steps));
+    if (a.predict) std::printf("  %12.3f", l.predicted_ms);
+    std::printf("\n");
+  }
+  std::printf("initialization %.1f ms (the first frame's grid and uploads)\n", init_ms);
+}
+
+// Build: which of the scene's animations --animation names (the first when it names none; none
+// when the file has none); refuses a name the file does not have.
+std::optional<size_t> find_animation(const RenderArgs& a, const std::string& path,
+                                     const host::AnimatedScene& animated) {
+  const std::vector<host::Animation>& list = animated.animations();
+  if (!a.animation.empty()) {
+    const std::optional<size_t> found = animated.find(a.animation);
+    if (!found) {
+      std::string known;
+      for (size_t i = 0; i < list.size(); ++i)
+        known += (i ? ", " : "") + std::to_string(i) + " '" + list[i].name + "'";
+      throw UsageError("--animation " + a.animation + ": " + path +
+                       " has no animation named or numbered '" + a.animation + "' (" +
+                       (known.empty() ? "it has none" : "it has " + known) + ")");
+    }
+    return found;
+  } else if (!list.empty()) {
+    return 0;  // the first, as --help says
+  }
+  return std::nullopt;
+}
+
+// Build (a later frame, --accel bvh): --update refit keeps the topology and moves the boxes;
+// auto refits until the refitted tree's SAH cost passes kRefitLimit times the last build's (in
+// `built_sah`), then builds again. Returns what it did: "refit" or "rebuild".
+std::string update_bvh(std::optional<host::Bvh>& bvh, double& built_sah, const host::Scene& scene,
+                       const std::string& update) {
+  // --update auto rebuilds when the refitted BVH's SAH cost (expected node visits and triangle
+  // tests per ray) has grown past this factor of its last build's.
+  constexpr double kRefitLimit = 1.25;
+  host::Bvh refitted = *bvh;
+  bool refit = update != "rebuild";
+  if (refit) {
+    host::refit_bvh(refitted, scene);
+    refit = update == "refit" || refitted.sah_cost <= kRefitLimit * built_sah;
+  }
+  if (refit) {
+    bvh = std::move(refitted);
+    return "refit";
+  }
+  bvh = host::build_bvh(scene);
+  built_sah = bvh->sah_cost;
+  return "rebuild";
+}
+
+// Write: a frame's image and AOVs (numbered when animating: frame_####.png).
+void write_images(const RenderArgs& a, const RenderPlan& plan, const host::RenderResult& r,
+                  int number) {
+  auto numbered = [&](const std::string& file) {
+    return plan.animating ? cli::frame_path(file, number) : file;
+  };
+  if (!a.out.empty()) host::write_image(numbered(a.out), r.width, r.height, 3, r.rgb);
+  if (!plan.aov_depth.empty())
+    host::write_image(numbered(plan.aov_depth), r.width, r.height, 1, r.depth);
+  if (!plan.aov_hit.empty())
+    host::write_image(numbered(plan.aov_hit), r.width, r.height, 1, r.hit_id);
+}
+
+// Build: the report's recorder (--report, --stats-csv) as the tracer's observer; with
+// --report-frame K, behind a OneFrame that passes on frame K alone.
+void attach_recorder(const RenderArgs& a, host::RenderOptions& opt,
+                     std::optional<host::FrameRecorder>& recorder,
+                     std::optional<OneFrame>& one_frame) {
+  if (a.report.empty() && a.stats_csv.empty()) return;
+  recorder.emplace(opt.width, opt.height, opt.masks, a.report.empty() ? 0 : host::kHistoryStride,
+                   opt.trace_pixel ? std::vector{*opt.trace_pixel} : std::vector<glm::ivec2>{},
+                   !a.report.empty());
+  opt.observer = &*recorder;
+  if (a.report_frame) opt.observer = &one_frame.emplace(*recorder);
+}
+
+// The iteration counter on stderr: rewritten in place on a terminal, a line each elsewhere.
+std::function<void(int, int)> progress_line(bool tty) {
+  return [tty](int it, int n) {
+    std::fprintf(stderr, tty ? "\rvgpu-rt: iteration %d/%d" : "vgpu-rt: iteration %d/%d\n", it, n);
+    std::fflush(stderr);
+  };
+}
+
+int run_render(const RenderArgs& a, bool lanes_given) {
+  RenderPlan plan = parse_render(a, lanes_given);
+  host::RenderOptions& opt = plan.opt;
+  const host::FormatRequest& formats = plan.formats;
+  const host::GridSpec& grid_spec = plan.grid_spec;
+  const std::vector<double>& times = plan.times;
+  const bool animating = plan.animating, cpu = plan.cpu, gl = plan.gl;
   std::optional<host::FrameRecorder> recorder;
   std::optional<OneFrame> one_frame;  // --report-frame K: the recorder sees frame K alone
-  if (!a.report.empty() || !a.stats_csv.empty()) {
-    recorder.emplace(opt.width, opt.height, opt.masks, a.report.empty() ? 0 : host::kHistoryStride,
-                     opt.trace_pixel ? std::vector{*opt.trace_pixel} : std::vector<glm::ivec2>{},
-                     !a.report.empty());
-    opt.observer = &*recorder;
-    if (a.report_frame) opt.observer = &one_frame.emplace(*recorder);
-  }
+  attach_recorder(a, opt, recorder, one_frame);
 
   // The scene: as the file has it, or posed at each frame's time (--time, --frames).
   const std::string path = host::resolve_scene(a.scene);
@@ -258,28 +450,11 @@ int run_render(const RenderArgs& a, bool lanes_given) {
   std::optional<size_t> animation;
   if (animating) {
     animated.emplace(path, host::with_images());
-    const std::vector<host::Animation>& list = animated->animations();
-    if (!a.animation.empty()) {
-      animation = animated->find(a.animation);
-      if (!animation) {
-        std::string known;
-        for (size_t i = 0; i < list.size(); ++i)
-          known += (i ? ", " : "") + std::to_string(i) + " '" + list[i].name + "'";
-        throw UsageError("--animation " + a.animation + ": " + path +
-                         " has no animation named or numbered '" + a.animation + "' (" +
-                         (known.empty() ? "it has none" : "it has " + known) + ")");
-      }
-    } else if (!list.empty()) {
-      animation = 0;  // the first, as --help says
-    }
+    animation = find_animation(a, path, *animated);
     animated->check(animation);  // skinned meshes, morph-target weights: one line, exit 2
   }
-  nlohmann::ordered_json animation_json = nullptr;
-  if (animation) {
-    const host::Animation& an = animated->animations()[*animation];
-    animation_json = {
-        {"name", an.name}, {"index", *animation}, {"start", an.start}, {"end", an.end}};
-  }
+  const nlohmann::ordered_json animation_json =
+      animation ? host::animation_json(animated->animations()[*animation], *animation) : nullptr;
   auto pose_start = std::chrono::steady_clock::now();
   host::Scene scene =
       animated ? animated->at(animation, times[0]) : host::load_scene(path, host::with_images());
@@ -322,10 +497,8 @@ int run_render(const RenderArgs& a, bool lanes_given) {
                : host::resolve(formats, scene, *box, p, kd->lists.size());
   };
   opt.formats = formats_for(accel_kind);
-  if (opt.mrt) {
-    const std::string why = host::mrt_refusal(vgpu::profile(opt.profile), opt.formats);
-    if (!why.empty()) throw UsageError(why);
-  }
+  if (const std::string why = opt.refusal(vgpu::profile(opt.profile)); !why.empty())
+    throw UsageError(why);
   const float aspect = float(opt.width) / float(opt.height);
   // A frame's camera: the file's (moving with its node), else the rest scene's framing.
   auto camera_for = [&](const host::Scene& s) {
@@ -333,12 +506,7 @@ int run_render(const RenderArgs& a, bool lanes_given) {
   };
   const bool several = times.size() > 1;
   const bool tty = ::isatty(2) && !a.quiet && !several;
-  if (!a.quiet && !several)  // several frames: one line per frame instead
-    opt.progress = [&](int it, int n) {
-      std::fprintf(stderr, tty ? "\rvgpu-rt: iteration %d/%d" : "vgpu-rt: iteration %d/%d\n", it,
-                   n);
-      std::fflush(stderr);
-    };
+  if (!a.quiet && !several) opt.progress = progress_line(tty);  // several: a line per frame
   std::optional<host::AccelChoice> choice;
   if (auto_accel) {
     std::vector<host::AccelCandidate> candidates;
@@ -348,7 +516,6 @@ int run_render(const RenderArgs& a, bool lanes_given) {
     opt.formats = formats_for(accel_kind);
   }
   const host::Accel accel = accel_of(accel_kind);
-  const host::Grid& walk_grid = *accel.grid;
   // The host's build of the structure walked (and of its box), ms.
   auto build_ms = [&] {
     return accel_kind == host::AccelKind::grid    ? grid.build_ms
@@ -364,187 +531,16 @@ int run_render(const RenderArgs& a, bool lanes_given) {
   host::RenderResult r;
   // One frame's statistics object (the whole --stats-json of a render that is not animated).
   auto record = [&](double frame_init_ms) {
-    nlohmann::ordered_json j;
-    j["scene"] = scene.name;
-    j["scene_path"] = path;
-    j["engine"] = a.engine;
-    if (tracer) j["device"] = tracer->device().description();
-    j["triangles"] = scene.triangle_count();
-    j["input_triangles"] = scene.input_triangles;
-    j["dropped_degenerate"] = scene.dropped_degenerate;
-    j["grid"] = {walk_grid.res.x, walk_grid.res.y, walk_grid.res.z};
-    j["grid_references"] = walk_grid.references();
-    {
-      nlohmann::ordered_json acc;
-      acc["structure"] = host::accel_name(accel_kind);
-      if (accel_kind == host::AccelKind::bvh) {
-        acc["nodes"] = bvh->nodes.size();
-        acc["leaves"] = bvh->leaves;
-        acc["depth"] = bvh->depth;
-        acc["max_leaf"] = bvh->max_leaf;
-        acc["references"] = bvh->references();
-        acc["sah_cost"] = bvh->sah_cost;
-        acc["build_ms"] = bvh->build_ms;
-      } else if (accel_kind == host::AccelKind::kdtree) {
-        acc["nodes"] = kd->nodes.size();
-        acc["leaves"] = kd->leaves;
-        acc["empty_leaves"] = kd->empty_leaves;
-        acc["depth"] = kd->depth;
-        acc["max_leaf"] = kd->max_leaf;
-        acc["references"] = kd->references();
-        acc["sah_cost"] = kd->sah_cost;
-        acc["build_ms"] = kd->build_ms;
-      } else if (accel_kind == host::AccelKind::grid2) {
-        const host::Grid& c = grid2->coarse;
-        acc["coarse"] = {c.res.x, c.res.y, c.res.z};
-        acc["crowded_cells"] = grid2->crowded;
-        acc["sub_cells"] = grid2->sub_cells();
-        acc["list_entries"] = grid2->lists.size();
-        acc["references"] = grid2->references;
-        acc["max_list"] = grid2->max_list;
-        acc["build_ms"] = grid2->build_ms;
-      } else {
-        acc["voxels"] = {walk_grid.res.x, walk_grid.res.y, walk_grid.res.z};
-        acc["references"] = walk_grid.references();
-        acc["build_ms"] = walk_grid.build_ms;
-      }
-      if (!cpu) {
-        const host::WalkWork w = host::walk_work(r.stats, r.rays_traced);
-        acc["work"] = {{"voxel_steps", w.voxel_steps},
-                       {"nodes_visited", w.nodes_visited},
-                       {"triangle_tests", w.triangle_tests},
-                       {"loop_iterations", w.loop_iterations}};
-        // kd-restart's restarts, where the passes show them (WalkWork::restarts); else null.
-        acc["work"]["restarts"] =
-            w.restarts >= 0 ? nlohmann::ordered_json(w.restarts) : nlohmann::ordered_json();
-      }
-      if (choice) {
-        nlohmann::ordered_json au;
-        au["probe_size"] = {choice->probe_width, choice->probe_height};
-        au["profile"] = opt.profile;
-        au["predicted_ms"] = choice->predicted_ms;
-        au["probe_passes"] = choice->probe_passes;
-        au["probe_ms"] = choice->probe_ms;
-        au["why"] = choice->why;
-        acc["auto"] = au;
-      }
-      j["accel"] = acc;
-    }
-    j["profile"] = opt.profile;
-    j["size"] = {r.width, r.height};
-    j["bounces"] = opt.bounces;
-    j["iterations"] = r.iterations;
-    j["shading"] = a.shading;
-    j["shadows"] = opt.shadows;
-    if (!scene.textures.empty()) {  // base-colour textures (kernels/base_color.h)
-      j["textures"] = scene.textures.size();
-      j["texture_filter"] = a.texture_filter;
-    }
-    j["masks"] = opt.masks;
-    j["mrt"] = opt.mrt;  // fused two-output passes (kernels/fused.h)
-    j["fused_programs"] = opt.mrt ? host::mrt_programs() : std::vector<std::string>{};
-    j["kernel_variant"] = a.kernels;  // multipass | looping ("kernels" lists the programs)
-    if (opt.looping) j["steps_per_pass"] = opt.steps_per_pass;
-    j["threads"] = opt.threads;
-    j["lanes"] = opt.lanes;
-    // How the emulator ran the grid walks: in batches or pass by pass (same statistics).
-    if (!cpu && !gl) j["walk"] = r.batch_walk ? "batches" : "passes";
-    j["precision"] = a.precision;
-    if (!cpu) j["formats"] = host::to_json(opt.formats);
-    j["init_ms"] = frame_init_ms;
-    j["grid_build_ms"] = walk_grid.build_ms;
-    j["render_ms"] = r.render_ms;
-    if (tracer) j["texture_bytes"] = tracer->texture_bytes();
-    if (cpu)
-      j["cpu"] = {{"rays", cpu_stats.rays},
-                  {"voxel_steps", cpu_stats.voxel_steps},
-                  {"triangle_tests", cpu_stats.triangle_tests},
-                  {"nodes_visited", cpu_stats.nodes_visited},
-                  {"restarts", cpu_stats.restarts},
-                  {"reflected", cpu_stats.reflected},
-                  {"refracted", cpu_stats.refracted},
-                  {"total_internal", cpu_stats.total_internal},
-                  {"glass_shadow_crossings", cpu_stats.glass_shadow_crossings}};
-    j["rays_traced"] = r.rays_traced;
-    if (r.streams.on) j["streams"] = host::to_json(r.streams);  // glass's ray streams
-    j["rays_unfinished"] = r.rays_unfinished;
-    // Supersampling (--spp): samples per pixel and the passes it added to the first sample frame.
-    {
-      double mean = double(r.samples);
-      uint64_t most = uint64_t(r.samples);
-      if (!r.rays_per_pixel.empty()) {
-        uint64_t total = 0;
-        most = 0;
-        for (const uint32_t n : r.rays_per_pixel) total += n, most = std::max<uint64_t>(most, n);
-        mean = double(total) / double(r.rays_per_pixel.size());
-      }
-      j["sampling"] = {{"mode", opt.undersample > 0           ? "undersample"
-                                : opt.adaptive && opt.spp > 1 ? "adaptive"
-                                                              : "uniform"},
-                       {"spp", opt.spp},
-                       {"samples_per_pixel_mean", mean},
-                       {"samples_per_pixel_max", most},
-                       {"passes_added", cpu ? 0 : r.stats.totals.passes - r.first_frame_passes}};
-      if (opt.adaptive) j["sampling"]["threshold"] = opt.aa_threshold;
-      if (opt.undersample > 0) j["sampling"]["k"] = opt.undersample;
-    }
-    {
-      nlohmann::ordered_json stats = r.stats.json();
-      if (gl)  // the emulator's SIMD model: a driver does not show its lanes
-        for (const char* key :
-             {"lanes_idle", "idle_in_batch32", "idle_in_batch1024", "loop_iterations",
-              "loop_lane_slots", "loop_lanes_idle", "loop_batch_iterations",
-              "loop_idle_instructions", "loop_idle_fetches"}) {
-          stats["totals"][key] = nullptr;
-          for (auto& k : stats["programs"]) k[key] = nullptr;
-        }
-      j["totals"] = std::move(stats["totals"]);
-      j["downloads"] = stats["downloads"];
-      j["download_bytes"] = stats["download_bytes"];
-      j["kernels"] = std::move(stats["programs"]);
-    }
-    // The cost model's prediction for every built-in profile (the counters do not depend on it).
-    nlohmann::ordered_json predicted_ms, predicted_breakdown;
-    for (const vgpu::Profile& p : vgpu::profiles()) {
-      if (cpu || gl) break;  // no passes, or no SIMD counters to predict from
-      if (opt.looping && p.max_loop_iterations < opt.steps_per_pass) {
-        predicted_ms[p.name] = nullptr;  // the looping program cannot run there
-        continue;
-      }
-      const host::CostBreakdown c = host::predict(r.stats, p);
-      predicted_ms[p.name] = c.total_ms;
-      for (const auto& [key, v] : c.items()) predicted_breakdown[p.name][key] = v;
-    }
-    j["predicted_ms"] = predicted_ms;
-    j["predicted_breakdown"] = predicted_breakdown;
-    auto what_if = nlohmann::ordered_json::array();  // MRT and resident programs (docs/table1.md)
-    for (const auto& [name, s] :
-         cpu || gl ? decltype(host::what_ifs(r.stats)){} : host::what_ifs(r.stats)) {
-      nlohmann::ordered_json w = {{"name", name}, {"totals", vgpu::to_json(s.totals)}};
-      for (const vgpu::Profile& p : vgpu::profiles())
-        for (const auto& [key, v] : host::predict(s, p).items())
-          w["predicted_breakdown"][p.name][key] = v;
-      what_if.push_back(w);
-    }
-    j["predicted_what_if"] = what_if;
-    return j;
+    return host::frame_stats_json({scene, path, a.engine, tracer ? &*tracer : nullptr, accel,
+                                   choice ? &*choice : nullptr, opt, r, cpu_stats, a.shading,
+                                   a.texture_filter, a.kernels, a.precision, frame_init_ms});
   };
 
   // Frame by frame: the scene posed, the structure rebuilt, the static textures that changed
   // uploaded again (--update rebuild), the frame rendered and its files written.
   nlohmann::ordered_json j, frames_json = nlohmann::ordered_json::array();
-  struct FrameLine {
-    double time, pose_ms, build_ms, write_ms, render_ms;
-    uint64_t uploaded, passes;
-    double predicted_ms;
-    std::string action;                   // initial, rebuild or refit
-    uint64_t nodes_visited, voxel_steps;  // the walk's work (a tree's nodes, the grid's voxels)
-  };
   std::vector<FrameLine> lines;
   std::optional<std::pair<host::RenderResult, nlohmann::ordered_json>> reported;  // --report-frame
-  // --update auto rebuilds when the refitted BVH's SAH cost (expected node visits and triangle
-  // tests per ray) has grown past this factor of its last build's.
-  constexpr double kRefitLimit = 1.25;
   double built_sah = bvh ? bvh->sah_cost : 0.0;
   std::string action = "initial";
   for (size_t f = 0; f < times.size(); ++f) {
@@ -560,24 +556,8 @@ int run_render(const RenderArgs& a, bool lanes_given) {
         grid = host::build_grid(scene, frame_grid);
       } else {  // the structure walked, in the scene's new box
         box = host::build_grid(scene, host::GridSpec{glm::ivec3(1)});
-        if (accel_kind == host::AccelKind::bvh) {
-          // --update refit keeps the topology and moves the boxes; auto refits until the
-          // refitted tree's SAH cost passes kRefitLimit times the last build's, then rebuilds.
-          host::Bvh refitted = *bvh;
-          bool refit = a.update != "rebuild";
-          if (refit) {
-            host::refit_bvh(refitted, scene);
-            refit = a.update == "refit" || refitted.sah_cost <= kRefitLimit * built_sah;
-          }
-          if (refit) {
-            bvh = std::move(refitted);
-            action = "refit";
-          } else {
-            bvh = host::build_bvh(scene);
-            built_sah = bvh->sah_cost;
-            action = "rebuild";
-          }
-        }
+        if (accel_kind == host::AccelKind::bvh)
+          action = update_bvh(bvh, built_sah, scene, a.update);
         if (accel_kind == host::AccelKind::kdtree) kd = host::build_kdtree(scene, box->lo, box->hi);
         if (accel_kind == host::AccelKind::grid2) grid2 = host::build_grid2(scene);
       }
@@ -594,35 +574,15 @@ int run_render(const RenderArgs& a, bool lanes_given) {
     if (tty) std::fprintf(stderr, "\n");
     if (recorder && (!one_frame || one_frame->on)) recorder->finish(r.stats);
 
-    auto numbered = [&](const std::string& file) {
-      return animating ? cli::frame_path(file, number) : file;
-    };
-    if (!a.out.empty()) host::write_image(numbered(a.out), r.width, r.height, 3, r.rgb);
-    if (!aov_depth.empty()) host::write_image(numbered(aov_depth), r.width, r.height, 1, r.depth);
-    if (!aov_hit.empty()) host::write_image(numbered(aov_hit), r.width, r.height, 1, r.hit_id);
+    write_images(a, plan, r, number);
 
     j = record(f == 0 ? init_ms : 0.0);
     double predicted = 0;
     if (!cpu && !gl) predicted = host::predict(r.stats, vgpu::profile(opt.profile)).total_ms;
     if (animating) {
-      // What the frame's update cost: the host's work, the bytes sent to the device, and the
-      // cost model's charge for them on each profile (host/model/cost_model.h, predict_update).
-      nlohmann::ordered_json update = {
-          {"mode", f == 0 ? std::string("initial") : action},
-          {"pose_ms", pose_ms},
-          {"structure", host::accel_name(accel_kind)},
-          {"build_ms", build_ms()},
-          {"write_ms", write_ms},
-          {"uploaded_bytes", tracer ? nlohmann::ordered_json(up.bytes) : nullptr},
-          {"uploaded_textures", up.textures}};
-      nlohmann::ordered_json charged;
-      for (const vgpu::Profile& p : vgpu::profiles()) {
-        if (!tracer) break;
-        const host::UpdateCost c = host::predict_update(up.bytes, build_ms(), p);
-        charged[p.name] = {
-            {"upload_ms", c.upload_ms}, {"build_ms", c.build_ms}, {"total_ms", c.total_ms}};
-      }
-      update["predicted"] = charged;
+      const nlohmann::ordered_json update =
+          host::frame_update_json(f == 0 ? std::string("initial") : action, pose_ms, accel_kind,
+                                  build_ms(), write_ms, up, tracer.has_value());
       j["frame"] = number;
       j["time"] = times[f];
       j["animation"] = animation_json;
@@ -647,16 +607,7 @@ int run_render(const RenderArgs& a, bool lanes_given) {
   if (several)
     j = {{"scene", scene.name}, {"scene_path", path},          {"animation", animation_json},
          {"update", a.update},  {"frame_count", times.size()}, {"frames", frames_json}};
-  if (!a.stats_json.empty()) {
-    const std::string tmp = a.stats_json + ".tmp";
-    std::ofstream f(tmp);
-    f << j.dump(2) << "\n";
-    f.close();
-    if (!f || std::rename(tmp.c_str(), a.stats_json.c_str()) != 0) {
-      std::remove(tmp.c_str());
-      throw host::InputError(a.stats_json + ": cannot write the statistics");
-    }
-  }
+  if (!a.stats_json.empty()) host::write_stats_json(a.stats_json, j);
   if (!a.stats_csv.empty()) host::write_stats_csv(a.stats_csv, *recorder);
   if (!a.report.empty())
     host::write_report(a.report, *recorder, reported ? reported->first : r,
@@ -664,85 +615,14 @@ int run_render(const RenderArgs& a, bool lanes_given) {
   if (a.stats == "json") {
     std::cout << j.dump(2) << "\n";
   } else if (a.stats == "table" && several) {
-    std::printf("scene %s, animation %s, %zu frames, %s, --update %s, %dx%d, %s %s\n",
-                scene.name.c_str(),
-                animation ? ("'" + animated->animations()[*animation].name + "'").c_str()
-                          : "none (the scene is static)",
-                times.size(), std::string(host::accel_name(accel_kind)).c_str(), a.update.c_str(),
-                r.width, r.height, cpu ? "engine" : "profile", cpu ? "cpu" : opt.profile.c_str());
-    std::printf("%6s %9s %8s %9s %9s %11s %12s %10s %8s %12s %12s%s\n", "frame", "time s", "update",
-                "pose ms", "build ms", "textures ms", "uploaded B", "render ms", "passes", "nodes",
-                "voxels", a.predict ? "  predicted ms" : "");
-    for (size_t f = 0; f < lines.size(); ++f) {
-      const FrameLine& l = lines[f];
-      std::printf("%6zu %9.4g %8s %9.2f %9.2f %11.2f %12llu %10.1f %8llu %12llu %12llu", f + 1,
-                  l.time, l.action.c_str(), l.pose_ms, l.build_ms, l.write_ms,
-                  static_cast<unsigned long long>(l.uploaded), l.render_ms,
-                  static_cast<unsigned long long>(l.passes),
-                  static_cast<unsigned long long>(l.nodes_visited),
-                  static_cast<unsigned long long>(l.voxel_steps));
-      if (a.predict) std::printf("  %12.3f", l.predicted_ms);
-      std::printf("\n");
-    }
-    std::printf("initialization %.1f ms (the first frame's grid and uploads)\n", init_ms);
+    print_frames_table(a, plan, scene, accel_kind, r, lines, init_ms,
+                       animation ? "'" + animated->animations()[*animation].name + "'"
+                                 : "none (the scene is static)");
   } else if (a.stats == "table") {
-    if (cpu) {
-      std::printf(
-          "CPU reference (double precision, recursive Whitted): %llu rays, %llu voxel steps, %llu "
-          "triangle tests\n",
-          static_cast<unsigned long long>(cpu_stats.rays),
-          static_cast<unsigned long long>(cpu_stats.voxel_steps),
-          static_cast<unsigned long long>(cpu_stats.triangle_tests));
-      // Glass (docs/materials.md): the rays of each kind, summed over the iterations.
-      auto sum = [](const std::vector<uint64_t>& v) {
-        return static_cast<unsigned long long>(std::accumulate(v.begin(), v.end(), uint64_t(0)));
-      };
-      if (sum(cpu_stats.refracted) + sum(cpu_stats.total_internal) +
-              cpu_stats.glass_shadow_crossings >
-          0)
-        std::printf(
-            "glass: %llu reflected rays (%llu of them totally internally), %llu refracted; %llu "
-            "shadow-ray crossings\n",
-            sum(cpu_stats.reflected), sum(cpu_stats.total_internal), sum(cpu_stats.refracted),
-            static_cast<unsigned long long>(cpu_stats.glass_shadow_crossings));
-    } else
-      std::cout << r.stats.to_table();
-    std::printf(
-        "scene %s: %zu triangles (%u dropped as degenerate), grid %dx%dx%d (%llu references)\n",
-        scene.name.c_str(), scene.triangle_count(), scene.dropped_degenerate, walk_grid.res.x,
-        walk_grid.res.y, walk_grid.res.z, static_cast<unsigned long long>(walk_grid.references()));
-    if (accel_kind == host::AccelKind::bvh)
-      std::printf("%s (%.1f ms to build)\n", host::describe(*bvh).c_str(), bvh->build_ms);
-    if (accel_kind == host::AccelKind::kdtree)
-      std::printf("%s (%.1f ms to build)\n", host::describe(*kd).c_str(), kd->build_ms);
-    if (accel_kind == host::AccelKind::grid2)
-      std::printf(
-          "two-level grid: coarse %dx%dx%d, %d crowded cells, %zu sub-cells, %llu "
-          "references (%.1f ms to build)\n",
-          grid2->coarse.res.x, grid2->coarse.res.y, grid2->coarse.res.z, grid2->crowded,
-          grid2->sub_cells(), static_cast<unsigned long long>(grid2->references), grid2->build_ms);
-    if (choice)
-      std::printf("accel auto: %s (probes %.0f ms)\n", choice->why.c_str(), choice->probe_ms);
-    std::printf("%s %s, %dx%d, %d iteration(s), %s shading, shadows %s, masks %s, mrt %s\n",
-                cpu ? "engine" : "profile", cpu ? "cpu" : opt.profile.c_str(), r.width, r.height,
-                r.iterations, a.shading.c_str(), a.shadows.c_str(), a.masks.c_str(), a.mrt.c_str());
-    if (!cpu)
-      std::cout << "formats (texture and arithmetic, per group):\n" << describe(opt.formats);
-    if (r.streams.on) std::cout << host::describe(r.streams);
-    std::printf("initialization %.1f ms (grid %.1f ms), render %.1f ms (%s)\n", init_ms,
-                walk_grid.build_ms, r.render_ms,
-                cpu            ? "host CPU"
-                : gl           ? "wall, GL device"
-                : r.batch_walk ? "host, emulated, walks in batches"
-                               : "host, emulated");
-    if (gl)
-      std::printf("device %s: passes %.2f ms of GPU time (timer queries)\n",
-                  tracer->device().description().c_str(), r.stats.totals.device_ms);
-    if (animating)
-      std::printf("time %g s of %s\n", times[0],
-                  animation
-                      ? ("animation '" + animated->animations()[*animation].name + "'").c_str()
-                      : "no animation (the scene is static)");
+    print_table(a, plan, scene, accel, choice ? &*choice : nullptr, r, cpu_stats, init_ms,
+                tracer ? &*tracer : nullptr,
+                animation ? "animation '" + animated->animations()[*animation].name + "'"
+                          : "no animation (the scene is static)");
   }
   if (a.predict && !several) {
     const vgpu::Profile& p = vgpu::profile(opt.profile);

@@ -118,6 +118,12 @@ struct RenderOptions {
   // Called at the start of each ray-tracing iteration (1-based) with the iteration count.
   std::function<void(int iteration, int iterations)> progress;
   PassObserver* observer = nullptr;  // not owned
+
+  // Every combination of options that cannot run, in one place: the first one's reason, in the
+  // command line's words (empty: these options run on `profile`). The command line refuses them
+  // before any work (exit 2), and the stream tracer's constructor throws vgpu::Error with the same
+  // text. Needs `formats` resolved for the MRT check (fp32 everywhere before that).
+  std::string refusal(const vgpu::Profile& profile) const;
 };
 
 // Glass's ray streams (host/trace/stream/ray_streams.h): what one frame's streams held and cost,

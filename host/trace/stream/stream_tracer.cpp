@@ -108,15 +108,10 @@ StreamTracer::StreamTracer(const Scene& scene, const Accel& accel, const RenderO
                                                                {&s.shader, Group::colour},
                                                                {&s.reflected, Group::colour}})
     prog->set_precision(fm.arithmetic(g));
-  if (opt_.mrt) {
-    const std::string why = mrt_refusal(gpu.profile(), fm);
-    if (!why.empty()) throw vgpu::Error(why);
-  }
+  // Combinations of options that cannot run (RenderOptions::refusal, the command line's words).
+  if (const std::string why = opt_.refusal(gpu.profile()); !why.empty()) throw vgpu::Error(why);
   if (const std::string why = spp_refusal(opt_.spp); !why.empty())
     throw std::invalid_argument("spp: " + why);
-  if (opt_.undersample < 0 || (opt_.undersample > 0 && (opt_.spp > 1 || opt_.adaptive)))
-    throw std::invalid_argument(
-        "undersample: K must be 1 or more, with one ray per traced pixel (spp 1, not adaptive)");
   const bool sums = opt_.spp > 1 || opt_.undersample > 0;
   const bool marking = (opt_.adaptive && opt_.spp > 1) || opt_.undersample > 0;
 

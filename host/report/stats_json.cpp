@@ -1,0 +1,233 @@
+// The statistics object of one frame (stats_json.h); its keys and their order are what
+// --stats-json has always written.
+
+// GCC 12 reports false positives inside nlohmann_json's templates.
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#pragma GCC diagnostic ignored "-Wrestrict"
+#include "host/report/stats_json.h"
+
+#include <cstdio>
+#include <fstream>
+
+#include "host/model/cost_model.h"
+#include "host/model/formats.h"
+#include "host/trace/stream/ray_streams.h"
+#include "host/trace/walks/grid_walk.h"
+#include "vgpu/vgpu.h"
+
+namespace host {
+
+nlohmann::ordered_json frame_stats_json(const FrameStatsInputs& in) {
+  const Scene& scene = in.scene;
+  StreamTracer* tracer = in.tracer;  // device() is not const
+  const Accel& accel = in.accel;
+  const Grid& walk_grid = *accel.grid;
+  const RenderOptions& opt = in.options;
+  const RenderResult& r = in.result;
+  const CpuStats& cpu_stats = in.cpu_stats;
+  const bool cpu = in.engine == "cpu", gl = in.engine == "gl";
+  nlohmann::ordered_json j;
+  j["scene"] = scene.name;
+  j["scene_path"] = in.scene_path;
+  j["engine"] = in.engine;
+  if (tracer) j["device"] = tracer->device().description();
+  j["triangles"] = scene.triangle_count();
+  j["input_triangles"] = scene.input_triangles;
+  j["dropped_degenerate"] = scene.dropped_degenerate;
+  j["grid"] = {walk_grid.res.x, walk_grid.res.y, walk_grid.res.z};
+  j["grid_references"] = walk_grid.references();
+  {
+    nlohmann::ordered_json acc;
+    acc["structure"] = accel_name(accel.kind);
+    if (accel.kind == AccelKind::bvh) {
+      acc["nodes"] = accel.bvh->nodes.size();
+      acc["leaves"] = accel.bvh->leaves;
+      acc["depth"] = accel.bvh->depth;
+      acc["max_leaf"] = accel.bvh->max_leaf;
+      acc["references"] = accel.bvh->references();
+      acc["sah_cost"] = accel.bvh->sah_cost;
+      acc["build_ms"] = accel.bvh->build_ms;
+    } else if (accel.kind == AccelKind::kdtree) {
+      acc["nodes"] = accel.kd->nodes.size();
+      acc["leaves"] = accel.kd->leaves;
+      acc["empty_leaves"] = accel.kd->empty_leaves;
+      acc["depth"] = accel.kd->depth;
+      acc["max_leaf"] = accel.kd->max_leaf;
+      acc["references"] = accel.kd->references();
+      acc["sah_cost"] = accel.kd->sah_cost;
+      acc["build_ms"] = accel.kd->build_ms;
+    } else if (accel.kind == AccelKind::grid2) {
+      const Grid& c = accel.grid2->coarse;
+      acc["coarse"] = {c.res.x, c.res.y, c.res.z};
+      acc["crowded_cells"] = accel.grid2->crowded;
+      acc["sub_cells"] = accel.grid2->sub_cells();
+      acc["list_entries"] = accel.grid2->lists.size();
+      acc["references"] = accel.grid2->references;
+      acc["max_list"] = accel.grid2->max_list;
+      acc["build_ms"] = accel.grid2->build_ms;
+    } else {
+      acc["voxels"] = {walk_grid.res.x, walk_grid.res.y, walk_grid.res.z};
+      acc["references"] = walk_grid.references();
+      acc["build_ms"] = walk_grid.build_ms;
+    }
+    if (!cpu) {
+      const WalkWork w = walk_work(r.stats, r.rays_traced);
+      acc["work"] = {{"voxel_steps", w.voxel_steps},
+                     {"nodes_visited", w.nodes_visited},
+                     {"triangle_tests", w.triangle_tests},
+                     {"loop_iterations", w.loop_iterations}};
+      // kd-restart's restarts, where the passes show them (WalkWork::restarts); else null.
+      acc["work"]["restarts"] =
+          w.restarts >= 0 ? nlohmann::ordered_json(w.restarts) : nlohmann::ordered_json();
+    }
+    if (in.choice) {
+      nlohmann::ordered_json au;
+      au["probe_size"] = {in.choice->probe_width, in.choice->probe_height};
+      au["profile"] = opt.profile;
+      au["predicted_ms"] = in.choice->predicted_ms;
+      au["probe_passes"] = in.choice->probe_passes;
+      au["probe_ms"] = in.choice->probe_ms;
+      au["why"] = in.choice->why;
+      acc["auto"] = au;
+    }
+    j["accel"] = acc;
+  }
+  j["profile"] = opt.profile;
+  j["size"] = {r.width, r.height};
+  j["bounces"] = opt.bounces;
+  j["iterations"] = r.iterations;
+  j["shading"] = in.shading;
+  j["shadows"] = opt.shadows;
+  if (!scene.textures.empty()) {  // base-colour textures (kernels/base_color.h)
+    j["textures"] = scene.textures.size();
+    j["texture_filter"] = in.texture_filter;
+  }
+  j["masks"] = opt.masks;
+  j["mrt"] = opt.mrt;  // fused two-output passes (kernels/fused.h)
+  j["fused_programs"] = opt.mrt ? mrt_programs() : std::vector<std::string>{};
+  j["kernel_variant"] = in.kernels;  // multipass | looping ("kernels" lists the programs)
+  if (opt.looping) j["steps_per_pass"] = opt.steps_per_pass;
+  j["threads"] = opt.threads;
+  j["lanes"] = opt.lanes;
+  // How the emulator ran the grid walks: in batches or pass by pass (same statistics).
+  if (!cpu && !gl) j["walk"] = r.batch_walk ? "batches" : "passes";
+  j["precision"] = in.precision;
+  if (!cpu) j["formats"] = to_json(opt.formats);
+  j["init_ms"] = in.init_ms;
+  j["grid_build_ms"] = walk_grid.build_ms;
+  j["render_ms"] = r.render_ms;
+  if (tracer) j["texture_bytes"] = tracer->texture_bytes();
+  if (cpu)
+    j["cpu"] = {{"rays", cpu_stats.rays},
+                {"voxel_steps", cpu_stats.voxel_steps},
+                {"triangle_tests", cpu_stats.triangle_tests},
+                {"nodes_visited", cpu_stats.nodes_visited},
+                {"restarts", cpu_stats.restarts},
+                {"reflected", cpu_stats.reflected},
+                {"refracted", cpu_stats.refracted},
+                {"total_internal", cpu_stats.total_internal},
+                {"glass_shadow_crossings", cpu_stats.glass_shadow_crossings}};
+  j["rays_traced"] = r.rays_traced;
+  if (r.streams.on) j["streams"] = to_json(r.streams);  // glass's ray streams
+  j["rays_unfinished"] = r.rays_unfinished;
+  // Supersampling (--spp): samples per pixel and the passes it added to the first sample frame.
+  {
+    double mean = double(r.samples);
+    uint64_t most = uint64_t(r.samples);
+    if (!r.rays_per_pixel.empty()) {
+      uint64_t total = 0;
+      most = 0;
+      for (const uint32_t n : r.rays_per_pixel) total += n, most = std::max<uint64_t>(most, n);
+      mean = double(total) / double(r.rays_per_pixel.size());
+    }
+    j["sampling"] = {{"mode", opt.undersample > 0           ? "undersample"
+                              : opt.adaptive && opt.spp > 1 ? "adaptive"
+                                                            : "uniform"},
+                     {"spp", opt.spp},
+                     {"samples_per_pixel_mean", mean},
+                     {"samples_per_pixel_max", most},
+                     {"passes_added", cpu ? 0 : r.stats.totals.passes - r.first_frame_passes}};
+    if (opt.adaptive) j["sampling"]["threshold"] = opt.aa_threshold;
+    if (opt.undersample > 0) j["sampling"]["k"] = opt.undersample;
+  }
+  {
+    nlohmann::ordered_json stats = r.stats.json();
+    if (gl)  // the emulator's SIMD model: a driver does not show its lanes
+      for (const char* key :
+           {"lanes_idle", "idle_in_batch32", "idle_in_batch1024", "loop_iterations",
+            "loop_lane_slots", "loop_lanes_idle", "loop_batch_iterations", "loop_idle_instructions",
+            "loop_idle_fetches"}) {
+        stats["totals"][key] = nullptr;
+        for (auto& k : stats["programs"]) k[key] = nullptr;
+      }
+    j["totals"] = std::move(stats["totals"]);
+    j["downloads"] = stats["downloads"];
+    j["download_bytes"] = stats["download_bytes"];
+    j["kernels"] = std::move(stats["programs"]);
+  }
+  // The cost model's prediction for every built-in profile (the counters do not depend on it).
+  nlohmann::ordered_json predicted_ms, predicted_breakdown;
+  for (const vgpu::Profile& p : vgpu::profiles()) {
+    if (cpu || gl) break;  // no passes, or no SIMD counters to predict from
+    if (opt.looping && p.max_loop_iterations < opt.steps_per_pass) {
+      predicted_ms[p.name] = nullptr;  // the looping program cannot run there
+      continue;
+    }
+    const CostBreakdown c = predict(r.stats, p);
+    predicted_ms[p.name] = c.total_ms;
+    for (const auto& [key, v] : c.items()) predicted_breakdown[p.name][key] = v;
+  }
+  j["predicted_ms"] = predicted_ms;
+  j["predicted_breakdown"] = predicted_breakdown;
+  auto what_if = nlohmann::ordered_json::array();  // MRT and resident programs (docs/table1.md)
+  for (const auto& [name, s] : cpu || gl ? decltype(what_ifs(r.stats)){} : what_ifs(r.stats)) {
+    nlohmann::ordered_json w = {{"name", name}, {"totals", vgpu::to_json(s.totals)}};
+    for (const vgpu::Profile& p : vgpu::profiles())
+      for (const auto& [key, v] : predict(s, p).items()) w["predicted_breakdown"][p.name][key] = v;
+    what_if.push_back(w);
+  }
+  j["predicted_what_if"] = what_if;
+  return j;
+}
+
+nlohmann::ordered_json animation_json(const Animation& animation, size_t index) {
+  return {{"name", animation.name},
+          {"index", index},
+          {"start", animation.start},
+          {"end", animation.end}};
+}
+
+nlohmann::ordered_json frame_update_json(const std::string& mode, double pose_ms,
+                                         AccelKind structure, double build_ms, double write_ms,
+                                         const StreamTracer::Upload& up, bool uploaded) {
+  nlohmann::ordered_json update = {
+      {"mode", mode},
+      {"pose_ms", pose_ms},
+      {"structure", accel_name(structure)},
+      {"build_ms", build_ms},
+      {"write_ms", write_ms},
+      {"uploaded_bytes", uploaded ? nlohmann::ordered_json(up.bytes) : nullptr},
+      {"uploaded_textures", up.textures}};
+  nlohmann::ordered_json charged;
+  for (const vgpu::Profile& p : vgpu::profiles()) {
+    if (!uploaded) break;
+    const UpdateCost c = predict_update(up.bytes, build_ms, p);
+    charged[p.name] = {
+        {"upload_ms", c.upload_ms}, {"build_ms", c.build_ms}, {"total_ms", c.total_ms}};
+  }
+  update["predicted"] = charged;
+  return update;
+}
+
+void write_stats_json(const std::string& path, const nlohmann::ordered_json& j) {
+  const std::string tmp = path + ".tmp";
+  std::ofstream f(tmp);
+  f << j.dump(2) << "\n";
+  f.close();
+  if (!f || std::rename(tmp.c_str(), path.c_str()) != 0) {
+    std::remove(tmp.c_str());
+    throw InputError(path + ": cannot write the statistics");
+  }
+}
+
+}  // namespace host

@@ -1,0 +1,55 @@
+#pragma once
+// The statistics of one rendered frame as JSON (vgpu-rt render --stats-json, --stats json, and
+// the frame a report shows): the scene, the structure walked, the options, the pass counters
+// and the cost model's predictions. The command line gathers the pieces; this file names them.
+
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "host/accel/accel.h"
+#include "host/scene/animation.h"
+#include "host/scene/scene.h"
+#include "host/trace/cpu/cpu_tracer.h"
+#include "host/trace/render_options.h"
+#include "host/trace/stream/accel_choice.h"
+#include "host/trace/stream/stream_tracer.h"
+
+namespace host {
+
+// What one frame's statistics object is made of. The strings are the command line's words
+// (--engine, --shading, --texture-filter, --kernels, --precision), written as given.
+struct FrameStatsInputs {
+  const Scene& scene;
+  const std::string& scene_path;
+  const std::string& engine;  // stream, cpu or gl
+  StreamTracer* tracer;       // nullptr: the CPU reference rendered the frame
+  const Accel& accel;  // the structure walked (its grid: the scene box of a non-grid structure)
+  const AccelChoice* choice;  // --accel auto's choice, else nullptr
+  const RenderOptions& options;
+  const RenderResult& result;
+  const CpuStats& cpu_stats;  // the CPU reference's counts (engine cpu)
+  const std::string& shading;
+  const std::string& texture_filter;
+  const std::string& kernels;
+  const std::string& precision;
+  double init_ms;  // initialization charged to this frame (the first), else 0
+};
+
+nlohmann::ordered_json frame_stats_json(const FrameStatsInputs& in);
+
+// The animation a moving scene's frames were posed by (--animation): its name, index and times.
+nlohmann::ordered_json animation_json(const Animation& animation, size_t index);
+
+// What a frame of an animation cost to update (the "update" object of --frames and --time): the
+// host's work (`mode`: initial, rebuild or refit), the bytes sent to the device, and the cost
+// model's charge for them on each profile (host/model/cost_model.h, predict_update). `uploaded`:
+// whether a device took them (false: the CPU reference, whose bytes and charges are null).
+nlohmann::ordered_json frame_update_json(const std::string& mode, double pose_ms,
+                                         AccelKind structure, double build_ms, double write_ms,
+                                         const StreamTracer::Upload& up, bool uploaded);
+
+// Writes `j` (indented by 2, then a newline) to `path` through a temporary file renamed over it;
+// throws InputError naming the path when it cannot.
+void write_stats_json(const std::string& path, const nlohmann::ordered_json& j);
+
+}  // namespace host

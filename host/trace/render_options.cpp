@@ -1,0 +1,26 @@
+// The refusals of option combinations (RenderOptions::refusal): written once, read by the
+// command line and by the stream tracer.
+#include "host/trace/render_options.h"
+
+#include "host/trace/walks/grid_walk.h"
+
+namespace host {
+
+std::string RenderOptions::refusal(const vgpu::Profile& profile) const {
+  // Undersampling traces one ray through each traced pixel; supersampling traces several.
+  if (undersample > 0 && spp > 1)
+    return "--aa undersample" +
+           (undersample == 2 ? std::string() : ":" + std::to_string(undersample)) +
+           " traces one ray per traced pixel; drop --spp " + std::to_string(spp);
+  // The command line cannot ask for these two (--aa is one mode); a program can.
+  if (undersample < 0 || (undersample > 0 && adaptive))
+    return "undersample: K must be 1 or more, with one ray per traced pixel (spp 1, not adaptive)";
+  if (mrt && looping)
+    return "--mrt on with --kernels looping: the looping program already writes the traversal, "
+           "voxel and hit targets in one pass; there are no separate passes left to fuse";
+  // The fused programs' outputs against the profile's limit, and their groups' formats.
+  if (mrt) return mrt_refusal(profile, formats);
+  return {};
+}
+
+}  // namespace host
