@@ -13,14 +13,15 @@
 #include <stdexcept>
 
 #include "host/common/parallel.h"
-#include "host/trace/walks/bvh_walk.h"
+#include "host/trace/passes.h"
+#include "host/trace/sampling.h"
 #include "host/trace/stream/devices.h"
+#include "host/trace/stream/ray_streams.h"
+#include "host/trace/stream/stream_state.h"
+#include "host/trace/textures.h"
+#include "host/trace/walks/bvh_walk.h"
 #include "host/trace/walks/grid2_walk.h"
 #include "host/trace/walks/kd_walk.h"
-#include "host/trace/passes.h"
-#include "host/trace/stream/ray_streams.h"
-#include "host/trace/sampling.h"
-#include "host/trace/textures.h"
 
 namespace host {
 
@@ -29,48 +30,6 @@ using vgpu::Format;
 using vgpu::KernelProgram;
 using vgpu::Stencil;
 using vgpu::Texture;
-
-struct StreamTracer::State {
-  // Static textures: the scene, triangle i at texel (i mod width, i div width).
-  Texture v[3], n[3], colors;
-  // Base-colour textures (scenes with a textured material): the corners' coordinates, the
-  // texture table and the atlas of mip chains (kernels/layout.h).
-  bool textured = false;
-  Texture uvs01, uvs2, texture_table, atlas;
-  // Dynamic textures (ping-pong pairs where a pass reads what it replaces).
-  Texture rays[2], origins[2], shadow_rays, isect[2], result[2], counter;
-  int cur_rays = 0, cur_isect = 0, cur_result = 0;
-  // The rays still walking, and those with a triangle left to test (the walk's masks).
-  Stencil grid_mask, isect_mask;
-  // The programs of the pipeline around the walk, with their uniforms.
-  KernelProgram<GenerateRays> generate;
-  KernelProgram<Shader> shader;
-  KernelProgram<ReflectedRays> reflected;
-  KernelProgram<ReflectionOrigin> origin;
-  KernelProgram<ReflectionDirection> direction;
-  KernelProgram<ShadowRays> shadow;
-  // Supersampling (--spp N > 1): sample frames' rays, their sum and the box filter.
-  KernelProgram<GenerateSampleRays> sample_generate;
-  KernelProgram<AccumulateSamples> accumulate;
-  KernelProgram<ResolveSamples> resolve;
-  Texture sum[2];
-  int cur_sum = 0;
-  // Adaptive supersampling (--aa adaptive): surface keys and marks, each triangle's material.
-  KernelProgram<KeepHits> keep;
-  KernelProgram<MarkPixels> mark;
-  KernelProgram<MarkedPixels> marked;
-  Texture marks[2], materials;
-  int cur_mark = 0;
-  // Adaptive undersampling (--aa undersample:K): the lattice, the gaps, the fill.
-  KernelProgram<MarkLattice> mark_lattice;
-  KernelProgram<MarkGaps> mark_gaps;
-  KernelProgram<FillGaps> fill;
-  // The walk through the acceleration structure, and how passes are issued.
-  std::unique_ptr<AccelWalk> walk;
-  std::unique_ptr<PassRunner> runner;
-  // Glass (or --ray-streams on): the frame as ray streams (host/trace/stream/ray_streams.h).
-  std::unique_ptr<RayStreams> streams;
-};
 
 kernels::ShadingModel parse_shading(const std::string& name) {
   if (name == "diffuse") return ShadingModel::diffuse;
@@ -407,22 +366,7 @@ RenderResult StreamTracer::render(const Camera& cam) {
   } else if (opt_.adaptive) {
     render_adaptive(cam, res, iteration_number);
   } else {
-    // Supersampling as a 2004 card would: one whole frame per sample, each through its own
-    // sub-pixel offset (generadorRayosMuestra), added into a sum texture (acumularMuestras),
-    // then one box-filter pass (resolverMuestras). No texture grows with the sample count.
-    gpu.clear(s.sum[s.cur_sum], {0, 0, 0, 0});
-    for (int k = 0; k < opt_.spp; ++k) {
-      const glm::vec2 j = sample_offset(opt_.spp, k, opt_.sample_seed);
-      s.sample_generate.kernel.jitter_x = j.x;
-      s.sample_generate.kernel.jitter_y = j.y;
-      frame(cam, s.sample_generate, res, k == 0, iteration_number);
-      if (k == 0) res.first_frame_passes = gpu.stats().totals.passes;
-      r.pass(s.accumulate, {&s.sum[s.cur_sum], &s.result[s.cur_result]}, s.sum[s.cur_sum ^ 1]);
-      s.cur_sum ^= 1;
-    }
-    r.pass(s.resolve, {&s.sum[s.cur_sum]}, s.result[s.cur_result ^ 1]);
-    s.cur_result ^= 1;
-    res.samples = opt_.spp;
+    render_samples(cam, res, iteration_number);
   }
 
   Texture& out = s.result[s.cur_result];
@@ -443,137 +387,17 @@ RenderResult StreamTracer::render(const Camera& cam) {
   return res;
 }
 
-void StreamTracer::render_adaptive(const Camera& cam, RenderResult& res, int& iteration_number) {
-  vgpu::Device& gpu = *gpu_;
-  State& s = *s_;
-  PassRunner& r = *s.runner;
-  // The centre frame, the paper's, keeping each pixel's surface key; its colour is every
-  // pixel's first estimate (one sample).
-  frame(cam, s.generate, res, true, iteration_number, nullptr, true);
-  res.first_frame_passes = gpu.stats().totals.passes;
-  gpu.clear(s.sum[s.cur_sum], {0, 0, 0, 0});
-  s.accumulate.kernel.gated = false;
-  r.pass(s.accumulate, {&s.sum[s.cur_sum], &s.result[s.cur_result]}, s.sum[s.cur_sum ^ 1]);
-  s.cur_sum ^= 1;
-  const std::vector<int> levels = adaptive_levels(opt_.spp);
-  for (size_t l = 0; l < levels.size(); ++l) {
-    // marcarPixeles on the current estimate, then pixelesMarcados: how many get more samples.
-    r.pass(s.mark, {&s.marks[s.cur_mark], &s.result[s.cur_result]}, s.marks[s.cur_mark ^ 1]);
-    s.cur_mark ^= 1;
-    if (r.count(s.marked, s.marks[s.cur_mark], nullptr, nullptr) == 0) break;
-    // The level's n x n samples, only in marked pixels, replacing their earlier ones.
-    const int n = levels[l] * levels[l];
-    s.sample_generate.kernel.gated = true;
-    s.accumulate.kernel.gated = true;
-    for (int k = 0; k < n; ++k) {
-      const glm::vec2 j = sample_offset(n, k, opt_.sample_seed);
-      s.sample_generate.kernel.jitter_x = j.x;
-      s.sample_generate.kernel.jitter_y = j.y;
-      frame(cam, s.sample_generate, res, false, iteration_number, &s.marks[s.cur_mark]);
-      s.accumulate.kernel.restart = k == 0;
-      r.pass(s.accumulate, {&s.sum[s.cur_sum], &s.result[s.cur_result], &s.marks[s.cur_mark]},
-             s.sum[s.cur_sum ^ 1]);
-      s.cur_sum ^= 1;
-    }
-    // The new estimate: the next level's marks read it, and after the last level it is the
-    // image. (Where no pixel is marked at all, the centre frame's colour stays the image.)
-    r.pass(s.resolve, {&s.sum[s.cur_sum]}, s.result[s.cur_result ^ 1]);
-    s.cur_result ^= 1;
-  }
-  s.sample_generate.kernel.gated = false;
-  s.accumulate.kernel.gated = false;
-  // Each pixel's final sample count, for the rays-per-pixel statistics and map.
-  Texture& sum = s.sum[s.cur_sum];
-  gpu.download(sum);
-  const int W = opt_.width, H = opt_.height;
-  res.rays_per_pixel.resize(size_t(W) * size_t(H));
-  int most = 1;
-  for (int y = 0; y < H; ++y)
-    for (int x = 0; x < W; ++x) {
-      const int samples = int(sum.texel(x, y)[3]);
-      most = std::max(most, samples);
-      res.rays_per_pixel[size_t(y) * size_t(W) + size_t(x)] = adaptive_rays(opt_.spp, samples);
-    }
-  res.samples = most;
-}
-
-void StreamTracer::render_undersampled(const Camera& cam, RenderResult& res,
-                                       int& iteration_number) {
-  vgpu::Device& gpu = *gpu_;
-  State& s = *s_;
-  PassRunner& r = *s.runner;
-  const int W = opt_.width, H = opt_.height, K = opt_.undersample;
-  // marcarReticula into marks A; the lattice frame through the lattice pixels' centres, keeping
-  // their surface keys in marks B; their colours into the sum.
-  r.pass(s.mark_lattice, {}, s.marks[0]);
-  s.cur_mark = 1;
-  s.sample_generate.kernel.jitter_x = s.sample_generate.kernel.jitter_y = 0.5f;
-  s.sample_generate.kernel.gated = true;
-  frame(cam, s.sample_generate, res, true, iteration_number, &s.marks[0], true);
-  res.first_frame_passes = gpu.stats().totals.passes;
-  gpu.clear(s.sum[s.cur_sum], {0, 0, 0, 0});
-  s.accumulate.kernel.gated = true;
-  s.accumulate.kernel.restart = false;
-  r.pass(s.accumulate, {&s.sum[s.cur_sum], &s.result[s.cur_result], &s.marks[0]},
-         s.sum[s.cur_sum ^ 1]);
-  s.cur_sum ^= 1;
-  // marcarHuecos into marks A (the lattice flags are done with), pixelesMarcados counts them;
-  // the gaps' frame traces them.
-  r.pass(s.mark_gaps, {&s.marks[1], &s.sum[s.cur_sum]}, s.marks[0]);
-  std::vector<uint8_t> gap(size_t(W) * size_t(H), 0);
-  if (r.count(s.marked, s.marks[0], nullptr, nullptr) > 0) {
-    const std::vector<float> depth = res.depth, hit_id = res.hit_id;
-    frame(cam, s.sample_generate, res, true, iteration_number, &s.marks[0]);
-    r.pass(s.accumulate, {&s.sum[s.cur_sum], &s.result[s.cur_result], &s.marks[0]},
-           s.sum[s.cur_sum ^ 1]);
-    s.cur_sum ^= 1;
-    // The AOVs: the gaps' from this frame, the lattice's from the first.
-    gpu.download(s.marks[0]);
-    for (size_t i = 0; i < gap.size(); ++i) {
-      gap[i] = s.marks[0].texel(int(i % size_t(W)), int(i / size_t(W)))[0] > 0.0f;
-      if (!gap[i]) res.depth[i] = depth[i], res.hit_id[i] = hit_id[i];
-    }
-  }
-  s.sample_generate.kernel.gated = false;
-  s.accumulate.kernel.gated = false;
-  // rellenarHuecos: the traced pixels' colours, the rest blended from their lattice cell.
-  r.pass(s.fill, {&s.sum[s.cur_sum]}, s.result[s.cur_result ^ 1]);
-  s.cur_result ^= 1;
-  // The AOVs of a pixel never traced: its lattice cell's nearest corner's.
-  res.rays_per_pixel.assign(gap.size(), 0);
-  for (int y = 0; y < H; ++y)
-    for (int x = 0; x < W; ++x) {
-      const size_t i = size_t(y) * size_t(W) + size_t(x);
-      if (on_lattice(x, y, K, W, H) || gap[i]) {
-        res.rays_per_pixel[i] = 1;
-        continue;
-      }
-      const glm::ivec4 c = lattice_cell(x, y, K, W, H);
-      const int nx = x - c.x <= c.y - x ? c.x : c.y, ny = y - c.z <= c.w - y ? c.z : c.w;
-      const size_t j = size_t(ny) * size_t(W) + size_t(nx);
-      res.depth[i] = res.depth[j];
-      res.hit_id[i] = res.hit_id[j];
-    }
-  res.samples = 1;
-}
-
 void StreamTracer::frame(const Camera& cam, const vgpu::Program& generate, RenderResult& res,
                          bool aovs, int& iteration_number, const Texture* marks, bool keep_hits) {
   if (s_->streams) {
     stream_frame(cam, generate, res, aovs, iteration_number, marks, keep_hits);
     return;
   }
-  vgpu::Device& gpu = *gpu_;
   State& s = *s_;
-  PassRunner& r = *s.runner;
   int ro = 0;  // origins[ro]: this iteration's ray origins; origins[ro ^ 1]: its hit points
-  gpu.clear(s.origins[ro], {cam.position.x, cam.position.y, cam.position.z, 0});
-  if (marks)
-    r.pass(generate, {marks}, s.rays[s.cur_rays]);
-  else
-    r.pass(generate, {}, s.rays[s.cur_rays]);
-  gpu.clear(s.result[s.cur_result], {0, 0, 0, 1});
-
+  generate_rays(cam, generate, marks);
+  // Each iteration is one ray stream (the primary rays, then each bounce's reflected rays):
+  // the walk, inicioReflejo, the shading per light, then the reflected rays of the next one.
   const int iterations = 1 + std::max(0, opt_.bounces);
   for (int it = 0; it < iterations; ++it) {
     const int number = ++iteration_number;  // 1-based, counted over the sample frames
@@ -582,57 +406,117 @@ void StreamTracer::frame(const Camera& cam, const vgpu::Program& generate, Rende
     if (opt_.progress) opt_.progress(it + 1, iterations);
     if (opt_.observer) opt_.observer->iteration(number);
     Texture& rays = s.rays[s.cur_rays];
-    if (opt_.observer)
-      opt_.observer->trace_begin(it ? PassObserver::TraceKind::reflected
-                                    : PassObserver::TraceKind::primary);
-    trace(s.origins[ro], rays, it == 0, cam);
-    if (opt_.observer) opt_.observer->trace_end();
-    Texture& hits = s.isect[s.cur_isect];
-    // guardarImpactos: the primary hits' surface keys (--aa adaptive), before later traces
-    // overwrite the intersections.
-    if (it == 0 && keep_hits) r.pass(s.keep, {&hits, &s.materials}, s.marks[s.cur_mark]);
-    if (it == 0 && aovs) download_aovs(res);
-    // inicioReflejo: hit points, the shader's record and the next rays' origins.
+    walk_rays(s.origins[ro], rays, it == 0, cam);
+    if (it == 0) primary_hits(res, aovs, keep_hits);
     Texture& surface = s.origins[ro ^ 1];
-    r.pass(s.origin, {&s.origins[ro], &rays, &hits, &s.v[0], &s.v[1], &s.v[2]}, surface);
-    // shader: one pass per light, after that light's shadow rays are traced.
-    const auto& lights = scene_->lights;
-    for (size_t li = 0; li < lights.size(); ++li) {
-      Shader& sh = s.shader.kernel;
-      sh.light = lights[li].position;
-      sh.light_color = lights[li].color;
-      sh.first_light = li == 0;
-      sh.last_light = li + 1 == lights.size();
-      if (opt_.shadows) {
-        s.shadow.kernel.light = lights[li].position;
-        r.pass(s.shadow, {&surface, &s.result[s.cur_result]}, s.shadow_rays);
-        if (opt_.observer) opt_.observer->trace_begin(PassObserver::TraceKind::shadow);
-        trace(surface, s.shadow_rays, false, cam);
-        if (opt_.observer) opt_.observer->trace_end();
-      }
-      if (s.textured)
-        r.pass(s.shader,
-               {&surface, &rays, &s.result[s.cur_result], &s.isect[s.cur_isect], &s.colors, &s.v[0],
-                &s.v[1], &s.v[2], &s.n[0], &s.n[1], &s.n[2], &s.origins[ro], &s.uvs01, &s.uvs2,
-                &s.texture_table, &s.atlas},
-               s.result[s.cur_result ^ 1]);
-      else
-        r.pass(s.shader,
-               {&surface, &rays, &s.result[s.cur_result], &s.isect[s.cur_isect], &s.colors, &s.v[0],
-                &s.v[1], &s.v[2], &s.n[0], &s.n[1], &s.n[2]},
-               s.result[s.cur_result ^ 1]);
-      s.cur_result ^= 1;
-    }
+    reflection_origin(s.origins[ro], rays, surface);
+    Texture* col[2] = {&s.result[s.cur_result], &s.result[s.cur_result ^ 1]};
+    s.cur_result ^= shade_lights(cam, surface, rays, s.origins[ro], col);
     if (it + 1 == iterations) break;
-    // rayosReflejados: stop when no ray was reflected.
-    if (r.count(s.reflected, s.result[s.cur_result], nullptr, &s.grid_mask) == 0) break;
-    r.pass(s.direction,
-           {&rays, &surface, &s.result[s.cur_result], &s.v[0], &s.v[1], &s.v[2], &s.n[0], &s.n[1],
-            &s.n[2]},
-           s.rays[s.cur_rays ^ 1]);
+    if (!reflect(rays, surface, s.rays[s.cur_rays ^ 1])) break;
     s.cur_rays ^= 1;
     ro ^= 1;
   }
+}
+
+void StreamTracer::generate_rays(const Camera& cam, const vgpu::Program& generate,
+                                 const Texture* marks) {
+  State& s = *s_;
+  gpu_->clear(s.origins[0], {cam.position.x, cam.position.y, cam.position.z, 0});
+  if (marks)
+    s.runner->pass(generate, {marks}, s.rays[s.cur_rays]);
+  else
+    s.runner->pass(generate, {}, s.rays[s.cur_rays]);
+  gpu_->clear(s.result[s.cur_result], {0, 0, 0, 1});
+}
+
+void StreamTracer::walk_rays(Texture& origins, Texture& rays, bool primary, const Camera& cam) {
+  if (opt_.observer)
+    opt_.observer->trace_begin(primary ? PassObserver::TraceKind::primary
+                                       : PassObserver::TraceKind::reflected);
+  trace(origins, rays, primary, cam);
+  if (opt_.observer) opt_.observer->trace_end();
+}
+
+void StreamTracer::primary_hits(RenderResult& res, bool aovs, bool keep_hits) {
+  State& s = *s_;
+  // guardarImpactos: the primary hits' surface keys (--aa adaptive), before later traces
+  // overwrite the intersections.
+  if (keep_hits) s.runner->pass(s.keep, {&s.isect[s.cur_isect], &s.materials}, s.marks[s.cur_mark]);
+  if (aovs) download_aovs(res);
+}
+
+void StreamTracer::reflection_origin(const Texture& origins, const Texture& rays,
+                                     Texture& surface) {
+  State& s = *s_;
+  s.runner->pass(s.origin, {&origins, &rays, &s.isect[s.cur_isect], &s.v[0], &s.v[1], &s.v[2]},
+                 surface);
+}
+
+bool StreamTracer::reflect(const Texture& rays, const Texture& surface, Texture& next_rays) {
+  State& s = *s_;
+  PassRunner& r = *s.runner;
+  // rayosReflejados: how many rays the shader reflected (marked in the walk's mask).
+  if (r.count(s.reflected, s.result[s.cur_result], nullptr, &s.grid_mask) == 0) return false;
+  // direccionReflejo: their directions.
+  r.pass(s.direction,
+         {&rays, &surface, &s.result[s.cur_result], &s.v[0], &s.v[1], &s.v[2], &s.n[0], &s.n[1],
+          &s.n[2]},
+         next_rays);
+  return true;
+}
+
+int StreamTracer::shade_lights(const Camera& cam, Texture& surface, Texture& rays, Texture& origins,
+                               Texture* const col[2]) {
+  State& s = *s_;
+  PassRunner& r = *s.runner;
+  int cur = 0;
+  const auto& lights = scene_->lights;
+  for (size_t li = 0; li < lights.size(); ++li) {
+    Shader& sh = s.shader.kernel;
+    sh.light = lights[li].position;
+    sh.light_color = lights[li].color;
+    sh.first_light = li == 0;
+    sh.last_light = li + 1 == lights.size();
+    // rayosSombra: the shadow rays toward this light, traced through the same walk; the shader
+    // reads their intersections (continued through glass in a glass scene).
+    const Texture* shadow = nullptr;  // the shadow rays' hits, when not the current ones
+    if (opt_.shadows) {
+      s.shadow.kernel.light = lights[li].position;
+      r.pass(s.shadow, {&surface, col[cur]}, s.shadow_rays);
+      if (opt_.observer) opt_.observer->trace_begin(PassObserver::TraceKind::shadow);
+      trace(surface, s.shadow_rays, false, cam);
+      if (s.streams && s.streams->glass_scene())
+        shadow = &s.streams->shadows_through_glass(r, surface, s.shadow_rays, &s.isect[s.cur_isect],
+                                                   [&](Texture& o, Texture& d) {
+                                                     trace(o, d, false, cam);
+                                                     return &s.isect[s.cur_isect];
+                                                   });
+      if (opt_.observer) opt_.observer->trace_end();
+    }
+    shader_pass(surface, rays, *col[cur], shadow ? *shadow : s.isect[s.cur_isect], origins,
+                *col[cur ^ 1]);
+    cur ^= 1;
+  }
+  return cur;
+}
+
+void StreamTracer::shader_pass(const Texture& surface, const Texture& rays, const Texture& colour,
+                               const Texture& shadow, const Texture& origins, Texture& out) {
+  State& s = *s_;
+  // The shader's inputs, in its binding order (kernels/shader.h); a textured scene's shader
+  // also reads the rays' origins (for the ray differentials) and the base-colour textures.
+  if (s.textured)
+    s.runner->pass(
+        s.shader,
+        {&surface, &rays, &colour, &shadow, &s.colors, &s.v[0], &s.v[1], &s.v[2], &s.n[0], &s.n[1],
+         &s.n[2], &origins, &s.uvs01, &s.uvs2, &s.texture_table, &s.atlas},
+        out);
+  else
+    s.runner->pass(s.shader,
+                   {&surface, &rays, &colour, &shadow, &s.colors, &s.v[0], &s.v[1], &s.v[2],
+                    &s.n[0], &s.n[1], &s.n[2]},
+                   out);
 }
 
 void StreamTracer::download_aovs(RenderResult& res) {
@@ -654,19 +538,13 @@ void StreamTracer::download_aovs(RenderResult& res) {
 void StreamTracer::stream_frame(const Camera& cam, const vgpu::Program& generate, RenderResult& res,
                                 bool aovs, int& iteration_number, const Texture* marks,
                                 bool keep_hits) {
-  vgpu::Device& gpu = *gpu_;
   State& s = *s_;
   PassRunner& r = *s.runner;
   RayStreams& g = *s.streams;
   const int W = opt_.width, H = opt_.height;
   g.stats.on = true;
   // Level 0 is the paper's primary frame: one ray per pixel from the eye, weight 1.
-  gpu.clear(s.origins[0], {cam.position.x, cam.position.y, cam.position.z, 0});
-  if (marks)
-    r.pass(generate, {marks}, s.rays[s.cur_rays]);
-  else
-    r.pass(generate, {}, s.rays[s.cur_rays]);
-  gpu.clear(s.result[s.cur_result], {0, 0, 0, 1});
+  generate_rays(cam, generate, marks);
   const Texture* const statics[6] = {&s.v[0], &s.v[1], &s.v[2], &s.n[0], &s.n[1], &s.n[2]};
   const int iterations = 1 + std::max(0, opt_.bounces);
   uint64_t n = uint64_t(W) * uint64_t(H);
@@ -700,16 +578,9 @@ void StreamTracer::stream_frame(const Camera& cam, const vgpu::Program& generate
         g.copy_chunk(r, L.rays, *rays, c, false);
         g.copy_chunk(r, L.weight, *col[0], c, false);
       }
-      if (opt_.observer)
-        opt_.observer->trace_begin(k ? PassObserver::TraceKind::reflected
-                                     : PassObserver::TraceKind::primary);
-      trace(*origins, *rays, k == 0, cam);
-      if (opt_.observer) opt_.observer->trace_end();
-      Texture& hits = s.isect[s.cur_isect];
-      if (k == 0 && keep_hits) r.pass(s.keep, {&hits, &s.materials}, s.marks[s.cur_mark]);
-      if (k == 0 && aovs) download_aovs(res);
-      // inicioReflejo: the hit points (the shader's record, the reflected rays' origins).
-      r.pass(s.origin, {origins, rays, &hits, &s.v[0], &s.v[1], &s.v[2]}, *surface);
+      walk_rays(*origins, *rays, k == 0, cam);
+      if (k == 0) primary_hits(res, aovs, keep_hits);
+      reflection_origin(*origins, *rays, *surface);
       // dividirRayos: the weights of the rays this one spawns, before the shader replaces the
       // weight.
       if (spawns)
@@ -718,41 +589,7 @@ void StreamTracer::stream_frame(const Camera& cam, const vgpu::Program& generate
                 &s.n[2]},
                *split, nullptr, g.stats.split_passes, g.stats.split_bytes);
       // shader: one pass per light after its shadow rays (continued through glass).
-      int cur = 0;
-      const auto& lights = scene_->lights;
-      for (size_t li = 0; li < lights.size(); ++li) {
-        Shader& sh = s.shader.kernel;
-        sh.light = lights[li].position;
-        sh.light_color = lights[li].color;
-        sh.first_light = li == 0;
-        sh.last_light = li + 1 == lights.size();
-        const Texture* shadow = &s.isect[s.cur_isect];
-        if (opt_.shadows) {
-          s.shadow.kernel.light = lights[li].position;
-          r.pass(s.shadow, {surface, col[cur]}, s.shadow_rays);
-          if (opt_.observer) opt_.observer->trace_begin(PassObserver::TraceKind::shadow);
-          trace(*surface, s.shadow_rays, false, cam);
-          shadow = &s.isect[s.cur_isect];
-          if (g.glass_scene())
-            shadow = &g.shadows_through_glass(r, *surface, s.shadow_rays, shadow,
-                                              [&](Texture& o, Texture& d) {
-                                                trace(o, d, false, cam);
-                                                return &s.isect[s.cur_isect];
-                                              });
-          if (opt_.observer) opt_.observer->trace_end();
-        }
-        if (s.textured)
-          r.pass(s.shader,
-                 {surface, rays, col[cur], shadow, &s.colors, &s.v[0], &s.v[1], &s.v[2], &s.n[0],
-                  &s.n[1], &s.n[2], origins, &s.uvs01, &s.uvs2, &s.texture_table, &s.atlas},
-                 *col[cur ^ 1]);
-        else
-          r.pass(s.shader,
-                 {surface, rays, col[cur], shadow, &s.colors, &s.v[0], &s.v[1], &s.v[2], &s.n[0],
-                  &s.n[1], &s.n[2]},
-                 *col[cur ^ 1]);
-        cur ^= 1;
-      }
+      const int cur = shade_lights(cam, *surface, *rays, *origins, col);
       if (k == 0) s.cur_result ^= cur;
       if (!chunked) {
         L.shaded = col[cur];

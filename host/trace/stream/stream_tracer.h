@@ -12,8 +12,8 @@
 #include "host/accel/grid.h"
 #include "host/model/formats.h"
 #include "host/scene/scene.h"
-#include "host/trace/walks/grid_walk.h"
 #include "host/trace/render_options.h"
+#include "host/trace/walks/grid_walk.h"
 #include "kernels/kernels.h"
 #include "vgpu/vgpu.h"
 
@@ -67,10 +67,45 @@ class StreamTracer {
   // host/trace/stream/ray_streams.h): level 0 is the primary frame; each later level traces and
   // shades, chunk by chunk, the rays the level before spawned (compacted), and the colours
   // return to the pixels level by level. Same arguments and results as frame().
-  void stream_frame(const Camera& cam, const vgpu::Program& generate, RenderResult& res,
-                    bool aovs, int& iteration_number, const vgpu::Texture* marks, bool keep_hits);
+  void stream_frame(const Camera& cam, const vgpu::Program& generate, RenderResult& res, bool aovs,
+                    int& iteration_number, const vgpu::Texture* marks, bool keep_hits);
+  // Ray generation (generadorRayos, or generadorRayosMuestra for a sample frame): every ray
+  // starts at the eye (origins[0]), `generate` writes the directions into the current rays
+  // texture (reading `marks` if given), and the current result is cleared to black.
+  void generate_rays(const Camera& cam, const vgpu::Program& generate, const vgpu::Texture* marks);
+  // The walk: one ray stream (primary or reflected) through the acceleration structure, told
+  // to the observer as one trace. Leaves each ray's nearest hit in the current intersections.
+  void walk_rays(vgpu::Texture& origins, vgpu::Texture& rays, bool primary, const Camera& cam);
+  // After the primary walk: guardarImpactos (with `keep_hits`) writes the hits' surface keys
+  // into the current marks; with `aovs`, the hits' depth and id go into res.
+  void primary_hits(RenderResult& res, bool aovs, bool keep_hits);
+  // Reflection origin (inicioReflejo): from the rays and their hits, the hit points and the
+  // surface record into `surface`, which the shader reads and the next rays start from.
+  void reflection_origin(const vgpu::Texture& origins, const vgpu::Texture& rays,
+                         vgpu::Texture& surface);
+  // Reflection: rayosReflejados counts the rays the shader reflected (marking them in the
+  // walk's mask); false when none was. Otherwise direccionReflejo writes their directions into
+  // `next_rays`, the next iteration's rays.
+  bool reflect(const vgpu::Texture& rays, const vgpu::Texture& surface, vgpu::Texture& next_rays);
+  // Shading, one light at a time (the paper's per-light loop): for each light, rayosSombra makes
+  // the shadow rays from `surface` (inicioReflejo's record) and trace() walks them, then the
+  // shader pass adds that light's share. The colour ping-pongs between col[0] (the colour so
+  // far, or a spawned ray's weight) and col[1]; returns which of the two holds the result.
+  // frame() and stream_frame() both shade through here.
+  int shade_lights(const Camera& cam, vgpu::Texture& surface, vgpu::Texture& rays,
+                   vgpu::Texture& origins, vgpu::Texture* const col[2]);
+  // One shader pass: its binding list, written once (with the base-colour textures when the
+  // scene is textured).
+  void shader_pass(const vgpu::Texture& surface, const vgpu::Texture& rays,
+                   const vgpu::Texture& colour, const vgpu::Texture& shadow,
+                   const vgpu::Texture& origins, vgpu::Texture& out);
   // The primary hits' depths and input triangle ids into res, from the current intersections.
   void download_aovs(RenderResult& res);
+  // The sampling modes and their resolve (host/trace/stream/sampling_modes.cpp).
+  // --spp N (N > 1): N sample frames (generadorRayosMuestra, each through its sub-pixel
+  // offset), each added into the sum (acumularMuestras), then resolverMuestras box-filters the
+  // sum into the current result texture.
+  void render_samples(const Camera& cam, RenderResult& res, int& iteration_number);
   // --aa adaptive (RenderOptions::adaptive): the centre frame, then levels of samples where the
   // marks say; leaves the resolved colour in the current result texture.
   void render_adaptive(const Camera& cam, RenderResult& res, int& iteration_number);

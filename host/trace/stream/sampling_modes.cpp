@@ -1,0 +1,151 @@
+// The sampling modes around the frame (StreamTracer::frame): --spp N sample frames, --aa
+// adaptive and --aa undersample:K. Each runs whole frames and resolves them into the current
+// result texture with the paper-style passes (acumularMuestras, resolverMuestras, ...).
+#include <algorithm>
+#include <vector>
+
+#include "host/trace/sampling.h"
+#include "host/trace/stream/stream_state.h"
+
+namespace host {
+
+using namespace kernels;
+using vgpu::Texture;
+
+void StreamTracer::render_samples(const Camera& cam, RenderResult& res, int& iteration_number) {
+  vgpu::Device& gpu = *gpu_;
+  State& s = *s_;
+  PassRunner& r = *s.runner;
+  // Supersampling as a 2004 card would: one whole frame per sample, each through its own
+  // sub-pixel offset (generadorRayosMuestra), added into a sum texture (acumularMuestras),
+  // then one box-filter pass (resolverMuestras). No texture grows with the sample count.
+  gpu.clear(s.sum[s.cur_sum], {0, 0, 0, 0});
+  for (int k = 0; k < opt_.spp; ++k) {
+    const glm::vec2 j = sample_offset(opt_.spp, k, opt_.sample_seed);
+    s.sample_generate.kernel.jitter_x = j.x;
+    s.sample_generate.kernel.jitter_y = j.y;
+    frame(cam, s.sample_generate, res, k == 0, iteration_number);
+    if (k == 0) res.first_frame_passes = gpu.stats().totals.passes;
+    r.pass(s.accumulate, {&s.sum[s.cur_sum], &s.result[s.cur_result]}, s.sum[s.cur_sum ^ 1]);
+    s.cur_sum ^= 1;
+  }
+  r.pass(s.resolve, {&s.sum[s.cur_sum]}, s.result[s.cur_result ^ 1]);
+  s.cur_result ^= 1;
+  res.samples = opt_.spp;
+}
+
+void StreamTracer::render_adaptive(const Camera& cam, RenderResult& res, int& iteration_number) {
+  vgpu::Device& gpu = *gpu_;
+  State& s = *s_;
+  PassRunner& r = *s.runner;
+  // The centre frame, the paper's, keeping each pixel's surface key; its colour is every
+  // pixel's first estimate (one sample).
+  frame(cam, s.generate, res, true, iteration_number, nullptr, true);
+  res.first_frame_passes = gpu.stats().totals.passes;
+  gpu.clear(s.sum[s.cur_sum], {0, 0, 0, 0});
+  s.accumulate.kernel.gated = false;
+  r.pass(s.accumulate, {&s.sum[s.cur_sum], &s.result[s.cur_result]}, s.sum[s.cur_sum ^ 1]);
+  s.cur_sum ^= 1;
+  const std::vector<int> levels = adaptive_levels(opt_.spp);
+  for (size_t l = 0; l < levels.size(); ++l) {
+    // marcarPixeles on the current estimate, then pixelesMarcados: how many get more samples.
+    r.pass(s.mark, {&s.marks[s.cur_mark], &s.result[s.cur_result]}, s.marks[s.cur_mark ^ 1]);
+    s.cur_mark ^= 1;
+    if (r.count(s.marked, s.marks[s.cur_mark], nullptr, nullptr) == 0) break;
+    // The level's n x n samples, only in marked pixels, replacing their earlier ones.
+    const int n = levels[l] * levels[l];
+    s.sample_generate.kernel.gated = true;
+    s.accumulate.kernel.gated = true;
+    for (int k = 0; k < n; ++k) {
+      const glm::vec2 j = sample_offset(n, k, opt_.sample_seed);
+      s.sample_generate.kernel.jitter_x = j.x;
+      s.sample_generate.kernel.jitter_y = j.y;
+      frame(cam, s.sample_generate, res, false, iteration_number, &s.marks[s.cur_mark]);
+      s.accumulate.kernel.restart = k == 0;
+      r.pass(s.accumulate, {&s.sum[s.cur_sum], &s.result[s.cur_result], &s.marks[s.cur_mark]},
+             s.sum[s.cur_sum ^ 1]);
+      s.cur_sum ^= 1;
+    }
+    // The new estimate: the next level's marks read it, and after the last level it is the
+    // image. (Where no pixel is marked at all, the centre frame's colour stays the image.)
+    r.pass(s.resolve, {&s.sum[s.cur_sum]}, s.result[s.cur_result ^ 1]);
+    s.cur_result ^= 1;
+  }
+  s.sample_generate.kernel.gated = false;
+  s.accumulate.kernel.gated = false;
+  // Each pixel's final sample count, for the rays-per-pixel statistics and map.
+  Texture& sum = s.sum[s.cur_sum];
+  gpu.download(sum);
+  const int W = opt_.width, H = opt_.height;
+  res.rays_per_pixel.resize(size_t(W) * size_t(H));
+  int most = 1;
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      const int samples = int(sum.texel(x, y)[3]);
+      most = std::max(most, samples);
+      res.rays_per_pixel[size_t(y) * size_t(W) + size_t(x)] = adaptive_rays(opt_.spp, samples);
+    }
+  res.samples = most;
+}
+
+void StreamTracer::render_undersampled(const Camera& cam, RenderResult& res,
+                                       int& iteration_number) {
+  vgpu::Device& gpu = *gpu_;
+  State& s = *s_;
+  PassRunner& r = *s.runner;
+  const int W = opt_.width, H = opt_.height, K = opt_.undersample;
+  // marcarReticula into marks A; the lattice frame through the lattice pixels' centres, keeping
+  // their surface keys in marks B; their colours into the sum.
+  r.pass(s.mark_lattice, {}, s.marks[0]);
+  s.cur_mark = 1;
+  s.sample_generate.kernel.jitter_x = s.sample_generate.kernel.jitter_y = 0.5f;
+  s.sample_generate.kernel.gated = true;
+  frame(cam, s.sample_generate, res, true, iteration_number, &s.marks[0], true);
+  res.first_frame_passes = gpu.stats().totals.passes;
+  gpu.clear(s.sum[s.cur_sum], {0, 0, 0, 0});
+  s.accumulate.kernel.gated = true;
+  s.accumulate.kernel.restart = false;
+  r.pass(s.accumulate, {&s.sum[s.cur_sum], &s.result[s.cur_result], &s.marks[0]},
+         s.sum[s.cur_sum ^ 1]);
+  s.cur_sum ^= 1;
+  // marcarHuecos into marks A (the lattice flags are done with), pixelesMarcados counts them;
+  // the gaps' frame traces them.
+  r.pass(s.mark_gaps, {&s.marks[1], &s.sum[s.cur_sum]}, s.marks[0]);
+  std::vector<uint8_t> gap(size_t(W) * size_t(H), 0);
+  if (r.count(s.marked, s.marks[0], nullptr, nullptr) > 0) {
+    const std::vector<float> depth = res.depth, hit_id = res.hit_id;
+    frame(cam, s.sample_generate, res, true, iteration_number, &s.marks[0]);
+    r.pass(s.accumulate, {&s.sum[s.cur_sum], &s.result[s.cur_result], &s.marks[0]},
+           s.sum[s.cur_sum ^ 1]);
+    s.cur_sum ^= 1;
+    // The AOVs: the gaps' from this frame, the lattice's from the first.
+    gpu.download(s.marks[0]);
+    for (size_t i = 0; i < gap.size(); ++i) {
+      gap[i] = s.marks[0].texel(int(i % size_t(W)), int(i / size_t(W)))[0] > 0.0f;
+      if (!gap[i]) res.depth[i] = depth[i], res.hit_id[i] = hit_id[i];
+    }
+  }
+  s.sample_generate.kernel.gated = false;
+  s.accumulate.kernel.gated = false;
+  // rellenarHuecos: the traced pixels' colours, the rest blended from their lattice cell.
+  r.pass(s.fill, {&s.sum[s.cur_sum]}, s.result[s.cur_result ^ 1]);
+  s.cur_result ^= 1;
+  // The AOVs of a pixel never traced: its lattice cell's nearest corner's.
+  res.rays_per_pixel.assign(gap.size(), 0);
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      const size_t i = size_t(y) * size_t(W) + size_t(x);
+      if (on_lattice(x, y, K, W, H) || gap[i]) {
+        res.rays_per_pixel[i] = 1;
+        continue;
+      }
+      const glm::ivec4 c = lattice_cell(x, y, K, W, H);
+      const int nx = x - c.x <= c.y - x ? c.x : c.y, ny = y - c.z <= c.w - y ? c.z : c.w;
+      const size_t j = size_t(ny) * size_t(W) + size_t(nx);
+      res.depth[i] = res.depth[j];
+      res.hit_id[i] = res.hit_id[j];
+    }
+  res.samples = 1;
+}
+
+}  // namespace host

@@ -1,0 +1,56 @@
+// The stream tracer's private state: every texture and program of the pipeline, shared by the
+// files of the tracer (stream_tracer.cpp, sampling_modes.cpp). Not for users.
+#pragma once
+
+#include <memory>
+
+#include "host/trace/passes.h"
+#include "host/trace/stream/ray_streams.h"
+#include "host/trace/stream/stream_tracer.h"
+#include "host/trace/walks/accel_walk.h"
+
+namespace host {
+
+struct StreamTracer::State {
+  // Static textures: the scene, triangle i at texel (i mod width, i div width).
+  vgpu::Texture v[3], n[3], colors;
+  // Base-colour textures (scenes with a textured material): the corners' coordinates, the
+  // texture table and the atlas of mip chains (kernels/layout.h).
+  bool textured = false;
+  vgpu::Texture uvs01, uvs2, texture_table, atlas;
+  // Dynamic textures (ping-pong pairs where a pass reads what it replaces).
+  vgpu::Texture rays[2], origins[2], shadow_rays, isect[2], result[2], counter;
+  int cur_rays = 0, cur_isect = 0, cur_result = 0;
+  // The rays still walking, and those with a triangle left to test (the walk's masks).
+  vgpu::Stencil grid_mask, isect_mask;
+  // The programs of the pipeline around the walk, with their uniforms.
+  vgpu::KernelProgram<kernels::GenerateRays> generate;
+  vgpu::KernelProgram<kernels::Shader> shader;
+  vgpu::KernelProgram<kernels::ReflectedRays> reflected;
+  vgpu::KernelProgram<kernels::ReflectionOrigin> origin;
+  vgpu::KernelProgram<kernels::ReflectionDirection> direction;
+  vgpu::KernelProgram<kernels::ShadowRays> shadow;
+  // Supersampling (--spp N > 1): sample frames' rays, their sum and the box filter.
+  vgpu::KernelProgram<kernels::GenerateSampleRays> sample_generate;
+  vgpu::KernelProgram<kernels::AccumulateSamples> accumulate;
+  vgpu::KernelProgram<kernels::ResolveSamples> resolve;
+  vgpu::Texture sum[2];
+  int cur_sum = 0;
+  // Adaptive supersampling (--aa adaptive): surface keys and marks, each triangle's material.
+  vgpu::KernelProgram<kernels::KeepHits> keep;
+  vgpu::KernelProgram<kernels::MarkPixels> mark;
+  vgpu::KernelProgram<kernels::MarkedPixels> marked;
+  vgpu::Texture marks[2], materials;
+  int cur_mark = 0;
+  // Adaptive undersampling (--aa undersample:K): the lattice, the gaps, the fill.
+  vgpu::KernelProgram<kernels::MarkLattice> mark_lattice;
+  vgpu::KernelProgram<kernels::MarkGaps> mark_gaps;
+  vgpu::KernelProgram<kernels::FillGaps> fill;
+  // The walk through the acceleration structure, and how passes are issued.
+  std::unique_ptr<AccelWalk> walk;
+  std::unique_ptr<PassRunner> runner;
+  // Glass (or --ray-streams on): the frame as ray streams (host/trace/stream/ray_streams.h).
+  std::unique_ptr<RayStreams> streams;
+};
+
+}  // namespace host
