@@ -103,6 +103,8 @@ struct BvhStep {
   }
 };
 
+// cargarHoja: the first triangle of the leaf just entered (traversal y: its list start), for a
+// ray with nothing left to test (voxel state w = -1).
 struct BvhLoadLeaf {
   static constexpr const char* name = "bvh load leaf";
   static constexpr const char* paper_name = "cargarHoja (extension)";
