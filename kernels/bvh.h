@@ -15,34 +15,24 @@
 #pragma once
 
 #include "kernels/common.h"
-#include "kernels/next_triangle.h"
+#include "kernels/lists.h"
 
 namespace kernels {
 
-// Uniforms of the BVH's textures.
-struct BvhUniforms {
+// Uniforms of the BVH's textures: its lists' (list_width; t_slack is not read: a hit counts
+// anywhere) and its nodes'.
+struct BvhUniforms : ListUniforms {
   float node_width = 1;  // width of the two node textures, texels
   float nodes = 1;       // node count: a node index at or past it ends the walk
-  float list_width = 1;  // width of the BVH's triangle-list texture, texels
 };
 
-// Whether the ray o + t d, 0 <= t <= tfar, meets the box [lo, hi] (slab test; an axis the ray
-// runs parallel to keeps it inside the slab or outside for every t).
+// Whether the ray o + t d, 0 <= t <= tfar, meets the box [lo, hi] (the slab test,
+// kernels/lists.h, on a box fetched from the node textures).
 template <class F>
 inline auto ray_meets_box(const Vec3<F>& o, const Vec3<F>& d, const Vec3<F>& lo, const Vec3<F>& hi,
                           const F& tfar) {
-  F tn = F(0.0f), tf = tfar;
-  auto slab = [&](const F& oa, const F& da, const F& la, const F& ha) {
-    const F inv = F(1.0f) / da;
-    const F t0 = (la - oa) * inv, t1 = (ha - oa) * inv;
-    const auto parallel = da == F(0.0f);
-    const auto inside = (oa >= la) && (oa <= ha);
-    tn = max(tn, select(parallel, select(inside, F(-kFar), F(kFar)), min(t0, t1)));
-    tf = min(tf, select(parallel, select(inside, F(kFar), F(-kFar)), max(t0, t1)));
-  };
-  slab(o.x, d.x, lo.x, hi.x);
-  slab(o.y, d.y, lo.y, hi.y);
-  slab(o.z, d.z, lo.z, hi.z);
+  F tn, tf;
+  ray_box_segment(o, d, lo, hi, tfar, tn, tf);
   return tn <= tf;
 }
 
@@ -113,6 +103,8 @@ struct BvhStep {
   }
 };
 
+// cargarHoja: the first triangle of the leaf just entered (traversal y: its list start), for a
+// ray with nothing left to test (voxel state w = -1).
 struct BvhLoadLeaf {
   static constexpr const char* name = "bvh load leaf";
   static constexpr const char* paper_name = "cargarHoja (extension)";
@@ -130,31 +122,13 @@ struct BvhLoadLeaf {
     const Vec4<F> vs = f.fetch_own(kVoxelState);
     const auto load = (trav.y >= F(0.0f)) && (vs.w < F(0.0f));
     Vec4<F> next = vs;
-    if (f.branch(load)) {
-      const F tri = fetch_id(f, kLists, trav.y, bvh.list_width).x;
-      next = select(load, Vec4<F>{trav.y, F(0.0f), F(0.0f), tri}, vs);
-    }
+    if (f.branch(load)) next = load_list(f, kLists, trav.y, vs, load, bvh);
     f.out(0) = next;
   }
 };
 
-// The nearest of the hit so far and triangle vs.w, for the lanes where `testing`: no bound but
-// the ray's tmax (the BVH lists a triangle once; a hit is valid wherever it lies).
-template <class L>
-inline Vec4<typename L::F> nearest_hit_anywhere(
-    const Fragments<L>& f, int unit_v0, const Vec3<typename L::F>& o,
-    const Vec4<typename L::F>& ray, const Vec4<typename L::F>& vs, const Vec4<typename L::F>& best,
-    const typename L::M& testing, const SceneUniforms& scene) {
-  using F = typename L::F;
-  const Vec3<F> p0 = fetch_id(f, unit_v0, vs.w, scene.width).xyz();
-  const Vec3<F> p1 = fetch_id(f, unit_v0 + 1, vs.w, scene.width).xyz();
-  const Vec3<F> p2 = fetch_id(f, unit_v0 + 2, vs.w, scene.width).xyz();
-  F bu, bv;
-  const F t = intersect_triangle(o, ray.xyz(), p0, p1, p2, bu, bv);
-  const auto nearer = testing && (t < best.x) && (t < ray.w);
-  return select(nearer, Vec4<F>{t, bu, bv, vs.w}, best);
-}
-
+// interseccionesBVH: the BVH lists a triangle once, so a hit counts wherever it lies
+// (nearest_hit_anywhere, kernels/lists.h), bounded only by the ray's tmax.
 struct BvhIntersections {
   static constexpr const char* name = "bvh intersections";
   static constexpr const char* paper_name = "interseccionesBVH (extension)";
@@ -225,12 +199,12 @@ struct BvhLooping {
       const M testing = act && (vs.w >= F(0.0f));
       best = nearest_hit_anywhere(f, kV0, o, ray, vs, best, testing, scene);
       const F pos = vs.x + F(1.0f);
-      const F tri = fetch_id(f, kLists, pos, bvh.list_width).x;
+      const F tri = list_entry(f, kLists, pos, bvh);
       const M stepping = act && !testing;
       const Vec4<F> stepped =
           bvh_step(f, kNodesLo, kNodesHi, trav, o, ray.xyz(), min(best.x, ray.w), stepping, bvh);
       const M load = stepping && (stepped.y >= F(0.0f));
-      const F first = fetch_id(f, kLists, stepped.y, bvh.list_width).x;
+      const F first = list_entry(f, kLists, stepped.y, bvh);
       vs = select(testing, Vec4<F>{pos, F(0.0f), F(0.0f), tri},
                   select(load, Vec4<F>{stepped.y, F(0.0f), F(0.0f), first}, vs));
       trav = select(stepping, Vec4<F>{stepped.x, F(kNone), F(0.0f), F(0.0f)}, trav);
@@ -273,8 +247,7 @@ struct BvhStepLoad {
       const Vec3<F> o = f.fetch_own(kOrigins).xyz();
       next = bvh_step(f, kNodesLo, kNodesHi, trav, o, ray.xyz(), min(best.x, ray.w), walking, bvh);
       const auto load = walking && (next.y >= F(0.0f)) && (vs.w < F(0.0f));
-      const F tri = fetch_id(f, kLists, next.y, bvh.list_width).x;
-      nvs = select(load, Vec4<F>{next.y, F(0.0f), F(0.0f), tri}, vs);
+      nvs = load_list(f, kLists, next.y, vs, load, bvh);
     }
     f.out(0) = next;
     f.out(1) = nvs;
@@ -306,9 +279,7 @@ struct BvhIntersectNext {
       const Vec3<F> o = f.fetch_own(kOrigins).xyz();
       const Vec4<F> ray = f.fetch_own(kRays);
       next = nearest_hit_anywhere(f, kV0, o, ray, vs, best, testing, scene);
-      const F pos = vs.x + F(1.0f);
-      const F tri = fetch_id(f, kLists, pos, bvh.list_width).x;
-      nvs = select(testing, Vec4<F>{pos, F(0.0f), F(0.0f), tri}, vs);
+      nvs = load_list(f, kLists, vs.x + F(1.0f), vs, testing, bvh);
     }
     f.out(0) = next;
     f.out(1) = nvs;

@@ -1,7 +1,8 @@
 // Fused programs for multiple render targets (MRT; the paper's future work, Sec. 5): on a part
 // that writes more than one output per pass (GeForce 6, R300, the modern profiles), two kernels
 // that always run back to back become one program writing both kernels' targets, so the frame
-// has fewer passes and fewer program loads. `--mrt on` runs them (host/trace/stream/stream_tracer.cpp).
+// has fewer passes and fewer program loads. `--mrt on` runs them
+// (host/trace/stream/stream_tracer.cpp).
 //
 // Each fused program computes exactly what its two kernels compute, from the textures the first
 // of them reads: no output is read back in the same pass (a read/write hazard), so where the

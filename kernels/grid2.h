@@ -10,7 +10,7 @@
 //                                      else the next sub-cell (descend / step / climb)
 //                                      (traversal's place)
 //   cargarCelda (extension)            the first triangle of the sub-cell reached
-//                                      (actualizarVoxel's place; cargarHoja over these lists)
+//                                      (actualizarVoxel's place)
 //   interseccionesGrilla2 (extension)  one triangle per pass, a hit counting only inside the
 //                                      sub-cell's segment widened by t_slack (the in-voxel rule)
 // with proximoTriangulo, rayosIntersectando and rayosEnGrilla as the grid has them. Traversal
@@ -18,21 +18,20 @@
 // where the ray enters and leaves the sub-cell.
 #pragma once
 
-#include "kernels/bvh.h"
 #include "kernels/common.h"
 #include "kernels/init_traversal.h"
-#include "kernels/kdtree.h"
+#include "kernels/lists.h"
 
 namespace kernels {
 
-struct Grid2Uniforms {
+// Uniforms of the two-level grid: its lists' (t_slack: the in-cell rule's tolerance), its
+// coarse grid's box and its two cell textures'.
+struct Grid2Uniforms : ListUniforms {
   glm::vec3 lo{0.0f};    // coarse grid box minimum, world space
   glm::vec3 cell{1.0f};  // world size of one coarse cell
   glm::vec3 res{1.0f};   // coarse cells per axis, as floats
   float cell_width = 1;  // width of the coarse-cell texture, texels
   float sub_width = 1;   // width of the sub-cell texture, texels
-  float list_width = 1;  // width of the two-level grid's triangle-list texture, texels
-  float t_slack = 0;     // the in-cell rule's tolerance, world units along a unit ray
 };
 
 // Index `id` of an x-fastest rx × ry × rz array as (x, y, z); ids below 2^24 decode exactly
@@ -104,7 +103,10 @@ inline Vec4<typename L::F> grid2_entry(const Fragments<L>& f, int unit_cells, in
                                        const Vec3<typename L::F>& o, const Vec3<typename L::F>& d,
                                        const typename L::F& ray_w, const Grid2Uniforms& u) {
   using F = typename L::F;
-  const GridUniforms coarse{u.lo, u.cell, u.res, u.list_width, u.t_slack};
+  GridUniforms coarse;  // grid_entry reads the box alone
+  coarse.lo = u.lo;
+  coarse.cell = u.cell;
+  coarse.res = u.res;
   const Vec4<F> e = grid_entry<L>(o, d, ray_w, coarse);
   const Vec3<F> zero{F(0.0f), F(0.0f), F(0.0f)}, one{F(1.0f), F(1.0f), F(1.0f)};
   const Vec3<F> cc = select(e.x >= F(0.0f), e.xyz(), zero);  // a done ray reads cell 0
@@ -209,18 +211,61 @@ struct Grid2Step {
   }
 };
 
-// cargarCelda: cargarHoja (kernels/bvh.h) over the two-level grid's lists.
-struct Grid2LoadCell : BvhLoadLeaf {
+// cargarCelda: the first triangle of the sub-cell just reached (traversal y: its list start),
+// for a ray with nothing left to test (voxel state w = -1).
+struct Grid2LoadCell {
   static constexpr const char* name = "grid2 load cell";
   static constexpr const char* paper_name = "cargarCelda (extension)";
+  static constexpr int outputs = 1;  // -> voxel state
+  enum Unit { kTraversal, kVoxelState, kLists };
   static constexpr std::array<const char*, 3> units{"traversal", "voxel_state", "grid2_lists"};
+  static constexpr std::array<int, 1> passthrough{kVoxelState};
+
+  Grid2Uniforms grid2;
+
+  template <class L>
+  void operator()(Fragments<L>& f) const {
+    using F = typename L::F;
+    const Vec4<F> trav = f.fetch_own(kTraversal);
+    const Vec4<F> vs = f.fetch_own(kVoxelState);
+    const auto load = (trav.y >= F(0.0f)) && (vs.w < F(0.0f));
+    Vec4<F> next = vs;
+    if (f.branch(load)) next = load_list(f, kLists, trav.y, vs, load, grid2);
+    f.out(0) = next;
+  }
 };
 
-// interseccionesGrilla2: interseccionesKd's test (the segment trav.zw is the sub-cell's); only
-// the uniforms' t_slack is read.
-struct Grid2Intersections : KdIntersections {
+// interseccionesGrilla2: one triangle per pass, a hit counting only inside the sub-cell's
+// segment trav.zw widened by t_slack (nearest_hit_in_segment, kernels/lists.h: the grid's
+// in-voxel rule).
+struct Grid2Intersections {
   static constexpr const char* name = "grid2 intersections";
   static constexpr const char* paper_name = "interseccionesGrilla2 (extension)";
+  static constexpr int outputs = 1;  // -> intersection
+  enum Unit { kOrigins, kRays, kTraversal, kVoxelState, kIntersection, kV0, kV1, kV2 };
+  static constexpr std::array<const char*, 8> units{"origins",     "rays",         "traversal",
+                                                    "voxel_state", "intersection", "vertices0",
+                                                    "vertices1",   "vertices2"};
+  static constexpr std::array<int, 1> passthrough{kIntersection};
+
+  Grid2Uniforms grid2;
+  SceneUniforms scene;
+
+  template <class L>
+  void operator()(Fragments<L>& f) const {
+    using F = typename L::F;
+    const Vec4<F> vs = f.fetch_own(kVoxelState);
+    const Vec4<F> best = f.fetch_own(kIntersection);
+    const auto testing = vs.w >= F(0.0f);
+    Vec4<F> next = best;
+    if (f.branch(testing)) {
+      const Vec3<F> o = f.fetch_own(kOrigins).xyz();
+      const Vec4<F> ray = f.fetch_own(kRays);
+      const Vec4<F> trav = f.fetch_own(kTraversal);
+      next = nearest_hit_in_segment(f, kV0, o, ray, trav, vs, best, testing, scene, grid2.t_slack);
+    }
+    f.out(0) = next;
+  }
 };
 
 // recorridoGrilla2 + cargarCelda (--mrt on): one step, and the first triangle of the sub-cell
@@ -249,22 +294,44 @@ struct Grid2StepLoad {
       const Vec3<F> o = f.fetch_own(kOrigins).xyz(), d = f.fetch_own(kRays).xyz();
       next = grid2_step(f, kCells, kSubCells, trav, best, o, d, walking, grid2);
       const auto load = walking && (next.y >= F(0.0f)) && (vs.w < F(0.0f));
-      const F tri = fetch_id(f, kLists, next.y, grid2.list_width).x;
-      nvs = select(load, Vec4<F>{next.y, F(0.0f), F(0.0f), tri}, vs);
+      nvs = load_list(f, kLists, next.y, vs, load, grid2);
     }
     f.out(0) = next;
     f.out(1) = nvs;
   }
 };
 
-// interseccionesGrilla2 + proximoTriangulo (--mrt on): interseccionesKd + proximoTriangulo over
-// these lists (only the uniforms' list_width and t_slack are read).
-struct Grid2IntersectNext : KdIntersectNext {
+// interseccionesGrilla2 + proximoTriangulo (--mrt on): test the current triangle and move on.
+struct Grid2IntersectNext {
   static constexpr const char* name = "grid2 intersections + next triangle";
   static constexpr const char* paper_name = "interseccionesGrilla2+proximoTriangulo (extension)";
+  static constexpr int outputs = 2;  // -> intersection, voxel state
+  enum Unit { kOrigins, kRays, kTraversal, kVoxelState, kIntersection, kV0, kV1, kV2, kLists };
   static constexpr std::array<const char*, 9> units{"origins",     "rays",         "traversal",
                                                     "voxel_state", "intersection", "vertices0",
                                                     "vertices1",   "vertices2",    "grid2_lists"};
+  static constexpr std::array<int, 2> passthrough{kIntersection, kVoxelState};
+
+  Grid2Uniforms grid2;
+  SceneUniforms scene;
+
+  template <class L>
+  void operator()(Fragments<L>& f) const {
+    using F = typename L::F;
+    const Vec4<F> vs = f.fetch_own(kVoxelState);
+    const Vec4<F> best = f.fetch_own(kIntersection);
+    const auto testing = vs.w >= F(0.0f);
+    Vec4<F> next = best, nvs = vs;
+    if (f.branch(testing)) {
+      const Vec3<F> o = f.fetch_own(kOrigins).xyz();
+      const Vec4<F> ray = f.fetch_own(kRays);
+      const Vec4<F> trav = f.fetch_own(kTraversal);
+      next = nearest_hit_in_segment(f, kV0, o, ray, trav, vs, best, testing, scene, grid2.t_slack);
+      nvs = load_list(f, kLists, vs.x + F(1.0f), vs, testing, grid2);
+    }
+    f.out(0) = next;
+    f.out(1) = nvs;
+  }
 };
 
 // recorridoGrilla2Iterativo (extension): the walk in one looping program. Each iteration tests
@@ -307,14 +374,14 @@ struct Grid2Looping {
     const Vec4<F> ray = f.fetch_own(kRays);
     f.loop(steps, trav.x >= F(0.0f), [&](const M& act) {
       const M testing = act && (vs.w >= F(0.0f));
-      best = nearest_hit_in_leaf(f, kV0, o, ray, trav, vs, best, testing, scene, grid2.t_slack);
+      best = nearest_hit_in_segment(f, kV0, o, ray, trav, vs, best, testing, scene, grid2.t_slack);
       const F pos = vs.x + F(1.0f);
-      const F tri = fetch_id(f, kLists, pos, grid2.list_width).x;
+      const F tri = list_entry(f, kLists, pos, grid2);
       const M stepping = act && !testing;
       const Vec4<F> next =
           grid2_step(f, kCells, kSubCells, trav, best, o, ray.xyz(), stepping, grid2);
       const M load = stepping && (next.y >= F(0.0f));
-      const F first = fetch_id(f, kLists, next.y, grid2.list_width).x;
+      const F first = list_entry(f, kLists, next.y, grid2);
       vs = select(testing, Vec4<F>{pos, F(0.0f), F(0.0f), tri},
                   select(load, Vec4<F>{next.y, F(0.0f), F(0.0f), first}, vs));
       trav = select(stepping, next, trav);

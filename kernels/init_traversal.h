@@ -4,6 +4,7 @@
 #pragma once
 
 #include "kernels/common.h"
+#include "kernels/lists.h"
 
 namespace kernels {
 
@@ -12,19 +13,11 @@ template <class L>
 inline Vec4<typename L::F> grid_entry(const Vec3<typename L::F>& o, const Vec3<typename L::F>& d,
                                       const typename L::F& tmax, const GridUniforms& g) {
   using F = typename L::F;
-  auto slab = [&](const F& oa, const F& da, float lo, float cell, float res, F& tnear, F& tfar) {
-    const F inv = F(1.0f) / da;
-    const F t0 = (F(lo) - oa) * inv, t1 = (F(lo + cell * res) - oa) * inv;
-    // Parallel to this slab: inside it for every t, or outside for every t.
-    const auto parallel = da == F(0.0f);
-    const auto inside = (oa >= F(lo)) && (oa <= F(lo + cell * res));
-    tnear = max(tnear, select(parallel, select(inside, F(-kFar), F(kFar)), min(t0, t1)));
-    tfar = min(tfar, select(parallel, select(inside, F(kFar), F(-kFar)), max(t0, t1)));
-  };
+  // The slab test (kernels/lists.h) on the grid's box, lo to lo + cell * res per axis.
   F tnear = F(0.0f), tfar = tmax;
-  slab(o.x, d.x, g.lo.x, g.cell.x, g.res.x, tnear, tfar);
-  slab(o.y, d.y, g.lo.y, g.cell.y, g.res.y, tnear, tfar);
-  slab(o.z, d.z, g.lo.z, g.cell.z, g.res.z, tnear, tfar);
+  clip_to_slab(o.x, d.x, g.lo.x, g.lo.x + g.cell.x * g.res.x, tnear, tfar);
+  clip_to_slab(o.y, d.y, g.lo.y, g.lo.y + g.cell.y * g.res.y, tnear, tfar);
+  clip_to_slab(o.z, d.z, g.lo.z, g.lo.z + g.cell.z * g.res.z, tnear, tfar);
   const auto enters = (tnear <= tfar) && (tmax >= F(0.0f));
   const Vec3<F> p = o + d * tnear;  // world space, on or inside the box
   auto cell_of = [&](const F& pa, float lo, float cell, float res) {

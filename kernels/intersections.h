@@ -5,6 +5,7 @@
 #pragma once
 
 #include "kernels/common.h"
+#include "kernels/lists.h"
 
 namespace kernels {
 
@@ -27,13 +28,11 @@ inline Vec4<typename L::F> nearest_hit(const Fragments<L>& f, const HitUnits& u,
   const Vec4<F> ray = f.fetch_own(u.rays);
   const Vec4<F> trav = f.fetch_own(u.traversal);
   const Vec3<F> d = ray.xyz();
-  const Vec3<F> p0 = fetch_id(f, u.v0, vs.w, scene.width).xyz();
-  const Vec3<F> p1 = fetch_id(f, u.v0 + 1, vs.w, scene.width).xyz();
-  const Vec3<F> p2 = fetch_id(f, u.v0 + 2, vs.w, scene.width).xyz();
   F bu, bv;
-  const F t = intersect_triangle(o, d, p0, p1, p2, bu, bv);
+  const F t = hit_triangle(f, u.v0, o, d, vs.w, scene, bu, bv);
+  // The voxel's segment: from where the ray entered it (trav.w) to where it leaves.
   const F t_exit = min3(voxel_exits(o, d, trav.xyz(), grid));
-  const auto in_voxel = (t >= trav.w - F(grid.t_slack)) && (t <= t_exit + F(grid.t_slack));
+  const auto in_voxel = in_segment(t, trav.w, t_exit, grid.t_slack);
   const auto nearer = testing && in_voxel && (t < best.x) && (t < ray.w);
   return select(nearer, Vec4<F>{t, bu, bv, vs.w}, best);
 }

@@ -5,7 +5,7 @@
 //   recorridoKd (extension)       one node per pass: an inner node sends the ray to the child
 //                                 its segment starts in (cutting tmax at the plane when it
 //                                 reaches the other); a leaf just reached is handed to
-//                                 cargarHoja; a leaf already tested ends the ray (a hit inside
+//                                 cargarHojaKd; a leaf already tested ends the ray (a hit inside
 //                                 it, or the segment reached the box's exit) or restarts it
 //                                 from the root with tmin at the leaf's exit (traversal's place)
 //   cargarHojaKd (extension)      the first triangle of the leaf reached (actualizarVoxel's)
@@ -17,42 +17,22 @@
 // inside a leaf's segment is the nearest.
 #pragma once
 
-#include "kernels/bvh.h"
 #include "kernels/common.h"
+#include "kernels/lists.h"
 
 namespace kernels {
 
-struct KdUniforms {
+// Uniforms of the kd-tree: its lists' (t_slack: the in-leaf rule's tolerance) and its nodes'.
+struct KdUniforms : ListUniforms {
   glm::vec3 lo{0.0f}, hi{0.0f};  // the root's box
   float node_width = 1;          // width of the node texture, texels
-  float list_width = 1;          // width of the kd-tree's triangle-list texture, texels
-  float t_slack = 0;             // the in-leaf rule's tolerance, world units along a unit ray
 };
-
-// Where the ray o + t d, 0 <= t <= tfar, is inside the box: [tn, tf] (empty: tn > tf).
-template <class F>
-inline void box_segment(const Vec3<F>& o, const Vec3<F>& d, const glm::vec3& lo,
-                        const glm::vec3& hi, const F& tfar, F& tn, F& tf) {
-  tn = F(0.0f);
-  tf = tfar;
-  auto slab = [&](const F& oa, const F& da, float la, float ha) {
-    const F inv = F(1.0f) / da;
-    const F t0 = (F(la) - oa) * inv, t1 = (F(ha) - oa) * inv;
-    const auto parallel = da == F(0.0f);
-    const auto inside = (oa >= F(la)) && (oa <= F(ha));
-    tn = max(tn, select(parallel, select(inside, F(-kFar), F(kFar)), min(t0, t1)));
-    tf = min(tf, select(parallel, select(inside, F(kFar), F(-kFar)), max(t0, t1)));
-  };
-  slab(o.x, d.x, lo.x, hi.x);
-  slab(o.y, d.y, lo.y, hi.y);
-  slab(o.z, d.z, lo.z, hi.z);
-}
 
 // The segment entry of a ray with tmax ray_w: root and [tn, tf], or done.
 template <class F>
 inline Vec4<F> kd_entry(const Vec3<F>& o, const Vec3<F>& d, const F& ray_w, const KdUniforms& kd) {
   F tn, tf;
-  box_segment(o, d, kd.lo, kd.hi, ray_w, tn, tf);
+  ray_box_segment(o, d, kd.lo, kd.hi, ray_w, tn, tf);
   const auto enters = (tn <= tf) && (ray_w >= F(0.0f));
   return select(enters, Vec4<F>{F(0.0f), F(kNone), tn, tf},
                 Vec4<F>{F(kNone), F(kNone), F(0.0f), F(0.0f)});
@@ -81,7 +61,7 @@ inline Vec4<typename L::F> kd_step(const Fragments<L>& f, int unit_nodes,
   // A leaf tested: a hit inside it ends the ray, as does a segment that reached the box's exit
   // (or the ray's tmax); otherwise restart from the root past the leaf.
   F tn, tend;
-  box_segment(o, d, kd.lo, kd.hi, ray_w, tn, tend);
+  ray_box_segment(o, d, kd.lo, kd.hi, ray_w, tn, tend);
   const auto over = (best.w >= F(0.0f)) || (trav.w >= tend);
   const Vec4<F> done{F(kNone), F(kNone), F(0.0f), F(0.0f)};
   const Vec4<F> restart{F(0.0f), F(kNone), trav.w, tend};
@@ -146,32 +126,32 @@ struct KdStep {
   }
 };
 
-// cargarHojaKd: cargarHoja (kernels/bvh.h) over the kd-tree's lists.
-struct KdLoadLeaf : BvhLoadLeaf {
+// cargarHojaKd: the first triangle of the leaf just reached (traversal y: its list start), for
+// a ray with nothing left to test (voxel state w = -1).
+struct KdLoadLeaf {
   static constexpr const char* name = "kd load leaf";
   static constexpr const char* paper_name = "cargarHojaKd (extension)";
+  static constexpr int outputs = 1;  // -> voxel state
+  enum Unit { kTraversal, kVoxelState, kLists };
   static constexpr std::array<const char*, 3> units{"traversal", "voxel_state", "kd_lists"};
+  static constexpr std::array<int, 1> passthrough{kVoxelState};
+
+  KdUniforms kd;
+
+  template <class L>
+  void operator()(Fragments<L>& f) const {
+    using F = typename L::F;
+    const Vec4<F> trav = f.fetch_own(kTraversal);
+    const Vec4<F> vs = f.fetch_own(kVoxelState);
+    const auto load = (trav.y >= F(0.0f)) && (vs.w < F(0.0f));
+    Vec4<F> next = vs;
+    if (f.branch(load)) next = load_list(f, kLists, trav.y, vs, load, kd);
+    f.out(0) = next;
+  }
 };
 
-// The nearest of the hit so far and triangle vs.w inside the leaf's segment trav.zw (widened by
-// t_slack), for the lanes where `testing`.
-template <class L>
-inline Vec4<typename L::F> nearest_hit_in_leaf(
-    const Fragments<L>& f, int unit_v0, const Vec3<typename L::F>& o,
-    const Vec4<typename L::F>& ray, const Vec4<typename L::F>& trav, const Vec4<typename L::F>& vs,
-    const Vec4<typename L::F>& best, const typename L::M& testing, const SceneUniforms& scene,
-    float t_slack) {
-  using F = typename L::F;
-  const Vec3<F> p0 = fetch_id(f, unit_v0, vs.w, scene.width).xyz();
-  const Vec3<F> p1 = fetch_id(f, unit_v0 + 1, vs.w, scene.width).xyz();
-  const Vec3<F> p2 = fetch_id(f, unit_v0 + 2, vs.w, scene.width).xyz();
-  F bu, bv;
-  const F t = intersect_triangle(o, ray.xyz(), p0, p1, p2, bu, bv);
-  const auto in_leaf = (t >= trav.z - F(t_slack)) && (t <= trav.w + F(t_slack));
-  const auto nearer = testing && in_leaf && (t < best.x) && (t < ray.w);
-  return select(nearer, Vec4<F>{t, bu, bv, vs.w}, best);
-}
-
+// interseccionesKd: a hit counts only inside the leaf's segment trav.zw, widened by t_slack
+// (nearest_hit_in_segment, kernels/lists.h: the grid's in-voxel rule).
 struct KdIntersections {
   static constexpr const char* name = "kd intersections";
   static constexpr const char* paper_name = "interseccionesKd (extension)";
@@ -196,7 +176,7 @@ struct KdIntersections {
       const Vec3<F> o = f.fetch_own(kOrigins).xyz();
       const Vec4<F> ray = f.fetch_own(kRays);
       const Vec4<F> trav = f.fetch_own(kTraversal);
-      next = nearest_hit_in_leaf(f, kV0, o, ray, trav, vs, best, testing, scene, kd.t_slack);
+      next = nearest_hit_in_segment(f, kV0, o, ray, trav, vs, best, testing, scene, kd.t_slack);
     }
     f.out(0) = next;
   }
@@ -227,8 +207,7 @@ struct KdStepLoad {
       const Vec3<F> o = f.fetch_own(kOrigins).xyz();
       next = kd_step(f, kNodes, trav, best, o, ray.xyz(), ray.w, walking, kd);
       const auto load = walking && (next.y >= F(0.0f)) && (vs.w < F(0.0f));
-      const F tri = fetch_id(f, kLists, next.y, kd.list_width).x;
-      nvs = select(load, Vec4<F>{next.y, F(0.0f), F(0.0f), tri}, vs);
+      nvs = load_list(f, kLists, next.y, vs, load, kd);
     }
     f.out(0) = next;
     f.out(1) = nvs;
@@ -260,10 +239,8 @@ struct KdIntersectNext {
       const Vec3<F> o = f.fetch_own(kOrigins).xyz();
       const Vec4<F> ray = f.fetch_own(kRays);
       const Vec4<F> trav = f.fetch_own(kTraversal);
-      next = nearest_hit_in_leaf(f, kV0, o, ray, trav, vs, best, testing, scene, kd.t_slack);
-      const F pos = vs.x + F(1.0f);
-      const F tri = fetch_id(f, kLists, pos, kd.list_width).x;
-      nvs = select(testing, Vec4<F>{pos, F(0.0f), F(0.0f), tri}, vs);
+      next = nearest_hit_in_segment(f, kV0, o, ray, trav, vs, best, testing, scene, kd.t_slack);
+      nvs = load_list(f, kLists, vs.x + F(1.0f), vs, testing, kd);
     }
     f.out(0) = next;
     f.out(1) = nvs;
@@ -312,9 +289,9 @@ struct KdLooping {
     const Vec4<F> ray = f.fetch_own(kRays);
     f.loop(steps, trav.x >= F(0.0f), [&](const M& act) {
       const M testing = act && (vs.w >= F(0.0f));
-      best = nearest_hit_in_leaf(f, kV0, o, ray, trav, vs, best, testing, scene, kd.t_slack);
+      best = nearest_hit_in_segment(f, kV0, o, ray, trav, vs, best, testing, scene, kd.t_slack);
       const F pos = vs.x + F(1.0f);
-      const F tri = fetch_id(f, kLists, pos, kd.list_width).x;
+      const F tri = list_entry(f, kLists, pos, kd);
       const M stepping = act && !testing;
       Vec4<F> next = kd_step(f, kNodes, trav, best, o, ray.xyz(), ray.w, stepping, kd);
       // Push-down: a restart goes to the remembered node; a descent that keeps the whole
@@ -328,7 +305,7 @@ struct KdLooping {
       const F pd = select(kept, next.x, vs.y);
       const F dirty = select(restarted, F(0.0f), select(cut, F(1.0f), vs.z));
       const M load = stepping && (next.y >= F(0.0f));
-      const F first = fetch_id(f, kLists, next.y, kd.list_width).x;
+      const F first = list_entry(f, kLists, next.y, kd);
       vs = select(testing, Vec4<F>{pos, vs.y, vs.z, tri},
                   select(load, Vec4<F>{next.y, pd, dirty, first},
                          select(stepping, Vec4<F>{vs.x, pd, dirty, vs.w}, vs)));

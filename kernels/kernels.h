@@ -1,6 +1,7 @@
 // The paper's fragment programs (and the shadow-ray extension), one functor per file, and the
 // fused two-output programs --mrt on runs (kernels/fused.h), and the ray streams of glass
-// (dividirRayos, sumaPrefijos, contarRayos, compactarRayos, copiarFilas, reunirHijos, sombraVidrio).
+// (dividirRayos, sumaPrefijos, contarRayos, compactarRayos, copiarFilas, reunirHijos,
+// sombraVidrio).
 #pragma once
 
 #include "kernels/accumulate_samples.h"

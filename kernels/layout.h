@@ -54,7 +54,8 @@
 //                   z, w = tmin, tmax of the ray's segment        (--accel kdtree)
 //   grid2 traversal x = sub-cell (-1: done), y = its first list entry, z, w = t where the ray
 //                   enters and leaves the sub-cell                 (--accel grid2)
-//   leaf state      as the voxel state, over the tree's (or the two-level grid's) lists; the kd-tree's looping kernel
+//   leaf state      as the voxel state, over the tree's (or the two-level grid's) lists; the
+//   kd-tree's looping kernel
 //                   keeps its push-down node in y and a "segment cut" flag in z
 //   intersection    x = t of the nearest valid hit so far, w = its triangle, -1 for none;
 //                   yz = barycentrics (u, v) of that hit      (paper: texturaEstadoInterseccion)
@@ -66,8 +67,8 @@
 //   sample sum      rgb = sum of the sample frames' colours, a = samples added (--spp N > 1;
 //                   an extension, kernels/accumulate_samples.h)
 //
-// Ray streams (glass, or --ray-streams on; host/trace/stream/ray_streams.h). Static, per triangle like
-// the colours:
+// Ray streams (glass, or --ray-streams on; host/trace/stream/ray_streams.h). Static, per triangle
+// like the colours:
 //   glass           x = mirror coefficient a, y = transmission t, z = index of refraction
 //   colors          under ray streams a = 1 - (1 - t)(1 - a): the share of a ray's weight its
 //                   surface does not shade itself (a itself when t = 0)
@@ -97,13 +98,19 @@ namespace kernels {
 inline constexpr float kNone = -1.0f;
 inline constexpr float kFar = 1e30f;
 
-// Uniforms describing the grid (world space).
-struct GridUniforms {
+// Uniforms of a structure's triangle lists, which every structure has (kernels/lists.h): the
+// list texture's width, and the tolerance of the rule that a hit counts only inside the piece
+// of the ray the current voxel (leaf, cell) holds.
+struct ListUniforms {
+  float list_width = 1;  // width of the triangle-list texture, texels
+  float t_slack = 0;     // tolerance of the in-voxel rule, world units along a unit ray
+};
+
+// Uniforms describing the grid (world space), besides its lists'.
+struct GridUniforms : ListUniforms {
   glm::vec3 lo{0.0f};    // grid box minimum corner
   glm::vec3 cell{1.0f};  // world size of one voxel
   glm::vec3 res{1.0f};   // voxels per axis, as floats
-  float list_width = 1;  // width of the triangle-list texture, texels
-  float t_slack = 0;     // tolerance of the in-voxel rule, world units along a unit ray
 };
 
 // Uniforms describing the scene textures' layout.

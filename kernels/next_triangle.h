@@ -3,6 +3,7 @@
 #pragma once
 
 #include "kernels/common.h"
+#include "kernels/lists.h"
 
 namespace kernels {
 
@@ -11,11 +12,9 @@ namespace kernels {
 template <class L>
 inline Vec4<typename L::F> next_in_list(const Fragments<L>& f, int unit_lists,
                                         const Vec4<typename L::F>& vs, const typename L::M& testing,
-                                        const GridUniforms& grid) {
+                                        const ListUniforms& lists) {
   using F = typename L::F;
-  const F pos = vs.x + F(1.0f);
-  const F tri = fetch_id(f, unit_lists, pos, grid.list_width).x;
-  return select(testing, Vec4<F>{pos, F(0.0f), F(0.0f), tri}, vs);
+  return load_list(f, unit_lists, vs.x + F(1.0f), vs, testing, lists);
 }
 
 struct NextTriangle {
@@ -26,7 +25,8 @@ struct NextTriangle {
   static constexpr std::array<const char*, 2> units{"voxel_state", "triangle_lists"};
   static constexpr std::array<int, 1> passthrough{kVoxelState};
 
-  GridUniforms grid;
+  // Every structure walks its lists with this kernel: only the lists' uniforms are read.
+  ListUniforms lists;
 
   template <class L>
   void operator()(Fragments<L>& f) const {
@@ -34,7 +34,7 @@ struct NextTriangle {
     const Vec4<F> vs = f.fetch_own(kVoxelState);
     const auto testing = vs.w >= F(0.0f);
     Vec4<F> next = vs;
-    if (f.branch(testing)) next = next_in_list(f, kLists, vs, testing, grid);
+    if (f.branch(testing)) next = next_in_list(f, kLists, vs, testing, lists);
     f.out(0) = next;
   }
 };

@@ -4,6 +4,7 @@
 #pragma once
 
 #include "kernels/common.h"
+#include "kernels/lists.h"
 
 namespace kernels {
 
@@ -19,8 +20,7 @@ inline Vec4<typename L::F> first_in_voxel(const Fragments<L>& f, int unit_pointe
   // Voxel (X, Y, Z) lives at texel (X * sizeY + Y, Z).
   const F px = trav.x * F(grid.res.y) + trav.y + F(0.5f), py = trav.z + F(0.5f);
   const F start = f.fetch(unit_pointers, px, py).x;
-  const F tri = fetch_id(f, unit_lists, start, grid.list_width).x;
-  return select(load, Vec4<F>{start, F(0.0f), F(0.0f), tri}, vs);
+  return load_list(f, unit_lists, start, vs, load, grid);
 }
 
 struct UpdateVoxel {

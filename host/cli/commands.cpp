@@ -20,12 +20,8 @@ namespace cli {
 
 // `vgpu-rt kernels [NAME] [--glsl]`: what a fragment program is, per kernel.
 int run_kernels(const std::string& name, bool glsl) {
-  auto programs = kernels::all_programs();
-  // The looping variant's program (--kernels looping) is listed after the paper's.
-  programs.push_back(std::make_unique<vgpu::KernelProgram<kernels::LoopingTraversal>>());
-  programs.push_back(std::make_unique<vgpu::KernelProgram<kernels::BvhLooping>>());
-  programs.push_back(std::make_unique<vgpu::KernelProgram<kernels::KdLooping>>());
-  programs.push_back(std::make_unique<vgpu::KernelProgram<kernels::Grid2Looping>>());
+  // Every kernel of the one list (kernels/registry.h), the looping variant's last.
+  const auto programs = kernels::all_programs(kernels::Programs::with_looping);
   auto spelled = [](std::string n) {
     for (char& c : n)
       if (c == ' ') c = '-';

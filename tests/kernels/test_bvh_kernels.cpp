@@ -291,7 +291,7 @@ TEST_CASE("bvh intersections + next triangle equals bvh intersections then next 
   kernels::BvhIntersections ki;
   ki.scene = k.scene;
   kernels::NextTriangle kn;
-  kn.grid.list_width = 4;
+  kn.lists.list_width = 4;
   check_same(
       out[0],
       ktest::run(ki, {&h.origins, &h.rays, &h.vs, &h.isect, &tree.v0, &tree.v1, &tree.v2}, n, 1));
@@ -334,7 +334,7 @@ State multipass(const Walk& w, int rounds) {
   kernels::BvhIntersections ki;
   ki.scene.width = 2;
   kernels::NextTriangle kn;
-  kn.grid.list_width = 4;
+  kn.lists.list_width = 4;
   const Tree& t = w.tree;
   for (int r = 0; r < rounds; ++r) {
     s.trav = ktest::run(ks, {&w.origins, &w.rays, &s.trav, &s.isect, &t.lo, &t.hi}, Walk::n, 1);

@@ -65,7 +65,7 @@ TEST_CASE("intersections + next triangle tests the current triangle and moves to
   ki.grid = k.grid;
   ki.scene = k.scene;
   kernels::NextTriangle kn;
-  kn.grid = k.grid;
+  kn.lists = k.grid;
   check_same(hit, ktest::run(ki, {&to, &tr, &tt, &tv, &tb, &v0, &v1, &v2}, 4, 1));
   check_same(vs, ktest::run(kn, {&tv, &lists}, 4, 1));
 }

@@ -135,17 +135,17 @@ State multipass(const Structure& t, const Rays& r, bool fused) {
   kernels::Grid2Step step;
   step.grid2 = u;
   kernels::Grid2LoadCell load;
-  load.bvh.list_width = u.list_width;
+  load.grid2.list_width = u.list_width;
   kernels::Grid2Intersections isect;
-  isect.kd.t_slack = u.t_slack;
+  isect.grid2.t_slack = u.t_slack;
   isect.scene.width = 1;
   kernels::NextTriangle next;
-  next.grid.list_width = u.list_width;
+  next.lists.list_width = u.list_width;
   kernels::Grid2StepLoad step_load;
   step_load.grid2 = u;
   kernels::Grid2IntersectNext isect_next;
-  isect_next.kd.t_slack = u.t_slack;
-  isect_next.kd.list_width = u.list_width;
+  isect_next.grid2.t_slack = u.t_slack;
+  isect_next.grid2.list_width = u.list_width;
   isect_next.scene.width = 1;
   State s{enter(t, r),
           texels("cell state", r.n, 1, std::vector<glm::vec4>(size_t(r.n), {0, 0, 0, kNone})),
@@ -254,7 +254,7 @@ TEST_CASE("grid2 load cell loads the first triangle of a sub-cell just entered")
   const Texture vs = texels("cell state", 4, 1,
                             {{0, 0, 0, kNone}, {0, 0, 0, kNone}, {0, 0, 0, kNone}, {1, 0, 0, 0}});
   kernels::Grid2LoadCell k;
-  k.bvh.list_width = 4;
+  k.grid2.list_width = 4;
   const Texture out = ktest::run(k, {&trav, &vs, &s.lists}, 4, 1);
   CHECK_TEXEL(out, 0, 0, glm::vec4(1, 0, 0, 0));      // list 1: triangle 0
   CHECK_TEXEL(out, 1, 0, glm::vec4(0, 0, 0, kNone));  // empty: the shared -1
@@ -306,7 +306,7 @@ TEST_CASE("the grid2 looping kernel ends in the multipass walk's hits and traver
   const State m = multipass(t, r, false);
   // Entered and loaded, then one looping pass of enough iterations.
   kernels::Grid2LoadCell load;
-  load.bvh.list_width = 4;
+  load.grid2.list_width = 4;
   const Texture trav = enter(t, r);
   const Texture vs0 =
       texels("cell state", r.n, 1, std::vector<glm::vec4>(size_t(r.n), {0, 0, 0, kNone}));

@@ -197,7 +197,7 @@ TEST_CASE(
   }
   {
     kernels::NextTriangle k;
-    k.grid = grid();
+    k.lists = grid();
     check_widths(k, {&in.vs, &in.lists});
   }
   check_widths(kernels::RaysIntersecting{}, {&in.vs}, true);

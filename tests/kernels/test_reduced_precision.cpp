@@ -25,7 +25,7 @@ Texture counting_list(int n) {
 // What next triangle reads for a ray at list position pos - 1 when computing in `precision`.
 glm::vec4 next_from(int pos, int list_width, Format precision) {
   kernels::NextTriangle k;
-  k.grid =
+  k.lists =
       ktest::grid_uniforms(glm::vec3(0.0f), glm::vec3(1.0f), glm::vec3(1.0f), float(list_width));
   const Texture lists = counting_list(list_width);
   const Texture vs = ktest::texels("voxel state", 1, 1, {{float(pos - 1), 0, 0, 0}});
@@ -90,7 +90,7 @@ TEST_CASE(
   const Texture lists = counting_list(2048);
   const Texture vs = ktest::texels("voxel state", 1, 1, {{1500.0f, 0, 0, 0}});
   kernels::NextTriangle k;
-  k.grid = ktest::grid_uniforms(glm::vec3(0.0f), glm::vec3(1.0f), glm::vec3(1.0f), 2048);
+  k.lists = ktest::grid_uniforms(glm::vec3(0.0f), glm::vec3(1.0f), glm::vec3(1.0f), 2048);
   vgpu::KernelProgram<kernels::NextTriangle> p(k);
   Texture out("out", 1, 1, 4);
   {

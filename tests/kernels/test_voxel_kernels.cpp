@@ -56,7 +56,7 @@ TEST_CASE("update voxel reads the pointer at (X*sizeY + Y, Z) and the first entr
 TEST_CASE("next triangle advances along the voxel's list and stops at the -1 that closes it") {
   const Texture lists = scalars("triangle lists", 4, 2, kLists);
   kernels::NextTriangle k;
-  k.grid = grid_uniforms(glm::vec3(0.0f), glm::vec3(1.0f), glm::vec3(1.0f), 4);
+  k.lists = grid_uniforms(glm::vec3(0.0f), glm::vec3(1.0f), glm::vec3(1.0f), 4);
   const Texture vs =
       texels("voxel state", 4, 1, {{1, 0, 0, 5}, {2, 0, 0, 7}, {4, 0, 0, 2}, {3, 1, 2, kNone}});
   const Texture out = ktest::run(k, {&vs, &lists}, 4, 1);

@@ -55,13 +55,11 @@ uint64_t BvhWalk::set_bvh(vgpu::Device& gpu, const Bvh& bvh, float scene_width,
   u.node_width = float(nw);
   u.nodes = float(nodes_);
   u.list_width = float(lw);
-  GridUniforms lists;
-  lists.list_width = float(lw);
   const SceneUniforms su{scene_width};
   step_.kernel.bvh = u;
   load_.kernel.bvh = u;
   intersect_.kernel.scene = su;
-  next_.kernel.grid = lists;
+  next_.kernel.lists = u;
   step_load_.kernel.bvh = u;
   intersect_next_.kernel.bvh = u;
   intersect_next_.kernel.scene = su;

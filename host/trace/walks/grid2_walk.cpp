@@ -72,22 +72,15 @@ uint64_t Grid2Walk::set_grid(vgpu::Device& gpu, const Grid2& g2, float scene_wid
   u.sub_width = float(subs_.width());
   u.list_width = float(lists_.width());
   u.t_slack = t_slack;
-  KdUniforms lists_kd;  // interseccionesKd's test reads only these two
-  lists_kd.list_width = u.list_width;
-  lists_kd.t_slack = t_slack;
-  BvhUniforms lists_only;
-  lists_only.list_width = u.list_width;
-  GridUniforms lists;
-  lists.list_width = u.list_width;
   const SceneUniforms su{scene_width};
   enter_.kernel.grid2 = u;
   step_.kernel.grid2 = u;
-  load_.kernel.bvh = lists_only;
-  intersect_.kernel.kd = lists_kd;
+  load_.kernel.grid2 = u;
+  intersect_.kernel.grid2 = u;
   intersect_.kernel.scene = su;
-  next_.kernel.grid = lists;
+  next_.kernel.lists = u;
   step_load_.kernel.grid2 = u;
-  intersect_next_.kernel.kd = lists_kd;
+  intersect_next_.kernel.grid2 = u;
   intersect_next_.kernel.scene = su;
   looping_.kernel.grid2 = u;
   looping_.kernel.scene = su;

@@ -157,7 +157,7 @@ uint64_t GridWalk::set_grid(vgpu::Device& gpu, const Grid& grid, float scene_wid
   update_.kernel.grid = g;
   intersect_.kernel.grid = g;
   intersect_.kernel.scene = su;
-  next_.kernel.grid = g;
+  next_.kernel.lists = g;
   intersect_next_.kernel.grid = g;
   intersect_next_.kernel.scene = su;
   traverse_update_.kernel.grid = g;
