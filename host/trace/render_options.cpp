@@ -8,10 +8,13 @@ namespace host {
 
 std::string RenderOptions::refusal(const vgpu::Profile& profile) const {
   // Undersampling traces one ray through each traced pixel; supersampling traces several.
-  if (undersample > 0 && spp > 1)
-    return "--aa undersample" +
-           (undersample == 2 ? std::string() : ":" + std::to_string(undersample)) +
-           " traces one ray per traced pixel; drop --spp " + std::to_string(spp);
+  if (undersample > 0 && spp > 1) {
+    std::string why = "--aa undersample";
+    if (undersample != 2) why += ":" + std::to_string(undersample);  // 2 is the default
+    why += " traces one ray per traced pixel; drop --spp ";
+    why += std::to_string(spp);
+    return why;
+  }
   // The command line cannot ask for these two (--aa is one mode); a program can.
   if (undersample < 0 || (undersample > 0 && adaptive))
     return "undersample: K must be 1 or more, with one ray per traced pixel (spp 1, not adaptive)";
