@@ -10,7 +10,10 @@ std::string RenderOptions::refusal(const vgpu::Profile& profile) const {
   // Undersampling traces one ray through each traced pixel; supersampling traces several.
   if (undersample > 0 && spp > 1) {
     std::string why = "--aa undersample";
-    if (undersample != 2) why += ":" + std::to_string(undersample);  // 2 is the default
+    if (undersample != 2) {  // 2 is the default, which the command line spells without K
+      why += ':';
+      why += std::to_string(undersample);
+    }
     why += " traces one ray per traced pixel; drop --spp ";
     why += std::to_string(spp);
     return why;
