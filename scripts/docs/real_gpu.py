@@ -84,6 +84,65 @@ def fixed_table(d):
     return lines
 
 
+def plot_chart(pred, llvm, remote, earlier):
+    """docs/real_gpu.png: per scene and size, bars for each measured and predicted frame time
+    (log scale); and the fixed cost of a pass against its size."""
+    fig, axes = plt.subplots(1, 2, figsize=(14, 6.4), gridspec_kw={"width_ratios": [3, 2]})
+    ax = axes[0]
+    cells = sorted({(s, z) for (s, z, e) in pred}, key=lambda c: (c[1], c[0]))
+    series = [("emulator host ms (2-core dev machine)",
+               {(s, z): f["wall_ms"] for (s, z, e), f in pred.items() if e == "stream"}),
+              ("llvmpipe wall ms", {(f["scene"], f["size"]): f["wall_ms"]
+                                    for f in llvm.get("frames", []) if f["engine"] == "gl"})]
+    for name, (d, _) in remote.items():
+        fb = frames_by(d)
+        for eng, label in (("gl", "wall ms, blocking"), ("gl-poll", "wall ms, polled")):
+            series.append((f"{name} {label}", {(s, z): f["wall_ms"]
+                                                for (s, z, e), f in fb.items() if e == eng}))
+        series.append((f"{name} GPU ms", {(s, z): f["gpu_ms"]
+                                          for (s, z, e), f in fb.items() if e == "gl-poll"}))
+        series.append((f"predicted {name}", {(s, z): f["predicted_ms"][name]
+                                             for (s, z, e), f in pred.items()
+                                             if e == "stream" and name in f["predicted_ms"]}))
+    for name, (d, _) in earlier.items():
+        series.append((f"{name} wall ms (clock dropped)",
+                       {(f["scene"], f["size"]): f["wall_ms"] for f in d.get("frames", [])
+                        if f["engine"] == "gl"}))
+    series = [s for s in series if s[1]]
+    width = 0.84 / max(1, len(series))
+    for i, (label, values) in enumerate(series):
+        xs = [c + i * width for c in range(len(cells)) if cells[c] in values]
+        ys = [values[cells[c]] for c in range(len(cells)) if cells[c] in values]
+        ax.bar(xs, ys, width, label=label)
+    ax.set_xticks([c + 0.42 - width / 2 for c in range(len(cells))])
+    ax.set_xticklabels([f"{s}\n{n}²" for s, n in cells])
+    ax.set_yscale("log")
+    ax.set_ylabel("frame time, ms (log scale)")
+    ax.set_title("One frame at Table 1's settings")
+    ax.legend(fontsize=7, ncol=3, loc="upper center", bbox_to_anchor=(0.5, -0.13))
+    ax.grid(axis="y", which="both", alpha=0.3)
+    ax = axes[1]
+    kinds = [("pass", "o"), ("pass + blocking query read-back", "s"),
+             ("pass + polled query read-back", "^"), ("pass, two RGBA32F targets (MRT)", "D")]
+    for name, d in [("llvmpipe", llvm)] + [(n, d) for n, (d, _) in remote.items()]:
+        for kind, marker in kinds:
+            rows = sorted((r for r in d["fixed"]
+                           if r["what"] == kind or (kind == "pass" and r["what"].startswith(
+                               "pass, one"))), key=lambda r: r["size"])
+            if rows:
+                ax.plot([r["size"] for r in rows], [r["wall_us"] for r in rows], marker=marker,
+                        label=f"{name}: {kind}")
+    ax.set_xscale("log", base=2)
+    ax.set_yscale("log")
+    ax.set_xlabel("pass size, pixels per side")
+    ax.set_ylabel("wall time per pass, µs (log scale)")
+    ax.set_title("Fixed and per-pixel cost of one pass")
+    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.13))
+    ax.grid(which="both", alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(os.path.join(DOCS, "real_gpu.png"), dpi=110)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--bench", default=os.path.join(ROOT, "build/bench/bench_gl"))
@@ -244,63 +303,8 @@ def main():
                      f"{fmt(f.get('gpu_ms'))} | {f['passes']:,} | {f['query_readbacks']:,} |")
     lines.append("")
 
-    # Chart: per scene x size, bars for each measured and predicted figure (log scale); and the
-    # fixed cost of a pass against its size.
-    fig, axes = plt.subplots(1, 2, figsize=(14, 6.4), gridspec_kw={"width_ratios": [3, 2]})
-    ax = axes[0]
-    cells = sorted({(s, z) for (s, z, e) in pred}, key=lambda c: (c[1], c[0]))
-    series = [("emulator host ms (2-core dev machine)",
-               {(s, z): f["wall_ms"] for (s, z, e), f in pred.items() if e == "stream"}),
-              ("llvmpipe wall ms", {(f["scene"], f["size"]): f["wall_ms"]
-                                    for f in llvm.get("frames", []) if f["engine"] == "gl"})]
-    for name, (d, _) in remote.items():
-        fb = frames_by(d)
-        for eng, label in (("gl", "wall ms, blocking"), ("gl-poll", "wall ms, polled")):
-            series.append((f"{name} {label}", {(s, z): f["wall_ms"]
-                                                for (s, z, e), f in fb.items() if e == eng}))
-        series.append((f"{name} GPU ms", {(s, z): f["gpu_ms"]
-                                          for (s, z, e), f in fb.items() if e == "gl-poll"}))
-        series.append((f"predicted {name}", {(s, z): f["predicted_ms"][name]
-                                             for (s, z, e), f in pred.items()
-                                             if e == "stream" and name in f["predicted_ms"]}))
-    for name, (d, _) in earlier.items():
-        series.append((f"{name} wall ms (clock dropped)",
-                       {(f["scene"], f["size"]): f["wall_ms"] for f in d.get("frames", [])
-                        if f["engine"] == "gl"}))
-    series = [s for s in series if s[1]]
-    width = 0.84 / max(1, len(series))
-    for i, (label, values) in enumerate(series):
-        xs = [c + i * width for c in range(len(cells)) if cells[c] in values]
-        ys = [values[cells[c]] for c in range(len(cells)) if cells[c] in values]
-        ax.bar(xs, ys, width, label=label)
-    ax.set_xticks([c + 0.42 - width / 2 for c in range(len(cells))])
-    ax.set_xticklabels([f"{s}\n{n}²" for s, n in cells])
-    ax.set_yscale("log")
-    ax.set_ylabel("frame time, ms (log scale)")
-    ax.set_title("One frame at Table 1's settings")
-    ax.legend(fontsize=7, ncol=3, loc="upper center", bbox_to_anchor=(0.5, -0.13))
-    ax.grid(axis="y", which="both", alpha=0.3)
-    ax = axes[1]
-    kinds = [("pass", "o"), ("pass + blocking query read-back", "s"),
-             ("pass + polled query read-back", "^"), ("pass, two RGBA32F targets (MRT)", "D")]
-    for name, d in [("llvmpipe", llvm)] + [(n, d) for n, (d, _) in remote.items()]:
-        for kind, marker in kinds:
-            rows = sorted((r for r in d["fixed"]
-                           if r["what"] == kind or (kind == "pass" and r["what"].startswith(
-                               "pass, one"))), key=lambda r: r["size"])
-            if rows:
-                ax.plot([r["size"] for r in rows], [r["wall_us"] for r in rows], marker=marker,
-                        label=f"{name}: {kind}")
-    ax.set_xscale("log", base=2)
-    ax.set_yscale("log")
-    ax.set_xlabel("pass size, pixels per side")
-    ax.set_ylabel("wall time per pass, µs (log scale)")
-    ax.set_title("Fixed and per-pixel cost of one pass")
-    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.13))
-    ax.grid(which="both", alpha=0.3)
-    fig.tight_layout()
+    plot_chart(pred, llvm, remote, earlier)
     png = os.path.join(DOCS, "real_gpu.png")
-    fig.savefig(png, dpi=110)
     lines += ["![frame times and pass costs](real_gpu.png)", ""]
     extra = os.path.join(DOCS, "real_gpu_notes.md")
     if os.path.exists(extra):
