@@ -399,6 +399,50 @@ def h200(paths, clocks, looping=None, control=None, looping_clocks=None):
     return "\n".join(out)
 
 
+def plot_chart(main_rows, scenes, size):
+    """docs/sampling.png: per scene, each mode's RMS error against its modeled gf6600 time,
+    the Pareto front outlined."""
+    fig, axes = plt.subplots(1, len(scenes), figsize=(4.2 * len(scenes), 4.2), sharey=False)
+    markers = {"spp": "o", "adaptive": "s", "undersample": "^"}
+    colours = {"spp": "tab:blue", "adaptive": "tab:orange", "undersample": "tab:green"}
+    for ax, scene in zip(axes, scenes):
+        rs = [r for r in main_rows if r["scene"] == scene]
+        pts = [(r["gf6600"], r["rms"]) for r in rs]
+        front = pareto(pts)
+        for i, r in enumerate(rs):
+            kind = r["mode"].split()[0]
+            ax.scatter(r["gf6600"] / 1000, r["rms"], marker=markers[kind],
+                       s=60 if i in front else 30, color=colours[kind],
+                       edgecolors="black" if i in front else "none")
+        fr = sorted((pts[i][0] / 1000, pts[i][1]) for i in front)
+        ax.plot([p[0] for p in fr], [p[1] for p in fr], "k--", lw=0.8, label="Pareto front")
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.autoscale_view()
+        # Labels from the top down, each moved down past the labels already placed near it (in
+        # points on the page), so that clustered modes stay readable.
+        placed = []
+        for r in sorted(rs, key=lambda r: -r["rms"]):
+            x, y = ax.transData.transform((r["gf6600"] / 1000, r["rms"])) * 72 / fig.dpi
+            dy = 3
+            while any(abs(y + dy - py) < 7 and abs(x - px) < 75 for px, py in placed):
+                dy -= 7
+            placed.append((x, y + dy))
+            ax.annotate(r["mode"], (r["gf6600"] / 1000, r["rms"]), fontsize=6,
+                        xytext=(3, dy), textcoords="offset points",
+                        arrowprops=None if dy == 3 else dict(arrowstyle="-", lw=0.3, color="0.5"))
+        ax.set_title(f"{scene}, {size}x{size}")
+        ax.set_xlabel("predicted gf6600 time (s)")
+        ax.grid(True, which="both", lw=0.3)
+    axes[0].set_ylabel("RMS error against 256 samples")
+    axes[0].legend(loc="lower left", fontsize=7)
+    fig.suptitle("Sampling modes: error against modeled time (circles: --spp; squares: "
+                 "--aa adaptive; triangles: --aa undersample; outlined: on the Pareto front)",
+                 fontsize=9)
+    fig.tight_layout()
+    fig.savefig(os.path.join(ROOT, "docs/sampling.png"), dpi=110)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--bench", default=os.path.join(ROOT, "build/bench/bench_sampling"))
@@ -453,45 +497,7 @@ def main():
                                      ",".join(scenes + others)], work, "changed")["rows"]
         bounds = bounds_section(args.bounds_bench, work, args.changed_size)
 
-    fig, axes = plt.subplots(1, len(scenes), figsize=(4.2 * len(scenes), 4.2), sharey=False)
-    markers = {"spp": "o", "adaptive": "s", "undersample": "^"}
-    colours = {"spp": "tab:blue", "adaptive": "tab:orange", "undersample": "tab:green"}
-    for ax, scene in zip(axes, scenes):
-        rs = [r for r in main_rows if r["scene"] == scene]
-        pts = [(r["gf6600"], r["rms"]) for r in rs]
-        front = pareto(pts)
-        for i, r in enumerate(rs):
-            kind = r["mode"].split()[0]
-            ax.scatter(r["gf6600"] / 1000, r["rms"], marker=markers[kind],
-                       s=60 if i in front else 30, color=colours[kind],
-                       edgecolors="black" if i in front else "none")
-        fr = sorted((pts[i][0] / 1000, pts[i][1]) for i in front)
-        ax.plot([p[0] for p in fr], [p[1] for p in fr], "k--", lw=0.8, label="Pareto front")
-        ax.set_xscale("log")
-        ax.set_yscale("log")
-        ax.autoscale_view()
-        # Labels from the top down, each moved down past the labels already placed near it (in
-        # points on the page), so that clustered modes stay readable.
-        placed = []
-        for r in sorted(rs, key=lambda r: -r["rms"]):
-            x, y = ax.transData.transform((r["gf6600"] / 1000, r["rms"])) * 72 / fig.dpi
-            dy = 3
-            while any(abs(y + dy - py) < 7 and abs(x - px) < 75 for px, py in placed):
-                dy -= 7
-            placed.append((x, y + dy))
-            ax.annotate(r["mode"], (r["gf6600"] / 1000, r["rms"]), fontsize=6,
-                        xytext=(3, dy), textcoords="offset points",
-                        arrowprops=None if dy == 3 else dict(arrowstyle="-", lw=0.3, color="0.5"))
-        ax.set_title(f"{scene}, {args.size}x{args.size}")
-        ax.set_xlabel("predicted gf6600 time (s)")
-        ax.grid(True, which="both", lw=0.3)
-    axes[0].set_ylabel("RMS error against 256 samples")
-    axes[0].legend(loc="lower left", fontsize=7)
-    fig.suptitle("Sampling modes: error against modeled time (circles: --spp; squares: "
-                 "--aa adaptive; triangles: --aa undersample; outlined: on the Pareto front)",
-                 fontsize=9)
-    fig.tight_layout()
-    fig.savefig(os.path.join(ROOT, "docs/sampling.png"), dpi=110)
+    plot_chart(main_rows, scenes, args.size)
 
     out = [
         "# Sampling: error against rays, passes and modeled time",
