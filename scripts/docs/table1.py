@@ -422,7 +422,16 @@ def write_doc(data, masks, cpu, figures, readings, mrt, mrt_masks):
         w("")
     w(explain_what_if(data, masks, mrt))
 
-    # --- parameters
+    L += parameters_section()
+    w(explain_readings(data, figures, readings))
+    open(os.path.join(ROOT, "docs/table1.md"), "w").write("\n".join(L))
+
+
+def parameters_section():
+    """The page's Parameters section: each profile's hardware figures and fixed costs, and the
+    cost model's own parameters, as lines."""
+    L = []
+    w = L.append
     w("## Parameters\n")
     w("Hardware figures and fixed costs, read from `vgpu/profile.cpp` with their source comments. "
       "*public*: a published figure (the comment names it); *assumed*: no public figure, set a "
@@ -462,8 +471,7 @@ def write_doc(data, masks, cpu, figures, readings, mrt, mrt_masks):
       "(counted) skip `branch_body_share` of the program's operations, fetches and bytes read. Not modeled: texture caches (every fetched "
       "byte is charged to memory), the branch instruction's own cost, early-z rejection cost "
       "(masked fragments are free), CPU-GPU overlap beyond the fitted fixed costs.\n")
-    w(explain_readings(data, figures, readings))
-    open(os.path.join(ROOT, "docs/table1.md"), "w").write("\n".join(L))
+    return L
 
 
 def explain_fx(data):
