@@ -222,7 +222,7 @@ RenderPlan parse_render(const RenderArgs& a, bool lanes_given) {
   // The combinations the tracer cannot run, before any work (with fp32 formats: MRT's formats
   // are checked again once resolved).
   opt.formats = host::Formats::all(vgpu::Format::fp32);
-  if (const std::string why = opt.refusal(vgpu::profile(opt.profile)); !why.empty())
+  if (const std::string why = opt.refusal(vgpu::profile(opt.profile), a.aa); !why.empty())
     throw UsageError(why);
   if (a.engine != "stream" && (!a.report.empty() || !a.stats_csv.empty()))
     throw UsageError(
@@ -497,7 +497,7 @@ int run_render(const RenderArgs& a, bool lanes_given) {
                : host::resolve(formats, scene, *box, p, kd->lists.size());
   };
   opt.formats = formats_for(accel_kind);
-  if (const std::string why = opt.refusal(vgpu::profile(opt.profile)); !why.empty())
+  if (const std::string why = opt.refusal(vgpu::profile(opt.profile), a.aa); !why.empty())
     throw UsageError(why);
   const float aspect = float(opt.width) / float(opt.height);
   // A frame's camera: the file's (moving with its node), else the rest scene's framing.

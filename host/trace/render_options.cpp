@@ -6,12 +6,14 @@
 
 namespace host {
 
-std::string RenderOptions::refusal(const vgpu::Profile& profile) const {
+std::string RenderOptions::refusal(const vgpu::Profile& profile, std::string_view aa) const {
   // Undersampling traces one ray through each traced pixel; supersampling traces several.
   if (undersample > 0 && spp > 1) {
-    std::string why = "--aa undersample";
-    if (undersample != 2) {  // 2 is the default, which the command line spells without K
-      why += ':';
+    std::string why = "--aa ";
+    if (!aa.empty()) {
+      why += aa;
+    } else {
+      why += "undersample:";
       why += std::to_string(undersample);
     }
     why += " traces one ray per traced pixel; drop --spp ";

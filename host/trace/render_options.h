@@ -10,6 +10,7 @@
 #include <ostream>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "host/model/formats.h"
@@ -122,8 +123,9 @@ struct RenderOptions {
   // Every combination of options that cannot run, in one place: the first one's reason, in the
   // command line's words (empty: these options run on `profile`). The command line refuses them
   // before any work (exit 2), and the stream tracer's constructor throws vgpu::Error with the same
-  // text. Needs `formats` resolved for the MRT check (fp32 everywhere before that).
-  std::string refusal(const vgpu::Profile& profile) const;
+  // text. Needs `formats` resolved for the MRT check (fp32 everywhere before that). `aa`: the
+  // command line's --aa text, named as the user wrote it (empty: the mode's own name).
+  std::string refusal(const vgpu::Profile& profile, std::string_view aa = {}) const;
 };
 
 // Glass's ray streams (host/trace/stream/ray_streams.h): what one frame's streams held and cost,
