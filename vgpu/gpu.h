@@ -105,10 +105,10 @@ class Gpu final : public Device {
   FrameStats& stats() override { return stats_; }
   const FrameStats& stats() const { return stats_; }
 
-  // Emulator shortcut for walks run batch by batch (vgpu/batch.h, host/trace/stream/stream_tracer.cpp):
-  // the next draw() runs no fragment and charges the pass as `t` says its fragments ran (t must
-  // outlive that draw). Every check a draw makes is still made; the targets and the stencil
-  // write hold what the walk left there.
+  // Emulator shortcut for walks run batch by batch (vgpu/batch.h,
+  // host/trace/walks/batch_walk.h): the next draw() runs no fragment and charges the pass as
+  // `t` says its fragments ran (t must outlive that draw). Every check a draw makes is still made;
+  // the targets and the stencil write hold what the walk left there.
   void replay_next(const PassTally& t) { replay_ = &t; }
   // body(item, slot) for items [0, n) on the calling thread and the workers; slot <
   // threads() is the running thread's own (for per-thread accumulators).

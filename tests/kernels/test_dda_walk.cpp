@@ -9,8 +9,8 @@
 #include <vector>
 
 #include "host/accel/grid.h"
-#include "tests/support/reference.h"
 #include "kernel_pass.h"
+#include "tests/support/reference.h"
 
 using kernels::kFar;
 using kernels::kNone;

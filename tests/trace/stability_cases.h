@@ -25,8 +25,8 @@
 #include "host/scene/camera.h"
 #include "host/scene/scene.h"
 #include "host/trace/cpu/cpu_tracer.h"
-#include "tests/support/reference.h"
 #include "host/trace/stream/stream_tracer.h"
+#include "tests/support/reference.h"
 
 namespace stability {
 

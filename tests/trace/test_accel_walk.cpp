@@ -1,5 +1,5 @@
-// The helpers every walk shares (host/trace/walks/accel_walk.h): the check that a format addresses a
-// structure's nodes and lists exactly, and the static textures' rewrite between frames.
+// The helpers every walk shares (host/trace/walks/accel_walk.h): the check that a format addresses
+// a structure's nodes and lists exactly, and the static textures' rewrite between frames.
 #include <doctest/doctest.h>
 
 #include <string>

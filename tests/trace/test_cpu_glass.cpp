@@ -14,8 +14,8 @@
 #include "host/accel/grid2.h"
 #include "host/accel/kdtree.h"
 #include "host/trace/cpu/cpu_tracer.h"
-#include "host/trace/walks/grid_walk.h"
 #include "host/trace/cpu/optics.h"
+#include "host/trace/walks/grid_walk.h"
 #include "kernels/kernels.h"
 
 namespace {

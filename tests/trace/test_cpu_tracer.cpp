@@ -12,8 +12,8 @@
 #include "host/scene/camera.h"
 #include "host/scene/gltf_loader.h"
 #include "host/trace/cpu/cpu_tracer.h"
-#include "tests/support/reference.h"
 #include "host/trace/stream/stream_tracer.h"
+#include "tests/support/reference.h"
 
 namespace {
 

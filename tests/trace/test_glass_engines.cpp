@@ -15,8 +15,8 @@
 #include "host/scene/camera.h"
 #include "host/scene/gltf_loader.h"
 #include "host/trace/cpu/cpu_tracer.h"
-#include "host/trace/walks/grid_walk.h"
 #include "host/trace/stream/stream_tracer.h"
+#include "host/trace/walks/grid_walk.h"
 #include "vgpu/profile.h"
 
 namespace {

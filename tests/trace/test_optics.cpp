@@ -1,5 +1,5 @@
-// Known answers for host/trace/cpu/optics.h, the glass optics of the CPU reference tracer: Fresnel at
-// normal incidence, total internal reflection exactly at the critical angle, Snell's law, the
+// Known answers for host/trace/cpu/optics.h, the glass optics of the CPU reference tracer: Fresnel
+// at normal incidence, total internal reflection exactly at the critical angle, Snell's law, the
 // reflectance seen from both sides, and a slab's parallel displacement.
 #include <doctest/doctest.h>
 

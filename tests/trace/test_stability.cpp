@@ -10,8 +10,8 @@
 #include <string>
 #include <tuple>
 
-#include "tests/support/reference.h"
 #include "stability_cases.h"
+#include "tests/support/reference.h"
 
 namespace {
 

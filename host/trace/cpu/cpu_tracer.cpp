@@ -603,10 +603,10 @@ class Tracer {
   double spread_ = 0;             // angle between neighbouring pixels' rays (base_texel)
 };
 
-// --aa adaptive as the stream tracer runs it (host/trace/stream/stream_tracer.cpp, render_adaptive):
-// the centre ray, then levels of n x n samples where marcarPixeles' rule marks the pixel (a
-// neighbour's surface key differs, or the colour's second difference exceeds the threshold),
-// each level's samples replacing the pixel's earlier ones.
+// --aa adaptive as the stream tracer runs it (host/trace/stream/stream_tracer.cpp,
+// render_adaptive): the centre ray, then levels of n x n samples where marcarPixeles' rule marks
+// the pixel (a neighbour's surface key differs, or the colour's second difference exceeds the
+// threshold), each level's samples replacing the pixel's earlier ones.
 void adaptive(const Tracer& tracer, const RenderOptions& opt, unsigned workers,
               std::vector<Counters>& counters, RenderResult& res) {
   const int W = opt.width, H = opt.height;

@@ -1,8 +1,9 @@
 // The paper's "CPU" column and the accuracy ground truth: a direct, recursive Whitted tracer on
 // the host in double precision. Same camera, grid, traversal rule, shading models, shadows,
-// offsets and blend formula as the stream tracer (host/trace/stream/stream_tracer.h), so the two images
-// can be compared pixel by pixel; only the precision (double against the card's fp32/fp24/fp16) and
-// the execution model (recursion and a per-ray loop against query-steered passes) differ.
+// offsets and blend formula as the stream tracer (host/trace/stream/stream_tracer.h), so the two
+// images can be compared pixel by pixel; only the precision (double against the card's
+// fp32/fp24/fp16) and the execution model (recursion and a per-ray loop against query-steered
+// passes) differ.
 #pragma once
 
 #include <cstdint>
@@ -71,8 +72,8 @@ struct CpuRay {
 //   - blend: final = sum_i w_i (1 - a_i) C_i, w_{i+1} = w_i a_i; reflection stops when
 //     w < 1/512 or after 1 + bounces iterations;
 //   - glass (Material::transmission t > 0): docs/materials.md's model, the exact Fresnel term F
-//     of host/trace/cpu/optics.h splitting w into (1 - t)(1 - a) for the local shading, (1 - t) a + t F
-//     for the reflected ray and t (1 - F) for the refracted one, the same cut-off and limit.
+//     of host/trace/cpu/optics.h splitting w into (1 - t)(1 - a) for the local shading, (1 - t) a +
+//     t F for the reflected ray and t (1 - F) for the refracted one, the same cut-off and limit.
 // Multi-threaded over rows (options.threads, 0 = every core); each pixel is computed alone, so
 // the output is bit-identical for any thread count. RenderResult::stats (vgpu::FrameStats) stays
 // empty; rays_traced counts the rays that enter the grid, as the stream tracer's queries do;

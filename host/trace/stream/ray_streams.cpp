@@ -1,5 +1,5 @@
-// Glass's ray streams (host/trace/stream/ray_streams.h): the levels' textures, the compaction (scan,
-// counts, gather), the chunk copies and the colour's way back, each pass counted by job.
+// Glass's ray streams (host/trace/stream/ray_streams.h): the levels' textures, the compaction
+// (scan, counts, gather), the chunk copies and the colour's way back, each pass counted by job.
 #include "host/trace/stream/ray_streams.h"
 
 #include <algorithm>

@@ -1,7 +1,8 @@
-// What the host loop (host/trace/stream/stream_tracer.cpp) needs of an acceleration structure's walk
-// (AccelWalk), and what the four walks share (ListWalk): the paper's uniform grid (grid_walk.h)
-// and the extensions (bvh_walk.h, kd_walk.h, grid2_walk.h) each keep only their textures,
-// programs, pass sites and sequence. How a pass sequence runs is host/trace/walks/walk.h's business.
+// What the host loop (host/trace/stream/stream_tracer.cpp) needs of an acceleration structure's
+// walk (AccelWalk), and what the four walks share (ListWalk): the paper's uniform grid
+// (grid_walk.h) and the extensions (bvh_walk.h, kd_walk.h, grid2_walk.h) each keep only their
+// textures, programs, pass sites and sequence. How a pass sequence runs is
+// host/trace/walks/walk.h's business.
 #pragma once
 
 #include <cstdint>

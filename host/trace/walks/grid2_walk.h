@@ -10,9 +10,9 @@
 #include <vector>
 
 #include "host/accel/grid2.h"
-#include "host/trace/walks/accel_walk.h"
 #include "host/trace/passes.h"
 #include "host/trace/render_options.h"
+#include "host/trace/walks/accel_walk.h"
 #include "kernels/kernels.h"
 #include "vgpu/vgpu.h"
 

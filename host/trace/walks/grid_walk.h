@@ -9,9 +9,9 @@
 #include "host/accel/grid.h"
 #include "host/model/formats.h"
 #include "host/scene/scene.h"
-#include "host/trace/walks/accel_walk.h"
 #include "host/trace/passes.h"
 #include "host/trace/render_options.h"
+#include "host/trace/walks/accel_walk.h"
 #include "kernels/kernels.h"
 #include "vgpu/vgpu.h"
 
