@@ -143,7 +143,7 @@ def plot_chart(pred, llvm, remote, earlier):
     fig.savefig(os.path.join(DOCS, "real_gpu.png"), dpi=110)
 
 
-def main():
+def parse_args():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--bench", default=os.path.join(ROOT, "build/bench/bench_gl"))
     ap.add_argument("--runs", type=int, default=3)
@@ -155,8 +155,12 @@ def main():
                     help="NAME=FILE.json: that machine's frames with --variants (MRT, looping)")
     ap.add_argument("--add-run", action="append", default=[],
                     help="NAME=FILE.json: an earlier run there, for its frame times and clocks")
-    args = ap.parse_args()
+    return ap.parse_args()
 
+
+def measure(args):
+    """Runs bench_gl on this machine for the JSON that is missing (all of it without --reuse).
+    Returns the paths of the llvmpipe figures, the predictions and the variants' predictions."""
     local = os.path.join(RESULTS, "real_gpu_llvmpipe.json")
     preds = os.path.join(RESULTS, "real_gpu_predictions.json")
     if not args.reuse or not os.path.exists(local):
@@ -168,132 +172,149 @@ def main():
     if args.add_variants and (not args.reuse or not os.path.exists(preds_var)):
         run([args.bench, "--runs", "1", "--sizes", "256", "1024", "--readback-wait", "none",
              "--variants", "mrt", "looping", "--json", preds_var])
+    return local, preds, preds_var
 
-    def named(specs):
-        out = {}
-        for a in specs:
-            name, _, path = a.partition("=")
-            if not path or not os.path.exists(path):
-                sys.exit(f"real_gpu: {a}: expected NAME=FILE.json with an existing file")
-            out[name] = (load(path), clocks(path.replace(".json", "_clocks.csv")))
-        return out
 
-    remote = named(args.add)
-    earlier = named(args.add_run)
-    variants = named(args.add_variants)
-    llvm = load(local)
-    pred = frames_by(load(preds))
+def named(specs):
+    """NAME=FILE.json arguments as {NAME: (the JSON, its busy SM clocks or None)}."""
+    out = {}
+    for a in specs:
+        name, _, path = a.partition("=")
+        if not path or not os.path.exists(path):
+            sys.exit(f"real_gpu: {a}: expected NAME=FILE.json with an existing file")
+        out[name] = (load(path), clocks(path.replace(".json", "_clocks.csv")))
+    return out
 
-    lines = ["# The paper's passes on real OpenGL drivers",
-             "",
-             "Written by `scripts/docs/real_gpu.py` from `bench/bench_gl` (do not edit by hand). The GL",
-             "device (`gl/`) runs the stream tracer's host loop unchanged, with fragment shaders",
-             "generated from the same C++ kernels the emulator runs. Frames use `docs/table1.md`'s",
-             "settings (3 iterations, phong, no shadow rays, a 15³ grid); every figure is the median",
-             "of the runs after one warm-up (which compiles the programs). Predictions are the cost",
-             "model's (`host/model/cost_model.cpp`) from the emulator's counts of the same frame, which",
-             "equal the GL device's (`tests/gl`).",
-             ""]
 
-    for name, (d, clk) in remote.items():
-        fb = frames_by(d)
-        lines += [f"## {name}: {d['device']}", ""]
-        if clk:
-            lines += [f"SM clock while the GPU was busy (nvidia-smi every 200 ms): median "
-                      f"**{statistics.median(clk):.0f} MHz**, {min(clk):.0f}–{max(clk):.0f} MHz "
-                      f"over {len(clk)} samples.", ""]
-        lines += ["### Fixed costs", "",
-                  "Tiny passes (copy the own texel), wall clock per pass; each pass also carries",
-                  "the GL device's own non-blocking sample and timer queries. *Blocking*: the host",
-                  "asks for GL_QUERY_RESULT and the driver waits; *polled*: it spins on",
-                  "GL_QUERY_RESULT_AVAILABLE.", "",
-                  f"- one pass: **{fmt(d['pass_us'], 2)} µs**; a blocking read-back "
-                  f"**{fmt(d['readback_us'], 2)} µs** more; a program switch "
-                  f"{fmt(d['program_switch_us'], 2)} µs (noise)", ""]
-        lines += fixed_table(d) + [""]
-        lines += ["### Frames, measured and predicted", "",
-                  "| scene | size | wall ms, blocking | wall ms, polled | GPU ms | passes | "
-                  "read-backs | predicted ms | predicted vs polled | vs blocking |",
-                  "|---|---|---|---|---|---|---|---|---|---|"]
-        for (scene, size, eng), f in fb.items():
-            if eng != "gl":
-                continue
-            p = fb.get((scene, size, "gl-poll"))
-            pr = pred.get((scene, size, "stream"))
-            pm = pr["predicted_ms"].get(name) if pr else None
-            lines.append(
-                f"| {scene} | {size}² | {fmt(f['wall_ms'])} | {fmt(p and p['wall_ms'])} | "
-                f"{fmt(f['gpu_ms'])} | {f['passes']:,} | {f['query_readbacks']:,} | {fmt(pm)} | "
-                f"{pct(pm, p and p['wall_ms'])} | {pct(pm, f['wall_ms'])} |")
-        lines += ["", "Per kernel at the largest size, GPU ms (timer queries, polled run) beside "
-                  "the predicted fragment work (the fixed costs apart):", ""]
-        big = max((k[1] for k in fb), default=None)
-        rows = [f for (s, z, e), f in fb.items() if z == big and e == "gl-poll"]
-        if rows:
-            lines += ["| scene | kernel | passes | GPU ms | predicted work ms | measured / "
-                      "predicted |", "|---|---|---|---|---|---|"]
-            for f in rows:
-                pr = pred.get((f["scene"], big, "stream"))
-                pk = {k["name"]: k for k in pr["kernels"]} if pr else {}
-                for k in f["kernels"]:
-                    w = pk.get(k["name"], {}).get(f"predicted_{name}_work_ms")
-                    if k["gpu_ms"] < 1:
-                        continue
-                    ratio = f"{k['gpu_ms'] / w:.2f}" if w else "—"
-                    lines.append(f"| {f['scene']} | {k['name']} | {k['passes']:,} | "
-                                 f"{fmt(k['gpu_ms'], 2)} | {fmt(w, 2)} | {ratio} |")
-            lines.append("")
-    for name, (d, clk) in variants.items():
-        pv = load(preds_var) if os.path.exists(preds_var) else {"frames": []}
-        lines += [f"### The paper's future work on the {name}: MRT and looping kernels", "",
-                  "The same frames with the fused two-output passes (`--mrt on`) and with the "
-                  "looping kernels (`--kernels looping`, 32 steps a pass), on the `h200` profile, "
-                  "polled read-backs, measured in one run beside the multipass pipeline "
-                  f"(`{os.path.relpath(os.path.abspath(args.add_variants[0].partition('=')[2]), ROOT)}`)."]
-        if clk:
-            lines[-1] += (f" SM clock while busy: median {statistics.median(clk):.0f} MHz, "
-                          f"{min(clk):.0f}–{max(clk):.0f} MHz.")
-        lines += ["", "| scene | size | pipeline | wall ms | GPU ms | passes | read-backs | "
-                  "predicted ms | predicted vs wall | frames per second | x multipass |",
-                  "|---|---|---|---|---|---|---|---|---|---|---|"]
-        base = frames_by(d, "multipass")
-        cells = sorted({(f["scene"], f["size"]) for f in d["frames"]}, key=lambda c: (c[1], c[0]))
-        for scene, size in cells:
-            for v in ("multipass", "mrt", "looping"):
-                f = frames_by(d, v).get((scene, size, "gl-poll"))
-                if not f:
+INTRO = ["# The paper's passes on real OpenGL drivers",
+         "",
+         "Written by `scripts/docs/real_gpu.py` from `bench/bench_gl` (do not edit by hand). The GL",
+         "device (`gl/`) runs the stream tracer's host loop unchanged, with fragment shaders",
+         "generated from the same C++ kernels the emulator runs. Frames use `docs/table1.md`'s",
+         "settings (3 iterations, phong, no shadow rays, a 15³ grid); every figure is the median",
+         "of the runs after one warm-up (which compiles the programs). Predictions are the cost",
+         "model's (`host/model/cost_model.cpp`) from the emulator's counts of the same frame, which",
+         "equal the GL device's (`tests/gl`).",
+         ""]
+
+
+def remote_kernels(name, fb, pred):
+    """Per kernel at the largest size: the polled run's GPU ms beside the predicted work."""
+    lines = ["", "Per kernel at the largest size, GPU ms (timer queries, polled run) beside "
+             "the predicted fragment work (the fixed costs apart):", ""]
+    big = max((k[1] for k in fb), default=None)
+    rows = [f for (s, z, e), f in fb.items() if z == big and e == "gl-poll"]
+    if rows:
+        lines += ["| scene | kernel | passes | GPU ms | predicted work ms | measured / "
+                  "predicted |", "|---|---|---|---|---|---|"]
+        for f in rows:
+            pr = pred.get((f["scene"], big, "stream"))
+            pk = {k["name"]: k for k in pr["kernels"]} if pr else {}
+            for k in f["kernels"]:
+                w = pk.get(k["name"], {}).get(f"predicted_{name}_work_ms")
+                if k["gpu_ms"] < 1:
                     continue
-                src = pred if v == "multipass" else frames_by(pv, v)
-                pr = src.get((scene, size, "stream"))
-                # multipass predictions are the gf5700-profile run's counts priced on the h200
-                pm = pr["predicted_ms"].get(name) if pr else None
-                b = base.get((scene, size, "gl-poll"))
-                lines.append(
-                    f"| {scene} | {size}² | {v} | {fmt(f['wall_ms'])} | {fmt(f['gpu_ms'])} | "
-                    f"{f['passes']:,} | {f['query_readbacks']:,} | {fmt(pm)} | "
-                    f"{pct(pm, f['wall_ms'])} | {fps(f['wall_ms'])} | "
-                    f"{b['wall_ms'] / f['wall_ms']:.1f}x |")
+                ratio = f"{k['gpu_ms'] / w:.2f}" if w else "—"
+                lines.append(f"| {f['scene']} | {k['name']} | {k['passes']:,} | "
+                             f"{fmt(k['gpu_ms'], 2)} | {fmt(w, 2)} | {ratio} |")
         lines.append("")
-    for name, (d, clk) in earlier.items():
-        fb = frames_by(d)
-        lines += [f"### An earlier run ({name}): the emulator's runs between the GL frames", ""]
-        if clk:
-            lines += [f"SM clock while busy: median {statistics.median(clk):.0f} MHz, "
-                      f"{min(clk):.0f}–{max(clk):.0f} MHz over {len(clk)} samples.", ""]
-        lines += ["| scene | size | GL wall ms (blocking) | GL GPU ms | emulator host ms "
-                  "(16 threads) |", "|---|---|---|---|---|"]
-        for (scene, size, eng), f in fb.items():
-            if eng != "gl":
-                continue
-            s = fb.get((scene, size, "stream"))
-            lines.append(f"| {scene} | {size}² | {fmt(f['wall_ms'])} | {fmt(f['gpu_ms'])} | "
-                         f"{fmt(s and s['wall_ms'])} |")
-        lines.append("")
+    return lines
 
-    lines += [f"## llvmpipe: {llvm['device']}", "",
-              f"- one pass: **{fmt(llvm['pass_us'], 2)} µs**; a blocking read-back "
-              f"**{fmt(llvm['readback_us'], 2)} µs** more; a program switch "
-              f"**{fmt(llvm['program_switch_us'], 2)} µs** more", ""]
+
+def remote_section(name, d, clk, pred):
+    """The section of one machine given with --add: its clock, fixed costs, frames and kernels."""
+    fb = frames_by(d)
+    lines = [f"## {name}: {d['device']}", ""]
+    if clk:
+        lines += [f"SM clock while the GPU was busy (nvidia-smi every 200 ms): median "
+                  f"**{statistics.median(clk):.0f} MHz**, {min(clk):.0f}–{max(clk):.0f} MHz "
+                  f"over {len(clk)} samples.", ""]
+    lines += ["### Fixed costs", "",
+              "Tiny passes (copy the own texel), wall clock per pass; each pass also carries",
+              "the GL device's own non-blocking sample and timer queries. *Blocking*: the host",
+              "asks for GL_QUERY_RESULT and the driver waits; *polled*: it spins on",
+              "GL_QUERY_RESULT_AVAILABLE.", "",
+              f"- one pass: **{fmt(d['pass_us'], 2)} µs**; a blocking read-back "
+              f"**{fmt(d['readback_us'], 2)} µs** more; a program switch "
+              f"{fmt(d['program_switch_us'], 2)} µs (noise)", ""]
+    lines += fixed_table(d) + [""]
+    lines += ["### Frames, measured and predicted", "",
+              "| scene | size | wall ms, blocking | wall ms, polled | GPU ms | passes | "
+              "read-backs | predicted ms | predicted vs polled | vs blocking |",
+              "|---|---|---|---|---|---|---|---|---|---|"]
+    for (scene, size, eng), f in fb.items():
+        if eng != "gl":
+            continue
+        p = fb.get((scene, size, "gl-poll"))
+        pr = pred.get((scene, size, "stream"))
+        pm = pr["predicted_ms"].get(name) if pr else None
+        lines.append(
+            f"| {scene} | {size}² | {fmt(f['wall_ms'])} | {fmt(p and p['wall_ms'])} | "
+            f"{fmt(f['gpu_ms'])} | {f['passes']:,} | {f['query_readbacks']:,} | {fmt(pm)} | "
+            f"{pct(pm, p and p['wall_ms'])} | {pct(pm, f['wall_ms'])} |")
+    return lines + remote_kernels(name, fb, pred)
+
+
+def variants_section(name, d, clk, pred, pv, source):
+    """The MRT and looping frames given with --add-variants (read from SOURCE) beside the
+    multipass ones; PV holds this machine's predictions of the variants."""
+    lines = [f"### The paper's future work on the {name}: MRT and looping kernels", "",
+             "The same frames with the fused two-output passes (`--mrt on`) and with the "
+             "looping kernels (`--kernels looping`, 32 steps a pass), on the `h200` profile, "
+             "polled read-backs, measured in one run beside the multipass pipeline "
+             f"(`{os.path.relpath(os.path.abspath(source), ROOT)}`)."]
+    if clk:
+        lines[-1] += (f" SM clock while busy: median {statistics.median(clk):.0f} MHz, "
+                      f"{min(clk):.0f}–{max(clk):.0f} MHz.")
+    lines += ["", "| scene | size | pipeline | wall ms | GPU ms | passes | read-backs | "
+              "predicted ms | predicted vs wall | frames per second | x multipass |",
+              "|---|---|---|---|---|---|---|---|---|---|---|"]
+    base = frames_by(d, "multipass")
+    cells = sorted({(f["scene"], f["size"]) for f in d["frames"]}, key=lambda c: (c[1], c[0]))
+    for scene, size in cells:
+        for v in ("multipass", "mrt", "looping"):
+            f = frames_by(d, v).get((scene, size, "gl-poll"))
+            if not f:
+                continue
+            src = pred if v == "multipass" else frames_by(pv, v)
+            pr = src.get((scene, size, "stream"))
+            # multipass predictions are the gf5700-profile run's counts priced on the h200
+            pm = pr["predicted_ms"].get(name) if pr else None
+            b = base.get((scene, size, "gl-poll"))
+            lines.append(
+                f"| {scene} | {size}² | {v} | {fmt(f['wall_ms'])} | {fmt(f['gpu_ms'])} | "
+                f"{f['passes']:,} | {f['query_readbacks']:,} | {fmt(pm)} | "
+                f"{pct(pm, f['wall_ms'])} | {fps(f['wall_ms'])} | "
+                f"{b['wall_ms'] / f['wall_ms']:.1f}x |")
+    lines.append("")
+    return lines
+
+
+def earlier_section(name, d, clk):
+    """An earlier run given with --add-run: its GL frames beside the emulator's."""
+    fb = frames_by(d)
+    lines = [f"### An earlier run ({name}): the emulator's runs between the GL frames", ""]
+    if clk:
+        lines += [f"SM clock while busy: median {statistics.median(clk):.0f} MHz, "
+                  f"{min(clk):.0f}–{max(clk):.0f} MHz over {len(clk)} samples.", ""]
+    lines += ["| scene | size | GL wall ms (blocking) | GL GPU ms | emulator host ms "
+              "(16 threads) |", "|---|---|---|---|---|"]
+    for (scene, size, eng), f in fb.items():
+        if eng != "gl":
+            continue
+        s = fb.get((scene, size, "stream"))
+        lines.append(f"| {scene} | {size}² | {fmt(f['wall_ms'])} | {fmt(f['gpu_ms'])} | "
+                     f"{fmt(s and s['wall_ms'])} |")
+    lines.append("")
+    return lines
+
+
+def llvmpipe_section(llvm):
+    """This machine's EGL device: fixed costs and Table 1's frames, GL beside the emulator."""
+    lines = [f"## llvmpipe: {llvm['device']}", "",
+             f"- one pass: **{fmt(llvm['pass_us'], 2)} µs**; a blocking read-back "
+             f"**{fmt(llvm['readback_us'], 2)} µs** more; a program switch "
+             f"**{fmt(llvm['program_switch_us'], 2)} µs** more", ""]
     lines += fixed_table(llvm) + [""]
     lines += ["| scene | size | engine | wall ms | GPU ms | passes | read-backs |",
               "|---|---|---|---|---|---|---|"]
@@ -302,6 +323,27 @@ def main():
         lines.append(f"| {f['scene']} | {f['size']}² | {eng} | {fmt(f['wall_ms'])} | "
                      f"{fmt(f.get('gpu_ms'))} | {f['passes']:,} | {f['query_readbacks']:,} |")
     lines.append("")
+    return lines
+
+
+def main():
+    args = parse_args()
+    local, preds, preds_var = measure(args)
+    remote = named(args.add)
+    earlier = named(args.add_run)
+    variants = named(args.add_variants)
+    llvm = load(local)
+    pred = frames_by(load(preds))
+
+    lines = list(INTRO)
+    for name, (d, clk) in remote.items():
+        lines += remote_section(name, d, clk, pred)
+    for name, (d, clk) in variants.items():
+        pv = load(preds_var) if os.path.exists(preds_var) else {"frames": []}
+        lines += variants_section(name, d, clk, pred, pv, args.add_variants[0].partition("=")[2])
+    for name, (d, clk) in earlier.items():
+        lines += earlier_section(name, d, clk)
+    lines += llvmpipe_section(llvm)
 
     plot_chart(pred, llvm, remote, earlier)
     png = os.path.join(DOCS, "real_gpu.png")

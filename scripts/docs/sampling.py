@@ -443,7 +443,7 @@ def plot_chart(main_rows, scenes, size):
     fig.savefig(os.path.join(ROOT, "docs/sampling.png"), dpi=110)
 
 
-def main():
+def parse_args():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--bench", default=os.path.join(ROOT, "build/bench/bench_sampling"))
     ap.add_argument("--size", type=int, default=128)
@@ -471,21 +471,13 @@ def main():
     ap.add_argument("--h200-looping-clocks", metavar="CSV",
                     default=os.path.join(ROOT, "results", "sampling", "sampling_h200_looping_clocks.csv"),
                     help="nvidia-smi's clock log of the looping run")
-    args = ap.parse_args()
-    if args.bounds_only:
-        with tempfile.TemporaryDirectory() as work:
-            hf.replace_section(DOC, BOUNDS_BEGIN, BOUNDS_END,
-                               bounds_section(args.bounds_bench, work, args.changed_size))
-        print("sampling.py: wrote docs/sampling.md's bounds section", file=sys.stderr)
-        return
-    if args.h200:
-        hf.replace_section(DOC, H200_BEGIN, H200_END,
-                           h200(args.h200, args.h200_clocks, args.h200_looping,
-                                args.h200_looping_control, args.h200_looping_clocks))
-        print("sampling.py: wrote docs/sampling.md's H200 section", file=sys.stderr)
-        return
-    scenes = args.scenes.split(",")
-    others = [s for s in args.other_scenes.split(",") if s]
+    return ap.parse_args()
+
+
+def measure(args, scenes, others):
+    """Runs bench_sampling three times (every mode on the main scenes; the adaptive and
+    undersampling modes on the others; undersampling's changed pixels at --changed-size) and
+    bench_undersample_bounds. Returns their rows and the bounds section's text."""
     common = ["--size", str(args.size), "--reps", str(args.reps)]
     with tempfile.TemporaryDirectory() as work:
         main_rows = bench(args.bench, [*common, "--scenes", args.scenes], work, "main")["rows"]
@@ -496,10 +488,12 @@ def main():
                                      "0", "--modes", "undersample", "--scenes",
                                      ",".join(scenes + others)], work, "changed")["rows"]
         bounds = bounds_section(args.bounds_bench, work, args.changed_size)
+    return main_rows, other_rows, changed, bounds
 
-    plot_chart(main_rows, scenes, args.size)
 
-    out = [
+def intro(args):
+    """The page's title, how the figures were made, the chart, and the prose before the tables."""
+    return [
         "# Sampling: error against rays, passes and modeled time",
         "",
         "Written by `scripts/docs/sampling.py` from `bench_sampling`'s figures (do not edit by hand; "
@@ -514,8 +508,12 @@ def main():
         "",
         "![error against modeled time](sampling.png)",
         "",
-    ] + HOW_2004
-    out += RULES
+    ] + HOW_2004 + RULES
+
+
+def scene_tables(scenes, others, main_rows, other_rows):
+    """One table per main scene (Pareto front marked), then the other scenes' tables."""
+    out = []
     for scene in scenes:
         rs = [r for r in main_rows if r["scene"] == scene]
         out += [f"## {scene} ({rs[0]['edge_pixels']} edge pixels)", ""] + table(rs, True) + [""]
@@ -527,13 +525,18 @@ def main():
             rs = [r for r in other_rows if r["scene"] == scene]
             out += [f"### {scene} ({rs[0]['edge_pixels']} edge pixels)", ""] + \
                 table(rs, False) + [""]
+    return out
 
-    out += ["## Against the targets", "",
-            "**Adaptive supersampling**: the RMS error of 16 samples per pixel within 1.5x, with "
-            "at most 35% of their rays (5.6 primary rays per pixel, the centre ray and every "
-            "level's counted).", "",
-            "| scene | spp 16 RMS | best adaptive 16 meeting it | its RMS / spp 16's | its rays "
-            "/ 16 | met |", "|---|---:|---|---:|---:|:-:|"]
+
+def adaptive_target(scenes, others, main_rows, other_rows):
+    """Adaptive supersampling against its target: the best mode meeting it per scene, then
+    which scenes each single threshold meets it on."""
+    out = ["## Against the targets", "",
+           "**Adaptive supersampling**: the RMS error of 16 samples per pixel within 1.5x, with "
+           "at most 35% of their rays (5.6 primary rays per pixel, the centre ray and every "
+           "level's counted).", "",
+           "| scene | spp 16 RMS | best adaptive 16 meeting it | its RMS / spp 16's | its rays "
+           "/ 16 | met |", "|---|---:|---|---:|---:|:-:|"]
     for scene in scenes + others:
         rows = main_rows if scene in scenes else other_rows
         rs = {r["mode"]: r for r in rows if r["scene"] == scene}
@@ -562,16 +565,22 @@ def main():
                 f"{100 * rs[mode]['rays_mean'] / 16:.0f}%)")
         out.append(f"- T {t} alone meets the target on {len(met)} of {len(met) + len(missed)} "
                    f"scenes" + (f"; not on {', '.join(missed)}." if missed else "."))
-    out += ["", "**Undersampling, K = 2**: at most 1% of the pixels of a full render changed, with "
-            "a third of its primary rays or fewer (0.333 per pixel), at "
-            f"{args.changed_size}x{args.changed_size}. A pixel *changes* when some channel of its "
-            "8-bit value differs from the one-ray render's by more than 1/255: a difference of "
-            "one step is the rounding of two nearly equal floats (the traced and the "
-            "interpolated colour of a smooth shade), not something a viewer sees; the share "
-            "differing by more than 0.05 (visibly) is given too. T: `--aa-threshold`, the "
-            "colour spread of the lattice pixels a pixel's fill blends above which it is traced.", "",
-            "| scene | mode | rays / pixel | changed > 1/255 | changed > 0.05 | met |",
-            "|---|---|---:|---:|---:|:-:|"]
+    return out
+
+
+def undersample_target(scenes, others, changed, changed_size):
+    """Undersampling against its target: rays and changed pixels per scene and threshold, which
+    scenes meet it, and why the modeled time does not follow the rays."""
+    out = ["", "**Undersampling, K = 2**: at most 1% of the pixels of a full render changed, with "
+           "a third of its primary rays or fewer (0.333 per pixel), at "
+           f"{changed_size}x{changed_size}. A pixel *changes* when some channel of its "
+           "8-bit value differs from the one-ray render's by more than 1/255: a difference of "
+           "one step is the rounding of two nearly equal floats (the traced and the "
+           "interpolated colour of a smooth shade), not something a viewer sees; the share "
+           "differing by more than 0.05 (visibly) is given too. T: `--aa-threshold`, the "
+           "colour spread of the lattice pixels a pixel's fill blends above which it is traced.", "",
+           "| scene | mode | rays / pixel | changed > 1/255 | changed > 0.05 | met |",
+           "|---|---|---:|---:|---:|:-:|"]
     for scene in scenes + others:
         for r in changed:
             if r["scene"] == scene and r["mode"].startswith("undersample 2"):
@@ -600,6 +609,33 @@ def main():
             "GeForce FX every fragment runs every pass, so the saved rays save nothing there; "
             "with early-z masks (`--masks on`) unmarked fragments cost nothing, but passes, "
             "program loads and query read-backs stay.", ""]
+    return out
+
+
+def main():
+    args = parse_args()
+    if args.bounds_only:
+        with tempfile.TemporaryDirectory() as work:
+            hf.replace_section(DOC, BOUNDS_BEGIN, BOUNDS_END,
+                               bounds_section(args.bounds_bench, work, args.changed_size))
+        print("sampling.py: wrote docs/sampling.md's bounds section", file=sys.stderr)
+        return
+    if args.h200:
+        hf.replace_section(DOC, H200_BEGIN, H200_END,
+                           h200(args.h200, args.h200_clocks, args.h200_looping,
+                                args.h200_looping_control, args.h200_looping_clocks))
+        print("sampling.py: wrote docs/sampling.md's H200 section", file=sys.stderr)
+        return
+    scenes = args.scenes.split(",")
+    others = [s for s in args.other_scenes.split(",") if s]
+    main_rows, other_rows, changed, bounds = measure(args, scenes, others)
+
+    plot_chart(main_rows, scenes, args.size)
+
+    out = intro(args)
+    out += scene_tables(scenes, others, main_rows, other_rows)
+    out += adaptive_target(scenes, others, main_rows, other_rows)
+    out += undersample_target(scenes, others, changed, args.changed_size)
     # Measured once by hand (session 9, bench_sampling), kept here so that a regeneration keeps it.
     out += [TRIED_BEND, ""]
     out += [BOUNDS_BEGIN, bounds, BOUNDS_END, ""]

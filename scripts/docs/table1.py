@@ -250,9 +250,22 @@ def main():
 
 
 def write_doc(data, masks, cpu, figures, readings, mrt, mrt_masks):
+    """docs/table1.md: the calibration, Table 1 beside the model, the statistics, where the
+    time goes, the what-ifs, the parameters and the reading of the paper's settings."""
+    L = intro_section()
+    L += table_section(data, cpu)
+    L += statistics_section(data)
+    L += breakdown_section(data)
+    L += what_if_section(data, masks, mrt, mrt_masks)
+    L += parameters_section()
+    L.append(explain_readings(data, figures, readings))
+    open(os.path.join(ROOT, "docs/table1.md"), "w").write("\n".join(L))
+
+
+def intro_section():
+    """The page's title, how it is written, the settings and the calibration."""
     L = []
     w = L.append
-    j0 = data[("Sphere", "gf5700")]
     w("# Table 1: the paper's times, our measurements and the cost model's predictions\n")
     w("Written by `/usr/bin/python3 scripts/docs/table1.py` (do not edit by hand). It renders every scene "
       "on every profile with `vgpu-rt render --stats-json`, and reads the statistics and the cost "
@@ -266,8 +279,13 @@ def write_doc(data, masks, cpu, figures, readings, mrt, mrt_masks):
       f"program load (u each) and a query read-back (2u each), is fitted on two of the six GPU "
       f"cells: {cal}. The other four GPU cells, every ratio but Bunny3's, and every what-if are "
       f"predictions. Everything else is a public hardware figure or an assumption stated below.\n")
+    return L
 
-    # --- the table
+
+def table_section(data, cpu):
+    """Table 1 beside the model's predictions, the 5700/6600 ratios and the targets."""
+    L = []
+    w = L.append
     w("## Table 1 beside the model\n")
     w("Times in ms. *paper*: Table 1. *pred.*: the cost model. *err*: (pred. - paper) / paper. "
       "*host*: wall time of this emulator on the build machine (a shared 2-core host; it measures "
@@ -323,8 +341,14 @@ def write_doc(data, masks, cpu, figures, readings, mrt, mrt_masks):
       f". 5700/6600 ratios within ±{TARGET_RATIO:.0%}: {len(in_ratio)} of {len(SCENES)}"
       + (f" ({', '.join(in_ratio)})" if in_ratio else "") + ". *Reading the paper's "
       "settings* below shows how these counts move with the settings the paper leaves unsaid.\n")
+    return L
 
-    # --- statistics
+
+def statistics_section(data):
+    """The virtual GPU's counts per scene that the predictions come from."""
+    L = []
+    w = L.append
+    j0 = data[("Sphere", "gf5700")]
     w("## The statistics the predictions come from\n")
     w("Counted by the virtual GPU (identical for every profile: the counters are static per-fragment "
       "counts times shaded fragments). *instructions* are the counted scalar operations of the "
@@ -346,8 +370,13 @@ def write_doc(data, masks, cpu, figures, readings, mrt, mrt_masks):
     w("")
     w("Passes by kernel (Sphere): " + ", ".join(
         f"{k['paper_name']} {k['passes']}" for k in j0["kernels"]) + ".\n")
+    return L
 
-    # --- breakdown
+
+def breakdown_section(data):
+    """Where the predicted time goes, per GPU and scene, and the FX 5700's overhead."""
+    L = []
+    w = L.append
     w("## Where the time goes\n")
     w("![breakdown](table1_breakdown.png)\n")
     w("Pass work is attributed to each pass's bottleneck (the larger of arithmetic, texture and "
@@ -370,8 +399,13 @@ def write_doc(data, masks, cpu, figures, readings, mrt, mrt_masks):
               f"{b['memory_demand_ms']:.0f} |")
     w("")
     w(explain_fx(data))
+    return L
 
-    # --- what if
+
+def what_if_section(data, masks, mrt, mrt_masks):
+    """What MRT, masks and resident programs would change on the FX 5700 and the 6600."""
+    L = []
+    w = L.append
     w("## What if the GeForce FX 5700 had ...\n")
     w("Every row is predicted by the same model and parameters from transformed or re-rendered "
       "statistics:\n")
@@ -421,10 +455,7 @@ def write_doc(data, masks, cpu, figures, readings, mrt, mrt_masks):
                   f"{b['total_ms']:.0f} | {pct(b['total_ms'] / b0 - 1) if name != 'baseline' else ''} |")
         w("")
     w(explain_what_if(data, masks, mrt))
-
-    L += parameters_section()
-    w(explain_readings(data, figures, readings))
-    open(os.path.join(ROOT, "docs/table1.md"), "w").write("\n".join(L))
+    return L
 
 
 def parameters_section():
