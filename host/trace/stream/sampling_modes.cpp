@@ -1,6 +1,8 @@
 // The sampling modes around the frame (StreamTracer::frame): --spp N sample frames, --aa
-// adaptive and --aa undersample:K. Each runs whole frames and resolves them into the current
-// result texture with the paper-style passes (acumularMuestras, resolverMuestras, ...).
+// adaptive and --aa undersample:K. Each runs whole frames, adds each frame's colours into a sum
+// (accumulate_samples, acumularMuestras) and ends in the frame's last stage, the sampling
+// resolve (resolve_samples: resolverMuestras, or rellenarHuecos), which leaves the pixels'
+// colours in the current result texture.
 #include <algorithm>
 #include <vector>
 
@@ -12,10 +14,26 @@ namespace host {
 using namespace kernels;
 using vgpu::Texture;
 
+void StreamTracer::accumulate_samples(const Texture* marks) {
+  State& s = *s_;
+  // acumularMuestras: the sum so far and the frame's colour (and, gated, the marks saying
+  // which pixels the frame traced) into the other sum texture.
+  if (marks)
+    s.runner->pass(s.accumulate, {&s.sum.current(), &s.result.current(), marks}, s.sum.next());
+  else
+    s.runner->pass(s.accumulate, {&s.sum.current(), &s.result.current()}, s.sum.next());
+  s.sum.swap();
+}
+
+void StreamTracer::resolve_samples(const vgpu::Program& resolve) {
+  State& s = *s_;
+  s.runner->pass(resolve, {&s.sum.current()}, s.result.next());
+  s.result.swap();
+}
+
 void StreamTracer::render_samples(const Camera& cam, RenderResult& res, int& iteration_number) {
   vgpu::Device& gpu = *gpu_;
   State& s = *s_;
-  PassRunner& r = *s.runner;
   // Supersampling as a 2004 card would: one whole frame per sample, each through its own
   // sub-pixel offset (generadorRayosMuestra), added into a sum texture (acumularMuestras),
   // then one box-filter pass (resolverMuestras). No texture grows with the sample count.
@@ -26,11 +44,9 @@ void StreamTracer::render_samples(const Camera& cam, RenderResult& res, int& ite
     s.sample_generate.kernel.jitter_y = j.y;
     frame(cam, s.sample_generate, res, k == 0, iteration_number);
     if (k == 0) res.first_frame_passes = gpu.stats().totals.passes;
-    r.pass(s.accumulate, {&s.sum.current(), &s.result.current()}, s.sum.next());
-    s.sum.swap();
+    accumulate_samples(nullptr);
   }
-  r.pass(s.resolve, {&s.sum.current()}, s.result.next());
-  s.result.swap();
+  resolve_samples(s.resolve);
   res.samples = opt_.spp;
 }
 
@@ -44,8 +60,7 @@ void StreamTracer::render_adaptive(const Camera& cam, RenderResult& res, int& it
   res.first_frame_passes = gpu.stats().totals.passes;
   gpu.clear(s.sum.current(), {0, 0, 0, 0});
   s.accumulate.kernel.gated = false;
-  r.pass(s.accumulate, {&s.sum.current(), &s.result.current()}, s.sum.next());
-  s.sum.swap();
+  accumulate_samples(nullptr);
   const std::vector<int> levels = adaptive_levels(opt_.spp);
   for (size_t l = 0; l < levels.size(); ++l) {
     // marcarPixeles on the current estimate, then pixelesMarcados: how many get more samples.
@@ -62,14 +77,11 @@ void StreamTracer::render_adaptive(const Camera& cam, RenderResult& res, int& it
       s.sample_generate.kernel.jitter_y = j.y;
       frame(cam, s.sample_generate, res, false, iteration_number, &s.marks.current());
       s.accumulate.kernel.restart = k == 0;
-      r.pass(s.accumulate, {&s.sum.current(), &s.result.current(), &s.marks.current()},
-             s.sum.next());
-      s.sum.swap();
+      accumulate_samples(&s.marks.current());
     }
     // The new estimate: the next level's marks read it, and after the last level it is the
     // image. (Where no pixel is marked at all, the centre frame's colour stays the image.)
-    r.pass(s.resolve, {&s.sum.current()}, s.result.next());
-    s.result.swap();
+    resolve_samples(s.resolve);
   }
   s.sample_generate.kernel.gated = false;
   s.accumulate.kernel.gated = false;
@@ -105,8 +117,7 @@ void StreamTracer::render_undersampled(const Camera& cam, RenderResult& res,
   gpu.clear(s.sum.current(), {0, 0, 0, 0});
   s.accumulate.kernel.gated = true;
   s.accumulate.kernel.restart = false;
-  r.pass(s.accumulate, {&s.sum.current(), &s.result.current(), &s.marks[0]}, s.sum.next());
-  s.sum.swap();
+  accumulate_samples(&s.marks[0]);
   // marcarHuecos into marks A (the lattice flags are done with), pixelesMarcados counts them;
   // the gaps' frame traces them.
   r.pass(s.mark_gaps, {&s.marks[1], &s.sum.current()}, s.marks[0]);
@@ -114,8 +125,7 @@ void StreamTracer::render_undersampled(const Camera& cam, RenderResult& res,
   if (r.count(s.marked, s.marks[0], nullptr, nullptr) > 0) {
     const std::vector<float> depth = res.depth, hit_id = res.hit_id;
     frame(cam, s.sample_generate, res, true, iteration_number, &s.marks[0]);
-    r.pass(s.accumulate, {&s.sum.current(), &s.result.current(), &s.marks[0]}, s.sum.next());
-    s.sum.swap();
+    accumulate_samples(&s.marks[0]);
     // The AOVs: the gaps' from this frame, the lattice's from the first.
     gpu.download(s.marks[0]);
     for (size_t i = 0; i < gap.size(); ++i) {
@@ -125,9 +135,9 @@ void StreamTracer::render_undersampled(const Camera& cam, RenderResult& res,
   }
   s.sample_generate.kernel.gated = false;
   s.accumulate.kernel.gated = false;
-  // rellenarHuecos: the traced pixels' colours, the rest blended from their lattice cell.
-  r.pass(s.fill, {&s.sum.current()}, s.result.next());
-  s.result.swap();
+  // The resolve, rellenarHuecos: the traced pixels' colours, the rest blended from their
+  // lattice cell.
+  resolve_samples(s.fill);
   // The AOVs of a pixel never traced: its lattice cell's nearest corner's.
   res.rays_per_pixel.assign(gap.size(), 0);
   for (int y = 0; y < H; ++y)

@@ -6,6 +6,7 @@
 
 #include "host/trace/passes.h"
 #include "host/trace/ping_pong.h"
+#include "host/trace/stream/atlas_upload.h"
 #include "host/trace/stream/ray_streams.h"
 #include "host/trace/stream/stream_tracer.h"
 #include "host/trace/walks/accel_walk.h"
@@ -16,9 +17,9 @@ struct StreamTracer::State {
   // Static textures: the scene, triangle i at texel (i mod width, i div width).
   vgpu::Texture v[3], n[3], colors;
   // Base-colour textures (scenes with a textured material): the corners' coordinates, the
-  // texture table and the atlas of mip chains (kernels/layout.h).
+  // texture table and the atlas of mip chains (host/trace/stream/atlas_upload.h).
   bool textured = false;
-  vgpu::Texture uvs01, uvs2, texture_table, atlas;
+  AtlasTextures base;
   // Dynamic textures: ping-pong pairs (host/trace/ping_pong.h) where a pass reads what it
   // replaces. The origins' current texture holds an iteration's ray origins, the next one its
   // hit points (the surface record the shader reads and the reflected rays start from).

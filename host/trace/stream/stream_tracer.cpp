@@ -15,6 +15,7 @@
 #include "host/common/parallel.h"
 #include "host/trace/passes.h"
 #include "host/trace/sampling.h"
+#include "host/trace/stream/atlas_upload.h"
 #include "host/trace/stream/devices.h"
 #include "host/trace/stream/ray_streams.h"
 #include "host/trace/stream/stream_state.h"
@@ -88,50 +89,10 @@ StreamTracer::StreamTracer(const Scene& scene, const Accel& accel, const RenderO
   // Scene textures: triangle i at texel (i mod width, i div width).
   write_scene(nullptr);
 
-  // Base-colour textures (kernels/base_color.h): the atlas, its table and the corners' UVs.
-  // Static: a moving scene's frames change positions, not UVs.
+  // Base-colour textures (kernels/base_color.h): the texture atlas upload (atlas_upload.h).
   if (!scene.textures.empty()) {
-    const int maxs = gpu.profile().max_texture_size;
-    const int sw = s.v[0].width(), sh = s.v[0].height();
-    const size_t ntri = scene.triangle_count();
-    std::vector<MipChain> chains;
-    size_t levels = 0;
-    for (const SceneTexture& t : scene.textures) {
-      chains.push_back(build_mip_chain(t));
-      levels = std::max(levels, chains.back().levels.size());
-    }
-    const TextureAtlas atlas = pack_atlas(chains, maxs);
-    const std::string why = atlas_refusal(atlas, scene.textures.size(), maxs, gpu.profile().name);
-    if (!why.empty()) throw vgpu::Error(why);
+    upload_texture_atlas(gpu, scene, s.v[0].width(), s.v[0].height(), s.base);
     s.textured = true;
-    s.atlas = gpu.make_texture("texture atlas", atlas.width, atlas.height, 4);
-    for (int y = 0; y < atlas.height; ++y)
-      for (int x = 0; x < atlas.width; ++x) {
-        const glm::vec4& c = atlas.texels[size_t(y) * size_t(atlas.width) + size_t(x)];
-        float* t = s.atlas.texel_mut(x, y);
-        for (int k = 0; k < 4; ++k) t[k] = c[k];
-      }
-    s.texture_table = gpu.make_texture("texture table", int(1 + levels), int(chains.size()), 4);
-    for (size_t i = 0; i < chains.size(); ++i) {
-      float* head = s.texture_table.texel_mut(0, int(i));
-      head[0] = float(chains[i].levels.size());
-      head[1] = float(scene.textures[i].wrap_s);
-      head[2] = float(scene.textures[i].wrap_t);
-      for (size_t k = 0; k < chains[i].levels.size(); ++k) {
-        float* r = s.texture_table.texel_mut(int(1 + k), int(i));
-        for (int c = 0; c < 4; ++c) r[c] = float(atlas.rects[i][k][c]);
-      }
-    }
-    s.uvs01 = gpu.make_texture("uvs01", sw, int(sh), 4);
-    s.uvs2 = gpu.make_texture("uvs2", sw, int(sh), 4);
-    for (size_t i = 0; i < ntri; ++i) {
-      float* a = s.uvs01.texel_mut(int(i % sw), int(i / sw));
-      float* b = s.uvs2.texel_mut(int(i % sw), int(i / sw));
-      a[0] = scene.uv0[i].x, a[1] = scene.uv0[i].y, a[2] = scene.uv1[i].x, a[3] = scene.uv1[i].y;
-      b[0] = scene.uv2[i].x, b[1] = scene.uv2[i].y;
-      b[2] = float(scene.materials[scene.material[i]].texture);
-    }
-    for (const Texture* t : {&s.uvs01, &s.uvs2, &s.texture_table, &s.atlas}) gpu.upload(*t);
   }
 
   // The acceleration structure's textures and walk (host/trace/walks/grid_walk.h, bvh_walk.h,
@@ -314,7 +275,7 @@ uint64_t StreamTracer::texture_bytes() const {
   if ((opt_.adaptive && opt_.spp > 1) || opt_.undersample > 0)
     b += s_->marks[0].bytes() + s_->marks[1].bytes() + s_->materials.bytes();
   if (s_->textured)
-    for (const Texture* t : {&s_->uvs01, &s_->uvs2, &s_->texture_table, &s_->atlas})
+    for (const Texture* t : {&s_->base.uvs01, &s_->base.uvs2, &s_->base.table, &s_->base.atlas})
       b += t->bytes();
   if (s_->streams) b += s_->streams->texture_bytes();  // grows with the frame's levels
   return b;
@@ -355,6 +316,8 @@ RenderResult StreamTracer::render(const Camera& cam) {
   int iteration_number = 0;
   // The sample frames' generator takes the same camera (its jitter and gate are set per frame).
   static_cast<GenerateRays&>(s.sample_generate.kernel) = g;
+  // One frame of the pipeline (frame()), or a sampling mode's frames, each mode ending in the
+  // sampling resolve (resolve_samples) that combines its sample frames into the pixels.
   if (opt_.undersample > 0) {
     render_undersampled(cam, res, iteration_number);
   } else if (opt_.spp <= 1) {
@@ -508,7 +471,7 @@ void StreamTracer::shader_pass(const Texture& surface, const Texture& rays, cons
     s.runner->pass(
         s.shader,
         {&surface, &rays, &colour, &shadow, &s.colors, &s.v[0], &s.v[1], &s.v[2], &s.n[0], &s.n[1],
-         &s.n[2], &origins, &s.uvs01, &s.uvs2, &s.texture_table, &s.atlas},
+         &s.n[2], &origins, &s.base.uvs01, &s.base.uvs2, &s.base.table, &s.base.atlas},
         out);
   else
     s.runner->pass(s.shader,

@@ -105,6 +105,14 @@ class StreamTracer {
   // The primary hits' depths and input triangle ids into res, from the current intersections.
   void download_aovs(RenderResult& res);
   // The sampling modes and their resolve (host/trace/stream/sampling_modes.cpp).
+  // acumularMuestras: the current frame's colours (gated: only in the pixels `marks` flags, if
+  // given) added into the sum of the sample frames; the sum ping-pongs.
+  void accumulate_samples(const vgpu::Texture* marks);
+  // The sampling resolve, the last stage of a frame with several samples per pixel: `resolve`
+  // (resolverMuestras, the box filter, or rellenarHuecos, the undersampling fill) turns the
+  // sum of the sample frames into the pixels' colours, in the next result texture, which
+  // becomes current (render() downloads it).
+  void resolve_samples(const vgpu::Program& resolve);
   // --spp N (N > 1): N sample frames (generadorRayosMuestra, each through its sub-pixel
   // offset), each added into the sum (acumularMuestras), then resolverMuestras box-filters the
   // sum into the current result texture.
