@@ -210,13 +210,14 @@ uint64_t RayStreams::compact(PassRunner& r, int k, const Texture& rays,
     const Texture* in = &L.split;
     scan.kernel.width = float(W_);
     scan.kernel.channel = 2;
+    L.scan.make_current(1);  // the first pass reads the split and writes scan A
     for (int p = 0; p < passes; ++p) {
       scan.kernel.offset = float(uint64_t(1) << p);
-      pass(r, scan, {in}, L.scan[p & 1], &rect, stats.compaction_passes, stats.compaction_bytes);
-      in = &L.scan[p & 1];
+      pass(r, scan, {in}, L.scan.next(), &rect, stats.compaction_passes, stats.compaction_bytes);
+      L.scan.swap();
+      in = &L.scan.current();
       scan.kernel.channel = 0;
     }
-    L.cur_scan = (passes - 1) & 1;
   }
   // contarRayos: the rays spawned by kind; their sum is the next level's length.
   const Texture& split_tex = levels_[size_t(k)].split;
@@ -248,7 +249,7 @@ uint64_t RayStreams::compact(PassRunner& r, int k, const Texture& rays,
   for (int part = 0; part < 3; ++part) {
     c.part = part;
     pass(r, compactor,
-         {&L.scan[L.cur_scan], &L.split, &rays, &L.surface, &glass_, statics[0], statics[1],
+         {&L.scan.current(), &L.split, &rays, &L.surface, &glass_, statics[0], statics[1],
           statics[2], statics[3], statics[4], statics[5]},
          *targets[part], &out, stats.compaction_passes, stats.compaction_bytes);
   }
@@ -262,7 +263,7 @@ void RayStreams::gather_back(PassRunner& r, int deepest, Texture& pixels) {
     Level& L = levels_[size_t(k)];
     Texture& out = k == 0 ? pixels : L.gathered;
     const Rect rect{0, 0, W_, int((L.n + uint64_t(W_) - 1) / uint64_t(W_))};
-    pass(r, gatherer, {L.shaded, &L.scan[L.cur_scan], &L.split, levels_[size_t(k + 1)].total}, out,
+    pass(r, gatherer, {L.shaded, &L.scan.current(), &L.split, levels_[size_t(k + 1)].total}, out,
          &rect, stats.gather_passes, stats.gather_bytes);
     L.total = &out;
   }

@@ -14,6 +14,7 @@
 
 #include "host/scene/scene.h"
 #include "host/trace/passes.h"
+#include "host/trace/ping_pong.h"
 #include "host/trace/render_options.h"
 #include "kernels/kernels.h"
 #include "vgpu/vgpu.h"
@@ -41,8 +42,7 @@ class RayStreams {
     // Written by compactarRayos (levels 1 and later; level 0 is the primary frame's textures).
     vgpu::Texture origins, rays, weight;
     vgpu::Texture surface, split, colour, gathered;  // inicioReflejo's, dividirRayos', shaded
-    vgpu::Texture scan[2];
-    int cur_scan = 0;
+    PingPong<vgpu::Texture> scan;           // sumaPrefijos' passes; current() holds the sums
     const vgpu::Texture* shaded = nullptr;  // the level's own colours (colour, or a pass's target)
     const vgpu::Texture* total = nullptr;   // with the children's added (reunirHijos)
   };

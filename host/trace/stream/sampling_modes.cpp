@@ -1,6 +1,8 @@
 // The sampling modes around the frame (StreamTracer::frame): --spp N sample frames, --aa
-// adaptive and --aa undersample:K. Each runs whole frames and resolves them into the current
-// result texture with the paper-style passes (acumularMuestras, resolverMuestras, ...).
+// adaptive and --aa undersample:K. Each runs whole frames, adds each frame's colours into a sum
+// (accumulate_samples, acumularMuestras) and ends in the frame's last stage, the sampling
+// resolve (resolve_samples: resolverMuestras, or rellenarHuecos), which leaves the pixels'
+// colours in the current result texture.
 #include <algorithm>
 #include <vector>
 
@@ -12,25 +14,39 @@ namespace host {
 using namespace kernels;
 using vgpu::Texture;
 
+void StreamTracer::accumulate_samples(const Texture* marks) {
+  State& s = *s_;
+  // acumularMuestras: the sum so far and the frame's colour (and, gated, the marks saying
+  // which pixels the frame traced) into the other sum texture.
+  if (marks)
+    s.runner->pass(s.accumulate, {&s.sum.current(), &s.result.current(), marks}, s.sum.next());
+  else
+    s.runner->pass(s.accumulate, {&s.sum.current(), &s.result.current()}, s.sum.next());
+  s.sum.swap();
+}
+
+void StreamTracer::resolve_samples(const vgpu::Program& resolve) {
+  State& s = *s_;
+  s.runner->pass(resolve, {&s.sum.current()}, s.result.next());
+  s.result.swap();
+}
+
 void StreamTracer::render_samples(const Camera& cam, RenderResult& res, int& iteration_number) {
   vgpu::Device& gpu = *gpu_;
   State& s = *s_;
-  PassRunner& r = *s.runner;
   // Supersampling as a 2004 card would: one whole frame per sample, each through its own
   // sub-pixel offset (generadorRayosMuestra), added into a sum texture (acumularMuestras),
   // then one box-filter pass (resolverMuestras). No texture grows with the sample count.
-  gpu.clear(s.sum[s.cur_sum], {0, 0, 0, 0});
+  gpu.clear(s.sum.current(), {0, 0, 0, 0});
   for (int k = 0; k < opt_.spp; ++k) {
     const glm::vec2 j = sample_offset(opt_.spp, k, opt_.sample_seed);
     s.sample_generate.kernel.jitter_x = j.x;
     s.sample_generate.kernel.jitter_y = j.y;
     frame(cam, s.sample_generate, res, k == 0, iteration_number);
     if (k == 0) res.first_frame_passes = gpu.stats().totals.passes;
-    r.pass(s.accumulate, {&s.sum[s.cur_sum], &s.result[s.cur_result]}, s.sum[s.cur_sum ^ 1]);
-    s.cur_sum ^= 1;
+    accumulate_samples(nullptr);
   }
-  r.pass(s.resolve, {&s.sum[s.cur_sum]}, s.result[s.cur_result ^ 1]);
-  s.cur_result ^= 1;
+  resolve_samples(s.resolve);
   res.samples = opt_.spp;
 }
 
@@ -42,16 +58,15 @@ void StreamTracer::render_adaptive(const Camera& cam, RenderResult& res, int& it
   // pixel's first estimate (one sample).
   frame(cam, s.generate, res, true, iteration_number, nullptr, true);
   res.first_frame_passes = gpu.stats().totals.passes;
-  gpu.clear(s.sum[s.cur_sum], {0, 0, 0, 0});
+  gpu.clear(s.sum.current(), {0, 0, 0, 0});
   s.accumulate.kernel.gated = false;
-  r.pass(s.accumulate, {&s.sum[s.cur_sum], &s.result[s.cur_result]}, s.sum[s.cur_sum ^ 1]);
-  s.cur_sum ^= 1;
+  accumulate_samples(nullptr);
   const std::vector<int> levels = adaptive_levels(opt_.spp);
   for (size_t l = 0; l < levels.size(); ++l) {
     // marcarPixeles on the current estimate, then pixelesMarcados: how many get more samples.
-    r.pass(s.mark, {&s.marks[s.cur_mark], &s.result[s.cur_result]}, s.marks[s.cur_mark ^ 1]);
-    s.cur_mark ^= 1;
-    if (r.count(s.marked, s.marks[s.cur_mark], nullptr, nullptr) == 0) break;
+    r.pass(s.mark, {&s.marks.current(), &s.result.current()}, s.marks.next());
+    s.marks.swap();
+    if (r.count(s.marked, s.marks.current(), nullptr, nullptr) == 0) break;
     // The level's n x n samples, only in marked pixels, replacing their earlier ones.
     const int n = levels[l] * levels[l];
     s.sample_generate.kernel.gated = true;
@@ -60,21 +75,18 @@ void StreamTracer::render_adaptive(const Camera& cam, RenderResult& res, int& it
       const glm::vec2 j = sample_offset(n, k, opt_.sample_seed);
       s.sample_generate.kernel.jitter_x = j.x;
       s.sample_generate.kernel.jitter_y = j.y;
-      frame(cam, s.sample_generate, res, false, iteration_number, &s.marks[s.cur_mark]);
+      frame(cam, s.sample_generate, res, false, iteration_number, &s.marks.current());
       s.accumulate.kernel.restart = k == 0;
-      r.pass(s.accumulate, {&s.sum[s.cur_sum], &s.result[s.cur_result], &s.marks[s.cur_mark]},
-             s.sum[s.cur_sum ^ 1]);
-      s.cur_sum ^= 1;
+      accumulate_samples(&s.marks.current());
     }
     // The new estimate: the next level's marks read it, and after the last level it is the
     // image. (Where no pixel is marked at all, the centre frame's colour stays the image.)
-    r.pass(s.resolve, {&s.sum[s.cur_sum]}, s.result[s.cur_result ^ 1]);
-    s.cur_result ^= 1;
+    resolve_samples(s.resolve);
   }
   s.sample_generate.kernel.gated = false;
   s.accumulate.kernel.gated = false;
   // Each pixel's final sample count, for the rays-per-pixel statistics and map.
-  Texture& sum = s.sum[s.cur_sum];
+  Texture& sum = s.sum.current();
   gpu.download(sum);
   const int W = opt_.width, H = opt_.height;
   res.rays_per_pixel.resize(size_t(W) * size_t(H));
@@ -97,27 +109,23 @@ void StreamTracer::render_undersampled(const Camera& cam, RenderResult& res,
   // marcarReticula into marks A; the lattice frame through the lattice pixels' centres, keeping
   // their surface keys in marks B; their colours into the sum.
   r.pass(s.mark_lattice, {}, s.marks[0]);
-  s.cur_mark = 1;
+  s.marks.make_current(1);  // guardarImpactos writes the lattice frame's keys into marks B
   s.sample_generate.kernel.jitter_x = s.sample_generate.kernel.jitter_y = 0.5f;
   s.sample_generate.kernel.gated = true;
   frame(cam, s.sample_generate, res, true, iteration_number, &s.marks[0], true);
   res.first_frame_passes = gpu.stats().totals.passes;
-  gpu.clear(s.sum[s.cur_sum], {0, 0, 0, 0});
+  gpu.clear(s.sum.current(), {0, 0, 0, 0});
   s.accumulate.kernel.gated = true;
   s.accumulate.kernel.restart = false;
-  r.pass(s.accumulate, {&s.sum[s.cur_sum], &s.result[s.cur_result], &s.marks[0]},
-         s.sum[s.cur_sum ^ 1]);
-  s.cur_sum ^= 1;
+  accumulate_samples(&s.marks[0]);
   // marcarHuecos into marks A (the lattice flags are done with), pixelesMarcados counts them;
   // the gaps' frame traces them.
-  r.pass(s.mark_gaps, {&s.marks[1], &s.sum[s.cur_sum]}, s.marks[0]);
+  r.pass(s.mark_gaps, {&s.marks[1], &s.sum.current()}, s.marks[0]);
   std::vector<uint8_t> gap(size_t(W) * size_t(H), 0);
   if (r.count(s.marked, s.marks[0], nullptr, nullptr) > 0) {
     const std::vector<float> depth = res.depth, hit_id = res.hit_id;
     frame(cam, s.sample_generate, res, true, iteration_number, &s.marks[0]);
-    r.pass(s.accumulate, {&s.sum[s.cur_sum], &s.result[s.cur_result], &s.marks[0]},
-           s.sum[s.cur_sum ^ 1]);
-    s.cur_sum ^= 1;
+    accumulate_samples(&s.marks[0]);
     // The AOVs: the gaps' from this frame, the lattice's from the first.
     gpu.download(s.marks[0]);
     for (size_t i = 0; i < gap.size(); ++i) {
@@ -127,9 +135,9 @@ void StreamTracer::render_undersampled(const Camera& cam, RenderResult& res,
   }
   s.sample_generate.kernel.gated = false;
   s.accumulate.kernel.gated = false;
-  // rellenarHuecos: the traced pixels' colours, the rest blended from their lattice cell.
-  r.pass(s.fill, {&s.sum[s.cur_sum]}, s.result[s.cur_result ^ 1]);
-  s.cur_result ^= 1;
+  // The resolve, rellenarHuecos: the traced pixels' colours, the rest blended from their
+  // lattice cell.
+  resolve_samples(s.fill);
   // The AOVs of a pixel never traced: its lattice cell's nearest corner's.
   res.rays_per_pixel.assign(gap.size(), 0);
   for (int y = 0; y < H; ++y)

@@ -5,6 +5,8 @@
 #include <memory>
 
 #include "host/trace/passes.h"
+#include "host/trace/ping_pong.h"
+#include "host/trace/stream/atlas_upload.h"
 #include "host/trace/stream/ray_streams.h"
 #include "host/trace/stream/stream_tracer.h"
 #include "host/trace/walks/accel_walk.h"
@@ -15,12 +17,14 @@ struct StreamTracer::State {
   // Static textures: the scene, triangle i at texel (i mod width, i div width).
   vgpu::Texture v[3], n[3], colors;
   // Base-colour textures (scenes with a textured material): the corners' coordinates, the
-  // texture table and the atlas of mip chains (kernels/layout.h).
+  // texture table and the atlas of mip chains (host/trace/stream/atlas_upload.h).
   bool textured = false;
-  vgpu::Texture uvs01, uvs2, texture_table, atlas;
-  // Dynamic textures (ping-pong pairs where a pass reads what it replaces).
-  vgpu::Texture rays[2], origins[2], shadow_rays, isect[2], result[2], counter;
-  int cur_rays = 0, cur_isect = 0, cur_result = 0;
+  AtlasTextures base;
+  // Dynamic textures: ping-pong pairs (host/trace/ping_pong.h) where a pass reads what it
+  // replaces. The origins' current texture holds an iteration's ray origins, the next one its
+  // hit points (the surface record the shader reads and the reflected rays start from).
+  PingPong<vgpu::Texture> rays, origins, isect, result;
+  vgpu::Texture shadow_rays, counter;
   // The rays still walking, and those with a triangle left to test (the walk's masks).
   vgpu::Stencil grid_mask, isect_mask;
   // The programs of the pipeline around the walk, with their uniforms.
@@ -34,14 +38,13 @@ struct StreamTracer::State {
   vgpu::KernelProgram<kernels::GenerateSampleRays> sample_generate;
   vgpu::KernelProgram<kernels::AccumulateSamples> accumulate;
   vgpu::KernelProgram<kernels::ResolveSamples> resolve;
-  vgpu::Texture sum[2];
-  int cur_sum = 0;
+  PingPong<vgpu::Texture> sum;
   // Adaptive supersampling (--aa adaptive): surface keys and marks, each triangle's material.
   vgpu::KernelProgram<kernels::KeepHits> keep;
   vgpu::KernelProgram<kernels::MarkPixels> mark;
   vgpu::KernelProgram<kernels::MarkedPixels> marked;
-  vgpu::Texture marks[2], materials;
-  int cur_mark = 0;
+  PingPong<vgpu::Texture> marks;
+  vgpu::Texture materials;
   // Adaptive undersampling (--aa undersample:K): the lattice, the gaps, the fill.
   vgpu::KernelProgram<kernels::MarkLattice> mark_lattice;
   vgpu::KernelProgram<kernels::MarkGaps> mark_gaps;

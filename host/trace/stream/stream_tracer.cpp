@@ -15,6 +15,7 @@
 #include "host/common/parallel.h"
 #include "host/trace/passes.h"
 #include "host/trace/sampling.h"
+#include "host/trace/stream/atlas_upload.h"
 #include "host/trace/stream/devices.h"
 #include "host/trace/stream/ray_streams.h"
 #include "host/trace/stream/stream_state.h"
@@ -88,50 +89,10 @@ StreamTracer::StreamTracer(const Scene& scene, const Accel& accel, const RenderO
   // Scene textures: triangle i at texel (i mod width, i div width).
   write_scene(nullptr);
 
-  // Base-colour textures (kernels/base_color.h): the atlas, its table and the corners' UVs.
-  // Static: a moving scene's frames change positions, not UVs.
+  // Base-colour textures (kernels/base_color.h): the texture atlas upload (atlas_upload.h).
   if (!scene.textures.empty()) {
-    const int maxs = gpu.profile().max_texture_size;
-    const int sw = s.v[0].width(), sh = s.v[0].height();
-    const size_t ntri = scene.triangle_count();
-    std::vector<MipChain> chains;
-    size_t levels = 0;
-    for (const SceneTexture& t : scene.textures) {
-      chains.push_back(build_mip_chain(t));
-      levels = std::max(levels, chains.back().levels.size());
-    }
-    const TextureAtlas atlas = pack_atlas(chains, maxs);
-    const std::string why = atlas_refusal(atlas, scene.textures.size(), maxs, gpu.profile().name);
-    if (!why.empty()) throw vgpu::Error(why);
+    upload_texture_atlas(gpu, scene, s.v[0].width(), s.v[0].height(), s.base);
     s.textured = true;
-    s.atlas = gpu.make_texture("texture atlas", atlas.width, atlas.height, 4);
-    for (int y = 0; y < atlas.height; ++y)
-      for (int x = 0; x < atlas.width; ++x) {
-        const glm::vec4& c = atlas.texels[size_t(y) * size_t(atlas.width) + size_t(x)];
-        float* t = s.atlas.texel_mut(x, y);
-        for (int k = 0; k < 4; ++k) t[k] = c[k];
-      }
-    s.texture_table = gpu.make_texture("texture table", int(1 + levels), int(chains.size()), 4);
-    for (size_t i = 0; i < chains.size(); ++i) {
-      float* head = s.texture_table.texel_mut(0, int(i));
-      head[0] = float(chains[i].levels.size());
-      head[1] = float(scene.textures[i].wrap_s);
-      head[2] = float(scene.textures[i].wrap_t);
-      for (size_t k = 0; k < chains[i].levels.size(); ++k) {
-        float* r = s.texture_table.texel_mut(int(1 + k), int(i));
-        for (int c = 0; c < 4; ++c) r[c] = float(atlas.rects[i][k][c]);
-      }
-    }
-    s.uvs01 = gpu.make_texture("uvs01", sw, int(sh), 4);
-    s.uvs2 = gpu.make_texture("uvs2", sw, int(sh), 4);
-    for (size_t i = 0; i < ntri; ++i) {
-      float* a = s.uvs01.texel_mut(int(i % sw), int(i / sw));
-      float* b = s.uvs2.texel_mut(int(i % sw), int(i / sw));
-      a[0] = scene.uv0[i].x, a[1] = scene.uv0[i].y, a[2] = scene.uv1[i].x, a[3] = scene.uv1[i].y;
-      b[0] = scene.uv2[i].x, b[1] = scene.uv2[i].y;
-      b[2] = float(scene.materials[scene.material[i]].texture);
-    }
-    for (const Texture* t : {&s.uvs01, &s.uvs2, &s.texture_table, &s.atlas}) gpu.upload(*t);
   }
 
   // The acceleration structure's textures and walk (host/trace/walks/grid_walk.h, bvh_walk.h,
@@ -184,11 +145,7 @@ StreamTracer::StreamTracer(const Scene& scene, const Accel& accel, const RenderO
   }
   s.grid_mask = Stencil(W, H, 1);
   s.isect_mask = Stencil(W, H, 1);
-  s.walk->make_state(gpu, {{&s.v[0], &s.v[1], &s.v[2]},
-                           {&s.isect[0], &s.isect[1]},
-                           &s.cur_isect,
-                           &s.grid_mask,
-                           &s.isect_mask});
+  s.walk->make_state(gpu, {{&s.v[0], &s.v[1], &s.v[2]}, &s.isect, &s.grid_mask, &s.isect_mask});
   s.runner = std::make_unique<PassRunner>(gpu, opt_, s.counter);
 
   s.shader.kernel.model = opt_.shading;
@@ -318,7 +275,7 @@ uint64_t StreamTracer::texture_bytes() const {
   if ((opt_.adaptive && opt_.spp > 1) || opt_.undersample > 0)
     b += s_->marks[0].bytes() + s_->marks[1].bytes() + s_->materials.bytes();
   if (s_->textured)
-    for (const Texture* t : {&s_->uvs01, &s_->uvs2, &s_->texture_table, &s_->atlas})
+    for (const Texture* t : {&s_->base.uvs01, &s_->base.uvs2, &s_->base.table, &s_->base.atlas})
       b += t->bytes();
   if (s_->streams) b += s_->streams->texture_bytes();  // grows with the frame's levels
   return b;
@@ -359,6 +316,8 @@ RenderResult StreamTracer::render(const Camera& cam) {
   int iteration_number = 0;
   // The sample frames' generator takes the same camera (its jitter and gate are set per frame).
   static_cast<GenerateRays&>(s.sample_generate.kernel) = g;
+  // One frame of the pipeline (frame()), or a sampling mode's frames, each mode ending in the
+  // sampling resolve (resolve_samples) that combines its sample frames into the pixels.
   if (opt_.undersample > 0) {
     render_undersampled(cam, res, iteration_number);
   } else if (opt_.spp <= 1) {
@@ -369,7 +328,7 @@ RenderResult StreamTracer::render(const Camera& cam) {
     render_samples(cam, res, iteration_number);
   }
 
-  Texture& out = s.result[s.cur_result];
+  Texture& out = s.result.current();
   gpu.download(out);
   res.rgb.resize(size_t(W) * H * 3);
   for (int y = 0; y < H; ++y)
@@ -394,7 +353,6 @@ void StreamTracer::frame(const Camera& cam, const vgpu::Program& generate, Rende
     return;
   }
   State& s = *s_;
-  int ro = 0;  // origins[ro]: this iteration's ray origins; origins[ro ^ 1]: its hit points
   generate_rays(cam, generate, marks);
   // Each iteration is one ray stream (the primary rays, then each bounce's reflected rays):
   // the walk, inicioReflejo, the shading per light, then the reflected rays of the next one.
@@ -405,29 +363,34 @@ void StreamTracer::frame(const Camera& cam, const vgpu::Program& generate, Rende
     res.iterations = std::max(res.iterations, it + 1);
     if (opt_.progress) opt_.progress(it + 1, iterations);
     if (opt_.observer) opt_.observer->iteration(number);
-    Texture& rays = s.rays[s.cur_rays];
-    walk_rays(s.origins[ro], rays, it == 0, cam);
+    Texture& rays = s.rays.current();
+    Texture& origins = s.origins.current();
+    walk_rays(origins, rays, it == 0, cam);
     if (it == 0) primary_hits(res, aovs, keep_hits);
-    Texture& surface = s.origins[ro ^ 1];
-    reflection_origin(s.origins[ro], rays, surface);
-    Texture* col[2] = {&s.result[s.cur_result], &s.result[s.cur_result ^ 1]};
-    s.cur_result ^= shade_lights(cam, surface, rays, s.origins[ro], col);
+    Texture& surface = s.origins.next();  // the hit points: the next iteration's origins
+    reflection_origin(origins, rays, surface);
+    PingPong<Texture*> col(&s.result.current(), &s.result.next());
+    shade_lights(cam, surface, rays, origins, col);
+    if (col.which() == 1) s.result.swap();  // the shading's last pass wrote result.next()
     if (it + 1 == iterations) break;
-    if (!reflect(rays, surface, s.rays[s.cur_rays ^ 1])) break;
-    s.cur_rays ^= 1;
-    ro ^= 1;
+    if (!reflect(rays, surface, s.rays.next())) break;
+    s.rays.swap();
+    s.origins.swap();
   }
 }
 
 void StreamTracer::generate_rays(const Camera& cam, const vgpu::Program& generate,
                                  const Texture* marks) {
   State& s = *s_;
-  gpu_->clear(s.origins[0], {cam.position.x, cam.position.y, cam.position.z, 0});
+  // Each frame's origins start over at A (the other pairs go on from where the last frame
+  // left them).
+  s.origins.make_current(0);
+  gpu_->clear(s.origins.current(), {cam.position.x, cam.position.y, cam.position.z, 0});
   if (marks)
-    s.runner->pass(generate, {marks}, s.rays[s.cur_rays]);
+    s.runner->pass(generate, {marks}, s.rays.current());
   else
-    s.runner->pass(generate, {}, s.rays[s.cur_rays]);
-  gpu_->clear(s.result[s.cur_result], {0, 0, 0, 1});
+    s.runner->pass(generate, {}, s.rays.current());
+  gpu_->clear(s.result.current(), {0, 0, 0, 1});
 }
 
 void StreamTracer::walk_rays(Texture& origins, Texture& rays, bool primary, const Camera& cam) {
@@ -442,14 +405,14 @@ void StreamTracer::primary_hits(RenderResult& res, bool aovs, bool keep_hits) {
   State& s = *s_;
   // guardarImpactos: the primary hits' surface keys (--aa adaptive), before later traces
   // overwrite the intersections.
-  if (keep_hits) s.runner->pass(s.keep, {&s.isect[s.cur_isect], &s.materials}, s.marks[s.cur_mark]);
+  if (keep_hits) s.runner->pass(s.keep, {&s.isect.current(), &s.materials}, s.marks.current());
   if (aovs) download_aovs(res);
 }
 
 void StreamTracer::reflection_origin(const Texture& origins, const Texture& rays,
                                      Texture& surface) {
   State& s = *s_;
-  s.runner->pass(s.origin, {&origins, &rays, &s.isect[s.cur_isect], &s.v[0], &s.v[1], &s.v[2]},
+  s.runner->pass(s.origin, {&origins, &rays, &s.isect.current(), &s.v[0], &s.v[1], &s.v[2]},
                  surface);
 }
 
@@ -457,20 +420,19 @@ bool StreamTracer::reflect(const Texture& rays, const Texture& surface, Texture&
   State& s = *s_;
   PassRunner& r = *s.runner;
   // rayosReflejados: how many rays the shader reflected (marked in the walk's mask).
-  if (r.count(s.reflected, s.result[s.cur_result], nullptr, &s.grid_mask) == 0) return false;
+  if (r.count(s.reflected, s.result.current(), nullptr, &s.grid_mask) == 0) return false;
   // direccionReflejo: their directions.
-  r.pass(s.direction,
-         {&rays, &surface, &s.result[s.cur_result], &s.v[0], &s.v[1], &s.v[2], &s.n[0], &s.n[1],
-          &s.n[2]},
-         next_rays);
+  r.pass(
+      s.direction,
+      {&rays, &surface, &s.result.current(), &s.v[0], &s.v[1], &s.v[2], &s.n[0], &s.n[1], &s.n[2]},
+      next_rays);
   return true;
 }
 
-int StreamTracer::shade_lights(const Camera& cam, Texture& surface, Texture& rays, Texture& origins,
-                               Texture* const col[2]) {
+void StreamTracer::shade_lights(const Camera& cam, Texture& surface, Texture& rays,
+                                Texture& origins, PingPong<Texture*>& col) {
   State& s = *s_;
   PassRunner& r = *s.runner;
-  int cur = 0;
   const auto& lights = scene_->lights;
   for (size_t li = 0; li < lights.size(); ++li) {
     Shader& sh = s.shader.kernel;
@@ -483,22 +445,21 @@ int StreamTracer::shade_lights(const Camera& cam, Texture& surface, Texture& ray
     const Texture* shadow = nullptr;  // the shadow rays' hits, when not the current ones
     if (opt_.shadows) {
       s.shadow.kernel.light = lights[li].position;
-      r.pass(s.shadow, {&surface, col[cur]}, s.shadow_rays);
+      r.pass(s.shadow, {&surface, col.current()}, s.shadow_rays);
       if (opt_.observer) opt_.observer->trace_begin(PassObserver::TraceKind::shadow);
       trace(surface, s.shadow_rays, false, cam);
       if (s.streams && s.streams->glass_scene())
-        shadow = &s.streams->shadows_through_glass(r, surface, s.shadow_rays, &s.isect[s.cur_isect],
+        shadow = &s.streams->shadows_through_glass(r, surface, s.shadow_rays, &s.isect.current(),
                                                    [&](Texture& o, Texture& d) {
                                                      trace(o, d, false, cam);
-                                                     return &s.isect[s.cur_isect];
+                                                     return &s.isect.current();
                                                    });
       if (opt_.observer) opt_.observer->trace_end();
     }
-    shader_pass(surface, rays, *col[cur], shadow ? *shadow : s.isect[s.cur_isect], origins,
-                *col[cur ^ 1]);
-    cur ^= 1;
+    shader_pass(surface, rays, *col.current(), shadow ? *shadow : s.isect.current(), origins,
+                *col.next());
+    col.swap();
   }
-  return cur;
 }
 
 void StreamTracer::shader_pass(const Texture& surface, const Texture& rays, const Texture& colour,
@@ -510,7 +471,7 @@ void StreamTracer::shader_pass(const Texture& surface, const Texture& rays, cons
     s.runner->pass(
         s.shader,
         {&surface, &rays, &colour, &shadow, &s.colors, &s.v[0], &s.v[1], &s.v[2], &s.n[0], &s.n[1],
-         &s.n[2], &origins, &s.uvs01, &s.uvs2, &s.texture_table, &s.atlas},
+         &s.n[2], &origins, &s.base.uvs01, &s.base.uvs2, &s.base.table, &s.base.atlas},
         out);
   else
     s.runner->pass(s.shader,
@@ -520,7 +481,7 @@ void StreamTracer::shader_pass(const Texture& surface, const Texture& rays, cons
 }
 
 void StreamTracer::download_aovs(RenderResult& res) {
-  Texture& hits = s_->isect[s_->cur_isect];
+  Texture& hits = s_->isect.current();
   const int W = opt_.width, H = opt_.height;
   gpu_->download(hits);
   res.depth.assign(size_t(W) * H, 0.0f);
@@ -563,20 +524,21 @@ void StreamTracer::stream_frame(const Camera& cam, const vgpu::Program& generate
       // This chunk's rays, its surface record and spawn shares, and the pair the shader
       // ping-pongs (the first holds the rays' weights): level 0 in the tracer's own textures,
       // a one-chunk level in its own, a longer one through the chunk textures.
-      Texture *origins, *rays, *surface, *split, *col[2];
+      Texture *origins, *rays, *surface, *split;
+      PingPong<Texture*> col;
       if (k == 0) {
-        origins = &s.origins[0], rays = &s.rays[s.cur_rays];
-        col[0] = &s.result[s.cur_result], col[1] = &s.result[s.cur_result ^ 1];
+        origins = &s.origins.current(), rays = &s.rays.current();
+        col = {&s.result.current(), &s.result.next()};
         surface = &L.surface, split = &L.split;
       } else if (!chunked) {
-        origins = &L.origins, rays = &L.rays, col[0] = &L.weight, col[1] = &L.colour;
+        origins = &L.origins, rays = &L.rays, col = {&L.weight, &L.colour};
         surface = &L.surface, split = &L.split;
       } else {
-        origins = &g.work(0), rays = &g.work(1), col[0] = &g.work(2), col[1] = &g.work(5);
+        origins = &g.work(0), rays = &g.work(1), col = {&g.work(2), &g.work(5)};
         surface = &g.work(3), split = &g.work(4);
         g.copy_chunk(r, L.origins, *origins, c, false);
         g.copy_chunk(r, L.rays, *rays, c, false);
-        g.copy_chunk(r, L.weight, *col[0], c, false);
+        g.copy_chunk(r, L.weight, *col.current(), c, false);
       }
       walk_rays(*origins, *rays, k == 0, cam);
       if (k == 0) primary_hits(res, aovs, keep_hits);
@@ -585,32 +547,32 @@ void StreamTracer::stream_frame(const Camera& cam, const vgpu::Program& generate
       // weight.
       if (spawns)
         g.pass(r, g.split,
-               {rays, surface, col[0], &g.glass(), &s.v[0], &s.v[1], &s.v[2], &s.n[0], &s.n[1],
-                &s.n[2]},
+               {rays, surface, col.current(), &g.glass(), &s.v[0], &s.v[1], &s.v[2], &s.n[0],
+                &s.n[1], &s.n[2]},
                *split, nullptr, g.stats.split_passes, g.stats.split_bytes);
       // shader: one pass per light after its shadow rays (continued through glass).
-      const int cur = shade_lights(cam, *surface, *rays, *origins, col);
-      if (k == 0) s.cur_result ^= cur;
+      shade_lights(cam, *surface, *rays, *origins, col);
+      if (k == 0 && col.which() == 1) s.result.swap();  // the shading's last pass wrote next()
       if (!chunked) {
-        L.shaded = col[cur];
+        L.shaded = col.current();
       } else {
         g.copy_chunk(r, *surface, L.surface, c, true);
         if (spawns) g.copy_chunk(r, *split, L.split, c, true);
-        g.copy_chunk(r, *col[cur], L.colour, c, true);
+        g.copy_chunk(r, *col.current(), L.colour, c, true);
         L.shaded = &L.colour;
       }
     }
     if (!spawns) break;
     // The compaction: the next level holds only the rays spawned.
-    n = g.compact(r, k, k == 0 ? s.rays[s.cur_rays] : L.rays, statics);
+    n = g.compact(r, k, k == 0 ? s.rays.current() : L.rays, statics);
     if (n == 0) break;
     deepest = k + 1;
   }
   // The colours return to the pixels, deepest level first (level 0's shaded colour is the
   // current result).
   if (deepest > 0) {
-    g.gather_back(r, deepest, s.result[s.cur_result ^ 1]);
-    s.cur_result ^= 1;
+    g.gather_back(r, deepest, s.result.next());
+    s.result.swap();
   }
 }
 

@@ -12,6 +12,7 @@
 #include "host/accel/grid.h"
 #include "host/model/formats.h"
 #include "host/scene/scene.h"
+#include "host/trace/ping_pong.h"
 #include "host/trace/render_options.h"
 #include "host/trace/walks/grid_walk.h"
 #include "kernels/kernels.h"
@@ -70,8 +71,9 @@ class StreamTracer {
   void stream_frame(const Camera& cam, const vgpu::Program& generate, RenderResult& res, bool aovs,
                     int& iteration_number, const vgpu::Texture* marks, bool keep_hits);
   // Ray generation (generadorRayos, or generadorRayosMuestra for a sample frame): every ray
-  // starts at the eye (origins[0]), `generate` writes the directions into the current rays
-  // texture (reading `marks` if given), and the current result is cleared to black.
+  // starts at the eye (the origins pair starts over at A), `generate` writes the directions into
+  // the current rays texture (reading `marks` if given), and the current result is cleared to
+  // black.
   void generate_rays(const Camera& cam, const vgpu::Program& generate, const vgpu::Texture* marks);
   // The walk: one ray stream (primary or reflected) through the acceleration structure, told
   // to the observer as one trace. Leaves each ray's nearest hit in the current intersections.
@@ -89,11 +91,12 @@ class StreamTracer {
   bool reflect(const vgpu::Texture& rays, const vgpu::Texture& surface, vgpu::Texture& next_rays);
   // Shading, one light at a time (the paper's per-light loop): for each light, rayosSombra makes
   // the shadow rays from `surface` (inicioReflejo's record) and trace() walks them, then the
-  // shader pass adds that light's share. The colour ping-pongs between col[0] (the colour so
-  // far, or a spawned ray's weight) and col[1]; returns which of the two holds the result.
-  // frame() and stream_frame() both shade through here.
-  int shade_lights(const Camera& cam, vgpu::Texture& surface, vgpu::Texture& rays,
-                   vgpu::Texture& origins, vgpu::Texture* const col[2]);
+  // shader pass adds that light's share. The colour ping-pongs through `col`: its current
+  // texture holds the colour so far (or a spawned ray's weight), each shader pass writes the
+  // next one and swaps, so at the end col.current() holds the result. frame() and
+  // stream_frame() both shade through here.
+  void shade_lights(const Camera& cam, vgpu::Texture& surface, vgpu::Texture& rays,
+                    vgpu::Texture& origins, PingPong<vgpu::Texture*>& col);
   // One shader pass: its binding list, written once (with the base-colour textures when the
   // scene is textured).
   void shader_pass(const vgpu::Texture& surface, const vgpu::Texture& rays,
@@ -102,6 +105,14 @@ class StreamTracer {
   // The primary hits' depths and input triangle ids into res, from the current intersections.
   void download_aovs(RenderResult& res);
   // The sampling modes and their resolve (host/trace/stream/sampling_modes.cpp).
+  // acumularMuestras: the current frame's colours (gated: only in the pixels `marks` flags, if
+  // given) added into the sum of the sample frames; the sum ping-pongs.
+  void accumulate_samples(const vgpu::Texture* marks);
+  // The sampling resolve, the last stage of a frame with several samples per pixel: `resolve`
+  // (resolverMuestras, the box filter, or rellenarHuecos, the undersampling fill) turns the
+  // sum of the sample frames into the pixels' colours, in the next result texture, which
+  // becomes current (render() downloads it).
+  void resolve_samples(const vgpu::Program& resolve);
   // --spp N (N > 1): N sample frames (generadorRayosMuestra, each through its sub-pixel
   // offset), each added into the sum (acumularMuestras), then resolverMuestras box-filters the
   // sum into the current result texture.

@@ -103,13 +103,13 @@ uint64_t ListWalk::state_bytes() const {
 }
 
 void ListWalk::clear(vgpu::Device& gpu) {
-  gpu.clear(*sh_.isect[*sh_.cur_isect], {kernels::kFar, 0, 0, kernels::kNone});
-  gpu.clear(vs_[cur_vs_], {0, 0, 0, kernels::kNone});
+  gpu.clear(sh_.isect->current(), {kernels::kFar, 0, 0, kernels::kNone});
+  gpu.clear(vs_.current(), {0, 0, 0, kernels::kNone});
 }
 
 uint64_t ListWalk::count_entered(PassRunner& r) {
   sh_.grid_mask->fill(1);
-  const uint64_t walking = r.count(walking_, trav_[cur_trav_], nullptr, sh_.grid_mask);
+  const uint64_t walking = r.count(walking_, trav_.current(), nullptr, sh_.grid_mask);
   r.counts.rays_traced += walking;
   return walking;
 }
@@ -119,8 +119,8 @@ WriteBack ListWalk::write_back(const Cursor& c) const {
   wb.npairs = 3;
   wb.pairs[0] = {const_cast<Texture*>(&trav_[0]), const_cast<Texture*>(&trav_[1])};
   wb.pairs[1] = {const_cast<Texture*>(&vs_[0]), const_cast<Texture*>(&vs_[1])};
-  wb.pairs[2] = {sh_.isect[0], sh_.isect[1]};
-  wb.current = {c.trav, c.vs, c.isect, 0};
+  wb.pairs[2] = {&(*sh_.isect)[0], &(*sh_.isect)[1]};
+  wb.current = {c.trav.which(), c.vs.which(), c.isect.which(), 0};
   wb.nmasks = 2;
   wb.masks = {sh_.grid_mask, sh_.isect_mask, nullptr, nullptr};
   return wb;
@@ -130,23 +130,22 @@ void ListWalk::walk_looping(PassRunner& r, const vgpu::Program& p, Texture& orig
                             std::initializer_list<const Texture*> statics, int64_t max_iterations,
                             uint64_t walking) {
   vgpu::Device& gpu = r.device();
-  int& cur_isect = *sh_.cur_isect;
   const int64_t max_passes = (max_iterations + opt_.steps_per_pass - 1) / opt_.steps_per_pass;
   for (int64_t k = 0; walking > 0; ++k) {
     if (k == max_passes) {
       r.counts.rays_unfinished += walking;
       break;
     }
-    Texture& trav = trav_[cur_trav_ ^ 1];
+    Texture& trav = trav_.next();
     gpu.use_program(p);
     gpu.unbind_textures();
     int unit = 0;
     for (const Texture* t : std::initializer_list<const Texture*>{
-             &origins, &rays, &trav_[cur_trav_], &vs_[cur_vs_], sh_.isect[cur_isect],
+             &origins, &rays, &trav_.current(), &vs_.current(), &sh_.isect->current(),
              sh_.vertices[0], sh_.vertices[1], sh_.vertices[2]})
       gpu.bind_texture(unit++, *t);
     for (const Texture* t : statics) gpu.bind_texture(unit++, *t);
-    gpu.set_targets({&trav, &vs_[cur_vs_ ^ 1], sh_.isect[cur_isect ^ 1]});
+    gpu.set_targets({&trav, &vs_.next(), &sh_.isect->next()});
     // The walking rays' mask, as for the multipass kernels (finished rays keep their state).
     r.set_work(sh_.grid_mask);
     const bool traced = r.traces_pixel(sh_.grid_mask);
@@ -154,11 +153,11 @@ void ListWalk::walk_looping(PassRunner& r, const vgpu::Program& p, Texture& orig
     const vgpu::PassRecord& rec = gpu.draw();
     if (opt_.observer)
       opt_.observer->pass({p, rec, trav, gpu.branch_flags(), gpu.stats(), gpu.loop_iterations()});
-    cur_trav_ ^= 1;
-    cur_vs_ ^= 1;
-    cur_isect ^= 1;
-    if (traced) r.trace_targets(p, {&trav_[cur_trav_], &vs_[cur_vs_], sh_.isect[cur_isect]});
-    walking = r.count(walking_, trav_[cur_trav_], sh_.grid_mask, sh_.grid_mask);
+    trav_.swap();
+    vs_.swap();
+    sh_.isect->swap();
+    if (traced) r.trace_targets(p, {&trav_.current(), &vs_.current(), &sh_.isect->current()});
+    walking = r.count(walking_, trav_.current(), sh_.grid_mask, sh_.grid_mask);
   }
 }
 

@@ -16,6 +16,7 @@
 #include "host/accel/accel.h"
 #include "host/model/formats.h"
 #include "host/trace/passes.h"
+#include "host/trace/ping_pong.h"
 #include "host/trace/render_options.h"
 #include "kernels/kernels.h"
 #include "vgpu/vgpu.h"
@@ -26,8 +27,7 @@ namespace host {
 // intersection state (nearest hit so far) and the two masks of walking and testing rays.
 struct WalkShared {
   const vgpu::Texture* vertices[3];
-  vgpu::Texture* isect[2];
-  int* cur_isect;  // which of isect is current
+  PingPong<vgpu::Texture>* isect;  // the nearest hit so far (host/trace/ping_pong.h)
   vgpu::Stencil* grid_mask;
   vgpu::Stencil* isect_mask;
 };
@@ -90,7 +90,9 @@ class ListWalk : public AccelWalk {
   // Where the walk is: the rays it traces and the current texture of each ping-pong pair.
   struct Cursor {
     vgpu::Texture *origins, *rays;
-    int trav, vs, isect;
+    // Copies of the pairs' current/next (a batch walk runs a copy per batch of pixels), written
+    // back by settle() when the walk ends.
+    PingPongRef<vgpu::Texture> trav, vs, isect;
   };
   // Not copied: statics_ points at the walk's own members.
   ListWalk(const ListWalk&) = delete;
@@ -130,13 +132,14 @@ class ListWalk : public AccelWalk {
   // the walking mask and counted as traced. Returns how many.
   uint64_t count_entered(PassRunner& r);
   // The multipass walk starts from the current textures and leaves them where it ends.
-  Cursor cursor(vgpu::Texture& origins, vgpu::Texture& rays) const {
-    return {&origins, &rays, cur_trav_, cur_vs_, *sh_.cur_isect};
+  Cursor cursor(vgpu::Texture& origins, vgpu::Texture& rays) {
+    return {&origins, &rays, PingPongRef<vgpu::Texture>(trav_), PingPongRef<vgpu::Texture>(vs_),
+            PingPongRef<vgpu::Texture>(*sh_.isect)};
   }
   void settle(const Cursor& c) {
-    cur_trav_ = c.trav;
-    cur_vs_ = c.vs;
-    *sh_.cur_isect = c.isect;
+    trav_.make_current(c.trav.which());
+    vs_.make_current(c.vs.which());
+    sh_.isect->make_current(c.isect.which());
   }
 
   // The passes of the triangle loop by where it issues them (the walk's own Site numbers).
@@ -181,8 +184,7 @@ class ListWalk : public AccelWalk {
   std::vector<const vgpu::Texture*> statics_;
   WalkShared sh_{};
   // Per-pixel state (ping-pong pairs): traversal and list state.
-  vgpu::Texture trav_[2], vs_[2];
-  int cur_trav_ = 0, cur_vs_ = 0;
+  PingPong<vgpu::Texture> trav_, vs_;
   vgpu::KernelProgram<kernels::NextTriangle> next_;
   vgpu::KernelProgram<kernels::RaysIntersecting> intersecting_;
   vgpu::KernelProgram<kernels::RaysInGrid> walking_;
@@ -194,42 +196,42 @@ void ListWalk::test_triangles(X& x, Cursor& c, const Key& key, int step, const T
                               const vgpu::Program& intersect_next, const vgpu::Texture& lists,
                               bool reads_traversal) {
   vgpu::Texture &origins = *c.origins, &rays = *c.rays;
-  vgpu::Texture* const* isect = sh_.isect;
   const vgpu::Texture* const* v = sh_.vertices;
   vgpu::Stencil &grid_mask = *sh_.grid_mask, &isect_mask = *sh_.isect_mask;
   x.copy(isect_mask, grid_mask);
   auto testing =
-      x.count(key(step, -1, site.testing), intersecting_, vs_[c.vs], &grid_mask, &isect_mask);
+      x.count(key(step, -1, site.testing), intersecting_, c.vs.current(), &grid_mask, &isect_mask);
   for (int k = 0; X::any(testing); ++k) {
     if (k == max_list + 1) break;  // lists cannot be longer: stuck positions (fp16)
-    const vgpu::Texture *trav = &trav_[c.trav], *vs = &vs_[c.vs];
+    const vgpu::Texture *trav = &c.trav.current(), *vs = &c.vs.current();
     if (opt_.mrt) {
       // The intersection and proximoTriangulo in one pass, two targets.
       const auto key_k = key(step, k, site.intersect_next);
       if (reads_traversal)
         x.pass(key_k, intersect_next,
-               {&origins, &rays, trav, vs, isect[c.isect], v[0], v[1], v[2], &lists},
-               {isect[c.isect ^ 1], &vs_[c.vs ^ 1]}, &isect_mask);
+               {&origins, &rays, trav, vs, &c.isect.current(), v[0], v[1], v[2], &lists},
+               {&c.isect.next(), &c.vs.next()}, &isect_mask);
       else
         x.pass(key_k, intersect_next,
-               {&origins, &rays, vs, isect[c.isect], v[0], v[1], v[2], &lists},
-               {isect[c.isect ^ 1], &vs_[c.vs ^ 1]}, &isect_mask);
-      c.isect ^= 1;
-      c.vs ^= 1;
+               {&origins, &rays, vs, &c.isect.current(), v[0], v[1], v[2], &lists},
+               {&c.isect.next(), &c.vs.next()}, &isect_mask);
+      c.isect.swap();
+      c.vs.swap();
     } else {
       const auto key_k = key(step, k, site.intersect);
       if (reads_traversal)
-        x.pass(key_k, intersect, {&origins, &rays, trav, vs, isect[c.isect], v[0], v[1], v[2]},
-               {isect[c.isect ^ 1]}, &isect_mask);
+        x.pass(key_k, intersect, {&origins, &rays, trav, vs, &c.isect.current(), v[0], v[1], v[2]},
+               {&c.isect.next()}, &isect_mask);
       else
-        x.pass(key_k, intersect, {&origins, &rays, vs, isect[c.isect], v[0], v[1], v[2]},
-               {isect[c.isect ^ 1]}, &isect_mask);
-      c.isect ^= 1;
-      x.pass(key(step, k, site.next), next_, {&vs_[c.vs], &lists}, {&vs_[c.vs ^ 1]}, &isect_mask);
-      c.vs ^= 1;
+        x.pass(key_k, intersect, {&origins, &rays, vs, &c.isect.current(), v[0], v[1], v[2]},
+               {&c.isect.next()}, &isect_mask);
+      c.isect.swap();
+      x.pass(key(step, k, site.next), next_, {&c.vs.current(), &lists}, {&c.vs.next()},
+             &isect_mask);
+      c.vs.swap();
     }
-    testing =
-        x.count(key(step, k, site.testing_on), intersecting_, vs_[c.vs], &isect_mask, &isect_mask);
+    testing = x.count(key(step, k, site.testing_on), intersecting_, c.vs.current(), &isect_mask,
+                      &isect_mask);
   }
 }
 
@@ -239,31 +241,31 @@ void ListWalk::step_and_load(X& x, Cursor& c, const Key& key, int step, const St
                              const vgpu::Program& step_load, const vgpu::Texture& nodes,
                              const vgpu::Texture* more_nodes, const vgpu::Texture& lists) {
   vgpu::Texture &origins = *c.origins, &rays = *c.rays;
-  const vgpu::Texture *trav = &trav_[c.trav], *hits = sh_.isect[c.isect];
+  const vgpu::Texture *trav = &c.trav.current(), *hits = &c.isect.current();
   vgpu::Stencil* grid_mask = sh_.grid_mask;
   if (opt_.mrt) {
     const auto key_s = key(step, -1, site.step_load);
-    const vgpu::Texture* vs = &vs_[c.vs];
+    const vgpu::Texture* vs = &c.vs.current();
     if (more_nodes)
       x.pass(key_s, step_load, {&origins, &rays, trav, hits, vs, &nodes, more_nodes, &lists},
-             {&trav_[c.trav ^ 1], &vs_[c.vs ^ 1]}, grid_mask);
+             {&c.trav.next(), &c.vs.next()}, grid_mask);
     else
       x.pass(key_s, step_load, {&origins, &rays, trav, hits, vs, &nodes, &lists},
-             {&trav_[c.trav ^ 1], &vs_[c.vs ^ 1]}, grid_mask);
-    c.trav ^= 1;
-    c.vs ^= 1;
+             {&c.trav.next(), &c.vs.next()}, grid_mask);
+    c.trav.swap();
+    c.vs.swap();
     return;
   }
   const auto key_s = key(step, -1, site.step);
   if (more_nodes)
-    x.pass(key_s, step_p, {&origins, &rays, trav, hits, &nodes, more_nodes}, {&trav_[c.trav ^ 1]},
+    x.pass(key_s, step_p, {&origins, &rays, trav, hits, &nodes, more_nodes}, {&c.trav.next()},
            grid_mask);
   else
-    x.pass(key_s, step_p, {&origins, &rays, trav, hits, &nodes}, {&trav_[c.trav ^ 1]}, grid_mask);
-  c.trav ^= 1;
-  x.pass(key(step, -1, site.load), load, {&trav_[c.trav], &vs_[c.vs], &lists}, {&vs_[c.vs ^ 1]},
-         grid_mask);
-  c.vs ^= 1;
+    x.pass(key_s, step_p, {&origins, &rays, trav, hits, &nodes}, {&c.trav.next()}, grid_mask);
+  c.trav.swap();
+  x.pass(key(step, -1, site.load), load, {&c.trav.current(), &c.vs.current(), &lists},
+         {&c.vs.next()}, grid_mask);
+  c.vs.swap();
 }
 
 }  // namespace host

@@ -81,8 +81,8 @@ void BvhWalk::make_state(vgpu::Device& gpu, const WalkShared& shared) {
 void BvhWalk::trace(PassRunner& r, Texture& origins, Texture& rays, bool, glm::vec3) {
   clear(r.device());
   // Every ray starts at the root (primary and secondary alike: the walk needs no entry point).
-  r.pass(enter_, {&rays}, trav_[cur_trav_ ^ 1]);
-  cur_trav_ ^= 1;
+  r.pass(enter_, {&rays}, trav_.next());
+  trav_.swap();
   if (opt_.looping) {
     // A ray iterates once per node and once per triangle of each leaf it enters, plus once to
     // end.
@@ -100,7 +100,7 @@ void BvhWalk::walk(X& x, Cursor& c) {
   Stencil& grid_mask = *sh_.grid_mask;
   const auto key = walk::keys(c);
   x.fill(grid_mask, 1);
-  auto walking = x.count(key(-1, -1, kEnter), walking_, trav_[c.trav], nullptr, &grid_mask);
+  auto walking = x.count(key(-1, -1, kEnter), walking_, c.trav.current(), nullptr, &grid_mask);
   x.traced(walking);
   // The stackless walk visits a node at most once, and takes one more step to end: past that
   // (reduced precision: fp16 cannot count nodes past 2048) the host stops and reports the rays
@@ -115,7 +115,7 @@ void BvhWalk::walk(X& x, Cursor& c) {
                   &nodes_hi_, lists_);
     test_triangles(x, c, key, step, {kTesting, kIntersect, kNext, kIntersectNext, kTestingOn},
                    max_leaf_, intersect_, intersect_next_, lists_, false);
-    walking = x.count(key(step, -1, kWalking), walking_, trav_[c.trav], &grid_mask, &grid_mask);
+    walking = x.count(key(step, -1, kWalking), walking_, c.trav.current(), &grid_mask, &grid_mask);
   }
 }
 

@@ -102,12 +102,12 @@ void Grid2Walk::trace(PassRunner& r, Texture& origins, Texture& rays, bool, glm:
   clear(r.device());
   // Every ray starts in the sub-cell where it enters the box (primary rays' origins hold the
   // eye), that sub-cell's list start in hand.
-  r.pass(enter_, {&origins, &rays, &cells_, &subs_}, trav_[cur_trav_ ^ 1]);
-  cur_trav_ ^= 1;
+  r.pass(enter_, {&origins, &rays, &cells_, &subs_}, trav_.next());
+  trav_.swap();
   if (opt_.looping) {
     const uint64_t walking = count_entered(r);
-    r.pass(load_, {&trav_[cur_trav_], &vs_[cur_vs_], &lists_}, vs_[cur_vs_ ^ 1], sh_.grid_mask);
-    cur_vs_ ^= 1;
+    r.pass(load_, {&trav_.current(), &vs_.current(), &lists_}, vs_.next(), sh_.grid_mask);
+    vs_.swap();
     // Per sub-cell visited: one step and its triangles.
     walk_looping(r, looping_, origins, rays, {&cells_, &subs_, &lists_},
                  max_steps_ * int64_t(max_list_ + 1), walking);
@@ -123,12 +123,12 @@ void Grid2Walk::walk(X& x, Cursor& c) {
   Stencil& grid_mask = *sh_.grid_mask;
   const auto key = walk::keys(c);
   x.fill(grid_mask, 1);
-  auto walking = x.count(key(-1, -1, kEnter), walking_, trav_[c.trav], nullptr, &grid_mask);
+  auto walking = x.count(key(-1, -1, kEnter), walking_, c.trav.current(), nullptr, &grid_mask);
   x.traced(walking);
   if (!X::any(walking)) return;
-  x.pass(key(-1, -1, kLoadFirst), load_, {&trav_[c.trav], &vs_[c.vs], &lists_}, {&vs_[c.vs ^ 1]},
-         &grid_mask);
-  c.vs ^= 1;
+  x.pass(key(-1, -1, kLoadFirst), load_, {&c.trav.current(), &c.vs.current(), &lists_},
+         {&c.vs.next()}, &grid_mask);
+  c.vs.swap();
   for (int64_t step = 0;; ++step) {
     // The triangles of the sub-cell each walking ray stands in, one per pass.
     test_triangles(x, c, key, int(step), {kTesting, kIntersect, kNext, kIntersectNext, kTestingOn},
@@ -137,7 +137,7 @@ void Grid2Walk::walk(X& x, Cursor& c) {
     step_and_load(x, c, key, int(step), {kStep, kLoad, kStepLoad}, step_, load_, step_load_, cells_,
                   &subs_, lists_);
     walking =
-        x.count(key(int(step), -1, kWalking), walking_, trav_[c.trav], &grid_mask, &grid_mask);
+        x.count(key(int(step), -1, kWalking), walking_, c.trav.current(), &grid_mask, &grid_mask);
     if (!X::any(walking)) break;
     if (step + 1 == max_steps_) {  // no ray visits more sub-cells: stuck positions (fp16)
       x.unfinished(walking);

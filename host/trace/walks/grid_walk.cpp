@@ -176,11 +176,11 @@ void GridWalk::trace(PassRunner& r, Texture& origins, Texture& rays, bool primar
   // Enter the grid.
   if (primary) {
     init_.kernel.eye = eye;
-    r.pass(init_, {&rays}, trav_[cur_trav_ ^ 1]);
+    r.pass(init_, {&rays}, trav_.next());
   } else {
-    r.pass(reset_, {&origins, &rays}, trav_[cur_trav_ ^ 1]);
+    r.pass(reset_, {&origins, &rays}, trav_.next());
   }
-  cur_trav_ ^= 1;
+  trav_.swap();
   if (opt_.looping) {
     // A ray iterates once per triangle it tests and once per voxel it steps through: at most
     // (nx + ny + nz + 2) voxels of (longest list + 1) iterations each.
@@ -196,11 +196,10 @@ void GridWalk::trace(PassRunner& r, Texture& origins, Texture& rays, bool primar
 template <class X>
 void GridWalk::walk(X& x, Cursor& c) {
   Texture &origins = *c.origins, &rays = *c.rays;
-  Texture* const* isect = sh_.isect;
   Stencil& grid_mask = *sh_.grid_mask;
   const auto key = walk::keys(c);
   x.fill(grid_mask, 1);
-  auto walking = x.count(key(-1, -1, kEnter), walking_, trav_[c.trav], nullptr, &grid_mask);
+  auto walking = x.count(key(-1, -1, kEnter), walking_, c.trav.current(), nullptr, &grid_mask);
   x.traced(walking);
   // In exact arithmetic a ray crosses at most nx+ny+nz voxels and tests each voxel's list once.
   // Reduced precision can break both (fp16 cannot count past 2048): the host stops there and
@@ -214,9 +213,9 @@ void GridWalk::walk(X& x, Cursor& c) {
     // The first triangle of each ray's new voxel (under --mrt on, only at the first step: later
     // ones come from the fused traversal + update voxel pass).
     if (!opt_.mrt || step == 0) {
-      x.pass(key(step, -1, kUpdate), update_, {&trav_[c.trav], &vs_[c.vs], &pointers_, &lists_},
-             {&vs_[c.vs ^ 1]}, &grid_mask);
-      c.vs ^= 1;
+      x.pass(key(step, -1, kUpdate), update_,
+             {&c.trav.current(), &c.vs.current(), &pointers_, &lists_}, {&c.vs.next()}, &grid_mask);
+      c.vs.swap();
     }
     // One triangle per pass, until no ray has a triangle left in its voxel.
     test_triangles(x, c, key, step, {kTesting, kIntersect, kNext, kIntersectNext, kTestingOn},
@@ -225,16 +224,18 @@ void GridWalk::walk(X& x, Cursor& c) {
     // triangle in the same pass).
     if (opt_.mrt) {
       x.pass(key(step, -1, kTraverseUpdate), traverse_update_,
-             {&origins, &rays, &trav_[c.trav], isect[c.isect], &vs_[c.vs], &pointers_, &lists_},
-             {&trav_[c.trav ^ 1], &vs_[c.vs ^ 1]}, &grid_mask);
-      c.trav ^= 1;
-      c.vs ^= 1;
+             {&origins, &rays, &c.trav.current(), &c.isect.current(), &c.vs.current(), &pointers_,
+              &lists_},
+             {&c.trav.next(), &c.vs.next()}, &grid_mask);
+      c.trav.swap();
+      c.vs.swap();
     } else {
       x.pass(key(step, -1, kTraversal), traversal_,
-             {&origins, &rays, &trav_[c.trav], isect[c.isect]}, {&trav_[c.trav ^ 1]}, &grid_mask);
-      c.trav ^= 1;
+             {&origins, &rays, &c.trav.current(), &c.isect.current()}, {&c.trav.next()},
+             &grid_mask);
+      c.trav.swap();
     }
-    walking = x.count(key(step, -1, kInGrid), walking_, trav_[c.trav], &grid_mask, &grid_mask);
+    walking = x.count(key(step, -1, kInGrid), walking_, c.trav.current(), &grid_mask, &grid_mask);
   }
 }
 

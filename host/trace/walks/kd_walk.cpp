@@ -90,8 +90,8 @@ void KdWalk::trace(PassRunner& r, Texture& origins, Texture& rays, bool, glm::ve
   clear(r.device());
   // Every ray starts at the root with its segment inside the scene box (primary rays' origins
   // hold the eye).
-  r.pass(enter_, {&origins, &rays}, trav_[cur_trav_ ^ 1]);
-  cur_trav_ ^= 1;
+  r.pass(enter_, {&origins, &rays}, trav_.next());
+  trav_.swap();
   if (opt_.looping) {
     // Per leaf visited: at most depth descents, two steps at the leaf, its triangles.
     walk_looping(r, looping_, origins, rays, {&tree_, &lists_},
@@ -108,7 +108,7 @@ void KdWalk::walk(X& x, Cursor& c) {
   Stencil& grid_mask = *sh_.grid_mask;
   const auto key = walk::keys(c);
   x.fill(grid_mask, 1);
-  auto walking = x.count(key(-1, -1, kEnter), walking_, trav_[c.trav], nullptr, &grid_mask);
+  auto walking = x.count(key(-1, -1, kEnter), walking_, c.trav.current(), nullptr, &grid_mask);
   x.traced(walking);
   // kd-restart visits each leaf at most once, descending at most depth nodes to it and taking
   // two steps there (reach, then end or restart): past that many steps (reduced precision:
@@ -123,7 +123,7 @@ void KdWalk::walk(X& x, Cursor& c) {
                   nullptr, lists_);
     test_triangles(x, c, key, step, {kTesting, kIntersect, kNext, kIntersectNext, kTestingOn},
                    max_leaf_, intersect_, intersect_next_, lists_, true);
-    walking = x.count(key(step, -1, kWalking), walking_, trav_[c.trav], &grid_mask, &grid_mask);
+    walking = x.count(key(step, -1, kWalking), walking_, c.trav.current(), &grid_mask, &grid_mask);
   }
 }
 

@@ -58,7 +58,8 @@ struct PassKey {
 template <class Cursor>
 auto keys(const Cursor& c) {
   return [&c](int step, int k, int site) {
-    return PassKey{step, k, site, uint8_t(c.trav | c.vs << 1 | c.isect << 2)};
+    return PassKey{step, k, site,
+                   uint8_t(c.trav.which() | c.vs.which() << 1 | c.isect.which() << 2)};
   };
 }
 
