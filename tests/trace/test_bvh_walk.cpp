@@ -40,8 +40,8 @@ namespace {
 
 using Json = nlohmann::ordered_json;
 
-// A bundled scene with the grid the CLI builds for the profile, the BVH and the one-voxel grid
-// the CLI builds beside it (the scene box); the camera for a square image.
+// A bundled scene with the grid the CLI builds for the profile and the BVH in the scene's box;
+// the camera for a square image.
 Structures bundled(const std::string& name, const std::string& profile = "gf5700") {
   return test_support::bundled_structures(host::AccelKind::bvh, name, 1, 1, profile);
 }
