@@ -13,6 +13,8 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <map>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <random>
@@ -598,25 +600,16 @@ void scene_frames(const Args& a, const host::Scene& scene, int size,
   opt.shadows = a.shadows;
   opt.threads = a.threads;
   opt.gl_device = a.device;
-  const host::Grid grid = host::build_grid(
-      scene,
-      host::grid_spec_for(host::parse_grid_spec(a.grid_text), scene, vgpu::profile(opt.profile)));
-  const host::Grid box = host::build_grid(scene, host::GridSpec{glm::ivec3(1)});
-  std::optional<host::Bvh> bvh;
-  std::optional<host::KdTree> kd;
-  std::optional<host::Grid2> grid2;
-  for (const std::string& name : a.accels) {
-    if (name == "bvh" && !bvh) bvh = host::build_bvh(scene);
-    if (name == "kdtree" && !kd) kd = host::build_kdtree(scene, box.lo, box.hi);
-    if (name == "grid2" && !grid2) grid2 = host::build_grid2(scene);
-  }
+  const host::AccelParams params{
+      host::grid_spec_for(host::parse_grid_spec(a.grid_text), scene, vgpu::profile(opt.profile))};
+  std::map<std::string, std::unique_ptr<host::Accel>> built;  // each structure named, once
+  for (const std::string& name : a.accels)
+    if (!built.count(name))
+      built[name] = host::make_accel(host::parse_accel_kind(name), scene, params);
   const host::Camera cam = host::scene_camera(scene);
   for (const std::string& accel_name : a.accels)
     for (const std::string& variant : a.variants) {
-      const host::AccelKind kind = host::parse_accel_kind(accel_name);
-      const host::Accel accel{kind, kind == host::AccelKind::grid ? &grid : &box,
-                              bvh ? &*bvh : nullptr, kd ? &*kd : nullptr,
-                              grid2 ? &*grid2 : nullptr};
+      const host::Accel& accel = *built.at(accel_name);
       // The paper's pipeline at Table 1's profile; its future work (MRT fused passes, the
       // looping kernels) needs a profile with several outputs and loops: the h200's.
       opt.mrt = variant == "mrt";

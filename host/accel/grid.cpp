@@ -1,5 +1,6 @@
 // Offline construction of the uniform grid (see grid.h): resolution parsing and the automatic
-// rule, padded bounds, exact triangle/voxel overlap, and the CSR voxel lists.
+// rule, the grid over the scene's padded box (Scene::box()), exact triangle/voxel overlap, and the
+// CSR voxel lists.
 #include "host/accel/grid.h"
 
 #include <algorithm>
@@ -229,14 +230,6 @@ void insert_triangles(const Grid& g, const Scene& scene, size_t begin, size_t en
   }
 }
 
-// float nearest to x, rounded toward -inf (down) or +inf (up).
-float round_float(double x, bool up) {
-  float f = float(x);
-  if (up && double(f) < x) f = std::nextafter(f, std::numeric_limits<float>::infinity());
-  if (!up && double(f) > x) f = std::nextafter(f, -std::numeric_limits<float>::infinity());
-  return f;
-}
-
 }  // namespace
 
 Grid build_grid(const Scene& scene, const GridSpec& spec, unsigned threads) {
@@ -244,18 +237,8 @@ Grid build_grid(const Scene& scene, const GridSpec& spec, unsigned threads) {
   const Bounds bounds = scene.bounds();
   const glm::ivec3 res =
       spec.automatic() ? auto_resolution(bounds, scene.triangle_count()) : spec.res;
-  glm::vec3 lo(-1.0f), hi(1.0f);  // no triangles: any box will do
-  if (!bounds.empty()) {
-    const glm::dvec3 blo(bounds.lo), bhi(bounds.hi);
-    const glm::dvec3 mag = glm::max(glm::abs(blo), glm::abs(bhi));
-    const double pad = std::max(kGridPadRelative * glm::length(bhi - blo),
-                                kGridPadMagnitude * std::max({mag.x, mag.y, mag.z}));
-    for (int a = 0; a < 3; ++a) {
-      lo[a] = round_float(blo[a] - pad, false);
-      hi[a] = round_float(bhi[a] + pad, true);
-    }
-  }
-  Grid g = build_grid_in_box(scene, lo, hi, res, threads);
+  const Bounds box = scene.box();  // padded, rounded outward to float
+  Grid g = build_grid_in_box(scene, box.lo, box.hi, res, threads);
   g.build_ms = ms_since(t_begin);
   return g;
 }

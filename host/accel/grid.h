@@ -39,16 +39,8 @@ inline constexpr int kMaxAutoGridRes = 128;
 // flat scene still gets ≈ density·N voxels. Empty bounds or no triangles give 1×1×1.
 glm::ivec3 auto_resolution(const Bounds& bounds, size_t triangles, double density = kGridDensity);
 
-// Grid bounds padding: the scene bounds grow on every side by
-//   pad = max(kGridPadRelative · |diagonal|, kGridPadMagnitude · max|coordinate|)
-// then are rounded outward to float. The relative term keeps triangles off the outer faces and
-// gives a flat scene a non-zero extent (2·pad) along its flat axis; the magnitude term (≈ 8 float
-// ulps) keeps the padding from vanishing when a small scene sits far from the origin.
-inline constexpr double kGridPadRelative = 1e-4;
-inline constexpr double kGridPadMagnitude = 1e-6;
-
 struct Grid {
-  glm::vec3 lo{0.0f}, hi{0.0f};  // world space, padded scene bounds
+  glm::vec3 lo{0.0f}, hi{0.0f};  // world space, the padded scene box (Scene::box())
   glm::ivec3 res{1};             // voxels per axis
   glm::vec3 cell{0.0f};          // world size of one voxel: (hi - lo) / res, in float
   // CSR: voxel v lists tris[start[v] .. start[v+1]), internal triangle indices into the Scene
@@ -84,17 +76,17 @@ struct Grid {
   void voxel_box(glm::ivec3 v, glm::dvec3& box_lo, glm::dvec3& box_hi) const;
 };
 
-// Builds the grid: a triangle goes in every voxel it actually overlaps (closed boxes, so a
-// triangle lying exactly in a voxel face is listed in both voxels sharing it). Candidates come
-// from the triangle's bounding box narrowed column by column by its plane; each candidate is
-// decided by triangle_box_overlap. Multi-threaded over contiguous triangle ranges merged in order,
-// so the result is identical for any thread count. `threads` = 0 means hardware concurrency.
-// Throws std::invalid_argument for a resolution outside [1, kMaxGridRes], std::length_error if
-// the references overflow 32 bits.
+// Builds the grid over the scene's padded box (Scene::box()): a triangle goes in every voxel it
+// actually overlaps (closed boxes, so a triangle lying exactly in a voxel face is listed in both
+// voxels sharing it). Candidates come from the triangle's bounding box narrowed column by column by
+// its plane; each candidate is decided by triangle_box_overlap. Multi-threaded over contiguous
+// triangle ranges merged in order, so the result is identical for any thread count. `threads` = 0
+// means hardware concurrency. Throws std::invalid_argument for a resolution outside [1,
+// kMaxGridRes], std::length_error if the references overflow 32 bits.
 Grid build_grid(const Scene& scene, const GridSpec& spec, unsigned threads = 0);
 
 // The same over a given world box [lo, hi] (hi > lo on every axis) and resolution, unpadded:
-// build_grid pads the scene bounds and calls this. Parts of triangles outside the box are
+// build_grid calls this with the scene's box. Parts of triangles outside the box are
 // ignored (a triangle is listed only in voxels it overlaps). Tests use it to put voxel planes at
 // known coordinates.
 Grid build_grid_in_box(const Scene& scene, glm::vec3 lo, glm::vec3 hi, glm::ivec3 res,

@@ -39,7 +39,7 @@ struct KdNode {
 };
 
 struct KdTree {
-  glm::vec3 lo{0.0f}, hi{0.0f};  // the root's box: the padded scene box (the grid's)
+  glm::vec3 lo{0.0f}, hi{0.0f};  // the root's box: the padded scene box (Scene::box)
   std::vector<KdNode> nodes;     // depth first; nodes[0] is the root
   std::vector<int32_t> lists;    // lists[0] = -1; each leaf's list closed by -1
   int depth = 0, leaves = 0, empty_leaves = 0, max_leaf = 0;
@@ -48,7 +48,7 @@ struct KdTree {
   uint64_t references() const;
 };
 
-// Builds the tree inside the box [lo, hi] (the grid's padded scene box). Deterministic.
+// Builds the tree inside the box [lo, hi] (the padded scene box, Scene::box). Deterministic.
 KdTree build_kdtree(const Scene& scene, glm::vec3 lo, glm::vec3 hi, const KdSpec& spec = {});
 
 // "kd-tree: 12,345 nodes, depth 21, 6,173 leaves (1,020 empty) of at most 9 triangles"

@@ -261,7 +261,6 @@ void print_table(const RenderArgs& a, const RenderPlan& plan, const host::Scene&
                  host::StreamTracer* tracer, const std::string& animation_text) {
   const host::RenderOptions& opt = plan.opt;
   const bool cpu = plan.cpu, gl = plan.gl, animating = plan.animating;
-  const host::Grid& walk_grid = *accel.grid;
   if (cpu) {
     std::printf(
         "CPU reference (double precision, recursive Whitted): %llu rays, %llu voxel steps, %llu "
@@ -285,19 +284,10 @@ void print_table(const RenderArgs& a, const RenderPlan& plan, const host::Scene&
     std::cout << r.stats.to_table();
   std::printf(
       "scene %s: %zu triangles (%u dropped as degenerate), grid %dx%dx%d (%llu references)\n",
-      scene.name.c_str(), scene.triangle_count(), scene.dropped_degenerate, walk_grid.res.x,
-      walk_grid.res.y, walk_grid.res.z, static_cast<unsigned long long>(walk_grid.references()));
-  if (accel.kind == host::AccelKind::bvh)
-    std::printf("%s (%.1f ms to build)\n", host::describe(*accel.bvh).c_str(), accel.bvh->build_ms);
-  if (accel.kind == host::AccelKind::kdtree)
-    std::printf("%s (%.1f ms to build)\n", host::describe(*accel.kd).c_str(), accel.kd->build_ms);
-  if (accel.kind == host::AccelKind::grid2)
-    std::printf(
-        "two-level grid: coarse %dx%dx%d, %d crowded cells, %zu sub-cells, %llu "
-        "references (%.1f ms to build)\n",
-        accel.grid2->coarse.res.x, accel.grid2->coarse.res.y, accel.grid2->coarse.res.z,
-        accel.grid2->crowded, accel.grid2->sub_cells(),
-        static_cast<unsigned long long>(accel.grid2->references), accel.grid2->build_ms);
+      scene.name.c_str(), scene.triangle_count(), scene.dropped_degenerate, accel.grid_res().x,
+      accel.grid_res().y, accel.grid_res().z,
+      static_cast<unsigned long long>(accel.grid_references()));
+  if (const std::string line = accel.describe(); !line.empty()) std::printf("%s\n", line.c_str());
   if (choice)
     std::printf("accel auto: %s (probes %.0f ms)\n", choice->why.c_str(), choice->probe_ms);
   std::printf("%s %s, %dx%d, %d iteration(s), %s shading, shadows %s, masks %s, mrt %s\n",
@@ -306,7 +296,7 @@ void print_table(const RenderArgs& a, const RenderPlan& plan, const host::Scene&
   if (!cpu) std::cout << "formats (texture and arithmetic, per group):\n" << describe(opt.formats);
   if (r.streams.on) std::cout << host::describe(r.streams);
   std::printf("initialization %.1f ms (grid %.1f ms), render %.1f ms (%s)\n", init_ms,
-              walk_grid.build_ms, r.render_ms,
+              accel.grid_build_ms(), r.render_ms,
               cpu            ? "host CPU"
               : gl           ? "wall, GL device"
               : r.batch_walk ? "host, emulated, walks in batches"
@@ -376,29 +366,6 @@ std::optional<size_t> find_animation(const RenderArgs& a, const std::string& pat
   return std::nullopt;
 }
 
-// Build (a later frame, --accel bvh): --update refit keeps the topology and moves the boxes;
-// auto refits until the refitted tree's SAH cost passes kRefitLimit times the last build's (in
-// `built_sah`), then builds again. Returns what it did: "refit" or "rebuild".
-std::string update_bvh(std::optional<host::Bvh>& bvh, double& built_sah, const host::Scene& scene,
-                       const std::string& update) {
-  // --update auto rebuilds when the refitted BVH's SAH cost (expected node visits and triangle
-  // tests per ray) has grown past this factor of its last build's.
-  constexpr double kRefitLimit = 1.25;
-  host::Bvh refitted = *bvh;
-  bool refit = update != "rebuild";
-  if (refit) {
-    host::refit_bvh(refitted, scene);
-    refit = update == "refit" || refitted.sah_cost <= kRefitLimit * built_sah;
-  }
-  if (refit) {
-    bvh = std::move(refitted);
-    return "refit";
-  }
-  bvh = host::build_bvh(scene);
-  built_sah = bvh->sah_cost;
-  return "rebuild";
-}
-
 // Write: a frame's image and AOVs (numbered when animating: frame_####.png).
 void write_images(const RenderArgs& a, const RenderPlan& plan, const host::RenderResult& r,
                   int number) {
@@ -461,42 +428,19 @@ int run_render(const RenderArgs& a, bool lanes_given) {
   double pose_ms = animated ? host::ms_since(pose_start) : 0.0;
   const host::Scene& rest = animated ? animated->rest() : scene;  // frames a camera-less file
   const auto t0 = std::chrono::steady_clock::now();
-  // With a structure other than the grid, the grid is one voxel: it gives the scene box only.
+  // The structure (make_accel): the one asked for, or with --accel auto every kind, each
+  // probed below and the cheapest kept.
   const bool auto_accel = a.accel == "auto";
-  host::AccelKind accel_kind = auto_accel ? host::AccelKind::grid : host::parse_accel_kind(a.accel);
-  const bool want_grid = auto_accel || accel_kind == host::AccelKind::grid;
-  host::Grid grid =
-      want_grid ? host::build_grid(
-                      scene, host::grid_spec_for(grid_spec, scene, vgpu::profile(opt.profile)))
-                : host::Grid{};
-  // Later frames keep the first frame's resolution (so the voxel pointers keep their texture).
-  const host::GridSpec frame_grid{grid.res};
-  std::optional<host::Grid> box;
-  std::optional<host::Bvh> bvh;
-  std::optional<host::KdTree> kd;
-  std::optional<host::Grid2> grid2;
-  if (auto_accel || accel_kind != host::AccelKind::grid)
-    box = host::build_grid(scene, host::GridSpec{glm::ivec3(1)});
-  if (auto_accel || accel_kind == host::AccelKind::bvh) bvh = host::build_bvh(scene);
-  if (auto_accel || accel_kind == host::AccelKind::kdtree)
-    kd = host::build_kdtree(scene, box->lo, box->hi);
-  if (auto_accel || accel_kind == host::AccelKind::grid2) grid2 = host::build_grid2(scene);
-  auto accel_of = [&](host::AccelKind k) {
-    return host::Accel{k, k == host::AccelKind::grid ? &grid : &*box,
-                       k == host::AccelKind::bvh ? &*bvh : nullptr,
-                       k == host::AccelKind::kdtree ? &*kd : nullptr,
-                       k == host::AccelKind::grid2 ? &*grid2 : nullptr};
+  const host::AccelParams params{host::grid_spec_for(grid_spec, scene, vgpu::profile(opt.profile))};
+  std::vector<std::unique_ptr<host::Accel>> built;
+  if (auto_accel)
+    for (host::AccelKind k : host::kAccelKinds) built.push_back(host::make_accel(k, scene, params));
+  else
+    built.push_back(host::make_accel(host::parse_accel_kind(a.accel), scene, params));
+  auto formats_for = [&](const host::Accel& accel) {
+    return host::resolve(formats, scene, accel, vgpu::profile(opt.profile));
   };
-  auto formats_for = [&](host::AccelKind k) {
-    const vgpu::Profile& p = vgpu::profile(opt.profile);
-    return k == host::AccelKind::grid  ? host::resolve(formats, scene, grid, p)
-           : k == host::AccelKind::bvh ? host::resolve(formats, scene, *box, p, bvh->lists.size())
-           : k == host::AccelKind::grid2
-               ? host::resolve(formats, scene, *box, p,
-                               std::max<uint64_t>(grid2->lists.size(), grid2->sub_cells()))
-               : host::resolve(formats, scene, *box, p, kd->lists.size());
-  };
-  opt.formats = formats_for(accel_kind);
+  opt.formats = formats_for(*built.front());
   if (const std::string why = opt.refusal(vgpu::profile(opt.profile), a.aa); !why.empty())
     throw UsageError(why);
   const float aspect = float(opt.width) / float(opt.height);
@@ -508,21 +452,18 @@ int run_render(const RenderArgs& a, bool lanes_given) {
   const bool tty = ::isatty(2) && !a.quiet && !several;
   if (!a.quiet && !several) opt.progress = progress_line(tty);  // several: a line per frame
   std::optional<host::AccelChoice> choice;
+  size_t chosen = 0;
   if (auto_accel) {
     std::vector<host::AccelCandidate> candidates;
-    for (host::AccelKind k : host::kAccelKinds) candidates.push_back({accel_of(k), formats_for(k)});
+    for (const auto& accel : built) candidates.push_back({accel.get(), formats_for(*accel)});
     choice = host::choose_accel(scene, candidates, opt, camera_for(scene));
-    accel_kind = choice->kind;
-    opt.formats = formats_for(accel_kind);
+    for (size_t i = 0; i < built.size(); ++i)
+      if (built[i]->kind() == choice->kind) chosen = i;
+    opt.formats = formats_for(*built[chosen]);
   }
-  const host::Accel accel = accel_of(accel_kind);
-  // The host's build of the structure walked (and of its box), ms.
-  auto build_ms = [&] {
-    return accel_kind == host::AccelKind::grid    ? grid.build_ms
-           : accel_kind == host::AccelKind::bvh   ? box->build_ms + bvh->build_ms
-           : accel_kind == host::AccelKind::grid2 ? grid2->build_ms
-                                                  : box->build_ms + kd->build_ms;
-  };
+  const std::unique_ptr<host::Accel> walked = std::move(built[chosen]);
+  built.clear();  // the structures not chosen
+  host::Accel& accel = *walked;
   std::optional<host::StreamTracer> tracer;
   if (!cpu) tracer.emplace(scene, accel, opt);
   const double init_ms =
@@ -541,7 +482,6 @@ int run_render(const RenderArgs& a, bool lanes_given) {
   nlohmann::ordered_json j, frames_json = nlohmann::ordered_json::array();
   std::vector<FrameLine> lines;
   std::optional<std::pair<host::RenderResult, nlohmann::ordered_json>> reported;  // --report-frame
-  double built_sah = bvh ? bvh->sah_cost : 0.0;
   std::string action = "initial";
   for (size_t f = 0; f < times.size(); ++f) {
     const int number = int(f) + 1;
@@ -551,16 +491,7 @@ int run_render(const RenderArgs& a, bool lanes_given) {
       pose_start = std::chrono::steady_clock::now();
       scene = animated->at(animation, times[f]);
       pose_ms = host::ms_since(pose_start);
-      action = "rebuild";
-      if (accel_kind == host::AccelKind::grid) {
-        grid = host::build_grid(scene, frame_grid);
-      } else {  // the structure walked, in the scene's new box
-        box = host::build_grid(scene, host::GridSpec{glm::ivec3(1)});
-        if (accel_kind == host::AccelKind::bvh)
-          action = update_bvh(bvh, built_sah, scene, a.update);
-        if (accel_kind == host::AccelKind::kdtree) kd = host::build_kdtree(scene, box->lo, box->hi);
-        if (accel_kind == host::AccelKind::grid2) grid2 = host::build_grid2(scene);
-      }
+      action = accel.update(scene, a.update);  // rebuilt (or a BVH refitted), in its new box
       const auto tu = std::chrono::steady_clock::now();
       if (tracer) up = tracer->update(scene, accel);
       write_ms = host::ms_since(tu);
@@ -581,8 +512,8 @@ int run_render(const RenderArgs& a, bool lanes_given) {
     if (!cpu && !gl) predicted = host::predict(r.stats, vgpu::profile(opt.profile)).total_ms;
     if (animating) {
       const nlohmann::ordered_json update =
-          host::frame_update_json(f == 0 ? std::string("initial") : action, pose_ms, accel_kind,
-                                  build_ms(), write_ms, up, tracer.has_value());
+          host::frame_update_json(f == 0 ? std::string("initial") : action, pose_ms, accel.kind(),
+                                  accel.build_ms(), write_ms, up, tracer.has_value());
       j["frame"] = number;
       j["time"] = times[f];
       j["animation"] = animation_json;
@@ -593,13 +524,13 @@ int run_render(const RenderArgs& a, bool lanes_given) {
         std::fprintf(stderr,
                      "vgpu-rt: frame %d/%zu (t = %g s): update %.1f ms (pose %.1f, %s %.1f, "
                      "textures %.1f), %llu bytes uploaded; render %.1f ms, %llu passes\n",
-                     number, times.size(), times[f], pose_ms + build_ms() + write_ms, pose_ms,
-                     std::string(host::accel_name(accel_kind)).c_str(), build_ms(), write_ms,
+                     number, times.size(), times[f], pose_ms + accel.build_ms() + write_ms, pose_ms,
+                     std::string(accel.name()).c_str(), accel.build_ms(), write_ms,
                      static_cast<unsigned long long>(up.bytes), r.render_ms,
                      static_cast<unsigned long long>(r.stats.totals.passes));
     }
     const host::WalkWork work = cpu ? host::WalkWork{} : host::walk_work(r.stats);
-    lines.push_back({times[f], pose_ms, build_ms(), write_ms, r.render_ms, up.bytes,
+    lines.push_back({times[f], pose_ms, accel.build_ms(), write_ms, r.render_ms, up.bytes,
                      r.stats.totals.passes, predicted, f == 0 ? std::string("initial") : action,
                      cpu ? cpu_stats.nodes_visited : work.nodes_visited,
                      cpu ? cpu_stats.voxel_steps : work.voxel_steps});
@@ -615,7 +546,7 @@ int run_render(const RenderArgs& a, bool lanes_given) {
   if (a.stats == "json") {
     std::cout << j.dump(2) << "\n";
   } else if (a.stats == "table" && several) {
-    print_frames_table(a, plan, scene, accel_kind, r, lines, init_ms,
+    print_frames_table(a, plan, scene, accel.kind(), r, lines, init_ms,
                        animation ? "'" + animated->animations()[*animation].name + "'"
                                  : "none (the scene is static)");
   } else if (a.stats == "table") {

@@ -85,12 +85,23 @@ Formats resolve(const FormatRequest& request, const Scene& scene, const Grid& gr
   return f;
 }
 
+Formats resolve(const FormatRequest& request, const Scene& scene, const Accel& accel,
+                const vgpu::Profile& profile) {
+  if (const Grid* grid = accel.grid()) return resolve(request, scene, *grid, profile);
+  // Only the resolution of the grid is read where the list length is given: one voxel.
+  const Grid one_voxel;
+  return resolve(request, scene, one_voxel, profile, accel.list_entries());
+}
+
 IntegerRanges integer_ranges(const Scene& scene, const Grid& grid, uint64_t list_entries) {
   IntegerRanges r;
-  uint64_t nonempty = 0;
-  for (size_t v = 0; v < grid.voxels(); ++v) nonempty += grid.start[v + 1] > grid.start[v];
-  // As the stream tracer lays the lists out: a shared -1, then each non-empty list and its -1.
-  r.list_entries = list_entries ? list_entries : 1 + grid.tris.size() + nonempty;
+  r.list_entries = list_entries;
+  if (!list_entries) {
+    // As the stream tracer lays the lists out: a shared -1, then each non-empty list and its -1.
+    uint64_t nonempty = 0;
+    for (size_t v = 0; v < grid.voxels(); ++v) nonempty += grid.start[v + 1] > grid.start[v];
+    r.list_entries = 1 + grid.tris.size() + nonempty;
+  }
   r.triangles = scene.triangle_count();
   r.pointer_texels = uint64_t(grid.res.x) * uint64_t(grid.res.y);
   r.voxels_per_axis = uint64_t(std::max({grid.res.x, grid.res.y, grid.res.z}));

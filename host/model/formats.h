@@ -9,6 +9,7 @@
 #include <string>
 #include <string_view>
 
+#include "host/accel/accel.h"
 #include "host/accel/grid.h"
 #include "host/scene/scene.h"
 #include "vgpu/profile.h"
@@ -66,6 +67,10 @@ FormatRequest parse_format_request(const std::string& precision, const std::stri
 // BVH's, host/accel/bvh.h).
 Formats resolve(const FormatRequest& request, const Scene& scene, const Grid& grid,
                 const vgpu::Profile& profile, uint64_t list_entries = 0);
+// The same for the structure walked: the grid's own lists, or another structure's
+// (Accel::list_entries) addressed beside the one voxel it reports as its grid.
+Formats resolve(const FormatRequest& request, const Scene& scene, const Accel& accel,
+                const vgpu::Profile& profile);
 
 // The largest integers each group must hold exactly in this scene and grid.
 struct IntegerRanges {

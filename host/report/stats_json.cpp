@@ -21,7 +21,6 @@ nlohmann::ordered_json frame_stats_json(const FrameStatsInputs& in) {
   const Scene& scene = in.scene;
   StreamTracer* tracer = in.tracer;  // device() is not const
   const Accel& accel = in.accel;
-  const Grid& walk_grid = *accel.grid;
   const RenderOptions& opt = in.options;
   const RenderResult& r = in.result;
   const CpuStats& cpu_stats = in.cpu_stats;
@@ -34,42 +33,15 @@ nlohmann::ordered_json frame_stats_json(const FrameStatsInputs& in) {
   j["triangles"] = scene.triangle_count();
   j["input_triangles"] = scene.input_triangles;
   j["dropped_degenerate"] = scene.dropped_degenerate;
-  j["grid"] = {walk_grid.res.x, walk_grid.res.y, walk_grid.res.z};
-  j["grid_references"] = walk_grid.references();
+  // The grid's resolution and references: a structure other than the grid reports the one
+  // voxel of its scene box (Accel::grid_res).
+  const glm::ivec3 grid_res = accel.grid_res();
+  j["grid"] = {grid_res.x, grid_res.y, grid_res.z};
+  j["grid_references"] = accel.grid_references();
   {
     nlohmann::ordered_json acc;
-    acc["structure"] = accel_name(accel.kind);
-    if (accel.kind == AccelKind::bvh) {
-      acc["nodes"] = accel.bvh->nodes.size();
-      acc["leaves"] = accel.bvh->leaves;
-      acc["depth"] = accel.bvh->depth;
-      acc["max_leaf"] = accel.bvh->max_leaf;
-      acc["references"] = accel.bvh->references();
-      acc["sah_cost"] = accel.bvh->sah_cost;
-      acc["build_ms"] = accel.bvh->build_ms;
-    } else if (accel.kind == AccelKind::kdtree) {
-      acc["nodes"] = accel.kd->nodes.size();
-      acc["leaves"] = accel.kd->leaves;
-      acc["empty_leaves"] = accel.kd->empty_leaves;
-      acc["depth"] = accel.kd->depth;
-      acc["max_leaf"] = accel.kd->max_leaf;
-      acc["references"] = accel.kd->references();
-      acc["sah_cost"] = accel.kd->sah_cost;
-      acc["build_ms"] = accel.kd->build_ms;
-    } else if (accel.kind == AccelKind::grid2) {
-      const Grid& c = accel.grid2->coarse;
-      acc["coarse"] = {c.res.x, c.res.y, c.res.z};
-      acc["crowded_cells"] = accel.grid2->crowded;
-      acc["sub_cells"] = accel.grid2->sub_cells();
-      acc["list_entries"] = accel.grid2->lists.size();
-      acc["references"] = accel.grid2->references;
-      acc["max_list"] = accel.grid2->max_list;
-      acc["build_ms"] = accel.grid2->build_ms;
-    } else {
-      acc["voxels"] = {walk_grid.res.x, walk_grid.res.y, walk_grid.res.z};
-      acc["references"] = walk_grid.references();
-      acc["build_ms"] = walk_grid.build_ms;
-    }
+    acc["structure"] = accel.name();
+    accel.stats_json(acc);  // the structure's own fields
     if (!cpu) {
       const WalkWork w = walk_work(r.stats, r.rays_traced);
       acc["work"] = {{"voxel_steps", w.voxel_steps},
@@ -114,7 +86,7 @@ nlohmann::ordered_json frame_stats_json(const FrameStatsInputs& in) {
   j["precision"] = in.precision;
   if (!cpu) j["formats"] = to_json(opt.formats);
   j["init_ms"] = in.init_ms;
-  j["grid_build_ms"] = walk_grid.build_ms;
+  j["grid_build_ms"] = accel.grid_build_ms();
   j["render_ms"] = r.render_ms;
   if (tracer) j["texture_bytes"] = tracer->texture_bytes();
   if (cpu)

@@ -23,7 +23,7 @@ struct FrameStatsInputs {
   const std::string& scene_path;
   const std::string& engine;  // stream, cpu or gl
   StreamTracer* tracer;       // nullptr: the CPU reference rendered the frame
-  const Accel& accel;  // the structure walked (its grid: the scene box of a non-grid structure)
+  const Accel& accel;         // the structure walked
   const AccelChoice* choice;  // --accel auto's choice, else nullptr
   const RenderOptions& options;
   const RenderResult& result;

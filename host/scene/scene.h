@@ -25,10 +25,10 @@ struct Material {
   // Glass (KHR_materials_transmission, KHR_materials_ior, KHR_materials_volume): the share of
   // light transmitted through the surface, the index of refraction inside it, and the volume's
   // absorption (Beer's law: colour reached after attenuation_distance world units inside).
-  float transmission = 0.0f;                // transmissionFactor, 0: opaque (the paper's model)
-  float ior = 1.5f;                         // KHR_materials_ior's default
-  glm::vec3 attenuation_color{1.0f};        // KHR_materials_volume, linear rgb
-  float attenuation_distance = 0.0f;        // world units; 0: no absorption (the spec's infinity)
+  float transmission = 0.0f;          // transmissionFactor, 0: opaque (the paper's model)
+  float ior = 1.5f;                   // KHR_materials_ior's default
+  glm::vec3 attenuation_color{1.0f};  // KHR_materials_volume, linear rgb
+  float attenuation_distance = 0.0f;  // world units; 0: no absorption (the spec's infinity)
 };
 
 // The sampler's wrap modes (glTF's REPEAT, CLAMP_TO_EDGE, MIRRORED_REPEAT), numbered as
@@ -116,6 +116,17 @@ struct Scene {
     }
     return b;
   }
+  // The scene's padded box, the world box every acceleration structure is built in (scene.cpp):
+  // bounds() grown on every side by
+  //   pad = max(kScenePadRelative · |diagonal|, kScenePadMagnitude · max|coordinate|)
+  // and rounded outward to float. A scene without triangles gets [-1, 1]³ (any box will do).
+  Bounds box() const;
 };
+
+// The padding of Scene::box(). The relative term keeps triangles off the box's faces and gives a
+// flat scene a non-zero extent (2·pad) along its flat axis; the magnitude term (≈ 8 float ulps)
+// keeps the padding from vanishing when a small scene sits far from the origin.
+inline constexpr double kScenePadRelative = 1e-4;
+inline constexpr double kScenePadMagnitude = 1e-6;
 
 }  // namespace host

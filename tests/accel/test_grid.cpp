@@ -241,7 +241,7 @@ TEST_CASE("Grid bounds are the scene bounds padded on every side, even along a f
   }
   const double diag = std::sqrt(125.0);
   CHECK(double(g.hi.z) - double(g.lo.z) ==
-        doctest::Approx(2 * host::kGridPadRelative * diag).epsilon(0.01));
+        doctest::Approx(2 * host::kScenePadRelative * diag).epsilon(0.01));
   CHECK(voxels_of(g, 0).size() > 0);
 }
 

@@ -4,6 +4,7 @@
 // frame (on llvmpipe bit for bit, tests/gl/gl_compare.h).
 #include <doctest/doctest.h>
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -34,20 +35,15 @@ Sequence play(const std::string& device, host::AccelKind kind) {
   opt.keep_pass_records = true;
   host::Scene scene = a.at(0, 0.0);
   const bool bvh_kind = kind == host::AccelKind::bvh;
-  host::Grid grid =
-      host::build_grid(scene, bvh_kind ? host::GridSpec{glm::ivec3(1)} : host::GridSpec{});
-  const host::GridSpec frame_grid{grid.res};
-  host::Bvh bvh = host::build_bvh(scene);
-  const host::Accel accel{kind, &grid, bvh_kind ? &bvh : nullptr};
-  host::StreamTracer tracer(scene, accel, opt);
+  const std::unique_ptr<host::Accel> accel = host::make_accel(kind, scene, {});
+  host::StreamTracer tracer(scene, *accel, opt);
   Sequence s;
   s.device = tracer.device().description();
   for (const double t : {0.0, 0.7, 1.4}) {
     if (t > 0) {
       scene = a.at(0, t);
-      grid = host::build_grid(scene, frame_grid);
-      if (bvh_kind) host::refit_bvh(bvh, scene);  // --update refit
-      (void)tracer.update(scene, accel);
+      (void)accel->update(scene, bvh_kind ? "refit" : "rebuild");  // --update refit for the BVH
+      (void)tracer.update(scene, *accel);
     }
     s.frames.push_back(tracer.render(host::scene_camera(scene, 1.25f)));  // hop's own camera
   }

@@ -2,9 +2,11 @@
 // group from the scene's integer ranges, with its reasons.
 #include <doctest/doctest.h>
 
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 
+#include "host/accel/accel.h"
 #include "host/accel/bvh.h"
 #include "host/accel/grid.h"
 #include "host/model/formats.h"
@@ -114,4 +116,11 @@ TEST_CASE("auto counts the BVH's list positions, not the one-voxel grid's, with 
                       entries)[Group::voxel] == Format::fp32);
   CHECK(host::resolve(host::parse_format_request("fp16", ""), scene, box, vgpu::profile("gf5700"),
                       entries)[Group::voxel] == Format::fp16);
+  // The CLI's way, from the structure (host::make_accel): the same formats and reasons.
+  const std::unique_ptr<host::Accel> accel = host::make_accel(host::AccelKind::bvh, scene, {});
+  CHECK(accel->list_entries() == entries);
+  const host::Formats g =
+      host::resolve(host::parse_format_request("auto", ""), scene, *accel, vgpu::profile("gf5700"));
+  CHECK(g.why == f.why);
+  for (Group grp : host::kGroups) CHECK(g[grp] == f[grp]);
 }

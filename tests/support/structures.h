@@ -1,9 +1,10 @@
 // The acceleration structures the walk tests compare, built in one place: a scene, its camera,
-// the paper's uniform grid (the reference every other walk is compared with), the one-voxel
-// "box" grid that gives the other walks the scene's box, and the structure under test.
+// the paper's uniform grid (the reference every other walk is compared with) and the structure
+// under test, each a host::Accel (host/accel/accel.h).
 // When the way structures are built changes, this file is the one to change.
 #pragma once
 
+#include <memory>
 #include <string>
 #include <utility>
 
@@ -24,48 +25,18 @@ struct Structures {
   host::AccelKind kind = host::AccelKind::grid;  // the structure under test
   host::Scene scene;
   host::Camera camera;
-  host::Grid grid;  // the paper's grid: the reference walk
-  host::Grid box;   // one voxel: the box the other walks enter
-  host::Bvh bvh;    // only the one of `kind` is built
-  host::KdTree kd;
-  host::Grid2 g2;
+  std::unique_ptr<host::Accel> grid;        // the paper's grid: the reference walk
+  std::unique_ptr<host::Accel> under_test;  // the structure of `kind` (none for the grid)
 
-  host::Accel grid_accel() const { return {host::AccelKind::grid, &grid}; }
+  const host::Accel& grid_accel() const { return *grid; }
   // The structure under test, as the stream and CPU tracers take it.
-  host::Accel accel() const {
-    switch (kind) {
-      case host::AccelKind::bvh:
-        return {kind, &box, &bvh};
-      case host::AccelKind::kdtree:
-        return {kind, &box, nullptr, &kd};
-      case host::AccelKind::grid2:
-        return {kind, &box, nullptr, nullptr, &g2};
-      default:
-        return grid_accel();
-    }
-  }
+  const host::Accel& accel() const { return under_test ? *under_test : *grid; }
+  const host::Bvh& bvh() const { return *accel().bvh(); }
+  const host::Grid2& g2() const { return *accel().grid2(); }
 };
 
-// The structure of `kind` for a scene whose box grid is built: a BVH over the scene, a kd-tree
-// in the box [lo, hi], a two-level grid over the scene's own (padded) bounds.
-inline void build_structure(Structures& s, glm::vec3 lo, glm::vec3 hi) {
-  switch (s.kind) {
-    case host::AccelKind::bvh:
-      s.bvh = host::build_bvh(s.scene);
-      break;
-    case host::AccelKind::kdtree:
-      s.kd = host::build_kdtree(s.scene, lo, hi);
-      break;
-    case host::AccelKind::grid2:
-      s.g2 = host::build_grid2(s.scene);
-      break;
-    default:
-      break;
-  }
-}
-
-// A scene with the grid the CLI builds for `profile`, the one-voxel box over the scene and the
-// structure of `kind` in that box.
+// A scene with the grid the CLI builds for `profile` and the structure of `kind` in the scene's
+// box, both made as the CLI makes them (host::make_accel).
 inline Structures build_structures(host::AccelKind kind, host::Scene scene,
                                    const host::Camera& camera,
                                    const std::string& profile = "gf5700") {
@@ -73,9 +44,9 @@ inline Structures build_structures(host::AccelKind kind, host::Scene scene,
   s.kind = kind;
   s.scene = std::move(scene);
   s.camera = camera;
-  s.grid = host::build_grid(s.scene, host::grid_spec_for({}, s.scene, vgpu::profile(profile)));
-  s.box = host::build_grid(s.scene, host::GridSpec{glm::ivec3(1)});
-  build_structure(s, s.box.lo, s.box.hi);
+  const host::AccelParams params{host::grid_spec_for({}, s.scene, vgpu::profile(profile))};
+  s.grid = host::make_accel(host::AccelKind::grid, s.scene, params);
+  if (kind != host::AccelKind::grid) s.under_test = host::make_accel(kind, s.scene, params);
   return s;
 }
 
@@ -87,8 +58,8 @@ inline Structures bundled_structures(host::AccelKind kind, const std::string& na
   return build_structures(kind, std::move(scene), camera, profile);
 }
 
-// A hand-built scene with its own grid in the box [lo, hi] (the stability cases): a kd-tree and
-// its box grid in that box; a two-level grid and its box over the scene's bounds.
+// A hand-built scene with its own grid in the box [lo, hi] (the stability cases): a kd-tree in
+// that box; a BVH or a two-level grid in the scene's own (padded) box.
 inline Structures structures_in_box(host::AccelKind kind, host::Scene scene,
                                     const host::Camera& camera, host::Grid grid, glm::vec3 lo,
                                     glm::vec3 hi) {
@@ -96,11 +67,11 @@ inline Structures structures_in_box(host::AccelKind kind, host::Scene scene,
   s.kind = kind;
   s.scene = std::move(scene);
   s.camera = camera;
-  s.grid = std::move(grid);
-  s.box = kind == host::AccelKind::kdtree
-              ? host::build_grid_in_box(s.scene, lo, hi, glm::ivec3(1), 1)
-              : host::build_grid(s.scene, host::GridSpec{glm::ivec3(1)});
-  build_structure(s, lo, hi);
+  s.grid = std::make_unique<host::GridAccel>(std::move(grid));
+  if (kind == host::AccelKind::kdtree)
+    s.under_test = std::make_unique<host::KdAccel>(s.scene, host::build_kdtree(s.scene, lo, hi));
+  else if (kind != host::AccelKind::grid)
+    s.under_test = host::make_accel(kind, s.scene, {});
   return s;
 }
 

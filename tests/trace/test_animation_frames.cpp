@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <glm/gtc/matrix_transform.hpp>
+#include <memory>
 #include <numbers>
 #include <stdexcept>
 #include <string>
@@ -167,29 +168,16 @@ TEST_CASE(
   for (const host::AccelKind kind :
        {host::AccelKind::bvh, host::AccelKind::kdtree, host::AccelKind::grid2}) {
     CAPTURE(std::string(host::accel_name(kind)));
-    // The structure in its scene box (a one-voxel grid), as the CLI builds them every frame.
-    struct Built {
-      host::Grid box;
-      host::Bvh bvh;
-      host::KdTree kd;
-      host::Grid2 grid2;
-    };
-    auto accel_of = [kind](const Scene& s, Built& b) {
-      b.box = host::build_grid(s, host::GridSpec{glm::ivec3(1)});
-      if (kind == host::AccelKind::bvh) b.bvh = host::build_bvh(s);
-      if (kind == host::AccelKind::kdtree) b.kd = host::build_kdtree(s, b.box.lo, b.box.hi);
-      if (kind == host::AccelKind::grid2) b.grid2 = host::build_grid2(s);
-      return host::Accel{kind, &b.box, kind == host::AccelKind::bvh ? &b.bvh : nullptr,
-                         kind == host::AccelKind::kdtree ? &b.kd : nullptr,
-                         kind == host::AccelKind::grid2 ? &b.grid2 : nullptr};
-    };
-    Built b1, b2;
-    host::StreamTracer tracer(first, accel_of(first, b1), options());
+    // The structure in its scene box, as the CLI builds it: for the first frame, then updated
+    // for the second (Accel::update, as the CLI's later frames); a fresh one for the second.
+    const std::unique_ptr<host::Accel> accel = host::make_accel(kind, first, {});
+    host::StreamTracer tracer(first, *accel, options());
     (void)tracer.render(cam);
-    const host::Accel accel2 = accel_of(second, b2);
-    const host::StreamTracer::Upload up = tracer.update(second, accel2);
+    (void)accel->update(second, "rebuild");
+    const std::unique_ptr<host::Accel> accel2 = host::make_accel(kind, second, {});
+    const host::StreamTracer::Upload up = tracer.update(second, *accel);
     const RenderResult updated = tracer.render(cam);
-    host::StreamTracer fresh_tracer(second, accel2, options());
+    host::StreamTracer fresh_tracer(second, *accel2, options());
     const RenderResult fresh = fresh_tracer.render(cam);
     CHECK(differing(updated.rgb, fresh.rgb) == 0);
     CHECK(differing(updated.hit_id, fresh.hit_id) == 0);

@@ -40,8 +40,8 @@ namespace {
 
 using Json = nlohmann::ordered_json;
 
-// A bundled scene with the grid the CLI builds for the profile, the BVH and the one-voxel grid
-// the CLI builds beside it (the scene box); the camera for a square image.
+// A bundled scene with the grid the CLI builds for the profile and the BVH in the scene's box;
+// the camera for a square image.
 Structures bundled(const std::string& name, const std::string& profile = "gf5700") {
   return test_support::bundled_structures(host::AccelKind::bvh, name, 1, 1, profile);
 }
@@ -142,11 +142,11 @@ TEST_CASE("every bundled scene gives the grid's primary hit ids and coverage wit
 TEST_CASE("every stability case gives its expected ids and the grid's with the bvh at fp32") {
   for (const stability::Case& c : stability::cases()) {
     CAPTURE(c.name);
-    const host::Grid grid = stability::grid_of(c);
-    const host::Bvh bvh = host::build_bvh(c.scene);
+    const host::GridAccel grid(stability::grid_of(c));
+    const host::BvhAccel bvh(c.scene, host::build_bvh(c.scene), grid.box());  // in the grid's box
     const RenderOptions opt = stability::options_of(c, vgpu::Format::fp32);
-    const RenderResult g = render(c.scene, {host::AccelKind::grid, &grid, nullptr}, c.camera, opt);
-    const RenderResult v = render(c.scene, {host::AccelKind::bvh, &grid, &bvh}, c.camera, opt);
+    const RenderResult g = render(c.scene, grid, c.camera, opt);
+    const RenderResult v = render(c.scene, bvh, c.camera, opt);
     CHECK(v.rays_unfinished == 0);
     int wrong = 0;
     for (size_t i = 0; i < c.expected.size(); ++i)
@@ -240,7 +240,7 @@ TEST_CASE("fp16 traversal or voxel state past 1023 node indices or list position
   // last leaf, whose escape is the end marker again) rays stopped by the step cap, and 218 or
   // 212 wrong pixels. The tracer now refuses at initialization, naming the group and the limit.
   const Structures b = bundled("teapot");
-  REQUIRE(b.bvh.nodes.size() == 5433);
+  REQUIRE(b.bvh().nodes.size() == 5433);
   RenderOptions opt = options(32, 32);
   opt.bounces = 0;
   opt.shadows = false;
@@ -255,8 +255,8 @@ TEST_CASE("fp16 traversal or voxel state past 1023 node indices or list position
   }
   opt.formats = host::Formats::all(vgpu::Format::fp32);
   opt.formats.set(host::Group::voxel, vgpu::Format::fp16, vgpu::Format::fp16);
-  const std::string lists = "bvh: list positions reach " + std::to_string(b.bvh.lists.size() - 1) +
-                            "; the voxel group's fp16";
+  const std::string lists = "bvh: list positions reach " +
+                            std::to_string(b.bvh().lists.size() - 1) + "; the voxel group's fp16";
   CHECK_THROWS_WITH_AS(host::StreamTracer(b.scene, b.accel(), opt),
                        doctest::Contains(lists.c_str()), vgpu::Error);
 }
@@ -264,7 +264,7 @@ TEST_CASE("fp16 traversal or voxel state past 1023 node indices or list position
 TEST_CASE("fp16 traversal texels on a bvh of fewer than 1024 nodes give fp32's hit ids") {
   // classic: 829 nodes, every index an exact fp16 address; the box tests still compute in fp32.
   const Structures b = bundled("classic");
-  REQUIRE(b.bvh.nodes.size() <= 1024);
+  REQUIRE(b.bvh().nodes.size() <= 1024);
   RenderOptions opt = options(48, 48);
   opt.bounces = 0;
   opt.shadows = false;
@@ -286,8 +286,8 @@ TEST_CASE("automatic formats keep fp32's hit ids with the bvh on every bundled s
     opt.bounces = 0;
     opt.shadows = false;
     const RenderResult ref = render(b.scene, b.accel(), b.camera, opt);
-    opt.formats = host::resolve(host::parse_format_request("auto", ""), b.scene, b.box,
-                                vgpu::profile("gf5700"), b.bvh.lists.size());
+    opt.formats = host::resolve(host::parse_format_request("auto", ""), b.scene, b.accel(),
+                                vgpu::profile("gf5700"));
     CAPTURE(host::describe(opt.formats));
     const RenderResult r = render(b.scene, b.accel(), b.camera, opt);
     CHECK(r.rays_unfinished == 0);

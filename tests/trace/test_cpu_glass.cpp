@@ -5,6 +5,8 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <functional>
+#include <memory>
 #include <numbers>
 #include <vector>
 
@@ -52,36 +54,31 @@ void quad_x(Scene& s, float x, float y0, float y1, float z0, float z1, bool up, 
   }
 }
 
-// A scene with its three structures: the grid, and the one-voxel box grid that a BVH or kd-tree
-// frame carries with it.
+// A scene with its four structures, as the CLI makes them (host::make_accel): a 4x4x4 grid, a
+// BVH, a kd-tree and a two-level grid, each in the scene's box.
 struct Structures {
   Scene scene;
-  host::Grid grid, box;
-  host::Bvh bvh;
-  host::KdTree kd;
-  host::Grid2 grid2;
-  explicit Structures(Scene s)
-      : scene(std::move(s)),
-        grid(host::build_grid(scene, host::GridSpec{glm::ivec3(4)})),
-        box(host::build_grid(scene, host::GridSpec{glm::ivec3(1)})),
-        bvh(host::build_bvh(scene)),
-        kd(host::build_kdtree(scene, box.lo, box.hi)),
-        grid2(host::build_grid2(scene)) {}
-  std::vector<host::Accel> all() const {
-    return {{host::AccelKind::grid, &grid, nullptr, nullptr},
-            {host::AccelKind::bvh, &box, &bvh, nullptr},
-            {host::AccelKind::kdtree, &box, nullptr, &kd},
-            {host::AccelKind::grid2, &box, nullptr, nullptr, &grid2}};
+  std::vector<std::unique_ptr<host::Accel>> accels;  // grid, bvh, kdtree, grid2
+  explicit Structures(Scene s) : scene(std::move(s)) {
+    const host::AccelParams params{host::GridSpec{glm::ivec3(4)}};
+    for (host::AccelKind kind : {host::AccelKind::grid, host::AccelKind::bvh,
+                                 host::AccelKind::kdtree, host::AccelKind::grid2})
+      accels.push_back(host::make_accel(kind, scene, params));
   }
-  host::Accel of(host::AccelKind kind) const {
-    for (const host::Accel& a : all())
-      if (a.kind == kind) return a;
+  std::vector<std::reference_wrapper<const host::Accel>> all() const {
+    std::vector<std::reference_wrapper<const host::Accel>> out;
+    for (const auto& a : accels) out.push_back(*a);
+    return out;
+  }
+  const host::Accel& of(host::AccelKind kind) const {
+    for (const auto& a : accels)
+      if (a->kind() == kind) return *a;
     FAIL("no structure of kind " << host::accel_name(kind));
-    return {};
+    return *accels.front();
   }
-  // The tracers' ray offset ε for a structure: a fraction of its grid's diagonal.
+  // The tracers' ray offset ε for a structure: a fraction of its scene box's diagonal.
   static double offset(const host::Accel& a) {
-    return host::kOffsetOfDiagonal * glm::length(glm::dvec3(a.grid->hi) - glm::dvec3(a.grid->lo));
+    return host::kOffsetOfDiagonal * glm::length(glm::dvec3(a.box().hi) - glm::dvec3(a.box().lo));
   }
 };
 
@@ -122,7 +119,7 @@ TEST_CASE(
   const float eta = 1.5f;
   const Structures st(slab_scene(thickness, eta));
   for (const host::Accel& accel : st.all()) {
-    CAPTURE(host::accel_name(accel.kind));
+    CAPTURE(accel.name());
     for (const double theta : {0.0, 0.3, 0.7, 1.1}) {
       CAPTURE(theta);
       const glm::dvec3 o(0.1, 0.2, 0.0);
@@ -270,7 +267,7 @@ TEST_CASE(
     cam.forward = glm::vec3(0, 0, -1);
     cam.up = glm::vec3(0, 1, 0);
     cam.yfov = 0.01f;
-    const host::Accel accel = st.of(kind);
+    const host::Accel& accel = st.of(kind);
     host::CpuStats stats;
     const host::RenderResult r = host::render_cpu(st.scene, accel, cam, options(0), &stats);
     REQUIRE(r.hit_id[0] >= 0.0f);

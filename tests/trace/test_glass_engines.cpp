@@ -4,6 +4,7 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -38,22 +39,17 @@ double psnr(const std::vector<float>& a, const std::vector<float>& b) {
 TEST_CASE("the glass scene gives the same hits, rays per level and image on both engines") {
   const host::Scene scene = host::load_scene(host::resolve_scene("glass"));
   const host::Camera cam = host::scene_camera(scene, 1.0f);
-  const host::Grid grid =
-      host::build_grid(scene, host::grid_spec_for({}, scene, vgpu::profile("gf5700")));
-  const host::Grid box = host::build_grid(scene, host::GridSpec{glm::ivec3(1)});
-  const host::Grid2 g2 = host::build_grid2(scene);
-  const host::Bvh bvh = host::build_bvh(scene);
-  const host::KdTree kd = host::build_kdtree(scene, box.lo, box.hi);
-  const std::vector<host::Accel> accels = {{host::AccelKind::grid, &grid, nullptr, nullptr},
-                                           {host::AccelKind::grid2, &box, nullptr, nullptr, &g2},
-                                           {host::AccelKind::bvh, &box, &bvh, nullptr},
-                                           {host::AccelKind::kdtree, &box, nullptr, &kd}};
+  const host::AccelParams params{host::grid_spec_for({}, scene, vgpu::profile("gf5700"))};
+  std::vector<std::unique_ptr<host::Accel>> accels;
+  for (host::AccelKind kind : host::kAccelKinds)
+    accels.push_back(host::make_accel(kind, scene, params));
   host::RenderOptions opt;
   opt.width = opt.height = kSize;
   opt.bounces = 2;
   opt.shadows = true;
-  for (const host::Accel& accel : accels) {
-    CAPTURE(host::accel_name(accel.kind));
+  for (const auto& built : accels) {
+    const host::Accel& accel = *built;
+    CAPTURE(accel.name());
     host::StreamTracer tracer(scene, accel, opt);
     const host::RenderResult s = tracer.render(cam);
     host::CpuStats cs;

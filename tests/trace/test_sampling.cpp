@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -292,14 +293,11 @@ TEST_CASE(
   // bunny-refl: a mirror floor under the bunny, two bounces, shadow rays (the CLI's defaults).
   const host::Scene scene = host::load_scene(host::resolve_scene("bunny-refl"));
   const host::Camera camera = host::scene_camera(scene);
-  const host::Grid grid =
-      host::build_grid(scene, host::grid_spec_for({}, scene, vgpu::profile("gf6600")));
-  const host::Grid box = host::build_grid(scene, host::GridSpec{glm::ivec3(1)});
-  const host::Bvh bvh = host::build_bvh(scene);
-  const host::KdTree kd = host::build_kdtree(scene, box.lo, box.hi);
-  const host::Accel accels[3] = {{host::AccelKind::grid, &grid, nullptr, nullptr},
-                                 {host::AccelKind::bvh, &box, &bvh, nullptr},
-                                 {host::AccelKind::kdtree, &box, nullptr, &kd}};
+  const host::AccelParams params{host::grid_spec_for({}, scene, vgpu::profile("gf6600"))};
+  std::unique_ptr<host::Accel> accels[3] = {
+      host::make_accel(host::AccelKind::grid, scene, params),
+      host::make_accel(host::AccelKind::bvh, scene, params),
+      host::make_accel(host::AccelKind::kdtree, scene, params)};
   for (const int mode : {0, 1}) {
     CAPTURE(mode);  // 0: adaptive up to 16 samples, 1: undersampling, K = 2
     host::RenderOptions opt;
@@ -313,8 +311,9 @@ TEST_CASE(
       opt.undersample = 2;
     }
     std::vector<uint32_t> first;
-    for (const host::Accel& a : accels) {
-      CAPTURE(std::string(host::accel_name(a.kind)));
+    for (const auto& built : accels) {
+      const host::Accel& a = *built;
+      CAPTURE(std::string(a.name()));
       const host::RenderResult g = host::StreamTracer(scene, a, opt).render(camera);
       const host::RenderResult c = host::render_cpu(scene, a, camera, opt);
       REQUIRE(g.rays_per_pixel.size() == 24 * 24);

@@ -11,6 +11,7 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -98,7 +99,7 @@ TEST_CASE_TEMPLATE("the walk gives the grid walk's hit ids on every bundled scen
   for (const auto& [name, path] : scenes) {
     CAPTURE(std::string(name));
     const Structures s = test_support::bundled_structures(T::kind, name, 48, 48);
-    crowded += s.g2.crowded;
+    crowded += s.g2().crowded;
     const host::RenderOptions opt = options(48, 48);
     const host::RenderResult g = stream(s.scene, s.grid_accel(), s.camera, opt);
     const host::RenderResult k = stream(s.scene, s.accel(), s.camera, opt);
@@ -296,17 +297,14 @@ TEST_CASE("accel auto picks the BVH or the kd-tree for a small bunny on a huge f
   scene.input_triangles = id + 2;
   const std::string profile = "gf6600";
   const vgpu::Profile& p = vgpu::profile(profile);
-  const host::Grid grid = host::build_grid(scene, host::grid_spec_for({}, scene, p));
-  const host::Grid box = host::build_grid(scene, host::GridSpec{glm::ivec3(1)});
-  const host::Bvh bvh = host::build_bvh(scene);
-  const host::KdTree kd = host::build_kdtree(scene, box.lo, box.hi);
+  const host::AccelParams params{host::grid_spec_for({}, scene, p)};
   const host::FormatRequest fr;
-  std::vector<host::AccelCandidate> cands = {
-      {{host::AccelKind::grid, &grid, nullptr, nullptr}, host::resolve(fr, scene, grid, p)},
-      {{host::AccelKind::bvh, &box, &bvh, nullptr},
-       host::resolve(fr, scene, box, p, bvh.lists.size())},
-      {{host::AccelKind::kdtree, &box, nullptr, &kd},
-       host::resolve(fr, scene, box, p, kd.lists.size())}};
+  std::vector<std::unique_ptr<host::Accel>> built;
+  std::vector<host::AccelCandidate> cands;
+  for (host::AccelKind k : {host::AccelKind::grid, host::AccelKind::bvh, host::AccelKind::kdtree}) {
+    built.push_back(host::make_accel(k, scene, params));
+    cands.push_back({built.back().get(), host::resolve(fr, scene, *built.back(), p)});
+  }
   host::RenderOptions opt = options(w, h, profile);
   const host::AccelChoice c = host::choose_accel(scene, cands, opt, cam);
   CHECK(c.kind != host::AccelKind::grid);
@@ -362,7 +360,7 @@ TEST_CASE("the two-level grid puts a small bunny on a huge floor in sub-grids of
   scene.input_triangles = id + 2;
   const Structures s =
       test_support::build_structures(host::AccelKind::grid2, std::move(scene), cam);
-  CHECK(s.g2.crowded > 0);
+  CHECK(s.g2().crowded > 0);
   const host::RenderOptions opt = options(w, h);
   const host::RenderResult g = stream(s.scene, s.grid_accel(), s.camera, opt);
   const host::RenderResult k = stream(s.scene, s.accel(), s.camera, opt);
@@ -376,10 +374,10 @@ TEST_CASE("a format that cannot address the two-level grid's sub-cells or lists 
   // exactly: a sub-cell index that rounds would send the walk to another cell. Refused at
   // initialization, naming the group, the count and the limit, and the format that holds it.
   const Structures s = test_support::bundled_structures(host::AccelKind::grid2, "bunny", 32, 32);
-  REQUIRE(s.g2.sub_cells() > 65536);
+  REQUIRE(s.g2().sub_cells() > 65536);
   host::RenderOptions opt = options(32, 32);
   const std::string reach = "two-level grid: sub-cell indices reach " +
-                            std::to_string(s.g2.sub_cells() - 1) + "; the traversal group's ";
+                            std::to_string(s.g2().sub_cells() - 1) + "; the traversal group's ";
   for (const vgpu::Format f : {vgpu::Format::fp16, vgpu::Format::fp24}) {
     CAPTURE(vgpu::format_name(f));
     opt.formats = host::Formats::all(vgpu::Format::fp32);
@@ -393,7 +391,7 @@ TEST_CASE("a format that cannot address the two-level grid's sub-cells or lists 
   opt.formats = host::Formats::all(vgpu::Format::fp32);
   opt.formats.set(host::Group::voxel, vgpu::Format::fp16, vgpu::Format::fp16);
   const std::string lists = "two-level grid: list positions reach " +
-                            std::to_string(s.g2.lists.size() - 1) + "; the voxel group's fp16";
+                            std::to_string(s.g2().lists.size() - 1) + "; the voxel group's fp16";
   CHECK_THROWS_WITH_AS(host::StreamTracer(s.scene, s.accel(), opt),
                        doctest::Contains(lists.c_str()), vgpu::Error);
 }

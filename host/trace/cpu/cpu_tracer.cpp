@@ -98,10 +98,10 @@ class Tracer {
  public:
   Tracer(const Scene& scene, const Accel& accel, const Camera& camera, const RenderOptions& opt)
       : scene_(scene),
-        grid_(*accel.grid),
-        bvh_(accel.kind == AccelKind::bvh ? accel.bvh : nullptr),
-        kd_(accel.kind == AccelKind::kdtree ? accel.kd : nullptr),
-        grid2_(accel.kind == AccelKind::grid2 ? accel.grid2 : nullptr),
+        grid_(accel.grid()),
+        bvh_(accel.bvh()),
+        kd_(accel.kd()),
+        grid2_(accel.grid2()),
         cam_(camera),
         opt_(opt),
         primary_(camera, opt.width, opt.height) {
@@ -113,15 +113,16 @@ class Tracer {
           tris_.emplace_back(Tri{p0, glm::dvec3(scene.p1[i]) - p0, glm::dvec3(scene.p2[i]) - p0});
       geo_normals_.push_back(glm::normalize(glm::cross(tri.e1, tri.e2)));
     }
-    const Grid& grid = grid_;
-    const double diag = glm::length(glm::dvec3(grid.hi) - glm::dvec3(grid.lo));
+    const Bounds& box = accel.box();
+    const double diag = glm::length(glm::dvec3(box.hi) - glm::dvec3(box.lo));
     slack_ = kSlackOfDiagonal * diag;
     offset_ = kOffsetOfDiagonal * diag;
     atten_dist_ = kAttenOfDiagonal * diag;
-    for (int a = 0; a < 3; ++a) {
-      box_lo_[a] = grid.boundary(a, 0);
-      box_hi_[a] = grid.boundary(a, grid.res[a]);
-    }
+    if (grid_)  // the grid walk's box: its outer voxel planes
+      for (int a = 0; a < 3; ++a) {
+        box_lo_[a] = grid_->boundary(a, 0);
+        box_hi_[a] = grid_->boundary(a, grid_->res[a]);
+      }
     iterations_ = 1 + std::max(0, opt.bounces);
     const kernels::Shader shader;
     ambient_ = glm::dvec3(shader.ambient);
@@ -190,18 +191,18 @@ class Tracer {
 
     // Amanatides & Woo set-up: the entry voxel, the t of the next boundary per axis, and the t
     // between two boundaries per axis.
-    glm::ivec3 vox = grid_.voxel_of(o + d * tnear);
+    glm::ivec3 vox = grid_->voxel_of(o + d * tnear);
     glm::ivec3 step(0);
     glm::dvec3 t_next(kInf), t_delta(kInf);
     for (int a = 0; a < 3; ++a) {
       if (d[a] > 0.0) {
         step[a] = 1;
-        t_next[a] = (grid_.boundary(a, vox[a] + 1) - o[a]) / d[a];
-        t_delta[a] = double(grid_.cell[a]) / d[a];
+        t_next[a] = (grid_->boundary(a, vox[a] + 1) - o[a]) / d[a];
+        t_delta[a] = double(grid_->cell[a]) / d[a];
       } else if (d[a] < 0.0) {
         step[a] = -1;
-        t_next[a] = (grid_.boundary(a, vox[a]) - o[a]) / d[a];
-        t_delta[a] = -double(grid_.cell[a]) / d[a];
+        t_next[a] = (grid_->boundary(a, vox[a]) - o[a]) / d[a];
+        t_delta[a] = -double(grid_->cell[a]) / d[a];
       }
     }
 
@@ -210,7 +211,7 @@ class Tracer {
       ++c.voxel_steps;
       const double t_exit = std::min({t_next.x, t_next.y, t_next.z});
       // Every triangle of the voxel; a hit counts only inside the voxel (with the slack).
-      for (const uint32_t k : grid_.triangles_in(grid_.index(vox))) {
+      for (const uint32_t k : grid_->triangles_in(grid_->index(vox))) {
         ++c.triangle_tests;
         double t, u, v;
         if (!intersect(o, d, tris_[k], t, u, v)) continue;
@@ -225,7 +226,7 @@ class Tracer {
         if (t_next[a] != t_exit) continue;
         vox[a] += step[a];
         t_next[a] += t_delta[a];
-        outside = outside || vox[a] < 0 || vox[a] >= grid_.res[a];
+        outside = outside || vox[a] < 0 || vox[a] >= grid_->res[a];
       }
       if (outside) return best;
       t_enter = t_exit;
@@ -583,7 +584,7 @@ class Tracer {
 
  private:
   const Scene& scene_;
-  const Grid& grid_;
+  const Grid* grid_ = nullptr;  // the uniform grid, when it is the structure walked
   const Bvh* bvh_ = nullptr;
   const KdTree* kd_ = nullptr;
   const Grid2* grid2_ = nullptr;
@@ -735,14 +736,14 @@ std::vector<CpuRay> cpu_ray_tree(const Scene& scene, const Accel& accel,
 
 RenderResult render_cpu(const Scene& scene, const Grid& grid, const Camera& camera,
                         const RenderOptions& options, CpuStats* stats) {
-  return render_cpu(scene, Accel{AccelKind::grid, &grid, nullptr}, camera, options, stats);
+  return render_cpu(scene, GridAccel(grid), camera, options, stats);
 }
 
 RenderResult render_cpu(const Scene& scene, const Accel& accel, const Camera& camera,
                         const RenderOptions& options, CpuStats* stats) {
-  const Grid& grid = *accel.grid;
+  const Grid* grid = accel.grid();
   const auto t0 = std::chrono::steady_clock::now();
-  if (grid.start.size() != grid.voxels() + 1)
+  if (grid && grid->start.size() != grid->voxels() + 1)
     throw std::invalid_argument("render_cpu: the grid has no voxel lists (not built)");
   RenderResult res;
   const int W = std::max(options.width, 0), H = std::max(options.height, 0);

@@ -39,6 +39,18 @@ WalkWork walk_work(const vgpu::FrameStats& stats, uint64_t rays_traced) {
   return w;
 }
 
+namespace {
+
+// The price of a candidate: the full frame predicted from its probe's cost breakdown. The costs
+// that follow the pass count (per pass, program loads, read-backs) as measured; the fragment
+// work scaled by `scale`, the full frame's pixels over the probe's.
+double full_frame_ms(const CostBreakdown& b, double scale) {
+  return b.per_pass_ms + b.program_load_ms + b.readback_ms +
+         scale * (b.arithmetic_ms + b.texture_ms + b.memory_ms + b.download_ms);
+}
+
+}  // namespace
+
 AccelChoice choose_accel(const Scene& scene, const std::vector<AccelCandidate>& candidates,
                          const RenderOptions& options, const Camera& camera) {
   const auto t0 = std::chrono::steady_clock::now();
@@ -60,16 +72,15 @@ AccelChoice choose_accel(const Scene& scene, const std::vector<AccelCandidate>& 
   double best = 0;
   bool any = false;
   for (const AccelCandidate& cand : candidates) {
-    const Accel& accel = cand.accel;
-    const AccelKind kind = accel.kind;
-    const std::string name(accel_name(kind));
+    const Accel& accel = *cand.accel;
+    const AccelKind kind = accel.kind();
+    const std::string name(accel.name());
     probe.formats = cand.formats;
     try {
       StreamTracer tracer(scene, accel, probe);
       const RenderResult r = tracer.render(camera);
       const CostBreakdown b = predict(r.stats, profile);
-      const double ms = b.per_pass_ms + b.program_load_ms + b.readback_ms +
-                        scale * (b.arithmetic_ms + b.texture_ms + b.memory_ms + b.download_ms);
+      const double ms = full_frame_ms(b, scale);
       c.predicted_ms[name] = ms;
       c.probe_passes[name] = r.stats.totals.passes;
       if (!any || ms < best) {

@@ -52,7 +52,7 @@ WalkWork walk_work(const vgpu::FrameStats& stats, uint64_t rays_traced = 0);
 // The candidates (built by the caller), each with the formats it renders with. A candidate the
 // profile's limits refuse (vgpu::Error) drops out; throws vgpu::Error if none is left.
 struct AccelCandidate {
-  Accel accel;
+  const Accel* accel;  // not owned
   Formats formats;
 };
 AccelChoice choose_accel(const Scene& scene, const std::vector<AccelCandidate>& candidates,

@@ -41,11 +41,10 @@ kernels::ShadingModel parse_shading(const std::string& name) {
 }
 
 StreamTracer::StreamTracer(const Scene& scene, const Grid& grid, const RenderOptions& options)
-    : StreamTracer(scene, Accel{AccelKind::grid, &grid, nullptr}, options) {}
+    : StreamTracer(scene, GridAccel(grid), options) {}
 
 StreamTracer::StreamTracer(const Scene& scene, const Accel& accel, const RenderOptions& options)
-    : scene_(&scene), grid_(accel.grid), accel_kind_(accel.kind), opt_(options) {
-  const Grid& grid = *grid_;
+    : scene_(&scene), box_(accel.box()), accel_kind_(accel.kind()), opt_(options) {
   const auto t0 = std::chrono::steady_clock::now();
   gpu_ = make_device(opt_);
   s_ = std::make_unique<State>();
@@ -96,17 +95,16 @@ StreamTracer::StreamTracer(const Scene& scene, const Accel& accel, const RenderO
   }
 
   // The acceleration structure's textures and walk (host/trace/walks/grid_walk.h, bvh_walk.h,
-  // kd_walk.h).
-  if (accel.kind == AccelKind::bvh)
-    s.walk = std::make_unique<BvhWalk>(gpu, *accel.bvh, opt_, float(s.v[0].width()));
-  else if (accel.kind == AccelKind::kdtree)
-    s.walk = std::make_unique<KdWalk>(gpu, *accel.kd, opt_, float(s.v[0].width()),
-                                      float(kSlackOfDiagonal) * glm::length(grid.hi - grid.lo));
-  else if (accel.kind == AccelKind::grid2)  // the two-level grid (grid2_walk.h)
-    s.walk = std::make_unique<Grid2Walk>(gpu, *accel.grid2, opt_, float(s.v[0].width()),
-                                         float(kSlackOfDiagonal) * glm::length(grid.hi - grid.lo));
+  // kd_walk.h, grid2_walk.h): the one place a structure's walk is chosen.
+  const float t_slack = float(kSlackOfDiagonal) * glm::length(box_.hi - box_.lo);
+  if (const Bvh* bvh = accel.bvh())
+    s.walk = std::make_unique<BvhWalk>(gpu, *bvh, opt_, float(s.v[0].width()));
+  else if (const KdTree* kd = accel.kd())
+    s.walk = std::make_unique<KdWalk>(gpu, *kd, opt_, float(s.v[0].width()), t_slack);
+  else if (const Grid2* g2 = accel.grid2())
+    s.walk = std::make_unique<Grid2Walk>(gpu, *g2, opt_, float(s.v[0].width()), t_slack);
   else
-    s.walk = std::make_unique<GridWalk>(gpu, grid, opt_, float(s.v[0].width()));
+    s.walk = std::make_unique<GridWalk>(gpu, *accel.grid(), opt_, float(s.v[0].width()));
 
   // Video memory gets the static textures at initialization (and again, where they change,
   // between frames of a moving scene: update()).
@@ -219,7 +217,7 @@ uint64_t StreamTracer::write_scene(std::vector<std::string>* uploaded) {
 
 void StreamTracer::set_uniforms() {
   State& s = *s_;
-  const float diag = glm::length(grid_->hi - grid_->lo);
+  const float diag = glm::length(box_.hi - box_.lo);
   const SceneUniforms su{float(s.v[0].width())};
   s.shader.kernel.scene = su;
   s.shader.kernel.atten_dist = float(kAttenOfDiagonal) * diag;
@@ -236,16 +234,16 @@ void StreamTracer::set_uniforms() {
 }
 
 StreamTracer::Upload StreamTracer::update(const Scene& scene, const Grid& grid) {
-  return update(scene, Accel{AccelKind::grid, &grid, nullptr});
+  return update(scene, GridAccel(grid));
 }
 
 StreamTracer::Upload StreamTracer::update(const Scene& scene, const Accel& accel) {
-  if (accel.kind != accel_kind_)
+  if (accel.kind() != accel_kind_)
     throw std::invalid_argument("StreamTracer::update: the tracer walks a " +
                                 std::string(accel_name(accel_kind_)) + ", not a " +
-                                std::string(accel_name(accel.kind)));
+                                std::string(accel.name()));
   scene_ = &scene;
-  grid_ = accel.grid;
+  box_ = accel.box();
   Upload up;
   up.bytes += write_scene(&up.textures);
   up.bytes += s_->walk->rebuild(*gpu_, accel, float(s_->v[0].width()), up.textures);

@@ -25,7 +25,7 @@ class StreamTracer {
   // Initialization, timed apart from rendering: the static textures (scene and grid) are built
   // and checked against the profile's limits. Throws vgpu::Error naming the limit.
   StreamTracer(const Scene& scene, const Grid& grid, const RenderOptions& options);
-  // The same with the structure `accel` names (its grid gives the scene box).
+  // The same with the structure `accel` (of any kind; the tracer keeps none of it but its box).
   StreamTracer(const Scene& scene, const Accel& accel, const RenderOptions& options);
   ~StreamTracer();
   RenderResult render(const Camera& camera);
@@ -42,8 +42,8 @@ class StreamTracer {
   // them are set. Both must outlive the next render, as at construction. Throws vgpu::Error
   // past the profile's limits, as the constructor does.
   Upload update(const Scene& scene, const Grid& grid);
-  // The same with the structure `accel` names, of the kind the tracer was made with (its grid,
-  // the scene box for another structure, rebuilt too).
+  // The same with the structure `accel`, of the kind the tracer was made with, updated for the
+  // new scene (Accel::update).
   Upload update(const Scene& scene, const Accel& accel);
   // Bytes of the static textures (the scene's and the grid's), all uploaded at initialization.
   uint64_t static_bytes() const;
@@ -130,7 +130,7 @@ class StreamTracer {
   void set_uniforms();
 
   const Scene* scene_;
-  const Grid* grid_;  // the grid walked, or the scene box another structure is walked in
+  Bounds box_;  // the scene box the structure was built in (Accel::box)
   AccelKind accel_kind_;
   RenderOptions opt_;
   std::unique_ptr<vgpu::Device> gpu_;

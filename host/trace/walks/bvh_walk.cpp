@@ -71,7 +71,7 @@ uint64_t BvhWalk::set_bvh(vgpu::Device& gpu, const Bvh& bvh, float scene_width,
 
 uint64_t BvhWalk::rebuild(vgpu::Device& gpu, const Accel& accel, float scene_width,
                           std::vector<std::string>& uploaded) {
-  return set_bvh(gpu, *accel.bvh, scene_width, &uploaded);
+  return set_bvh(gpu, *accel.bvh(), scene_width, &uploaded);
 }
 
 void BvhWalk::make_state(vgpu::Device& gpu, const WalkShared& shared) {

@@ -90,8 +90,8 @@ uint64_t Grid2Walk::set_grid(vgpu::Device& gpu, const Grid2& g2, float scene_wid
 
 uint64_t Grid2Walk::rebuild(vgpu::Device& gpu, const Accel& accel, float scene_width,
                             std::vector<std::string>& uploaded) {
-  const float t_slack = float(kSlackOfDiagonal) * glm::length(accel.grid->hi - accel.grid->lo);
-  return set_grid(gpu, *accel.grid2, scene_width, t_slack, &uploaded);
+  const float t_slack = float(kSlackOfDiagonal) * glm::length(accel.box().hi - accel.box().lo);
+  return set_grid(gpu, *accel.grid2(), scene_width, t_slack, &uploaded);
 }
 
 void Grid2Walk::make_state(vgpu::Device& gpu, const WalkShared& shared) {

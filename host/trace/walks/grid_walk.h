@@ -58,7 +58,7 @@ class GridWalk : public ListWalk {
                     std::vector<std::string>* uploaded);
   uint64_t rebuild(vgpu::Device& gpu, const Accel& accel, float scene_width,
                    std::vector<std::string>& uploaded) override {
-    return set_grid(gpu, *accel.grid, scene_width, &uploaded);
+    return set_grid(gpu, *accel.grid(), scene_width, &uploaded);
   }
 
   // One stream of rays through the grid: enter it (initTraversal for primary rays, from the eye;

@@ -78,8 +78,8 @@ uint64_t KdWalk::set_tree(vgpu::Device& gpu, const KdTree& kd, float scene_width
 
 uint64_t KdWalk::rebuild(vgpu::Device& gpu, const Accel& accel, float scene_width,
                          std::vector<std::string>& uploaded) {
-  const float t_slack = float(kSlackOfDiagonal) * glm::length(accel.grid->hi - accel.grid->lo);
-  return set_tree(gpu, *accel.kd, scene_width, t_slack, &uploaded);
+  const float t_slack = float(kSlackOfDiagonal) * glm::length(accel.box().hi - accel.box().lo);
+  return set_tree(gpu, *accel.kd(), scene_width, t_slack, &uploaded);
 }
 
 void KdWalk::make_state(vgpu::Device& gpu, const WalkShared& shared) {

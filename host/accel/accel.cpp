@@ -1,0 +1,180 @@
+// The acceleration structures behind one interface (accel.h): the factory, and each structure's
+// summary, statistics and update for a moved scene.
+#include "host/accel/accel.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <nlohmann/json.hpp>
+
+#include "host/common/parallel.h"
+
+namespace host {
+
+namespace {
+
+Bounds box_of(glm::vec3 lo, glm::vec3 hi) {
+  Bounds b;
+  b.lo = lo;
+  b.hi = hi;
+  return b;
+}
+
+// "SUMMARY (X.X ms to build)", as --stats table prints a structure's line.
+std::string with_build_ms(const std::string& summary, double ms) {
+  char tail[64];
+  std::snprintf(tail, sizeof tail, " (%.1f ms to build)", ms);
+  return summary + tail;
+}
+
+}  // namespace
+
+void Accel::find_box(const Scene& scene) {
+  const auto t0 = std::chrono::steady_clock::now();
+  box_ = scene.box();
+  box_ms_ = ms_since(t0);
+  triangles_ = scene.triangle_count();
+}
+
+std::unique_ptr<Accel> make_accel(AccelKind kind, const Scene& scene, const AccelParams& params) {
+  if (kind == AccelKind::grid)
+    return std::make_unique<GridAccel>(build_grid(scene, params.grid, params.threads),
+                                       params.threads);
+  // The other structures are built in the scene's box, found first (and timed: their build
+  // time includes it).
+  const auto t0 = std::chrono::steady_clock::now();
+  const Bounds box = scene.box();
+  const double box_ms = ms_since(t0);
+  switch (kind) {
+    case AccelKind::grid2:
+      return std::make_unique<Grid2Accel>(scene, build_grid2(scene, params.threads), params.threads,
+                                          box_ms);
+    case AccelKind::bvh:
+      return std::make_unique<BvhAccel>(scene, build_bvh(scene), box, box_ms);
+    default:
+      return std::make_unique<KdAccel>(scene, build_kdtree(scene, box.lo, box.hi), box_ms);
+  }
+}
+
+// --- The uniform grid ---
+
+GridAccel::GridAccel(Grid grid, unsigned threads)
+    : Accel(AccelKind::grid, box_of(grid.lo, grid.hi), grid.references(), 0.0),
+      grid_(std::move(grid)),
+      threads_(threads) {}
+
+void GridAccel::stats_json(nlohmann::ordered_json& acc) const {
+  acc["voxels"] = {grid_.res.x, grid_.res.y, grid_.res.z};
+  acc["references"] = grid_.references();
+  acc["build_ms"] = grid_.build_ms;
+}
+
+std::string GridAccel::update(const Scene& scene, const std::string&) {
+  grid_ = build_grid(scene, GridSpec{grid_.res}, threads_);
+  box_ = box_of(grid_.lo, grid_.hi);
+  return "rebuild";
+}
+
+// --- The two-level grid ---
+
+Grid2Accel::Grid2Accel(const Scene& scene, Grid2 g2, unsigned threads, double box_ms)
+    : Accel(AccelKind::grid2, box_of(g2.coarse.lo, g2.coarse.hi), scene.triangle_count(), box_ms),
+      g2_(std::move(g2)),
+      threads_(threads) {}
+
+std::string Grid2Accel::describe() const {
+  char line[256];
+  std::snprintf(line, sizeof line,
+                "two-level grid: coarse %dx%dx%d, %d crowded cells, %zu sub-cells, %llu "
+                "references",
+                g2_.coarse.res.x, g2_.coarse.res.y, g2_.coarse.res.z, g2_.crowded, g2_.sub_cells(),
+                static_cast<unsigned long long>(g2_.references));
+  return with_build_ms(line, g2_.build_ms);
+}
+
+uint64_t Grid2Accel::list_entries() const {
+  // Its textures address the lists and the sub-cells alike.
+  return std::max<uint64_t>(g2_.lists.size(), g2_.sub_cells());
+}
+
+void Grid2Accel::stats_json(nlohmann::ordered_json& acc) const {
+  const Grid& c = g2_.coarse;
+  acc["coarse"] = {c.res.x, c.res.y, c.res.z};
+  acc["crowded_cells"] = g2_.crowded;
+  acc["sub_cells"] = g2_.sub_cells();
+  acc["list_entries"] = g2_.lists.size();
+  acc["references"] = g2_.references;
+  acc["max_list"] = g2_.max_list;
+  acc["build_ms"] = g2_.build_ms;
+}
+
+std::string Grid2Accel::update(const Scene& scene, const std::string&) {
+  find_box(scene);
+  g2_ = build_grid2(scene, threads_);
+  return "rebuild";
+}
+
+// --- The BVH ---
+
+BvhAccel::BvhAccel(const Scene& scene, Bvh bvh, const Bounds& box, double box_ms)
+    : Accel(AccelKind::bvh, box, scene.triangle_count(), box_ms),
+      bvh_(std::move(bvh)),
+      built_sah_(bvh_.sah_cost) {}
+
+std::string BvhAccel::describe() const {
+  return with_build_ms(host::describe(bvh_), bvh_.build_ms);
+}
+
+void BvhAccel::stats_json(nlohmann::ordered_json& acc) const {
+  acc["nodes"] = bvh_.nodes.size();
+  acc["leaves"] = bvh_.leaves;
+  acc["depth"] = bvh_.depth;
+  acc["max_leaf"] = bvh_.max_leaf;
+  acc["references"] = bvh_.references();
+  acc["sah_cost"] = bvh_.sah_cost;
+  acc["build_ms"] = bvh_.build_ms;
+}
+
+std::string BvhAccel::update(const Scene& scene, const std::string& how) {
+  find_box(scene);
+  if (how != "rebuild") {
+    Bvh refitted = bvh_;
+    refit_bvh(refitted, scene);
+    if (how == "refit" || refitted.sah_cost <= kRefitLimit * built_sah_) {
+      bvh_ = std::move(refitted);
+      return "refit";
+    }
+  }
+  bvh_ = build_bvh(scene);
+  built_sah_ = bvh_.sah_cost;
+  return "rebuild";
+}
+
+// --- The kd-tree ---
+
+KdAccel::KdAccel(const Scene& scene, KdTree kd, double box_ms)
+    : Accel(AccelKind::kdtree, box_of(kd.lo, kd.hi), scene.triangle_count(), box_ms),
+      kd_(std::move(kd)) {}
+
+std::string KdAccel::describe() const {
+  return with_build_ms(host::describe(kd_), kd_.build_ms);
+}
+
+void KdAccel::stats_json(nlohmann::ordered_json& acc) const {
+  acc["nodes"] = kd_.nodes.size();
+  acc["leaves"] = kd_.leaves;
+  acc["empty_leaves"] = kd_.empty_leaves;
+  acc["depth"] = kd_.depth;
+  acc["max_leaf"] = kd_.max_leaf;
+  acc["references"] = kd_.references();
+  acc["sah_cost"] = kd_.sah_cost;
+  acc["build_ms"] = kd_.build_ms;
+}
+
+std::string KdAccel::update(const Scene& scene, const std::string&) {
+  find_box(scene);
+  kd_ = build_kdtree(scene, box_.lo, box_.hi);
+  return "rebuild";
+}
+
+}  // namespace host

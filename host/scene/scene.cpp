@@ -1,0 +1,40 @@
+// The scene's padded box (scene.h): the one place the padding rule lives.
+#include "host/scene/scene.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace host {
+
+namespace {
+
+// The float nearest to x, rounded toward -inf (down) or +inf (up): the box never shrinks when
+// its double corners are stored as floats.
+float round_float(double x, bool up) {
+  float f = float(x);
+  if (up && double(f) < x) f = std::nextafter(f, std::numeric_limits<float>::infinity());
+  if (!up && double(f) > x) f = std::nextafter(f, -std::numeric_limits<float>::infinity());
+  return f;
+}
+
+}  // namespace
+
+Bounds Scene::box() const {
+  const Bounds b = bounds();
+  Bounds box;
+  box.lo = glm::vec3(-1.0f);  // no triangles: any box will do
+  box.hi = glm::vec3(1.0f);
+  if (b.empty()) return box;
+  const glm::dvec3 blo(b.lo), bhi(b.hi);
+  const glm::dvec3 mag = glm::max(glm::abs(blo), glm::abs(bhi));
+  const double pad = std::max(kScenePadRelative * glm::length(bhi - blo),
+                              kScenePadMagnitude * std::max({mag.x, mag.y, mag.z}));
+  for (int a = 0; a < 3; ++a) {
+    box.lo[a] = round_float(blo[a] - pad, false);
+    box.hi[a] = round_float(bhi[a] + pad, true);
+  }
+  return box;
+}
+
+}  // namespace host
