@@ -1,8 +1,9 @@
 // Helpers shared by the kernel tests: hand-made textures, one kernel pass through a real
 // vgpu::Gpu (profile gf5700), and per-channel texel checks. Expected values always come from the
-// test itself, never from the kernels' own helpers. Built into test_gl (KTEST_GL), every pass
-// that run() makes on the vgpu is made again on the GL device, from the same texels, and its
-// outputs and query count are checked against the vgpu's (tests/gl/gl_compare.h).
+// test itself, never from the kernels' own helpers. Linked into test_gl too, where gl_check() is
+// set: there every pass that run() makes on the vgpu is made again on the GL device, from the
+// same texels, and its outputs and query count are checked against the vgpu's
+// (tests/gl/gl_compare.h).
 #pragma once
 
 #include <doctest/doctest.h>
@@ -10,18 +11,49 @@
 #include <array>
 #include <cstdint>
 #include <glm/glm.hpp>
+#include <initializer_list>
 #include <string>
 #include <vector>
 
 #include "kernels/kernels.h"
 #include "vgpu/vgpu.h"
-#ifdef KTEST_GL
-#include "tests/gl/gl_compare.h"
-#endif
 
 namespace ktest {
 
 using vgpu::Texture;
+
+// The GL comparison, switched on at run time. The kernel tests are compiled once and linked into
+// two executables: test_kernels runs them on the vgpu alone (gl_check() stays null), test_gl
+// links tests/gl/kernel_gl_check.cpp, which sets it to gltest::check_same_targets before any
+// test runs: the pass of program p that the vgpu made (units bound in order, targets starting
+// from `before` and ending as `outs`, the query count if any) is made again on the GL device and
+// compared channel by channel.
+using GlCheck = void (*)(const vgpu::Program& p, const std::vector<const Texture*>& units,
+                         const std::vector<const Texture*>& before,
+                         const std::vector<const Texture*>& outs, const uint64_t* query);
+inline GlCheck& gl_check() {
+  static GlCheck check = nullptr;
+  return check;
+}
+
+// Copies of a pass's targets as they were before it, kept only where the GL device will redo the
+// pass from them.
+inline std::vector<Texture> before_pass(std::initializer_list<const Texture*> targets) {
+  std::vector<Texture> copies;
+  if (gl_check())
+    for (const Texture* t : targets) copies.push_back(*t);
+  return copies;
+}
+
+// The GL device's check of a pass of p on the vgpu (see gl_check), where it is switched on.
+inline void check_on_gl(const vgpu::Program& p, const std::vector<const Texture*>& units,
+                        const std::vector<Texture>& before, const std::vector<const Texture*>& outs,
+                        const uint64_t* query) {
+  if (!gl_check()) return;
+  std::vector<const Texture*> from;
+  for (const Texture& t : before) from.push_back(&t);
+  gl_check()(p, units, from, outs, query);
+}
 
 inline const vgpu::Profile& gf5700() {
   return vgpu::profile("gf5700");
@@ -83,20 +115,16 @@ Texture run(vgpu::Device& gpu, const K& k, const std::vector<const Texture*>& un
   Texture out = gpu.make_texture(std::string(K::name) + " out", w, h, 4);
   const float f[4] = {fill.x, fill.y, fill.z, fill.w};
   out.fill(f);
-#ifdef KTEST_GL
-  const Texture before = out;  // the GL pass starts from the same texels
-#endif
+  const std::vector<Texture> before = before_pass({&out});  // the GL pass starts from these
   const vgpu::PassRecord rec = draw(gpu, program, units, out, query);
   gpu.download(out);
   if (record) *record = rec;
-#ifdef KTEST_GL
   // The GL device computes in fp32 (GLSL floats): compared where the vgpu does too.
   auto* vgpu_gpu = dynamic_cast<vgpu::Gpu*>(&gpu);
   bool fp32 = vgpu_gpu && vgpu_gpu->precision() == vgpu::Format::fp32 &&
               program.precision() == vgpu::Format::fp32 && out.format() == vgpu::Format::fp32;
   for (const Texture* t : units) fp32 = fp32 && t->format() == vgpu::Format::fp32;
-  if (fp32) gltest::check_same_pass(program, units, before, out, query);
-#endif
+  if (fp32) check_on_gl(program, units, before, {&out}, query);
   return out;
 }
 
@@ -127,19 +155,14 @@ std::array<Texture, K::outputs> run_targets(const K& k, const std::vector<const 
     const float f[4] = {v.x, v.y, v.z, v.w};
     outs[size_t(i)].fill(f);
   }
-#ifdef KTEST_GL
-  const std::array<Texture, K::outputs> before = outs;
-#endif
+  const std::vector<Texture> before = before_pass({&outs[0], &outs[1]});
   gpu.use_program(program);
   gpu.unbind_textures();
   for (size_t i = 0; i < units.size(); ++i) gpu.bind_texture(int(i), *units[i]);
   static_assert(K::outputs == 2, "run_targets binds two targets");
   gpu.set_targets({&outs[0], &outs[1]});
   gpu.draw();
-#ifdef KTEST_GL
-  gltest::check_same_targets(program, units, {&before[0], &before[1]}, {&outs[0], &outs[1]},
-                             nullptr);
-#endif
+  check_on_gl(program, units, before, {&outs[0], &outs[1]}, nullptr);
   return outs;
 }
 

@@ -1,7 +1,7 @@
 // Kernel tests for the BVH walk (kernels/bvh.h): inicioBVH, recorridoBVH, cargarHoja,
 // interseccionesBVH, their fused --mrt on forms and the looping kernel, each run as a real pass on
-// hand-made texels, every channel of every output checked against values worked out here. Built
-// into test_gl (KTEST_GL), every pass is made again on the GL device from the same texels.
+// hand-made texels, every channel of every output checked against values worked out here. Linked
+// into test_gl too, every pass is made again on the GL device from the same texels.
 //
 // The hand-made hierarchy (texture layouts of kernels/bvh.h and host/trace/walks/bvh_walk.cpp),
 // node textures 2 texels wide (nodes 2 to 4 sit on the second and third rows):
@@ -359,18 +359,16 @@ State looping_pass(vgpu::Gpu& gpu, const vgpu::KernelProgram<kernels::BvhLooping
   gpu.use_program(p);
   gpu.unbind_textures();
   for (int u = 0; u < 11; ++u) gpu.bind_texture(u, *units[u]);
-#ifdef KTEST_GL
-  const Texture before[] = {o.trav, o.vs, o.isect};  // the GL pass starts from the same texels
-#endif
+  const std::vector<Texture> before =
+      ktest::before_pass({&o.trav, &o.vs, &o.isect});  // the GL pass starts from the same texels
   gpu.set_targets({&o.trav, &o.vs, &o.isect});
   gpu.draw();
-#ifdef KTEST_GL
-  REQUIRE(gpu.precision() == vgpu::Format::fp32);
-  REQUIRE(p.precision() == vgpu::Format::fp32);
-  gltest::check_same_targets(p, {std::begin(units), std::end(units)},
-                             {&before[0], &before[1], &before[2]}, {&o.trav, &o.vs, &o.isect},
-                             nullptr);
-#endif
+  if (ktest::gl_check()) {
+    REQUIRE(gpu.precision() == vgpu::Format::fp32);
+    REQUIRE(p.precision() == vgpu::Format::fp32);
+    ktest::check_on_gl(p, {std::begin(units), std::end(units)}, before, {&o.trav, &o.vs, &o.isect},
+                       nullptr);
+  }
   return o;
 }
 

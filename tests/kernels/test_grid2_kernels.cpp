@@ -325,16 +325,13 @@ TEST_CASE("the grid2 looping kernel ends in the multipass walk's hits and traver
   const Texture* units[] = {&r.origins, &r.rays, &trav,    &vs,     &isect,  &t.v0,
                             &t.v1,      &t.v2,   &t.cells, &t.subs, &t.lists};
   for (int u = 0; u < 11; ++u) gpu.bind_texture(u, *units[u]);
-#ifdef KTEST_GL
-  const Texture before[] = {o_trav, o_vs, o_isect};
-#endif
+  const std::vector<Texture> before = ktest::before_pass({&o_trav, &o_vs, &o_isect});
   gpu.set_targets({&o_trav, &o_vs, &o_isect});
   gpu.draw();
-#ifdef KTEST_GL
-  gltest::check_same_targets(p, {std::begin(units), std::end(units)},
-                             {&before[0], &before[1], &before[2]}, {&o_trav, &o_vs, &o_isect},
-                             nullptr);
-#endif
+  if (ktest::gl_check()) {
+    ktest::check_on_gl(p, {std::begin(units), std::end(units)}, before, {&o_trav, &o_vs, &o_isect},
+                       nullptr);
+  }
   check_same(o_isect, m.isect, r.n);
   check_same(o_trav, m.trav, r.n);
 }

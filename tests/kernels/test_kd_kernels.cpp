@@ -358,16 +358,13 @@ LoopOut loop_pass(const Walk& w, const Texture& trav, const Texture& vs, const T
   const Texture* units[] = {&w.r.origins, &w.r.rays, &trav,   &vs,        &isect,
                             &w.t.v0,      &w.t.v1,   &w.t.v2, &w.t.nodes, &w.t.lists};
   for (int u = 0; u < 10; ++u) gpu.bind_texture(u, *units[u]);
-#ifdef KTEST_GL
-  const Texture before[] = {o.trav, o.vs, o.isect};
-#endif
+  const std::vector<Texture> before = ktest::before_pass({&o.trav, &o.vs, &o.isect});
   gpu.set_targets({&o.trav, &o.vs, &o.isect});
   o.rec = gpu.draw();
-#ifdef KTEST_GL
-  gltest::check_same_targets(p, {std::begin(units), std::end(units)},
-                             {&before[0], &before[1], &before[2]}, {&o.trav, &o.vs, &o.isect},
-                             nullptr);
-#endif
+  if (ktest::gl_check()) {
+    ktest::check_on_gl(p, {std::begin(units), std::end(units)}, before, {&o.trav, &o.vs, &o.isect},
+                       nullptr);
+  }
   return o;
 }
 

@@ -2,8 +2,8 @@
 // voxels, an empty voxel 0 and voxel 1 holding triangle 0 in the plane x = 1.5. Three rays from
 // (0.5, 0.5, 0.5): +x (3 iterations: step out of the empty voxel, test the triangle, step out
 // of the grid with the hit), -x (1 iteration: out of the grid) and one already done (0). Every
-// channel of the three outputs is checked, and the batch's loop counters. Built into test_gl
-// (KTEST_GL), every pass is made again as a GL pass (one GLSL loop) from the same texels, and
+// channel of the three outputs is checked, and the batch's loop counters. Linked into test_gl
+// too, every pass is made again as a GL pass (one GLSL loop) from the same texels, and
 // its three outputs must match the vgpu's texel by texel (tests/gl/gl_compare.h): a loop budget,
 // break or carried variable the GLSL gets wrong shows up there, the budget-stopped pass too.
 #include <iterator>
@@ -55,19 +55,17 @@ Outputs pass(vgpu::Gpu& gpu, const vgpu::KernelProgram<LoopingTraversal>& p, con
   const Texture* units[] = {&s.origins, &s.rays, &trav, &vs,         &isect,
                             &s.v0,      &s.v1,   &s.v2, &s.pointers, &s.lists};
   for (int u = 0; u < 10; ++u) gpu.bind_texture(u, *units[u]);
-#ifdef KTEST_GL
-  const Texture before[] = {o.trav, o.vs, o.isect};  // the GL pass starts from the same texels
-#endif
+  const std::vector<Texture> before =
+      ktest::before_pass({&o.trav, &o.vs, &o.isect});  // the GL pass starts from the same texels
   gpu.set_targets({&o.trav, &o.vs, &o.isect});
   o.rec = gpu.draw();
-#ifdef KTEST_GL
-  // The GL device computes in fp32, as the vgpu does here: compared channel by channel.
-  REQUIRE(gpu.precision() == vgpu::Format::fp32);
-  REQUIRE(p.precision() == vgpu::Format::fp32);
-  gltest::check_same_targets(p, {std::begin(units), std::end(units)},
-                             {&before[0], &before[1], &before[2]}, {&o.trav, &o.vs, &o.isect},
-                             nullptr);
-#endif
+  if (ktest::gl_check()) {
+    // The GL device computes in fp32, as the vgpu does here: compared channel by channel.
+    REQUIRE(gpu.precision() == vgpu::Format::fp32);
+    REQUIRE(p.precision() == vgpu::Format::fp32);
+    ktest::check_on_gl(p, {std::begin(units), std::end(units)}, before, {&o.trav, &o.vs, &o.isect},
+                       nullptr);
+  }
   return o;
 }
 
