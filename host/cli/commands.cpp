@@ -1,14 +1,18 @@
-// vgpu-rt's listing commands: `kernels` (each fragment program's outputs, instructions, branches
-// and fetches per unit, or its generated GLSL) and `gl-devices` (the EGL devices --gl-device
-// can name).
+// vgpu-rt's listing commands: `scenes` (the bundled scenes or named files, with their
+// animations), `kernels` (each fragment program's outputs, instructions, branches and fetches
+// per unit, or its generated GLSL) and `gl-devices` (the EGL devices --gl-device can name).
 #include "host/cli/commands.h"
 
 #include <cstdio>
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "host/cli/options.h"
+#include "host/scene/animation.h"
+#include "host/scene/gltf_loader.h"
 #include "kernels/registry.h"
 #include "vgpu/glsl.h"
 #include "vgpu/vgpu.h"
@@ -17,6 +21,47 @@
 #endif
 
 namespace cli {
+
+int run_scenes(const std::vector<std::string>& files) {
+  std::vector<std::pair<std::string, std::string>> listed;  // (name, path)
+  if (files.empty()) listed = host::list_scenes();
+  for (const std::string& f : files) listed.emplace_back(f, f);
+  for (const auto& [name, path] : listed) {
+    const int width = files.empty() ? 14 : 0;  // bundled names in a column
+    try {
+      // The listing counts triangles: images are not decoded (loading the image module would
+      // take the listing from 0.1 s to 1 s), each stands as one white texel.
+      host::LoadOptions listing;
+      listing.read_image = [](const std::vector<unsigned char>&) {
+        return host::ImagePixels{1, 1, 3, {1.0f, 1.0f, 1.0f}};
+      };
+      const host::AnimatedScene s(path, listing);
+      std::string animations;
+      const std::vector<host::Animation>& list = s.animations();
+      for (size_t i = 0; i < list.size(); ++i) {
+        char range[96];
+        std::snprintf(range, sizeof range, " %g-%g s (%g s)", list[i].start, list[i].end,
+                      list[i].end - list[i].start);
+        animations +=
+            (i ? ", " : "  animations: ") + std::to_string(i) + " '" + list[i].name + "'" + range;
+      }
+      if (list.size() > 1) {
+        const std::string clash = s.clash(s.all());
+        animations += clash.empty() ? "; all play together by default"
+                                    : "; " + clash + ": the first plays alone by default";
+      }
+      if (files.empty())
+        std::printf("%-*s %7zu triangles  %s%s\n", width, name.c_str(), s.rest().triangle_count(),
+                    path.c_str(), animations.c_str());
+      else
+        std::printf("%s: %zu triangles%s\n", path.c_str(), s.rest().triangle_count(),
+                    animations.c_str());
+    } catch (const std::exception& e) {
+      std::printf("%-*s (unreadable: %s)\n", width, name.c_str(), e.what());
+    }
+  }
+  return 0;
+}
 
 // `vgpu-rt kernels [NAME] [--glsl]`: what a fragment program is, per kernel.
 int run_kernels(const std::string& name, bool glsl) {

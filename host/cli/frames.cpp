@@ -40,10 +40,15 @@ double parse_time(const std::string& text) {
 std::string frames_problem(const std::string& text, FrameRange& range) {
   const size_t c1 = text.find(':'), c2 = c1 == std::string::npos ? c1 : text.find(':', c1 + 1);
   const std::string expected =
-      "expected A:B:N (N frames evenly from A to B seconds, e.g. 0:2:25), got '" + text + "'";
-  if (c2 == std::string::npos || text.find(':', c2 + 1) != std::string::npos) return expected;
-  const std::string sa = text.substr(0, c1), sb = text.substr(c1 + 1, c2 - c1 - 1),
-                    sn = text.substr(c2 + 1);
+      "expected A:B:N (N frames evenly from A to B seconds, e.g. 0:2:25) or N (N frames over "
+      "the animations' keys, e.g. 25), got '" +
+      text + "'";
+  const bool bounded = c1 != std::string::npos;  // else the count alone
+  if (bounded && (c2 == std::string::npos || text.find(':', c2 + 1) != std::string::npos))
+    return expected;
+  const std::string sa = bounded ? text.substr(0, c1) : "0",
+                    sb = bounded ? text.substr(c1 + 1, c2 - c1 - 1) : "0",
+                    sn = bounded ? text.substr(c2 + 1) : text;
   const double a = number(sa), b = number(sb);
   int n = 0;
   const auto [ptr, ec] = std::from_chars(sn.data(), sn.data() + sn.size(), n);
@@ -54,7 +59,7 @@ std::string frames_problem(const std::string& text, FrameRange& range) {
   if (a > b) return text + ": the first time (" + sa + " s) is after the last (" + sb + " s)";
   if (ec == std::errc::result_out_of_range || n < 1 || n > kMaxFrames)
     return text + ": the frame count must be 1 to " + std::to_string(kMaxFrames) + ", got " + sn;
-  range = {a, b, n};
+  range = {a, b, n, bounded};
   return {};
 }
 

@@ -16,10 +16,13 @@ std::string time_problem(const std::string& text);
 double parse_time(const std::string& text);  // a text time_problem() accepted
 
 // --frames A:B:N: N frames evenly from A to B seconds, both ends included (N = 1: A alone);
-// A <= B, N from 1 to kMaxFrames.
+// A <= B, N from 1 to kMaxFrames. --frames N, without bounds: N frames over the played
+// animations' span (from the first key time of any of them to the last), which only the file
+// knows: `bounded` is false and a, b are filled in once it is read.
 struct FrameRange {
   double a = 0, b = 0;
   int n = 1;
+  bool bounded = true;
 };
 // Empty when good, else the problem; `range` is set when good.
 std::string frames_problem(const std::string& text, FrameRange& range);

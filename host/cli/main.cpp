@@ -93,6 +93,7 @@ struct RenderPlan {
   host::GridSpec grid_spec;
   std::string aov_depth, aov_hit;  // --aov files (empty: not written)
   std::vector<double> times;       // the frames' times (one frame: {0} or --time)
+  bool span_frames = false;        // --frames N: times spread over the played animations' keys
   bool animating = false, cpu = false, gl = false;
 };
 
@@ -182,7 +183,8 @@ RenderPlan parse_render(const RenderArgs& a, bool lanes_given) {
   if (!a.frames.empty()) {
     cli::FrameRange range;
     cli::frames_problem(a.frames, range);  // CLI11 checked it
-    times = cli::frame_times(range);
+    times = cli::frame_times(range);       // --frames N: set once the file is read
+    plan.span_frames = !range.bounded;
   }
   if (times.size() > 1) {
     for (const auto& [option, file] : {std::pair<std::string, std::string>{"--out", a.out},
@@ -323,10 +325,10 @@ void print_frames_table(const RenderArgs& a, const RenderPlan& plan, const host:
                         const std::string& animation_text) {
   const host::RenderOptions& opt = plan.opt;
   const bool cpu = plan.cpu;
-  std::printf("scene %s, animation %s, %zu frames, %s, --update %s, %dx%d, %s %s\n",
-              scene.name.c_str(), animation_text.c_str(), lines.size(),
-              std::string(host::accel_name(accel)).c_str(), a.update.c_str(), r.width, r.height,
-              cpu ? "engine" : "profile", cpu ? "cpu" : opt.profile.c_str());
+  std::printf("scene %s, %s, %zu frames, %s, --update %s, %dx%d, %s %s\n", scene.name.c_str(),
+              animation_text.c_str(), lines.size(), std::string(host::accel_name(accel)).c_str(),
+              a.update.c_str(), r.width, r.height, cpu ? "engine" : "profile",
+              cpu ? "cpu" : opt.profile.c_str());
   std::printf("%6s %9s %8s %9s %9s %11s %12s %10s %8s %12s %12s%s\n", "frame", "time s", "update",
               "pose ms", "build ms", "textures ms", "uploaded B", "render ms", "passes", "nodes",
               "voxels", a.predict ? "  predicted ms" : "");
@@ -344,26 +346,62 @@ void print_frames_table(const RenderArgs& a, const RenderPlan& plan, const host:
   std::printf("initialization %.1f ms (the first frame's grid and uploads)\n", init_ms);
 }
 
-// Build: which of the scene's animations --animation names (the first when it names none; none
-// when the file has none); refuses a name the file does not have.
-std::optional<size_t> find_animation(const RenderArgs& a, const std::string& path,
-                                     const host::AnimatedScene& animated) {
+// Build: which of the scene's animations play, ascending (none when the file has none).
+// --animation names one (a name, even with commas in it, else an index) or a comma list; without
+// it every animation of the file plays, as glTF viewers play them, unless two drive the same
+// path of one node: they are alternatives then (a walk and a run), and the first plays alone, as
+// before issue 34, with a note. Refuses a name the file does not have, and two named animations
+// that drive the same path of one node (UsageError, exit 2).
+std::vector<size_t> played_animations(const RenderArgs& a, const std::string& path,
+                                      const host::AnimatedScene& animated) {
   const std::vector<host::Animation>& list = animated.animations();
-  if (!a.animation.empty()) {
-    const std::optional<size_t> found = animated.find(a.animation);
-    if (!found) {
-      std::string known;
-      for (size_t i = 0; i < list.size(); ++i)
-        known += (i ? ", " : "") + std::to_string(i) + " '" + list[i].name + "'";
-      throw UsageError("--animation " + a.animation + ": " + path +
-                       " has no animation named or numbered '" + a.animation + "' (" +
-                       (known.empty() ? "it has none" : "it has " + known) + ")");
-    }
-    return found;
-  } else if (!list.empty()) {
-    return 0;  // the first, as --help says
+  if (a.animation.empty()) {
+    const std::vector<size_t> all = animated.all();
+    const std::string why = animated.clash(all);
+    if (why.empty()) return all;
+    std::fprintf(stderr,
+                 "vgpu-rt: %s: %s, so they cannot play together: animation 0 '%s' plays alone "
+                 "(--animation chooses)\n",
+                 path.c_str(), why.c_str(), list[0].name.c_str());
+    return {0};
   }
-  return std::nullopt;
+  std::vector<size_t> played;
+  if (const std::optional<size_t> whole = animated.find(a.animation)) {
+    played = {*whole};
+  } else {
+    for (size_t start = 0;;) {
+      const size_t comma = std::min(a.animation.find(',', start), a.animation.size());
+      const std::string item = a.animation.substr(start, comma - start);
+      const std::optional<size_t> found = animated.find(item);
+      if (!found) {
+        std::string known;
+        for (size_t i = 0; i < list.size(); ++i)
+          known += (i ? ", " : "") + std::to_string(i) + " '" + list[i].name + "'";
+        throw UsageError("--animation " + a.animation + ": " + path +
+                         " has no animation named or numbered '" + item + "' (" +
+                         (known.empty() ? "it has none" : "it has " + known) + ")");
+      }
+      played.push_back(*found);
+      if (comma == a.animation.size()) break;
+      start = comma + 1;
+    }
+    std::sort(played.begin(), played.end());
+    played.erase(std::unique(played.begin(), played.end()), played.end());
+  }
+  if (const std::string why = animated.clash(played); !why.empty())
+    throw UsageError("--animation " + a.animation + ": " + path + ": " + why +
+                     "; they cannot play together");
+  return played;
+}
+
+// What plays, for the tables: "animation 'hop'", "animations 'rise' + 'spin'", or `none`.
+std::string played_text(const host::AnimatedScene* animated, const std::vector<size_t>& played,
+                        const std::string& none) {
+  if (played.empty()) return none;
+  std::string text = played.size() > 1 ? "animations " : "animation ";
+  for (size_t i = 0; i < played.size(); ++i)
+    text += (i ? " + '" : "'") + animated->animations()[played[i]].name + "'";
+  return text;
 }
 
 // Write: a frame's image and AOVs (numbered when animating: frame_####.png).
@@ -414,14 +452,18 @@ int run_render(const RenderArgs& a, bool lanes_given) {
   // The scene: as the file has it, or posed at each frame's time (--time, --frames).
   const std::string path = host::resolve_scene(a.scene);
   std::optional<host::AnimatedScene> animated;
-  std::optional<size_t> animation;
+  std::vector<size_t> animation;  // the animations played together
   if (animating) {
     animated.emplace(path, host::with_images());
-    animation = find_animation(a, path, *animated);
+    animation = played_animations(a, path, *animated);
     animated->check(animation);  // skinned meshes, morph-target weights: one line, exit 2
+    if (plan.span_frames) {      // --frames N: over the played animations' keys
+      const auto [first, last] = animated->span(animation);
+      plan.times = cli::frame_times({first, last, int(times.size())});
+    }
   }
   const nlohmann::ordered_json animation_json =
-      animation ? host::animation_json(animated->animations()[*animation], *animation) : nullptr;
+      animated ? host::animation_json(animated->animations(), animation) : nullptr;
   auto pose_start = std::chrono::steady_clock::now();
   host::Scene scene =
       animated ? animated->at(animation, times[0]) : host::load_scene(path, host::with_images());
@@ -547,13 +589,13 @@ int run_render(const RenderArgs& a, bool lanes_given) {
     std::cout << j.dump(2) << "\n";
   } else if (a.stats == "table" && several) {
     print_frames_table(a, plan, scene, accel.kind(), r, lines, init_ms,
-                       animation ? "'" + animated->animations()[*animation].name + "'"
-                                 : "none (the scene is static)");
+                       played_text(animated ? &*animated : nullptr, animation,
+                                   "animation none (the scene is static)"));
   } else if (a.stats == "table") {
     print_table(a, plan, scene, accel, choice ? &*choice : nullptr, r, cpu_stats, init_ms,
                 tracer ? &*tracer : nullptr,
-                animation ? "animation '" + animated->animations()[*animation].name + "'"
-                          : "no animation (the scene is static)");
+                played_text(animated ? &*animated : nullptr, animation,
+                            "no animation (the scene is static)"));
   }
   if (a.predict && !several) {
     const vgpu::Profile& p = vgpu::profile(opt.profile);
@@ -573,7 +615,12 @@ int main(int argc, char** argv) {
   auto* render = app.add_subcommand(
       "render", "Render a scene on the virtual GPU and print the pass statistics");
   cli::add_render_options(*render, a);
-  auto* scenes = app.add_subcommand("scenes", "List the scenes in scenes/");
+  auto* scenes = app.add_subcommand(
+      "scenes",
+      "List the scenes in scenes/, or the glTF files named: triangles and animations (index, "
+      "name, key times, duration; render --time/--frames plays them all together by default)");
+  std::vector<std::string> scene_files;
+  scenes->add_option("files", scene_files, "glTF files to list instead of the bundled scenes");
   std::string kernel_name;
   bool kernel_glsl = false;
   auto* kernels_cmd = app.add_subcommand(
@@ -610,30 +657,7 @@ int main(int argc, char** argv) {
   }
   try {
     if (*render) return run_render(a, render->count("--lanes") > 0);
-    if (*scenes) {
-      for (const auto& [name, path] : host::list_scenes()) {
-        try {
-          // The listing counts triangles: images are not decoded (loading the image module
-          // would take the listing from 0.1 s to 1 s), each stands as one white texel.
-          host::LoadOptions listing;
-          listing.read_image = [](const std::vector<unsigned char>&) {
-            return host::ImagePixels{1, 1, 3, {1.0f, 1.0f, 1.0f}};
-          };
-          const host::AnimatedScene s(path, listing);
-          std::string animations;
-          for (const host::Animation& an : s.animations()) {
-            char range[64];
-            std::snprintf(range, sizeof range, " %g-%g s", an.start, an.end);
-            animations += (animations.empty() ? "  animations: '" : ", '") + an.name + "'" + range;
-          }
-          std::printf("%-14s %7zu triangles  %s%s\n", name.c_str(), s.rest().triangle_count(),
-                      path.c_str(), animations.c_str());
-        } catch (const std::exception& e) {
-          std::printf("%-14s (unreadable: %s)\n", name.c_str(), e.what());
-        }
-      }
-      return 0;
-    }
+    if (*scenes) return cli::run_scenes(scene_files);
     if (*diff) {
       std::cout << host::diff_stats(da, db);
       return 0;

@@ -119,7 +119,7 @@ const CLI::Validator kFramesCheck(
       cli::FrameRange range;
       return cli::frames_problem(text, range);
     },
-    "A:B:N, N frames from A to B seconds", "A:B:N");
+    "A:B:N, N frames from A to B seconds, or N over the animations' keys", "A:B:N|N");
 
 // --update: how the structure follows a moving scene (refit and auto: a BVH only, checked with
 // --accel in main.cpp).
@@ -171,6 +171,8 @@ std::vector<std::string> profile_names() {
 }
 
 }  // namespace
+
+void add_animation_options(CLI::App& render, RenderArgs& a);
 
 void add_render_options(CLI::App& render, RenderArgs& a) {
   const std::vector<std::string> on_off{"on", "off"};
@@ -340,21 +342,31 @@ void add_render_options(CLI::App& render, RenderArgs& a) {
       ->capture_default_str();
   render.add_flag("--predict", a.predict,
                   "Print the cost model's predicted time for --profile, with its breakdown");
+  add_animation_options(render, a);
+}
+
+// The animation options (issue 23; issue 34: every animation plays by default).
+void add_animation_options(CLI::App& render, RenderArgs& a) {
   render
       .add_option("--time", a.time,
-                  "Render the scene at T seconds of its animation (glTF; a static scene renders "
-                  "as it is; before the first key and after the last, the keys' values)")
+                  "Render the scene at T seconds of its animations (glTF: every animation of the "
+                  "file plays, or those --animation names; a static scene renders as it is; "
+                  "before the first key and after the last, the keys' values)")
       ->check(kTimeCheck);
   render
       .add_option("--frames", a.frames,
-                  "Render N frames evenly from A to B seconds, both included (N = 1: A); --out "
+                  "Render N frames evenly from A to B seconds, both included (N = 1: A); with N "
+                  "alone, from the first key time to the last of the animations played; --out "
                   "and --aov need '#' in the file name for the frame number, zero-padded, "
                   "numbered from 1 (frame_####.png: frame_0001.png, ...); --stats-json holds one "
                   "record per frame")
       ->check(kFramesCheck);
   render.add_option("--animation", a.animation,
-                    "With --time or --frames: the animation to play, by name or index (default: "
-                    "the file's first)");
+                    "With --time or --frames: the animation to play, by name or index, or several "
+                    "to play together as a comma list (e.g. 0,2). Default: every animation of the "
+                    "file together, as glTF viewers play them, unless two drive the same path of "
+                    "one node (then the first alone, with a note). `vgpu-rt scenes FILE` lists a "
+                    "file's animations");
   render
       .add_option("--update", a.update,
                   "With --time or --frames: how the acceleration structure follows the moving "

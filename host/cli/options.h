@@ -51,8 +51,8 @@ struct RenderArgs {
   bool steps_given = false;
   bool walk_given = false;
   std::string time;       // --time T
-  std::string frames;     // --frames A:B:N
-  std::string animation;  // --animation NAME|INDEX
+  std::string frames;     // --frames A:B:N or N
+  std::string animation;  // --animation NAME|INDEX[,NAME|INDEX...]
   std::string update = "rebuild";
   bool update_given = false;
   int report_frame = 0;  // --report-frame K (1-based; 0: not given)

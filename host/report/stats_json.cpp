@@ -6,6 +6,7 @@
 #pragma GCC diagnostic ignored "-Wrestrict"
 #include "host/report/stats_json.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <fstream>
 
@@ -162,11 +163,21 @@ nlohmann::ordered_json frame_stats_json(const FrameStatsInputs& in) {
   return j;
 }
 
-nlohmann::ordered_json animation_json(const Animation& animation, size_t index) {
-  return {{"name", animation.name},
-          {"index", index},
-          {"start", animation.start},
-          {"end", animation.end}};
+nlohmann::ordered_json animation_json(const std::vector<Animation>& animations,
+                                      const std::vector<size_t>& played) {
+  if (played.empty()) return nullptr;
+  nlohmann::ordered_json each = nlohmann::ordered_json::array();
+  std::string name;
+  double start = 0, end = 0;
+  for (size_t i = 0; i < played.size(); ++i) {
+    const Animation& an = animations.at(played[i]);
+    each.push_back({{"name", an.name}, {"index", played[i]}, {"start", an.start}, {"end", an.end}});
+    name += (i ? " + " : "") + an.name;
+    start = i ? std::min(start, an.start) : an.start;
+    end = i ? std::max(end, an.end) : an.end;
+  }
+  if (played.size() == 1) return each[0];  // one animation: as before issue 34
+  return {{"name", name}, {"index", nullptr}, {"start", start}, {"end", end}, {"played", each}};
 }
 
 nlohmann::ordered_json frame_update_json(const std::string& mode, double pose_ms,

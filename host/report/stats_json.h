@@ -37,8 +37,14 @@ struct FrameStatsInputs {
 
 nlohmann::ordered_json frame_stats_json(const FrameStatsInputs& in);
 
-// The animation a moving scene's frames were posed by (--animation): its name, index and times.
-nlohmann::ordered_json animation_json(const Animation& animation, size_t index);
+// What posed a moving scene's frames: the animations of `animations` whose indices `played`
+// holds, played together (every animation of the file by default, or those --animation names).
+// One animation: its {name, index, start, end} (start and end its first and last key time).
+// Several: {name, index, start, end, played}, their names joined by " + ", a null index, the
+// first and last key time of any of them, and `played` each one's {name, index, start, end}.
+// Null when none plays (a file without animations).
+nlohmann::ordered_json animation_json(const std::vector<Animation>& animations,
+                                      const std::vector<size_t>& played);
 
 // What a frame of an animation cost to update (the "update" object of --frames and --time): the
 // host's work (`mode`: initial, rebuild or refit), the bytes sent to the device, and the cost

@@ -232,7 +232,43 @@ std::optional<size_t> AnimatedScene::find(const std::string& name_or_index) cons
   return std::nullopt;
 }
 
-void AnimatedScene::check(std::optional<size_t> animation) const {
+std::vector<size_t> AnimatedScene::all() const {
+  std::vector<size_t> every(animations_.size());
+  for (size_t a = 0; a < every.size(); ++a) every[a] = a;
+  return every;
+}
+
+std::string AnimatedScene::clash(const std::vector<size_t>& played) const {
+  // Which animation drives each (node, path) so far; one animation never drives a pair twice
+  // (read_animations refuses that).
+  std::map<std::pair<int, AnimatedPath>, size_t> driver;
+  for (const size_t a : played)
+    for (const Channel& ch : animations_.at(a).channels) {
+      const auto [it, fresh] = driver.emplace(std::make_pair(ch.node, ch.path), a);
+      if (fresh || it->second == a) continue;
+      const std::string& node_name = file_->model().nodes[size_t(ch.node)].name;
+      const size_t first = it->second;
+      return "animations " + std::to_string(first) + " '" + animations_[first].name + "' and " +
+             std::to_string(a) + " '" + animations_[a].name + "' both drive node " +
+             std::to_string(ch.node) + (node_name.empty() ? "" : " ('" + node_name + "')") + " " +
+             path_name(ch.path);
+    }
+  return {};
+}
+
+std::pair<double, double> AnimatedScene::span(const std::vector<size_t>& played) const {
+  std::pair<double, double> s{0.0, 0.0};
+  bool first = true;
+  for (const size_t a : played) {
+    const Animation& anim = animations_.at(a);
+    s.first = first ? anim.start : std::min(s.first, anim.start);
+    s.second = first ? anim.end : std::max(s.second, anim.end);
+    first = false;
+  }
+  return s;
+}
+
+void AnimatedScene::check(const std::vector<size_t>& played) const {
   const tinygltf::Model& model = file_->model();
   for (const int n : file_->walked()) {
     const tinygltf::Node& node = model.nodes[size_t(n)];
@@ -240,38 +276,44 @@ void AnimatedScene::check(std::optional<size_t> animation) const {
       throw UnsupportedFeature(file_->path() + ": node " + std::to_string(n) + " uses skin " +
                                std::to_string(node.skin) + "; skinned meshes are not supported");
   }
-  if (animation && !animations_.at(*animation).unsupported.empty())
-    throw UnsupportedFeature(file_->path() + ": " + animations_[*animation].unsupported);
+  for (const size_t a : played)
+    if (!animations_.at(a).unsupported.empty())
+      throw UnsupportedFeature(file_->path() + ": " + animations_[a].unsupported);
+  if (const std::string why = clash(played); !why.empty())
+    throw InputError(file_->path() + ": " + why);
 }
 
-Scene AnimatedScene::at(std::optional<size_t> animation, double time) const {
+Scene AnimatedScene::at(const std::vector<size_t>& played, double time) const {
   if (!std::isfinite(time)) throw std::invalid_argument("the time is not a finite number");
-  check(animation);
-  if (!animation) return rest_;
-  const Animation& anim = animations_.at(*animation);
+  check(played);
+  if (played.empty()) return rest_;
   const tinygltf::Model& model = file_->model();
-  // Each animated node's T, R, S: the file's, with the animated ones replaced.
+  // Each animated node's T, R, S: the file's, with the animated ones replaced. No two channels
+  // of `played` drive the same node and path (check), so the order does not matter.
   struct Trs {
     glm::dvec3 t{0.0}, s{1.0};
     glm::dquat r{1, 0, 0, 0};
   };
   std::map<int, Trs> posed;
-  for (const Channel& ch : anim.channels) {
-    auto [it, fresh] = posed.try_emplace(ch.node);
-    Trs& trs = it->second;
-    if (fresh) {
-      const tinygltf::Node& node = model.nodes[size_t(ch.node)];
-      if (node.translation.size() == 3)
-        trs.t = {node.translation[0], node.translation[1], node.translation[2]};
-      if (node.rotation.size() == 4)
-        trs.r = unit(
-            glm::dquat(node.rotation[3], node.rotation[0], node.rotation[1], node.rotation[2]));
-      if (node.scale.size() == 3) trs.s = {node.scale[0], node.scale[1], node.scale[2]};
+  for (const size_t a : played) {
+    const Animation& anim = animations_[a];
+    for (const Channel& ch : anim.channels) {
+      auto [it, fresh] = posed.try_emplace(ch.node);
+      Trs& trs = it->second;
+      if (fresh) {
+        const tinygltf::Node& node = model.nodes[size_t(ch.node)];
+        if (node.translation.size() == 3)
+          trs.t = {node.translation[0], node.translation[1], node.translation[2]};
+        if (node.rotation.size() == 4)
+          trs.r = unit(
+              glm::dquat(node.rotation[3], node.rotation[0], node.rotation[1], node.rotation[2]));
+        if (node.scale.size() == 3) trs.s = {node.scale[0], node.scale[1], node.scale[2]};
+      }
+      const Sampler& s = anim.samplers[ch.sampler];
+      if (ch.path == AnimatedPath::translation) trs.t = sample_vec3(s, time);
+      if (ch.path == AnimatedPath::rotation) trs.r = sample_rotation(s, time);
+      if (ch.path == AnimatedPath::scale) trs.s = sample_vec3(s, time);
     }
-    const Sampler& s = anim.samplers[ch.sampler];
-    if (ch.path == AnimatedPath::translation) trs.t = sample_vec3(s, time);
-    if (ch.path == AnimatedPath::rotation) trs.r = sample_rotation(s, time);
-    if (ch.path == AnimatedPath::scale) trs.s = sample_vec3(s, time);
   }
   std::vector<std::optional<glm::dmat4>> local(model.nodes.size());
   for (const auto& [n, trs] : posed) {

@@ -9,6 +9,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "host/scene/gltf_loader.h"
@@ -94,19 +95,36 @@ class AnimatedScene {
   // The animation with this name, else the one with this index (decimal digits); nullopt when
   // neither exists.
   std::optional<size_t> find(const std::string& name_or_index) const;
+  // Every animation of the file, 0 to N - 1: what a glTF viewer plays, and the CLI's default.
+  // Exporters often write one animation per animated node (a parent's translation and its
+  // child's rotation as two animations), meant to play together.
+  std::vector<size_t> all() const;
+  // Two animations of `played` that drive the same path of the same node cannot play together
+  // (which value would win?). Empty when no two do; else the first such pair, e.g.
+  // "animations 0 'rise' and 2 'sway' both drive node 1 ('outer') translation".
+  std::string clash(const std::vector<size_t>& played) const;
+  // The first and last key time of any animation of `played` (0, 0 when none): the span
+  // --frames N covers.
+  std::pair<double, double> span(const std::vector<size_t>& played) const;
   // Throws UnsupportedFeature, one line naming the feature, when the scene cannot be posed with
-  // `animation` (none: the file's transforms): a node of the scene uses a skin, or the
-  // animation has a channel on morph-target weights (or another unsupported path).
-  void check(std::optional<size_t> animation) const;
-  // The scene at `time` seconds of `animation` (none, or a file without animations: the rest
-  // scene): each animated node's translation, rotation and scale replaced by its channels'
-  // samples (the others kept), then flattened with the loader's rules. Cameras and lights of the
-  // file move with their nodes; the default light (a file without lights) stays the rest
-  // scene's, so that it does not follow the moving bounds. Calls check(). Not thread-safe (the
-  // open file is reused).
-  Scene at(std::optional<size_t> animation, double time) const;
+  // the animations `played` (none: the file's transforms): a node of the scene uses a skin, or
+  // an animation has a channel on morph-target weights (or another unsupported path). Throws
+  // InputError, "PATH: " and clash(), when two of them drive the same path of a node.
+  void check(const std::vector<size_t>& played) const;
+  void check(std::optional<size_t> animation) const { check(one(animation)); }
+  // The scene at `time` seconds of the animations `played`, all sampled at the same time (none,
+  // or a file without animations: the rest scene): each animated node's translation, rotation
+  // and scale replaced by its channels' samples (the others kept), then flattened with the
+  // loader's rules. Cameras and lights of the file move with their nodes; the default light (a
+  // file without lights) stays the rest scene's, so that it does not follow the moving bounds.
+  // Calls check(). Not thread-safe (the open file is reused).
+  Scene at(const std::vector<size_t>& played, double time) const;
+  Scene at(std::optional<size_t> animation, double time) const { return at(one(animation), time); }
 
  private:
+  static std::vector<size_t> one(std::optional<size_t> a) {
+    return a ? std::vector<size_t>{*a} : std::vector<size_t>{};
+  }
   std::unique_ptr<gltf_detail::OpenScene> file_;
   Scene rest_;
   std::vector<Animation> animations_;

@@ -41,10 +41,12 @@ TEST_CASE("bad times and frame ranges are refused with one line naming the probl
   check_refused("--frames 0:1:200000", "--frames", "the frame count must be 1 to 100000");
   check_refused("--frames=-1:1:3", "--frames",
                 "-1:1:3: times are seconds from the animation's start, 0 or more");
-  for (const char* bad : {"0:1", "0:1:2:3", "a:1:2", "0:1:2.5", "0:nan:2", ":1:2"})
+  for (const char* bad : {"0:1", "0:1:2:3", "a:1:2", "0:1:2.5", "0:nan:2", ":1:2", "2.5", "x"})
     check_refused(std::string("--frames ") + bad, "--frames",
-                  "expected A:B:N (N frames evenly from A to B seconds, e.g. 0:2:25), got '" +
+                  "expected A:B:N (N frames evenly from A to B seconds, e.g. 0:2:25) or N (N "
+                  "frames over the animations' keys, e.g. 25), got '" +
                       std::string(bad) + "'");
+  check_refused("--frames 0", "--frames", "0: the frame count must be 1 to 100000, got 0");
   check_refused("--time 1 --frames 0:1:2", "--time and --frames", "give one");
   check_refused("--animation hop", "--animation", "needs --time or --frames");
   check_refused("--update rebuild", "--update", "needs --time or --frames");
@@ -101,6 +103,79 @@ TEST_CASE("an unknown animation, a skinned mesh and morph-target weights are ref
   }
 }
 
+TEST_CASE("a file's animations play together by default, and two of one node's path are refused") {
+  // two_animations.gltf: "rise" (the outer cube, 0-2 s) and "spin" (its child, 1-3 s).
+  const std::string two = std::string(VGPU_TEST_DATA) + "/gltf/two_animations.gltf";
+  const std::string clash = std::string(VGPU_TEST_DATA) + "/gltf/animations_clash.gltf";
+  const fs::path dir = fresh_dir("two_animations");
+  const std::string common = " -q --size 24x16 --bounces 0 --stats none --stats-json ";
+  // --frames N without bounds: N frames over both animations' keys, 0 to 3 s.
+  Outcome o = run("render " + two + " --frames 4" + common + (dir / "all.json").string());
+  INFO(o.err);
+  REQUIRE(o.status == 0);
+  const nlohmann::json all = nlohmann::json::parse(slurp(dir / "all.json"));
+  CHECK(all["animation"]["name"] == "rise + spin");
+  CHECK(all["animation"]["index"].is_null());
+  CHECK(all["animation"]["start"] == 0.0);
+  CHECK(all["animation"]["end"] == 3.0);
+  REQUIRE(all["animation"]["played"].size() == 2);
+  CHECK(all["animation"]["played"][1] ==
+        nlohmann::json({{"name", "spin"}, {"index", 1}, {"start", 1.0}, {"end", 3.0}}));
+  REQUIRE(all["frames"].size() == 4);
+  for (int f = 0; f < 4; ++f) CHECK(all["frames"][size_t(f)]["time"] == double(f));
+  // One chosen animation: its own keys, 1 to 3 s for "spin".
+  o = run("render " + two + " --frames 3 --animation spin" + common + (dir / "spin.json").string());
+  REQUIRE(o.status == 0);
+  const nlohmann::json spin = nlohmann::json::parse(slurp(dir / "spin.json"));
+  CHECK(spin["animation"]["name"] == "spin");
+  CHECK(spin["animation"]["index"] == 1);
+  CHECK(spin["frames"][0]["time"] == 1.0);
+  CHECK(spin["frames"][2]["time"] == 3.0);
+  // The default and the comma list that names both render the same frame.
+  o = run("render " + two + " --time 1 --out " + (dir / "all.png").string() + common +
+          (dir / "t.json").string());
+  REQUIRE(o.status == 0);
+  o = run("render " + two + " --time 1 --animation spin,rise --out " + (dir / "list.png").string() +
+          common + (dir / "t.json").string());
+  REQUIRE(o.status == 0);
+  CHECK(compare(dir / "all.png", dir / "list.png", 0).differing_percent == 0);
+  o = run("render " + two + " --time 1 --animation rise --out " + (dir / "rise.png").string() +
+          common + (dir / "t.json").string());
+  REQUIRE(o.status == 0);
+  CHECK(compare(dir / "all.png", dir / "rise.png", 0).differing_percent > 0);
+  // Two chosen animations of one node's path: refused, naming the file, the node and the path.
+  o = run("render " + clash + " --time 0.5 --animation 0,1 --out " + (dir / "no.png").string() +
+          common + (dir / "no.json").string());
+  CHECK(o.status == 2);
+  check_one_line(o, "--animation 0,1: " + clash,
+                 "animations 0 'left' and 1 'right' both drive node 0 translation; they cannot "
+                 "play together");
+  CHECK_FALSE(fs::exists(dir / "no.png"));
+  o = run("render " + clash + " --time 0.5 --animation 0,walk" + common +
+          (dir / "no.json").string());
+  CHECK(o.status == 2);
+  check_one_line(o, "--animation 0,walk", "has no animation named or numbered 'walk'");
+  // By default such a file plays its first animation alone, and says so.
+  o = run("render " + clash + " --time 0.5" + common + (dir / "first.json").string());
+  CHECK(o.status == 0);
+  CHECK(o.err == "vgpu-rt: " + clash +
+                     ": animations 0 'left' and 1 'right' both drive node 0 translation, so they "
+                     "cannot play together: animation 0 'left' plays alone (--animation "
+                     "chooses)\n");
+  CHECK(nlohmann::json::parse(slurp(dir / "first.json"))["animation"]["name"] == "left");
+  // `scenes FILE` lists the animations with their key times and durations.
+  o = run("scenes " + two + " " + clash);
+  CHECK(o.status == 0);
+  CHECK(o.out == two +
+                     ": 26 triangles  animations: 0 'rise' 0-2 s (2 s), 1 'spin' 1-3 s (2 s); all "
+                     "play together by default\n" +
+                     clash +
+                     ": 1 triangles  animations: 0 'left' 0-1 s (1 s), 1 'right' 0-1 s (1 s); "
+                     "animations 0 'left' and 1 'right' both drive node 0 translation: the first "
+                     "plays alone by default\n");
+  fs::remove_all(dir);
+}
+
 TEST_CASE("a multi-frame render writes numbered files and one statistics record per frame") {
   const fs::path dir = fresh_dir("frames");
   const std::string size = " --size 40x32 --stats none";
@@ -124,7 +199,9 @@ TEST_CASE("a multi-frame render writes numbered files and one statistics record 
   REQUIRE_NOTHROW(j = nlohmann::json::parse(slurp(dir / "frames.json")));
   CHECK(j["scene"] == "hop");
   CHECK(j["animation"]["name"] == "hop");
+  CHECK(j["animation"]["index"] == 0);
   CHECK(j["animation"]["end"] == 2.0);
+  CHECK_FALSE(j["animation"].contains("played"));  // one animation: the object as before
   CHECK(j["update"] == "rebuild");
   REQUIRE(j["frames"].size() == 3);
   for (int f = 0; f < 3; ++f) {

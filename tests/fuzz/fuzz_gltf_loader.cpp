@@ -41,13 +41,16 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   } catch (const host::InputError&) {
   }
   try {
-    // The same file with its animations read and each posed mid-way and past its end
-    // (UnsupportedFeature is an InputError).
+    // The same file with its animations read and each posed mid-way and past its end, then all
+    // of them together, as the CLI plays them by default (UnsupportedFeature is an InputError,
+    // and so is a clash of two animations on one node's path).
     const host::AnimatedScene a(path, host::LoadOptions{1'000'000});
     for (size_t i = 0; i < a.animations().size() && i < 4; ++i) {
       a.at(i, 0.5 * (a.animations()[i].start + a.animations()[i].end));
       a.at(i, a.animations()[i].end + 1.0);
     }
+    if (a.clash(a.all()).empty())
+      a.at(a.all(), 0.5 * (a.span(a.all()).first + a.span(a.all()).second));
   } catch (const host::InputError&) {
   }
   std::remove(path.c_str());

@@ -1,6 +1,8 @@
 // Tests for host/scene/animation: the samplers' known answers on hand-made keys (LINEAR, STEP,
-// CUBICSPLINE, slerp the short way round, clamping outside the keys), and the scene of
-// tests/data/gltf/animated.gltf posed at a time against its transforms applied by hand.
+// CUBICSPLINE, slerp the short way round, clamping outside the keys), the scene of
+// tests/data/gltf/animated.gltf posed at a time against its transforms applied by hand, and a
+// file's animations played together (two_animations.gltf against the same scene posed by hand)
+// or refused when two drive one node's path (animations_clash.gltf).
 #include <doctest/doctest.h>
 
 #include <cmath>
@@ -9,6 +11,8 @@
 #include <numbers>
 #include <sstream>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "host/scene/animation.h"
 
@@ -248,4 +252,93 @@ TEST_CASE("key times that do not increase are refused, naming the sampler and th
                        ": animation 0 sampler 0: key times must increase strictly (key 2 at "
                        "1.000000 s follows 2.000000 s)");
   CHECK(host::load_scene(path).triangle_count() == 1);  // a static load ignores animations
+}
+
+// ---- every animation of a file played together (issue 34)
+
+namespace {
+
+// Two scenes with the same triangles, corners and normals, bit for bit.
+void check_same_triangles(const host::Scene& s, const host::Scene& t) {
+  REQUIRE(s.triangle_count() == t.triangle_count());
+  for (size_t i = 0; i < s.triangle_count(); ++i) {
+    CAPTURE(i);
+    CHECK(s.id[i] == t.id[i]);
+    CHECK(s.p0[i] == t.p0[i]);
+    CHECK(s.p1[i] == t.p1[i]);
+    CHECK(s.p2[i] == t.p2[i]);
+    CHECK(s.n0[i] == t.n0[i]);
+    CHECK(s.n1[i] == t.n1[i]);
+    CHECK(s.n2[i] == t.n2[i]);
+  }
+}
+
+}  // namespace
+
+TEST_CASE("a parent's and a child's animations play together as the scene posed by hand") {
+  // two_animations.gltf (make_cases.py): "rise" moves the outer cube (node 1) up from 0.5 to 1.5
+  // over 0-2 s; "spin" turns its child, the inner cube (node 2), about +X from an eighth of a
+  // turn (45 degrees) at 1 s to a half turn (180) at 3 s. The _at_1s and _at_3s files are the same
+  // scene without animations, its two nodes' transforms set by hand to the values worked out there.
+  const host::AnimatedScene a(data_path("two_animations.gltf"));
+  REQUIRE(a.animations().size() == 2);
+  CHECK(a.all() == std::vector<size_t>{0, 1});
+  CHECK(a.clash(a.all()).empty());
+  CHECK(a.span(a.all()) == std::pair<double, double>{0.0, 3.0});
+  CHECK(a.span({1}) == std::pair<double, double>{1.0, 3.0});
+  const host::Scene at1 = host::load_scene(data_path("two_animations_at_1s.gltf"));
+  const host::Scene at3 = host::load_scene(data_path("two_animations_at_3s.gltf"));
+  check_same_triangles(a.at(a.all(), 1.0), at1);
+  check_same_triangles(a.at(a.all(), 3.0), at3);
+  check_same_triangles(a.at(a.all(), 7.0), at3);  // past every key: the last keys hold
+  // Either animation alone moves one cube: the other stays as the file has it. The inner cube's
+  // triangles (14-25) follow "rise" too (it is the outer's child), but do not turn: triangle 18,
+  // on the inner cube's -Y face, keeps its normal (a turn about +X moves it).
+  const host::Scene rise_only = a.at(size_t(0), 1.0), spin_only = a.at(size_t(1), 1.0);
+  const host::Scene& rest = a.rest();
+  CHECK(rise_only.p0[2] == at1.p0[2]);     // the outer cube where "rise" puts it
+  CHECK(rise_only.n0[18] == rest.n0[18]);  // the inner cube not turned
+  CHECK(rise_only.n0[18] != at1.n0[18]);
+  CHECK(spin_only.p0[2] == rest.p0[2]);  // the outer cube at rest
+  CHECK(spin_only.n0[18] != rest.n0[18]);
+  // Halfway through "spin" (2 s, u = 1/2): halfway from 45 to 180 degrees, 112.5 degrees about
+  // +X, with the outer cube at the top (1.5, "rise" ended at 2 s). Slerp is not exact in
+  // floats: compare the corners and normals with the hand-made matrices at float precision.
+  const double pi = std::numbers::pi;
+  const glm::dmat4 I(1.0);
+  const glm::dmat4 outer = glm::translate(I, {0, 1.5, 0});
+  const glm::dmat4 inner_local = glm::scale(
+      glm::rotate(glm::translate(I, {0, 1.25, 0}), 5 * pi / 8, {1, 0, 0}), glm::dvec3(0.5));
+  const glm::dmat4 inner_rest_world =
+      glm::translate(I, {0, 0.5, 0}) * glm::scale(glm::translate(I, {0, 1.25, 0}), glm::dvec3(0.5));
+  const host::Scene two = a.at(a.all(), 2.0);
+  for (size_t i = 2; i < 26; ++i) {
+    CAPTURE(i);
+    const glm::dmat4 m = i < 14 ? outer * glm::inverse(glm::translate(I, {0, 0.5, 0}))
+                                : outer * inner_local * glm::inverse(inner_rest_world);
+    const glm::vec3 want(m * glm::dvec4(glm::dvec3(rest.p0[i]), 1.0));
+    CHECK_MESSAGE(glm::all(glm::epsilonEqual(two.p0[i], want, 1e-5f)),
+                  str(glm::dvec3(two.p0[i])) << " != " << str(glm::dvec3(want)));
+    // Normals by the rotation alone (the scales are uniform).
+    const glm::dmat3 turn =
+        i < 14 ? glm::dmat3(1.0) : glm::dmat3(glm::rotate(I, 5 * pi / 8, {1, 0, 0}));
+    const glm::vec3 n(glm::normalize(turn * glm::dvec3(rest.n0[i])));
+    CHECK(glm::all(glm::epsilonEqual(two.n0[i], n, 1e-6f)));
+  }
+}
+
+TEST_CASE("two animations of one node's path cannot play together and are refused by name") {
+  const std::string path = data_path("animations_clash.gltf");
+  const host::AnimatedScene a(path);
+  const std::string why = "animations 0 'left' and 1 'right' both drive node 0 translation";
+  CHECK(a.clash(a.all()) == why);
+  CHECK(a.clash({1}).empty());
+  std::string message;
+  try {
+    a.at(a.all(), 0.5);
+  } catch (const host::InputError& e) {
+    message = e.what();
+  }
+  CHECK(message == path + ": " + why);
+  CHECK(a.at(size_t(1), 1.0).p0[0].x == 1.0f);  // "right" alone plays
 }

@@ -41,11 +41,13 @@ WalkWork walk_work(const vgpu::FrameStats& stats, uint64_t rays_traced) {
 
 namespace {
 
-// The price of a candidate: the full frame predicted from its probe's cost breakdown. The costs
-// that follow the pass count (per pass, program loads, read-backs) as measured; the fragment
-// work scaled by `scale`, the full frame's pixels over the probe's.
+// The price of a candidate: the full frame predicted from its probe's cost breakdown, every term
+// of the model's total (CostBreakdown::total_ms). The costs that follow the pass count (per pass,
+// program loads, read-backs) and the looping passes' longest lanes (latency: one lane's chain,
+// which does not grow with the pixel count) as measured; the fragment work scaled by `scale`,
+// the full frame's pixels over the probe's. At scale 1 this is the probe's total_ms.
 double full_frame_ms(const CostBreakdown& b, double scale) {
-  return b.per_pass_ms + b.program_load_ms + b.readback_ms +
+  return b.per_pass_ms + b.program_load_ms + b.readback_ms + b.latency_ms +
          scale * (b.arithmetic_ms + b.texture_ms + b.memory_ms + b.download_ms);
 }
 

@@ -1,9 +1,12 @@
 // --accel auto: which structure to walk, chosen by the cost model. Each candidate structure is
 // built and a probe frame (the same options at a quarter of the size in x and y, at least 16x16)
 // is rendered with it on the emulator; the cost model predicts the full frame from the probe's
-// statistics on the profile asked for: the per-pass, program-load and read-back costs as
-// measured (they follow the pass count, which the image size hardly changes), the fragment
-// work (arithmetic, texture, memory, downloads) scaled by the pixel ratio. The cheapest wins.
+// statistics on the profile asked for: the per-pass, program-load and read-back costs and the
+// looping passes' longest lanes (latency) as measured (they follow the pass count and the
+// longest walk, which the image size hardly changes), the fragment work (arithmetic, texture,
+// memory, downloads) scaled by the pixel ratio: every term of the model's total, so that a
+// probe of the whole frame is priced at its predict().total_ms. The cheapest wins, within
+// kAutoGridMargin of the grid.
 #pragma once
 
 #include <map>

@@ -531,6 +531,8 @@ def animated_case():
               animations=[move, bounce])
     write_gltf("animated.gltf", d, b.bin)
 
+    two_animations_case()
+
     # Features a frame at time T cannot honour: a skinned mesh, morph-target weights.
     b, d = simple(TRI, idx=[0, 1, 2])
     d["nodes"] = [{"mesh": 0, "skin": 0}, {"name": "joint", "translation": [0, 1, 0]}]
@@ -568,6 +570,74 @@ def animated_case():
                                       "output": floats(b, [(0, 0, 0)] * 3, "VEC3")}],
                         "channels": [{"sampler": 0, "target": {"node": 0, "path": "translation"}}]}]
     write_gltf("animation_times_back.gltf", b.doc(**{k: v for k, v in d.items() if k not in (
+        "asset", "buffers", "bufferViews", "accessors")}), b.bin)
+
+
+def f32(x):
+    """x as the float an accessor stores, then read back (a double, written exactly by json)."""
+    return struct.unpack("<f", struct.pack("<f", x))[0]
+
+
+def two_animations_case():
+    # As exporters from COLLADA write them (the Khronos sample BoxAnimated): one animation per
+    # animated node, meant to play together. A floor (triangles 0-1), an outer cube (2-13) and
+    # an inner cube (14-25, the outer's child, half size, 1.25 above it). Animation 0 "rise": the
+    # outer cube's translation, LINEAR from (0, 0.5, 0) at 0 s to (0, 1.5, 0) at 2 s. Animation 1
+    # "spin": the inner cube's rotation about +X, LINEAR from an eighth of a turn (45 degrees) at
+    # 1 s to a half turn at 3 s. Played together they span 0 to 3 s.
+    b = Builder()
+    floor = {"attributes": {"POSITION": b.vec3([(-5, 0, -5), (-5, 0, 5), (5, 0, 5), (5, 0, -5)])},
+             "indices": b.indices([0, 1, 2, 0, 2, 3])}
+    cube = {"attributes": {"POSITION": b.vec3(cube_points(0.5))}}
+    c8, s8 = math.cos(math.pi / 8), math.sin(math.pi / 8)  # 45 degrees: half-angle pi / 8
+    rise = {"name": "rise", "samplers": [
+        {"input": floats(b, [0, 2], "SCALAR"),
+         "output": floats(b, [(0, 0.5, 0), (0, 1.5, 0)], "VEC3")}],
+        "channels": [{"sampler": 0, "target": {"node": 1, "path": "translation"}}]}
+    spin = {"name": "spin", "samplers": [
+        {"input": floats(b, [1, 3], "SCALAR"),
+         "output": floats(b, [(s8, 0, 0, c8), (1, 0, 0, 0)], "VEC4")}],
+        "channels": [{"sampler": 0, "target": {"node": 2, "path": "rotation"}}]}
+
+    def nodes(outer_y, inner_rotation):
+        inner = {"name": "inner", "mesh": 1, "translation": [0, 1.25, 0], "scale": [0.5] * 3}
+        if inner_rotation:
+            inner["rotation"] = inner_rotation
+        return [
+            {"name": "floor", "mesh": 0},
+            {"name": "outer", "mesh": 1, "translation": [0, outer_y, 0], "children": [2]},
+            inner,
+            {"name": "camera", "camera": 0, "translation": [0, 1.5, 7]},
+            {"name": "light", "translation": [2, 6, 4],
+             "extensions": {"KHR_lights_punctual": {"light": 0}}},
+        ]
+
+    def doc(outer_y, inner_rotation, animations):
+        parts = dict(scene=0, scenes=[{"nodes": [0, 1, 3, 4]}], nodes=nodes(outer_y, inner_rotation),
+                     meshes=[{"primitives": [floor]}, {"primitives": [cube]}],
+                     cameras=[{"type": "perspective", "perspective": {"yfov": 0.7, "znear": 0.1}}],
+                     extensionsUsed=["KHR_lights_punctual"],
+                     extensions={"KHR_lights_punctual": {"lights": [{"type": "point",
+                                                                     "intensity": 1}]}})
+        if animations:
+            parts["animations"] = animations
+        return b.doc(**parts)
+
+    write_gltf("two_animations.gltf", doc(0.5, None, [rise, spin]), b.bin)
+    # The same scene posed by hand, without animations, at 1 s and at 3 s. At 1 s "rise" is
+    # halfway (u = 1/2): 0.5 + (1.5 - 0.5) / 2 = 1.0; "spin" is on its first key, the eighth of a
+    # turn as the accessor stores it (floats). At 3 s both are on their last keys: 1.5, a half turn.
+    write_gltf("two_animations_at_1s.gltf", doc(1.0, [f32(s8), 0, 0, f32(c8)], None), b.bin)
+    write_gltf("two_animations_at_3s.gltf", doc(1.5, [1, 0, 0, 0], None), b.bin)
+
+    # Two animations of one node's translation: alternatives, not parts (a walk and a run).
+    b, d = simple(TRI, idx=[0, 1, 2])
+    d["animations"] = [{"name": name,
+                        "samplers": [{"input": floats(b, [0, 1], "SCALAR"),
+                                      "output": floats(b, [(0, 0, 0), (dx, 0, 0)], "VEC3")}],
+                        "channels": [{"sampler": 0, "target": {"node": 0, "path": "translation"}}]}
+                       for name, dx in (("left", -1), ("right", 1))]
+    write_gltf("animations_clash.gltf", b.doc(**{k: v for k, v in d.items() if k not in (
         "asset", "buffers", "bufferViews", "accessors")}), b.bin)
 
 
