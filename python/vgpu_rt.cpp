@@ -117,9 +117,10 @@ py::dict breakdown_dict(const host::CostBreakdown& c) {
   return d;
 }
 
-// A frame's statistics from --stats-json's object (a file written by the command line, or a
-// render's dict without its C++ statistics): each kernel's counters and the frame's totals. It
-// has no per-pass records, so the cost model spreads each kernel's totals evenly over its passes.
+// A frame's statistics from --stats-json's object (a file the command line wrote, or a render's
+// dict): each kernel's counters and the frame's totals. The command line keeps no per-pass records
+// (RenderOptions::keep_pass_records), so the cost model prices its frames from these same
+// per-kernel totals, and the figure is the command line's.
 vgpu::FrameStats stats_from_json(const std::string& text) {
   const nlohmann::json j = nlohmann::json::parse(text);
   if (!j.is_object() || !j.contains("totals") || !j.contains("kernels"))
@@ -337,7 +338,10 @@ class PassStepper final : public host::PassObserver {
     flush();
     trace_ = trace_name(k);
   }
-  void trace_end() override { flush(); }
+  void trace_end() override {
+    flush();
+    trace_.clear();
+  }
   void pass_begin(const vgpu::Stencil*) override { flush(); }
   void pass(const Pass& p) override {
     flush();
@@ -404,7 +408,7 @@ class PassStepper final : public host::PassObserver {
   std::exception_ptr error_;
   std::optional<cli::RenderOutcome> outcome_;
   int iteration_ = 0;
-  std::string trace_ = "primary";
+  std::string trace_;  // empty outside a trace (the ray generator's pass)
   uint64_t count_ = 0;
 };
 
@@ -414,7 +418,7 @@ py::dict pass_dict(PassEvent&& e) {
   d["kernel"] = e.kernel;
   d["paper_name"] = e.paper_name;
   d["iteration"] = e.iteration;
-  d["trace"] = e.trace;
+  d["trace"] = e.trace.empty() ? py::object(py::none()) : py::object(py::str(e.trace));
   d["target_name"] = e.target;
   d["counters"] = counters_dict(e.counters);
   d["frame_totals"] = counters_dict(e.frame_totals);
@@ -430,7 +434,8 @@ PYBIND11_MODULE(_vgpu_rt, m) {
   py::register_exception_translator(translate);
 
   py::class_<vgpu::FrameStats, std::shared_ptr<vgpu::FrameStats>>(
-      m, "FrameStats", "A frame's pass statistics as the C++ library keeps them (every pass).")
+      m, "FrameStats",
+      "A frame's pass statistics as the C++ library keeps them (per kernel and in total).")
       .def_property_readonly(
           "passes", [](const vgpu::FrameStats& s) { return s.totals.passes; },
           "Render-to-texture passes in the frame.")

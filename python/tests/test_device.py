@@ -55,8 +55,10 @@ class DeviceTest(unittest.TestCase):
         sums.write(np.array([[[1, 2, 3, 4], [0, 0, 0, 0], [-1, 0.5, 8, 1]]], dtype=np.float32))
         colours.write(np.array([[[0.5, 0.25, 0.125, 9], [1, 1, 1, 1], [1, -0.5, 0, 0]]],
                                dtype=np.float32))
+        marks = dev.texture("marks", 3, 1)  # read only when gated (not by default)
+        marks.write(np.full((1, 3, 4), 7.0, dtype=np.float32))
         out = dev.texture("out", 3, 1)
-        r = dev.run(k, [sums, colours, sums], [out], query=True)
+        r = dev.run(k, [sums, colours, marks], [out], query=True)
         want = np.array([[[1.5, 2.25, 3.125, 5], [1, 1, 1, 1], [0, 0, 8, 2]]], dtype=np.float32)
         self.assertTrue(np.array_equal(out.array, want), out.array)
         self.assertEqual(r["kernel"], "accumulate samples")

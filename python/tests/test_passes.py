@@ -1,12 +1,17 @@
 """vgpu_rt.passes: a frame pass by pass, stopped and resumed, agrees with the whole frame."""
 
+import csv
 import gc
+import os
+import subprocess
+import tempfile
 import unittest
 
 import numpy as np
 
 import vgpu_rt
 
+CLI = os.environ.get("VGPU_RT_CLI", "")
 OPTIONS = dict(size="16x16", bounces=1)
 
 
@@ -32,6 +37,26 @@ class PassesTest(unittest.TestCase):
             self.assertLessEqual(p.query, 16 * 16)
         self.assertEqual(counted[-1].frame_totals["query_readbacks"],
                          self.whole.stats["totals"]["query_readbacks"])
+
+    @unittest.skipUnless(CLI, "VGPU_RT_CLI names the vgpu-rt executable")
+    def test_each_pass_is_the_command_line_s_stats_csv_row(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "passes.csv")
+            subprocess.run([CLI, "render", "bunny", "--size", "16x16", "--bounces", "1", "--stats",
+                            "none", "--quiet", "--stats-csv", path], check=True)
+            with open(path) as f:
+                rows = list(csv.DictReader(f))
+        self.assertEqual(len(rows), len(self.seen))
+        for row, p in zip(rows, self.seen):
+            where = f"pass {p.index} {p.kernel}"
+            self.assertEqual(row["kernel"], p.kernel, where)
+            self.assertEqual(int(row["iteration"]), p.iteration, where)
+            self.assertEqual(row["trace_kind"] or None, p.trace, where)
+            self.assertEqual(row["target"], p.target_name, where)
+            for key in ("fragments_shaded", "instructions", "texture_fetches", "bytes_written"):
+                self.assertEqual(int(row[key]), p.counters[key], f"{where} {key}")
+            self.assertEqual(int(row["query_result"]) if row["query_result"] else None, p.query,
+                             where)
 
     def test_each_pass_shows_its_target_after_the_pass(self):
         first = self.seen[0]  # generate rays: unit directions

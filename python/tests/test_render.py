@@ -3,6 +3,7 @@
 import json
 import os
 import subprocess
+import sys
 import tempfile
 import unittest
 
@@ -77,6 +78,15 @@ class RenderTest(unittest.TestCase):
         self.assertEqual(f.stats["time"], 0.25)
         a = vgpu_rt.render("bunny", size="16x16", bounces=0, spp=4, aa="adaptive")
         self.assertEqual(a.stats["sampling"]["mode"], "adaptive")
+
+    def test_render_prints_nothing_unless_asked(self):
+        # The command line prints its table on stdout and progress on stderr; Python returns them.
+        code = "import vgpu_rt; vgpu_rt.render('bunny', size='8x8', bounces=0)"
+        r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+        self.assertEqual((r.returncode, r.stdout, r.stderr), (0, "", ""))
+        code = "import vgpu_rt; vgpu_rt.render('bunny', size='8x8', bounces=0, stats='json')"
+        r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+        self.assertEqual(json.loads(r.stdout)["size"], [8, 8])
 
     def test_scenes_lists_the_bundled_files(self):
         s = vgpu_rt.scenes()

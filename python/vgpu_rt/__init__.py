@@ -64,8 +64,8 @@ _ON_OFF = {"shadows", "masks", "mrt"}  # options taking on|off, which also take 
 
 
 class Stats(dict):
-    """The dict `--stats-json` writes, holding the frame's C++ statistics as `frame_stats`
-    (every pass's counters), which predict() prices exactly as the command line does."""
+    """The dict `--stats-json` writes, holding the frame's C++ statistics as `frame_stats`,
+    which predict() prices as the command line does (without reading the dict back)."""
 
     def __init__(self, data, frame_stats=None):
         super().__init__(data)
@@ -148,7 +148,7 @@ render.__doc__ += "\n    Options (from the command line's --help):\n" + _option_
 
 class Pass:
     """One pass of a frame, as passes() shows it: its index (from 0), kernel and paper_name,
-    iteration (from 1) and trace (primary, shadow or reflected), counters (the pass's own),
+    iteration (from 1) and trace (primary, shadow or reflected; None outside a trace), counters (the pass's own),
     frame_totals (the frame so far), query (the fragments its occlusion query counted, or None
     when it ran without one), target_name and target, the render target's texels after the pass
     as a (height, width, channels) float32 array (a copy: later passes rewrite the texture)."""
@@ -229,9 +229,8 @@ def predict(stats, profile):
     of --stats-json's predicted_breakdown, plus total_ms).
 
     `stats` is a Frame, its Stats, or a plain --stats-json dict (e.g. json.load of a file the
-    command line wrote). A render's statistics hold every pass, priced pass by pass as the
-    command line prices them; a plain dict has only each kernel's totals, spread evenly over
-    its passes (close, not always equal, to the command line's figure).
+    command line wrote). Either gives the command line's figure: a render keeps each kernel's
+    totals (not every pass), and the model prices those, which the dict holds too.
     """
     if isinstance(stats, Frame):
         stats = stats.stats

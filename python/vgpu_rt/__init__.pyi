@@ -9,7 +9,7 @@ import numpy.typing as npt
 _Array = npt.NDArray[np.float32]
 
 class FrameStats:
-    """A frame's pass statistics as the C++ library keeps them (every pass)."""
+    """A frame's pass statistics as the C++ library keeps them (per kernel and in total)."""
     @property
     def passes(self) -> int: ...
     def json(self) -> str: ...
@@ -29,7 +29,7 @@ class Pass:
     kernel: str
     paper_name: str
     iteration: int
-    trace: str  # primary, shadow or reflected
+    trace: Optional[str]  # primary, shadow, reflected; None outside a trace
     counters: dict[str, int]
     frame_totals: dict[str, int]
     query: Optional[int]
