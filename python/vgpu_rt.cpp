@@ -46,7 +46,9 @@ struct FileNotFound : std::runtime_error {
 
 // C++ errors as the Python exceptions a caller expects: a bad value (the command line's usage
 // errors, an unreadable scene, an unknown profile) is a ValueError, a missing file a
-// FileNotFoundError; the message is the command line's line without its "vgpu-rt: " prefix.
+// FileNotFoundError; the message is the command line's line without its "vgpu-rt: " prefix. What
+// the device refuses (vgpu::Error: a texture past the profile's size, a read/write hazard, a unit
+// read with no texture bound) is a ValueError too.
 void translate(std::exception_ptr p) {
   try {
     if (p) std::rethrow_exception(p);
@@ -55,6 +57,8 @@ void translate(std::exception_ptr p) {
   } catch (const cli::UsageError& e) {
     PyErr_SetString(PyExc_ValueError, e.what());
   } catch (const host::InputError& e) {
+    PyErr_SetString(PyExc_ValueError, e.what());
+  } catch (const vgpu::Error& e) {  // what the device refuses: a hazard, a missing texture, a size
     PyErr_SetString(PyExc_ValueError, e.what());
   } catch (const std::invalid_argument& e) {
     PyErr_SetString(PyExc_ValueError, e.what());

@@ -79,6 +79,20 @@ class DeviceTest(unittest.TestCase):
         with self.assertRaisesRegex(ValueError, "gf9999"):
             vgpu_rt.Device("gf9999")
 
+    def test_what_the_device_refuses_is_a_value_error_and_the_device_runs_on(self):
+        dev = vgpu_rt.Device("gf5700")
+        k = vgpu_rt.kernels["accumulate samples"]
+        t, out = dev.texture("t", 2, 2), dev.texture("out", 2, 2)
+        with self.assertRaisesRegex(ValueError, "read/write hazard"):
+            dev.run(k, [out, t, t], [out])
+        with self.assertRaisesRegex(ValueError, "unit 0, which has no texture bound"):
+            dev.run(k, [], [out])
+        with self.assertRaisesRegex(ValueError, "texture unit 16 does not exist"):
+            dev.run(k, [t] * 17, [out])
+        with self.assertRaisesRegex(ValueError, "at most 4096x4096"):
+            dev.texture("big", 8192, 1)
+        self.assertEqual(dev.run(k, [t, t, t], [out])["counters"]["passes"], 1)
+
 
 if __name__ == "__main__":
     unittest.main()
