@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs everything vgpu-rt needs on a fresh Debian 12 machine (run as root or with sudo).
-# EGL, glvnd's libOpenGL and Mesa (llvmpipe) are for the GL device (--engine gl) and its tests.
+# EGL, glvnd's libOpenGL and Mesa (llvmpipe) are for the GL device (--engine gl) and its tests;
+# pybind11 and NumPy for the Python module (python/), nbclient and ipykernel for its notebooks.
 # Idempotent: skips apt when every package is already present.
 set -euo pipefail
 pkgs=(
@@ -9,6 +10,7 @@ pkgs=(
   doctest-dev libbenchmark-dev libcli11-dev libmeshoptimizer-dev
   clang libclang-rt-14-dev clang-format
   python3-matplotlib
+  pybind11-dev python3-dev python3-numpy python3-nbclient python3-nbformat python3-ipykernel
   libegl-dev libopengl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri
   zlib1g-dev ccache
   chromium

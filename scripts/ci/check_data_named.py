@@ -17,7 +17,8 @@ import sys
 
 ROOT = sys.argv[1] if len(sys.argv) > 1 else os.path.join(os.path.dirname(__file__), "..", "..")
 ROOT = os.path.abspath(ROOT)
-PAGE_FILES = (".md", ".png", ".jpg", ".svg")
+# Notebooks (.ipynb) are pages too: prose and code, run by CTest (scripts/docs/notebooks.py).
+PAGE_FILES = (".md", ".ipynb", ".png", ".jpg", ".svg")
 IMAGES = (".png", ".jpg", ".svg")
 # A repository path in prose: docs/..., results/... or scripts/..., up to a space, a quote or a
 # bracket; braces and stars are kept for expansion.

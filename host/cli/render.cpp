@@ -1,0 +1,642 @@
+// vgpu-rt render as a library call (render.h): the options parsed into a plan, the scene
+// loaded and its structure built, each frame rendered and its files and statistics written.
+// The command line (main.cpp) and the Python module (python/) both run a render through it.
+
+// GCC 12 reports false positives inside nlohmann_json's templates.
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#pragma GCC diagnostic ignored "-Wrestrict"
+#include "host/cli/render.h"
+
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <functional>
+#include <iostream>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <numeric>
+#include <optional>
+
+#include "host/accel/accel.h"
+#include "host/accel/grid.h"
+#include "host/cli/frames.h"
+#include "host/cli/options.h"
+#include "host/common/parallel.h"
+#include "host/image/image_io.h"
+#include "host/model/cost_model.h"
+#include "host/model/formats.h"
+#include "host/report/report.h"
+#include "host/report/stats_json.h"
+#include "host/scene/animation.h"
+#include "host/scene/camera.h"
+#include "host/scene/gltf_loader.h"
+#include "host/trace/cpu/cpu_tracer.h"
+#include "host/trace/sampling.h"
+#include "host/trace/stream/accel_choice.h"
+#include "host/trace/stream/devices.h"
+#include "host/trace/stream/ray_streams.h"
+#include "host/trace/stream/stream_tracer.h"
+#include "vgpu/vgpu.h"
+
+namespace cli {
+
+namespace {
+
+// Passes on what the tracer shows while `on`, and drops it otherwise: --report-frame K points the
+// report's recorder at frame K of a sequence (a refitted BVH's frame K depends on the frames
+// before it, so --time cannot render it alone).
+class OneFrame final : public host::PassObserver {
+ public:
+  explicit OneFrame(host::PassObserver& to) : to_(to) {}
+  bool on = false;
+  void iteration(int i) override {
+    if (on) to_.iteration(i);
+  }
+  void trace_begin(TraceKind k) override {
+    if (on) to_.trace_begin(k);
+  }
+  void trace_end() override {
+    if (on) to_.trace_end();
+  }
+  void pass_begin(const vgpu::Stencil* work) override {
+    if (on) to_.pass_begin(work);
+  }
+  void pass(const Pass& p) override {
+    if (on) to_.pass(p);
+  }
+  void query(uint64_t result, const vgpu::Stencil* written, const vgpu::FrameStats& s) override {
+    if (on) to_.query(result, written, s);
+  }
+
+ private:
+  host::PassObserver& to_;
+};
+
+// What a render was asked for, once every option and every combination was checked: the tracer's
+// options, and what the command line keeps for itself.
+struct RenderPlan {
+  host::RenderOptions opt;
+  host::FormatRequest formats;  // resolved once the scene and its structure are known
+  host::GridSpec grid_spec;
+  std::string aov_depth, aov_hit;  // --aov files (empty: not written)
+  std::vector<double> times;       // the frames' times (one frame: {0} or --time)
+  bool span_frames = false;        // --frames N: times spread over the played animations' keys
+  bool animating = false, cpu = false, gl = false;
+};
+
+// Parse: the options into a plan, refusing what cannot run before any work (UsageError, exit 2).
+RenderPlan parse_render(const RenderArgs& a, bool lanes_given) {
+  // CLI11 checked each value; what is left are combinations of options.
+  RenderPlan plan;
+  host::RenderOptions& opt = plan.opt;
+  const glm::ivec2 size = *parse_size(a.size);
+  opt.width = size.x;
+  opt.height = size.y;
+  opt.bounces = a.bounces;
+  opt.shading = host::parse_shading(a.shading);
+  opt.shadows = a.shadows == "on";
+  opt.texture_filter = a.texture_filter == "nearest"    ? vgpu::Filter::nearest
+                       : a.texture_filter == "bilinear" ? vgpu::Filter::bilinear
+                                                        : vgpu::Filter::trilinear;
+  opt.masks = a.masks == "on";
+  opt.mrt = a.mrt == "on";
+  opt.ray_streams = a.ray_streams == "on";
+  opt.looping = a.kernels == "looping";
+  opt.steps_per_pass = a.steps_per_pass;
+  opt.batch_walk = a.walk == "batches";
+  opt.spp = a.spp;
+  opt.adaptive = a.aa == "adaptive";
+  opt.undersample = a.aa == "adaptive" || a.aa == "none" ? 0 : *parse_aa(a.aa);
+  opt.aa_threshold = a.aa_threshold;
+  opt.profile = vgpu::profile(a.profile).name;
+  opt.threads = a.threads;
+  opt.lanes = a.lanes;
+  try {
+    plan.formats = host::parse_format_request(a.precision, a.formats);
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(e.what());
+  }
+  plan.grid_spec = host::parse_grid_spec(a.grid);
+  std::string& aov_depth = plan.aov_depth;
+  std::string& aov_hit = plan.aov_hit;
+  for (const std::string& aov : a.aovs) {
+    const auto eq = aov.find('=');
+    (aov.compare(0, eq, "depth") == 0 ? aov_depth : aov_hit) = aov.substr(eq + 1);
+  }
+  if (!a.trace_pixel.empty()) {
+    const glm::ivec2 p = *parse_pixel(a.trace_pixel);
+    if (p.x >= opt.width || p.y >= opt.height)
+      throw UsageError("--trace-pixel: " + a.trace_pixel + " is outside the " + a.size + " image");
+    opt.trace_pixel = p;
+    opt.trace_out = &std::cout;
+  }
+
+  if (a.engine != "stream" && a.engine != "cpu" && a.engine != "gl")
+    throw UsageError("--engine: expected stream, cpu or gl, got '" + a.engine + "'");
+  const bool cpu = plan.cpu = a.engine == "cpu";
+  const bool gl = plan.gl = a.engine == "gl";
+  // Settings the CPU reference does not use are refused rather than recorded as if they ran.
+  if (cpu) {
+    const char* unused = a.predict                ? "--predict"
+                         : !a.trace_pixel.empty() ? "--trace-pixel"
+                         : lanes_given            ? "--lanes"
+                         : opt.masks              ? "--masks on"
+                         : opt.mrt                ? "--mrt on"
+                         : a.precision != "fp32"  ? "--precision"
+                         : !a.formats.empty()     ? "--formats"
+                         : opt.looping            ? "--kernels looping"
+                         : opt.ray_streams        ? "--ray-streams on"
+                                                  : nullptr;
+    if (unused)
+      throw UsageError(std::string(unused) +
+                       " needs --engine stream (the cpu engine is a double-precision reference "
+                       "without passes, lanes or masks)");
+  }
+  if (a.steps_given && !opt.looping) throw UsageError("--steps-per-pass needs --kernels looping");
+  // Animation (issue 23): the frames' times, and what several frames need.
+  const bool animating = plan.animating = !a.time.empty() || !a.frames.empty();
+  if (!a.time.empty() && !a.frames.empty())
+    throw UsageError("--time and --frames: give one (--frames A:A:1 is --time A)");
+  if (!animating && (!a.animation.empty() || a.update_given))
+    throw UsageError(std::string(a.animation.empty() ? "--update" : "--animation") +
+                     " needs --time or --frames");
+  if (a.update != "rebuild" && a.accel != "bvh")
+    throw UsageError("--update " + a.update +
+                     ": only a BVH's boxes can be refitted (--accel bvh); the grid and the "
+                     "kd-tree are rebuilt (--update rebuild)");
+  std::vector<double>& times = plan.times;
+  times = {0.0};
+  if (!a.time.empty()) times = {cli::parse_time(a.time)};
+  if (!a.frames.empty()) {
+    cli::FrameRange range;
+    cli::frames_problem(a.frames, range);  // CLI11 checked it
+    times = cli::frame_times(range);       // --frames N: set once the file is read
+    plan.span_frames = !range.bounded;
+  }
+  if (times.size() > 1) {
+    for (const auto& [option, file] : {std::pair<std::string, std::string>{"--out", a.out},
+                                       {"--aov", aov_depth},
+                                       {"--aov", aov_hit}})
+      if (!file.empty() && !cli::has_frame_number(file))
+        throw UsageError(option + " " + file + ": " + std::to_string(times.size()) +
+                         " frames need '#' in the file name for the frame number (e.g. "
+                         "frame_####.png)");
+    const char* one_frame = opt.trace_pixel        ? "--trace-pixel"
+                            : a.report_frame       ? nullptr
+                            : !a.report.empty()    ? "--report"
+                            : !a.stats_csv.empty() ? "--stats-csv"
+                                                   : nullptr;
+    if (one_frame)
+      throw UsageError(
+          std::string(one_frame) + " follows one frame: render it with --time T" +
+          (opt.trace_pixel ? "" : ", or name one of the frames with --report-frame K"));
+  }
+  if (a.report_frame) {
+    if (a.frames.empty())
+      throw UsageError("--report-frame needs --frames (with --time the report is that frame's)");
+    if (a.report.empty() && a.stats_csv.empty())
+      throw UsageError("--report-frame needs --report or --stats-csv");
+    if (size_t(a.report_frame) > times.size())
+      throw UsageError("--report-frame " + std::to_string(a.report_frame) + ": --frames " +
+                       a.frames + " gives " + std::to_string(times.size()) + " frame" +
+                       (times.size() > 1 ? "s" : "") + ", numbered from 1");
+  }
+  if (a.walk_given && a.engine != "stream")
+    throw UsageError("--walk needs --engine stream (it says how the emulator runs the walk)");
+  // Reduced precision runs at 1 or 8 lanes (vgpu/gpu.cpp): refuse another width.
+  const bool reduced = a.precision != "fp32" || !a.formats.empty();
+  if (reduced && opt.lanes != 1 && opt.lanes != 8)
+    throw UsageError("--lanes " + std::to_string(opt.lanes) + ": --precision " + a.precision +
+                     " runs at 1 or 8 lanes");
+  // The combinations the tracer cannot run, before any work (with fp32 formats: MRT's formats
+  // are checked again once resolved).
+  opt.formats = host::Formats::all(vgpu::Format::fp32);
+  if (const std::string why = opt.refusal(vgpu::profile(opt.profile), a.aa); !why.empty())
+    throw UsageError(why);
+  if (a.engine != "stream" && (!a.report.empty() || !a.stats_csv.empty()))
+    throw UsageError(
+        "--report and --stats-csv need --engine stream (the report reads the "
+        "emulator's per-fragment state)");
+  if (gl) {
+    // The GL device runs every fragment in fp32 GLSL; the emulator-only features are refused.
+    if (!host::have_gl_device())
+      throw host::InputError(
+          "--engine gl: this build has no GL device (EGL and OpenGL were not found when it was "
+          "built; scripts/setup.sh installs them)");
+    if (a.predict || !a.trace_pixel.empty() || opt.masks || a.precision != "fp32")
+      throw UsageError(
+          "--engine gl runs the multipass pipeline as a driver does: --predict, --trace-pixel, "
+          "--masks on and --precision fp24/fp16 need --engine stream");
+    opt.device = "gl";
+    opt.gl_device = a.gl_device;
+    opt.gl_readback = a.gl_readback;
+  } else if (a.gl_device != "auto" || a.gl_readback != "auto") {
+    throw UsageError(std::string(a.gl_device != "auto" ? "--gl-device" : "--gl-readback") +
+                     " needs --engine gl");
+  }
+  if (!a.report.empty() && int64_t(opt.width) * opt.height > host::kReportMaxPixels)
+    throw UsageError("--report: at most " + std::to_string(host::kReportMaxPixels) +
+                     " pixels (512x512); got " + a.size);
+  if (!a.report.empty()) host::check_output_path(a.report, {".html"});
+  if (!a.stats_csv.empty()) host::check_output_path(a.stats_csv, {".csv"});
+  return plan;
+}
+
+// Write (--stats table, one frame): the pass statistics, the scene and its structure, the options
+// and the times. `animation_text` names what --time posed (read only when animating).
+void print_table(const RenderArgs& a, const RenderPlan& plan, const host::Scene& scene,
+                 const host::Accel& accel, const host::AccelChoice* choice,
+                 const host::RenderResult& r, const host::CpuStats& cpu_stats, double init_ms,
+                 host::StreamTracer* tracer, const std::string& animation_text) {
+  const host::RenderOptions& opt = plan.opt;
+  const bool cpu = plan.cpu, gl = plan.gl, animating = plan.animating;
+  if (cpu) {
+    std::printf(
+        "CPU reference (double precision, recursive Whitted): %llu rays, %llu voxel steps, %llu "
+        "triangle tests\n",
+        static_cast<unsigned long long>(cpu_stats.rays),
+        static_cast<unsigned long long>(cpu_stats.voxel_steps),
+        static_cast<unsigned long long>(cpu_stats.triangle_tests));
+    // Glass (docs/materials.md): the rays of each kind, summed over the iterations.
+    auto sum = [](const std::vector<uint64_t>& v) {
+      return static_cast<unsigned long long>(std::accumulate(v.begin(), v.end(), uint64_t(0)));
+    };
+    if (sum(cpu_stats.refracted) + sum(cpu_stats.total_internal) +
+            cpu_stats.glass_shadow_crossings >
+        0)
+      std::printf(
+          "glass: %llu reflected rays (%llu of them totally internally), %llu refracted; %llu "
+          "shadow-ray crossings\n",
+          sum(cpu_stats.reflected), sum(cpu_stats.total_internal), sum(cpu_stats.refracted),
+          static_cast<unsigned long long>(cpu_stats.glass_shadow_crossings));
+  } else
+    std::cout << r.stats.to_table();
+  std::printf(
+      "scene %s: %zu triangles (%u dropped as degenerate), grid %dx%dx%d (%llu references)\n",
+      scene.name.c_str(), scene.triangle_count(), scene.dropped_degenerate, accel.grid_res().x,
+      accel.grid_res().y, accel.grid_res().z,
+      static_cast<unsigned long long>(accel.grid_references()));
+  if (const std::string line = accel.describe(); !line.empty()) std::printf("%s\n", line.c_str());
+  if (choice)
+    std::printf("accel auto: %s (probes %.0f ms)\n", choice->why.c_str(), choice->probe_ms);
+  std::printf("%s %s, %dx%d, %d iteration(s), %s shading, shadows %s, masks %s, mrt %s\n",
+              cpu ? "engine" : "profile", cpu ? "cpu" : opt.profile.c_str(), r.width, r.height,
+              r.iterations, a.shading.c_str(), a.shadows.c_str(), a.masks.c_str(), a.mrt.c_str());
+  if (!cpu) std::cout << "formats (texture and arithmetic, per group):\n" << describe(opt.formats);
+  if (r.streams.on) std::cout << host::describe(r.streams);
+  std::printf("initialization %.1f ms (grid %.1f ms), render %.1f ms (%s)\n", init_ms,
+              accel.grid_build_ms(), r.render_ms,
+              cpu            ? "host CPU"
+              : gl           ? "wall, GL device"
+              : r.batch_walk ? "host, emulated, walks in batches"
+                             : "host, emulated");
+  if (gl)
+    std::printf("device %s: passes %.2f ms of GPU time (timer queries)\n",
+                tracer->device().description().c_str(), r.stats.totals.device_ms);
+  if (animating) std::printf("time %g s of %s\n", plan.times[0], animation_text.c_str());
+}
+
+// One line of the frames table (--frames with --stats table).
+struct FrameLine {
+  double time, pose_ms, build_ms, write_ms, render_ms;
+  uint64_t uploaded, passes;
+  double predicted_ms;
+  std::string action;                   // initial, rebuild or refit
+  uint64_t nodes_visited, voxel_steps;  // the walk's work (a tree's nodes, the grid's voxels)
+};
+
+// Write (--stats table, several frames): one line per frame, then the initialization.
+void print_frames_table(const RenderArgs& a, const RenderPlan& plan, const host::Scene& scene,
+                        host::AccelKind accel, const host::RenderResult& r,
+                        const std::vector<FrameLine>& lines, double init_ms,
+                        const std::string& animation_text) {
+  const host::RenderOptions& opt = plan.opt;
+  const bool cpu = plan.cpu;
+  std::printf("scene %s, %s, %zu frames, %s, --update %s, %dx%d, %s %s\n", scene.name.c_str(),
+              animation_text.c_str(), lines.size(), std::string(host::accel_name(accel)).c_str(),
+              a.update.c_str(), r.width, r.height, cpu ? "engine" : "profile",
+              cpu ? "cpu" : opt.profile.c_str());
+  std::printf("%6s %9s %8s %9s %9s %11s %12s %10s %8s %12s %12s%s\n", "frame", "time s", "update",
+              "pose ms", "build ms", "textures ms", "uploaded B", "render ms", "passes", "nodes",
+              "voxels", a.predict ? "  predicted ms" : "");
+  for (size_t f = 0; f < lines.size(); ++f) {
+    const FrameLine& l = lines[f];
+    std::printf("%6zu %9.4g %8s %9.2f %9.2f %11.2f %12llu %10.1f %8llu %12llu %12llu", f + 1,
+                l.time, l.action.c_str(), l.pose_ms, l.build_ms, l.write_ms,
+                static_cast<unsigned long long>(l.uploaded), l.render_ms,
+                static_cast<unsigned long long>(l.passes),
+                static_cast<unsigned long long>(l.nodes_visited),
+                static_cast<unsigned long long>(l.voxel_steps));
+    if (a.predict) std::printf("  %12.3f", l.predicted_ms);
+    std::printf("\n");
+  }
+  std::printf("initialization %.1f ms (the first frame's grid and uploads)\n", init_ms);
+}
+
+// Build: which of the scene's animations play, ascending (none when the file has none).
+// --animation names one (a name, even with commas in it, else an index) or a comma list; without
+// it every animation of the file plays, as glTF viewers play them, unless two drive the same
+// path of one node: they are alternatives then (a walk and a run), and the first plays alone, as
+// before issue 34, with a note. Refuses a name the file does not have, and two named animations
+// that drive the same path of one node (UsageError, exit 2).
+std::vector<size_t> played_animations(const RenderArgs& a, const std::string& path,
+                                      const host::AnimatedScene& animated) {
+  const std::vector<host::Animation>& list = animated.animations();
+  if (a.animation.empty()) {
+    const std::vector<size_t> all = animated.all();
+    const std::string why = animated.clash(all);
+    if (why.empty()) return all;
+    std::fprintf(stderr,
+                 "vgpu-rt: %s: %s, so they cannot play together: animation 0 '%s' plays alone "
+                 "(--animation chooses)\n",
+                 path.c_str(), why.c_str(), list[0].name.c_str());
+    return {0};
+  }
+  std::vector<size_t> played;
+  if (const std::optional<size_t> whole = animated.find(a.animation)) {
+    played = {*whole};
+  } else {
+    for (size_t start = 0;;) {
+      const size_t comma = std::min(a.animation.find(',', start), a.animation.size());
+      const std::string item = a.animation.substr(start, comma - start);
+      const std::optional<size_t> found = animated.find(item);
+      if (!found) {
+        std::string known;
+        for (size_t i = 0; i < list.size(); ++i)
+          known += (i ? ", " : "") + std::to_string(i) + " '" + list[i].name + "'";
+        throw UsageError("--animation " + a.animation + ": " + path +
+                         " has no animation named or numbered '" + item + "' (" +
+                         (known.empty() ? "it has none" : "it has " + known) + ")");
+      }
+      played.push_back(*found);
+      if (comma == a.animation.size()) break;
+      start = comma + 1;
+    }
+    std::sort(played.begin(), played.end());
+    played.erase(std::unique(played.begin(), played.end()), played.end());
+  }
+  if (const std::string why = animated.clash(played); !why.empty())
+    throw UsageError("--animation " + a.animation + ": " + path + ": " + why +
+                     "; they cannot play together");
+  return played;
+}
+
+// What plays, for the tables: "animation 'hop'", "animations 'rise' + 'spin'", or `none`.
+std::string played_text(const host::AnimatedScene* animated, const std::vector<size_t>& played,
+                        const std::string& none) {
+  if (played.empty()) return none;
+  std::string text = played.size() > 1 ? "animations " : "animation ";
+  for (size_t i = 0; i < played.size(); ++i)
+    text += (i ? " + '" : "'") + animated->animations()[played[i]].name + "'";
+  return text;
+}
+
+// Write: a frame's image and AOVs (numbered when animating: frame_####.png).
+void write_images(const RenderArgs& a, const RenderPlan& plan, const host::RenderResult& r,
+                  int number) {
+  auto numbered = [&](const std::string& file) {
+    return plan.animating ? cli::frame_path(file, number) : file;
+  };
+  if (!a.out.empty()) host::write_image(numbered(a.out), r.width, r.height, 3, r.rgb);
+  if (!plan.aov_depth.empty())
+    host::write_image(numbered(plan.aov_depth), r.width, r.height, 1, r.depth);
+  if (!plan.aov_hit.empty())
+    host::write_image(numbered(plan.aov_hit), r.width, r.height, 1, r.hit_id);
+}
+
+// Build: the report's recorder (--report, --stats-csv) as the tracer's observer; with
+// --report-frame K, behind a OneFrame that passes on frame K alone.
+void attach_recorder(const RenderArgs& a, host::RenderOptions& opt,
+                     std::optional<host::FrameRecorder>& recorder,
+                     std::optional<OneFrame>& one_frame) {
+  if (a.report.empty() && a.stats_csv.empty()) return;
+  recorder.emplace(opt.width, opt.height, opt.masks, a.report.empty() ? 0 : host::kHistoryStride,
+                   opt.trace_pixel ? std::vector{*opt.trace_pixel} : std::vector<glm::ivec2>{},
+                   !a.report.empty());
+  opt.observer = &*recorder;
+  if (a.report_frame) opt.observer = &one_frame.emplace(*recorder);
+}
+
+// The iteration counter on stderr: rewritten in place on a terminal, a line each elsewhere.
+std::function<void(int, int)> progress_line(bool tty) {
+  return [tty](int it, int n) {
+    std::fprintf(stderr, tty ? "\rvgpu-rt: iteration %d/%d" : "vgpu-rt: iteration %d/%d\n", it, n);
+    std::fflush(stderr);
+  };
+}
+
+}  // namespace
+
+RenderArgs parse_render_args(const std::vector<std::string>& args, bool& lanes_given) {
+  CLI::App app{"vgpu-rt render"};
+  RenderArgs a;
+  add_render_options(app, a);
+  try {
+    app.parse(std::vector<std::string>(args.rbegin(), args.rend()));  // CLI11 takes them reversed
+  } catch (const CLI::ParseError& e) {
+    throw UsageError(e.what());
+  }
+  lanes_given = app.count("--lanes") > 0;
+  return a;
+}
+
+std::vector<RenderOptionInfo> render_option_infos() {
+  CLI::App app{"vgpu-rt render"};
+  RenderArgs a;
+  add_render_options(app, a);
+  std::vector<RenderOptionInfo> out;
+  for (const CLI::Option* o : app.get_options()) {
+    if (o->get_lnames().empty()) continue;  // the scene (positional) and --help
+    const std::string name = o->get_lnames().front();
+    if (name == "help") continue;
+    out.push_back({name, o->get_default_str(), o->get_description(), o->get_expected_max() == 0});
+  }
+  return out;
+}
+
+int run_render(const RenderArgs& a, bool lanes_given, RenderOutcome* outcome,
+               host::PassObserver* observer) {
+  RenderPlan plan = parse_render(a, lanes_given);
+  host::RenderOptions& opt = plan.opt;
+  const host::FormatRequest& formats = plan.formats;
+  const host::GridSpec& grid_spec = plan.grid_spec;
+  const std::vector<double>& times = plan.times;
+  const bool animating = plan.animating, cpu = plan.cpu, gl = plan.gl;
+  std::optional<host::FrameRecorder> recorder;
+  std::optional<OneFrame> one_frame;  // --report-frame K: the recorder sees frame K alone
+  attach_recorder(a, opt, recorder, one_frame);
+  if (observer) {
+    // A caller's observer (Python's pass by pass) follows one frame, as the report does.
+    if (recorder) throw UsageError("a pass observer and --report or --stats-csv: give one");
+    if (plan.cpu || plan.gl)
+      throw UsageError("following the passes needs --engine stream (the cpu engine has none)");
+    if (times.size() > 1)
+      throw UsageError("following the passes follows one frame: render it with --time T");
+    opt.observer = observer;
+  }
+
+  // The scene: as the file has it, or posed at each frame's time (--time, --frames).
+  const std::string path = host::resolve_scene(a.scene);
+  std::optional<host::AnimatedScene> animated;
+  std::vector<size_t> animation;  // the animations played together
+  if (animating) {
+    animated.emplace(path, host::with_images());
+    animation = played_animations(a, path, *animated);
+    animated->check(animation);  // skinned meshes, morph-target weights: one line, exit 2
+    if (plan.span_frames) {      // --frames N: over the played animations' keys
+      const auto [first, last] = animated->span(animation);
+      plan.times = cli::frame_times({first, last, int(times.size())});
+    }
+  }
+  const nlohmann::ordered_json animation_json =
+      animated ? host::animation_json(animated->animations(), animation) : nullptr;
+  auto pose_start = std::chrono::steady_clock::now();
+  host::Scene scene =
+      animated ? animated->at(animation, times[0]) : host::load_scene(path, host::with_images());
+  double pose_ms = animated ? host::ms_since(pose_start) : 0.0;
+  const host::Scene& rest = animated ? animated->rest() : scene;  // frames a camera-less file
+  const auto t0 = std::chrono::steady_clock::now();
+  // The structure (make_accel): the one asked for, or with --accel auto every kind, each
+  // probed below and the cheapest kept.
+  const bool auto_accel = a.accel == "auto";
+  const host::AccelParams params{host::grid_spec_for(grid_spec, scene, vgpu::profile(opt.profile))};
+  std::vector<std::unique_ptr<host::Accel>> built;
+  if (auto_accel)
+    for (host::AccelKind k : host::kAccelKinds) built.push_back(host::make_accel(k, scene, params));
+  else
+    built.push_back(host::make_accel(host::parse_accel_kind(a.accel), scene, params));
+  auto formats_for = [&](const host::Accel& accel) {
+    return host::resolve(formats, scene, accel, vgpu::profile(opt.profile));
+  };
+  opt.formats = formats_for(*built.front());
+  if (const std::string why = opt.refusal(vgpu::profile(opt.profile), a.aa); !why.empty())
+    throw UsageError(why);
+  const float aspect = float(opt.width) / float(opt.height);
+  // A frame's camera: the file's (moving with its node), else the rest scene's framing.
+  auto camera_for = [&](const host::Scene& s) {
+    return host::scene_camera(s.camera ? s : rest, aspect);
+  };
+  const bool several = times.size() > 1;
+  const bool tty = ::isatty(2) && !a.quiet && !several;
+  if (!a.quiet && !several) opt.progress = progress_line(tty);  // several: a line per frame
+  std::optional<host::AccelChoice> choice;
+  size_t chosen = 0;
+  if (auto_accel) {
+    std::vector<host::AccelCandidate> candidates;
+    for (const auto& accel : built) candidates.push_back({accel.get(), formats_for(*accel)});
+    choice = host::choose_accel(scene, candidates, opt, camera_for(scene));
+    for (size_t i = 0; i < built.size(); ++i)
+      if (built[i]->kind() == choice->kind) chosen = i;
+    opt.formats = formats_for(*built[chosen]);
+  }
+  const std::unique_ptr<host::Accel> walked = std::move(built[chosen]);
+  built.clear();  // the structures not chosen
+  host::Accel& accel = *walked;
+  std::optional<host::StreamTracer> tracer;
+  if (!cpu) tracer.emplace(scene, accel, opt);
+  const double init_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  host::CpuStats cpu_stats;
+  host::RenderResult r;
+  // One frame's statistics object (the whole --stats-json of a render that is not animated).
+  auto record = [&](double frame_init_ms) {
+    return host::frame_stats_json({scene, path, a.engine, tracer ? &*tracer : nullptr, accel,
+                                   choice ? &*choice : nullptr, opt, r, cpu_stats, a.shading,
+                                   a.texture_filter, a.kernels, a.precision, frame_init_ms});
+  };
+
+  // Frame by frame: the scene posed, the structure rebuilt, the static textures that changed
+  // uploaded again (--update rebuild), the frame rendered and its files written.
+  nlohmann::ordered_json j, frames_json = nlohmann::ordered_json::array();
+  std::vector<FrameLine> lines;
+  std::optional<std::pair<host::RenderResult, nlohmann::ordered_json>> reported;  // --report-frame
+  std::string action = "initial";
+  for (size_t f = 0; f < times.size(); ++f) {
+    const int number = int(f) + 1;
+    host::StreamTracer::Upload up;
+    double write_ms = 0;
+    if (f > 0) {
+      pose_start = std::chrono::steady_clock::now();
+      scene = animated->at(animation, times[f]);
+      pose_ms = host::ms_since(pose_start);
+      action = accel.update(scene, a.update);  // rebuilt (or a BVH refitted), in its new box
+      const auto tu = std::chrono::steady_clock::now();
+      if (tracer) up = tracer->update(scene, accel);
+      write_ms = host::ms_since(tu);
+    } else if (tracer) {
+      up.bytes = tracer->static_bytes();  // the first frame's: initialization uploads them all
+    }
+    const host::Camera cam = camera_for(scene);
+    cpu_stats = {};
+    if (one_frame) one_frame->on = number == a.report_frame;
+    r = cpu ? host::render_cpu(scene, accel, cam, opt, &cpu_stats) : tracer->render(cam);
+    if (tty) std::fprintf(stderr, "\n");
+    if (recorder && (!one_frame || one_frame->on)) recorder->finish(r.stats);
+
+    write_images(a, plan, r, number);
+
+    j = record(f == 0 ? init_ms : 0.0);
+    double predicted = 0;
+    if (!cpu && !gl) predicted = host::predict(r.stats, vgpu::profile(opt.profile)).total_ms;
+    if (animating) {
+      const nlohmann::ordered_json update =
+          host::frame_update_json(f == 0 ? std::string("initial") : action, pose_ms, accel.kind(),
+                                  accel.build_ms(), write_ms, up, tracer.has_value());
+      j["frame"] = number;
+      j["time"] = times[f];
+      j["animation"] = animation_json;
+      j["update"] = update;
+      if (several) frames_json.push_back(j);
+      if (number == a.report_frame) reported.emplace(r, j);
+      if (!a.quiet)
+        std::fprintf(stderr,
+                     "vgpu-rt: frame %d/%zu (t = %g s): update %.1f ms (pose %.1f, %s %.1f, "
+                     "textures %.1f), %llu bytes uploaded; render %.1f ms, %llu passes\n",
+                     number, times.size(), times[f], pose_ms + accel.build_ms() + write_ms, pose_ms,
+                     std::string(accel.name()).c_str(), accel.build_ms(), write_ms,
+                     static_cast<unsigned long long>(up.bytes), r.render_ms,
+                     static_cast<unsigned long long>(r.stats.totals.passes));
+    }
+    const host::WalkWork work = cpu ? host::WalkWork{} : host::walk_work(r.stats);
+    lines.push_back({times[f], pose_ms, accel.build_ms(), write_ms, r.render_ms, up.bytes,
+                     r.stats.totals.passes, predicted, f == 0 ? std::string("initial") : action,
+                     cpu ? cpu_stats.nodes_visited : work.nodes_visited,
+                     cpu ? cpu_stats.voxel_steps : work.voxel_steps});
+  }
+  if (several)
+    j = {{"scene", scene.name}, {"scene_path", path},          {"animation", animation_json},
+         {"update", a.update},  {"frame_count", times.size()}, {"frames", frames_json}};
+  if (!a.stats_json.empty()) host::write_stats_json(a.stats_json, j);
+  if (!a.stats_csv.empty()) host::write_stats_csv(a.stats_csv, *recorder);
+  if (!a.report.empty())
+    host::write_report(a.report, *recorder, reported ? reported->first : r,
+                       reported ? reported->second : j);
+  if (a.stats == "json") {
+    std::cout << j.dump(2) << "\n";
+  } else if (a.stats == "table" && several) {
+    print_frames_table(a, plan, scene, accel.kind(), r, lines, init_ms,
+                       played_text(animated ? &*animated : nullptr, animation,
+                                   "animation none (the scene is static)"));
+  } else if (a.stats == "table") {
+    print_table(a, plan, scene, accel, choice ? &*choice : nullptr, r, cpu_stats, init_ms,
+                tracer ? &*tracer : nullptr,
+                played_text(animated ? &*animated : nullptr, animation,
+                            "no animation (the scene is static)"));
+  }
+  if (outcome) {
+    outcome->result = std::move(r);
+    outcome->stats = std::move(j);
+    outcome->frames = times.size();
+    return 0;  // --predict's lines are the caller's to print
+  }
+  if (a.predict && !several) {
+    const vgpu::Profile& p = vgpu::profile(opt.profile);
+    std::cout << host::describe(host::predict(r.stats, p), p);
+  }
+  return 0;
+}
+
+}  // namespace cli

@@ -1,0 +1,98 @@
+"""vgpu_rt.passes: a frame pass by pass, stopped and resumed, agrees with the whole frame."""
+
+import csv
+import gc
+import os
+import subprocess
+import tempfile
+import unittest
+
+import numpy as np
+
+import vgpu_rt
+
+CLI = os.environ.get("VGPU_RT_CLI", "")
+OPTIONS = dict(size="16x16", bounces=1)
+
+
+class PassesTest(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.whole = vgpu_rt.render("bunny", **OPTIONS)
+        cls.steps = vgpu_rt.passes("bunny", **OPTIONS)
+        cls.seen = list(cls.steps)
+
+    def test_every_pass_is_seen_once_in_order(self):
+        totals = self.whole.stats["totals"]
+        self.assertEqual(len(self.seen), totals["passes"])
+        self.assertEqual([p.index for p in self.seen], list(range(len(self.seen))))
+        self.assertEqual(self.seen[0].kernel, "generate rays")
+        self.assertEqual(sum(p.counters["passes"] for p in self.seen), totals["passes"])
+        self.assertEqual(max(p.iteration for p in self.seen), self.whole.stats["iterations"])
+
+    def test_the_occlusion_query_counts_are_shown_at_their_passes(self):
+        counted = [p for p in self.seen if p.query is not None]
+        self.assertEqual(len(counted), self.whole.stats["totals"]["queries"])
+        for p in counted:
+            self.assertLessEqual(p.query, 16 * 16)
+        self.assertEqual(counted[-1].frame_totals["query_readbacks"],
+                         self.whole.stats["totals"]["query_readbacks"])
+
+    @unittest.skipUnless(CLI, "VGPU_RT_CLI names the vgpu-rt executable")
+    def test_each_pass_is_the_command_line_s_stats_csv_row(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "passes.csv")
+            subprocess.run([CLI, "render", "bunny", "--size", "16x16", "--bounces", "1", "--stats",
+                            "none", "--quiet", "--stats-csv", path], check=True)
+            with open(path) as f:
+                rows = list(csv.DictReader(f))
+        self.assertEqual(len(rows), len(self.seen))
+        for row, p in zip(rows, self.seen):
+            where = f"pass {p.index} {p.kernel}"
+            self.assertEqual(row["kernel"], p.kernel, where)
+            self.assertEqual(int(row["iteration"]), p.iteration, where)
+            self.assertEqual(row["trace_kind"] or None, p.trace, where)
+            self.assertEqual(row["target"], p.target_name, where)
+            for key in ("fragments_shaded", "instructions", "texture_fetches", "bytes_written"):
+                self.assertEqual(int(row[key]), p.counters[key], f"{where} {key}")
+            self.assertEqual(int(row["query_result"]) if row["query_result"] else None, p.query,
+                             where)
+
+    def test_each_pass_shows_its_target_after_the_pass(self):
+        first = self.seen[0]  # generate rays: unit directions
+        self.assertEqual(first.target.shape, (16, 16, first.target.shape[2]))
+        norms = np.linalg.norm(first.target[:, :, :3], axis=2)
+        self.assertTrue(np.allclose(norms, 1.0, atol=1e-5), norms)
+
+    def test_the_frame_after_its_passes_is_the_whole_frame(self):
+        f = self.steps.frame
+        self.assertTrue(np.array_equal(f.image, self.whole.image))
+        self.assertTrue(np.array_equal(f.hit, self.whole.hit))
+        self.assertEqual(f.stats["totals"]["passes"], self.whole.stats["totals"]["passes"])
+
+    def test_a_frame_stopped_and_resumed_gives_the_same_passes(self):
+        steps = vgpu_rt.passes("bunny", **OPTIONS)
+        head = [next(steps) for _ in range(5)]
+        self.assertIsNone(steps.frame, "not finished")
+        rest = list(steps)
+        self.assertEqual([p.kernel for p in head + rest], [p.kernel for p in self.seen])
+        self.assertEqual([p.query for p in head + rest], [p.query for p in self.seen])
+
+    def test_a_frame_left_half_way_is_let_go(self):
+        steps = vgpu_rt.passes("bunny", **OPTIONS)
+        next(steps)
+        del steps
+        gc.collect()  # the worker runs the frame out and is joined
+        self.assertEqual(len(list(vgpu_rt.passes("bunny", size="8x8", bounces=0))) > 0, True)
+
+    def test_what_passes_cannot_follow_is_refused(self):
+        with self.assertRaisesRegex(ValueError, "follows one frame"):
+            vgpu_rt.passes("hop", size="8x8", frames="0:1:2")
+        with self.assertRaisesRegex(ValueError, "needs --engine stream"):
+            vgpu_rt.passes("bunny", size="8x8", engine="cpu")
+        with self.assertRaises(FileNotFoundError):
+            vgpu_rt.passes("nowhere.glb")
+
+
+if __name__ == "__main__":
+    unittest.main()

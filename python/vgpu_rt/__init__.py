@@ -1,0 +1,245 @@
+"""vgpu-rt from Python: the virtual 2004 GPU and the stream ray tracer, frame by frame.
+
+    import vgpu_rt
+    frame = vgpu_rt.render("bunny", size="64x64", profile="gf6600")
+    frame.image        # (64, 64, 3) float32, linear RGB, row 0 at the top
+    frame.depth        # (64, 64) distance to the primary hit, 0 where the ray misses
+    frame.hit          # (64, 64) the primary hit's input triangle id, -1 where it misses
+    frame.stats        # the dict `vgpu-rt render --stats-json` writes
+    vgpu_rt.predict(frame.stats, "gf5700")   # the cost model's breakdown, in ms
+
+render() takes the command line's render options under the same names, '-' written '_'
+(texture_filter="bilinear", spp=4, aa="adaptive", time=0.5, ...) and with its defaults, with
+two exceptions: `stats` defaults to "none" (the statistics come back as frame.stats) and `quiet`
+to True (no progress lines on stderr). Bad values raise ValueError with the command line's
+message; a scene that is neither a bundled name nor a file raises FileNotFoundError.
+
+The extension (_vgpu_rt) is built by the project's CMake into build/python/vgpu_rt/. This
+package finds it there both when imported from the build folder (PYTHONPATH=build/python) and
+from the source tree (the repository root's vgpu_rt link to python/vgpu_rt).
+"""
+
+import glob as _glob
+import importlib.util as _importlib_util
+import json as _json
+import os as _os
+import sys as _sys
+
+
+def _load_extension():
+    """Imports _vgpu_rt from beside this file, else from the build folder of this source tree."""
+    here = _os.path.dirname(_os.path.realpath(__file__))
+    candidates = [here]
+    build = _os.environ.get("VGPU_RT_BUILD")  # a build folder other than <repo>/build
+    root = _os.path.dirname(_os.path.dirname(here))  # python/vgpu_rt -> the repository
+    candidates.append(_os.path.join(build or _os.path.join(root, "build"), "python", "vgpu_rt"))
+    for folder in candidates:
+        found = sorted(_glob.glob(_os.path.join(folder, "_vgpu_rt*.so")))
+        if found:
+            spec = _importlib_util.spec_from_file_location(__name__ + "._vgpu_rt", found[0])
+            module = _importlib_util.module_from_spec(spec)
+            spec.loader.exec_module(module)
+            _sys.modules[__name__ + "._vgpu_rt"] = module
+            return module
+    raise ImportError(
+        "vgpu_rt: the extension _vgpu_rt is not built; build it with `cmake -S . -B build -G Ninja "
+        "&& cmake --build build --target _vgpu_rt` (looked in " + ", ".join(candidates) + ")")
+
+
+_ext = _load_extension()
+
+FrameStats = _ext.FrameStats
+Device = _ext.Device
+Texture = _ext.Texture
+Kernel = _ext.Kernel
+#: Every kernel (fragment program) by name, in kernels/registry.h's order, with its default
+#: uniforms: vgpu_rt.kernels["traversal"].units lists what each texture unit holds.
+kernels = _ext.kernels()
+
+# The command line's render options: name -> (default, description, is_flag).
+_OPTIONS = {name: (default, text, flag) for name, default, text, flag in _ext.render_options()}
+# Where Python's default differs from the command line's (see the module's docstring).
+_PYTHON_DEFAULTS = {"stats": "none", "quiet": True}
+_ON_OFF = {"shadows", "masks", "mrt"}  # options taking on|off, which also take True/False
+
+
+class Stats(dict):
+    """The dict `--stats-json` writes, holding the frame's C++ statistics as `frame_stats`,
+    which predict() prices as the command line does (without reading the dict back)."""
+
+    def __init__(self, data, frame_stats=None):
+        super().__init__(data)
+        self.frame_stats = frame_stats
+
+
+class Frame:
+    """One rendered frame: image (H, W, 3), depth (H, W), hit (H, W) as float32 NumPy arrays
+    (no copies: each owns the library's buffer) and stats, the --stats-json dict (Stats)."""
+
+    __slots__ = ("image", "depth", "hit", "stats")
+
+    def __init__(self, image, depth, hit, stats):
+        self.image, self.depth, self.hit, self.stats = image, depth, hit, stats
+
+    def __repr__(self):
+        h, w = self.image.shape[:2]
+        return f"<vgpu_rt.Frame {w}x{h} {self.stats.get('scene', '')!r}>"
+
+
+def _word(name, value):
+    """One option's value as the command line's word."""
+    if isinstance(value, bool) and name in _ON_OFF:
+        return "on" if value else "off"
+    if isinstance(value, (tuple, list)) and name in ("size", "trace_pixel"):
+        if len(value) != 2:
+            raise ValueError(f"{name}: expected two numbers, got {value!r}")
+        return ("{}x{}" if name == "size" else "{},{}").format(*value)
+    return str(value)
+
+
+def _arguments(scene, options):
+    """render()'s arguments as the command line's: [scene, --option, value, ...]."""
+    if not isinstance(scene, (str, _os.PathLike)):
+        raise TypeError(f"render(): scene must be a name or a path, not {type(scene).__name__}")
+    args = [_os.fspath(scene)]
+    given = dict(_PYTHON_DEFAULTS)
+    given.update(options)
+    for key, value in given.items():
+        name = key.replace("_", "-")
+        if name not in _OPTIONS:
+            raise TypeError(f"render() got an unexpected keyword argument '{key}'")
+        if value is None:
+            continue
+        flag = _OPTIONS[name][2]
+        if flag:
+            if value:
+                args.append("--" + name)
+            continue
+        values = value if name == "aov" and isinstance(value, (list, tuple)) else [value]
+        for v in values:
+            args += ["--" + name, _word(key, v)]
+    return args
+
+
+def render(scene="bunny", **options):
+    """Renders `scene` (a name from scenes() or a .gltf/.glb path) as `vgpu-rt render` does.
+
+    Options are the command line's, '-' written '_', e.g. size="128x128" (or (128, 128)),
+    bounces=2, spp=4, aa="adaptive", profile="gf6600", accel="bvh", masks=True, time=0.5,
+    out="frame.png", stats_json="frame.json". Defaults are the command line's except stats
+    ("none") and quiet (True). Returns a Frame; with frames="A:B:N" (several frames) the
+    arrays are the last frame's and stats holds every frame, as --stats-json writes them.
+    Raises ValueError for a bad value or combination, FileNotFoundError for a missing scene.
+    """
+    image, depth, hit, text, frame_stats = _ext.render(_arguments(scene, options))
+    return Frame(image, depth, hit, Stats(_json.loads(text), frame_stats))
+
+
+def _option_lines():
+    lines = []
+    for name, (default, text, flag) in _OPTIONS.items():
+        shown = _PYTHON_DEFAULTS.get(name, "False" if flag else default)
+        lines.append(f"    {name.replace('-', '_')}: {text}" + (f" (default {shown})" if shown != "" else ""))
+    return "\n".join(lines)
+
+
+render.__doc__ += "\n    Options (from the command line's --help):\n" + _option_lines() + "\n"
+
+
+class Pass:
+    """One pass of a frame, as passes() shows it: its index (from 0), kernel and paper_name,
+    iteration (from 1) and trace (primary, shadow or reflected; None outside a trace), counters (the pass's own),
+    frame_totals (the frame so far), query (the fragments its occlusion query counted, or None
+    when it ran without one), target_name and target, the render target's texels after the pass
+    as a (height, width, channels) float32 array (a copy: later passes rewrite the texture)."""
+
+    __slots__ = ("index", "kernel", "paper_name", "iteration", "trace", "counters",
+                 "frame_totals", "query", "target_name", "target")
+
+    def __init__(self, fields):
+        for key in self.__slots__:
+            setattr(self, key, fields[key])
+
+    def __repr__(self):
+        q = "" if self.query is None else f", query {self.query}"
+        return (f"<vgpu_rt.Pass {self.index} {self.kernel} -> {self.target_name}, "
+                f"iteration {self.iteration} {self.trace}{q}>")
+
+
+class Passes:
+    """A frame rendered pass by pass (see passes()). The render runs on a worker thread that
+    stops after each pass until the next one is asked for: stop iterating to stop the frame
+    there, iterate again to resume it. Once every pass was seen, `frame` is the Frame."""
+
+    def __init__(self, scene="bunny", **options):
+        self._stepper = _ext.PassStepper(_arguments(scene, options))
+        # The first pass, fetched now so that options the frame refuses raise here.
+        self._first = self._stepper.next()
+
+    def __iter__(self):
+        return self
+
+    def __next__(self):
+        if self._first is not None:
+            fields, self._first = self._first, None
+        else:
+            fields = self._stepper.next()
+        if fields is None:
+            raise StopIteration
+        return Pass(fields)
+
+    @property
+    def frame(self):
+        """The frame as render() returns it, once every pass was seen; else None."""
+        result = self._stepper.result()
+        if result is None:
+            return None
+        image, depth, hit, text, frame_stats = result
+        return Frame(image, depth, hit, Stats(_json.loads(text), frame_stats))
+
+
+def passes(scene="bunny", **options):
+    """Renders `scene` with render()'s options, stopping after each pass: returns an iterator
+    of Pass objects (the tracer's pass observer, as the HTML report sees the frame).
+
+        steps = vgpu_rt.passes("bunny", size="32x32")
+        for p in steps:
+            if p.query is not None:
+                print(p.index, p.kernel, p.query)   # the counts that steer the host
+        steps.frame.image
+
+    One frame only (not frames=...), on the stream engine, without report or stats_csv.
+    """
+    return Passes(scene, **options)
+
+
+def scenes():
+    """The bundled scenes as a dict: name -> path of its glTF file."""
+    return dict(_ext.scenes())
+
+
+def profiles():
+    """The built-in hardware profiles (gf5700, r300, gf6600, rtx4090, h200), each a dict of
+    its main figures: name, core_mhz, mem_gbps, bus_mbps, max_outputs, max_loop_iterations."""
+    return _ext.profiles()
+
+
+def predict(stats, profile):
+    """The cost model's prediction of a frame on `profile`, in ms, by where it goes (the keys
+    of --stats-json's predicted_breakdown, plus total_ms).
+
+    `stats` is a Frame, its Stats, or a plain --stats-json dict (e.g. json.load of a file the
+    command line wrote). Either gives the command line's figure: a render keeps each kernel's
+    totals (not every pass), and the model prices those, which the dict holds too.
+    """
+    if isinstance(stats, Frame):
+        stats = stats.stats
+    if isinstance(stats, Stats) and stats.frame_stats is not None:
+        return _ext.predict(stats.frame_stats, profile)
+    if isinstance(stats, dict):
+        return _ext.predict_json(_json.dumps(stats), profile)
+    raise TypeError(f"predict(): stats must be a Frame or a --stats-json dict, not {type(stats).__name__}")
+
+
+__all__ = ["render", "passes", "scenes", "profiles", "predict", "kernels", "Device", "Texture",
+           "Kernel", "Frame", "Stats", "FrameStats", "Pass", "Passes"]
