@@ -14,7 +14,6 @@
 #include "host/accel/grid2.h"
 #include "host/accel/kdtree.h"
 #include "host/trace/cpu/cpu_tracer.h"
-#include "host/trace/cpu/optics.h"
 #include "host/trace/walks/grid_walk.h"
 #include "kernels/kernels.h"
 
@@ -123,8 +122,21 @@ TEST_CASE(
   const Structures st(slab_scene(thickness, eta));
   for (const host::Accel& accel : st.all()) {
     CAPTURE(host::accel_name(accel.kind));
-    for (const double theta : {0.0, 0.3, 0.7, 1.1}) {
+    // Normal incidence, 45 degrees, Brewster's angle (tan theta = 1.5) and a steep 1.1 rad, with
+    // each one's reflectance known without optics::meet: ((n - 1)/(n + 1))^2 = 0.04; 0.0502399
+    // (test_optics: the s term (1 - q)^2/(1 + q)^2 with q = sqrt(3.5), the p term its square);
+    // (25/169)/2 (no p term); and Fresnel's sine and tangent form in the angles themselves.
+    const double pi = std::numbers::pi;
+    for (const double theta : {0.0, pi / 4, std::atan(1.5), 1.1}) {
       CAPTURE(theta);
+      const double q = std::sqrt(3.5), rs45 = (1 - q) / (1 + q);
+      const double theta_t = std::asin(std::sin(theta) / double(eta));
+      const double rs = std::sin(theta - theta_t) / std::sin(theta + theta_t);
+      const double rp = std::tan(theta - theta_t) / std::tan(theta + theta_t);
+      const double fresnel = theta == 0.0      ? 0.04
+                             : theta == pi / 4 ? 0.5 * (rs45 * rs45 + rs45 * rs45 * rs45 * rs45)
+                             : theta == 1.1    ? 0.5 * (rs * rs + rp * rp)
+                                               : 25.0 / 338.0;
       const glm::dvec3 o(0.1, 0.2, 0.0);
       const glm::dvec3 d(std::sin(theta), 0.0, -std::cos(theta));
       const std::vector<CpuRay> tree = host::cpu_ray_tree(st.scene, accel, options(4), o, d);
@@ -135,16 +147,13 @@ TEST_CASE(
       REQUIRE(out != nullptr);
       REQUIRE(out->hit >= 4);  // the wall's triangles
       CHECK(glm::length(out->dir - d) < 1e-12);
-      // The light left by the slab is what Fresnel let through twice: t (1 - F) at each face.
-      const host::optics::Interface front = host::optics::meet(std::cos(theta), 1.0 / eta);
-      const host::optics::Interface back = host::optics::meet(front.cos_t, double(eta));
-      CHECK(out->weight ==
-            doctest::Approx((1.0 - front.reflectance) * (1.0 - back.reflectance)).epsilon(1e-12));
+      // The light left by the slab is what Fresnel let through twice: (1 - F) at each face, the
+      // same F inside and out (the back face is met at theta_t from inside: Stokes).
+      CHECK(out->weight == doctest::Approx((1.0 - fresnel) * (1.0 - fresnel)).epsilon(1e-12));
       // Where it lands on the wall, against the line it came in on.
       const glm::dvec3 landing = out->origin + out->dir * out->t;
       const glm::dvec3 rel = landing - o;
       const double shift = glm::length(rel - d * glm::dot(rel, d));
-      const double theta_t = std::asin(std::sin(theta) / double(eta));
       const double analytic = thickness * std::sin(theta - theta_t) / std::cos(theta_t);
       // Each face's offset ε along the normal moves the path by at most ε (tan θ + tan θt) cos θ.
       const double eps = Structures::offset(accel);
