@@ -240,8 +240,26 @@ TEST_CASE("a posed scene is the rest scene with each node's animated transform a
     const glm::vec3 want2(m * glm::dvec4(glm::dvec3(rest.p2[i]), 1.0));
     CHECK(glm::all(glm::epsilonEqual(two.p2[i], want2, 1e-5f)));
   }
-  // Normals turn with the body: the floor's stay +Y, the body's +X face now faces (1, 0, -1).
+  // Normals turn with the body: the floor's stay +Y, the body's +X face now faces (1, 0, -1),
+  // every body and head normal the rest one turned an eighth about +Y (the scale is uniform).
   CHECK(glm::all(glm::epsilonEqual(two.n0[0], glm::vec3(0, 1, 0), 1e-6f)));
+  const glm::dmat4 turn = glm::rotate(I, pi / 4, {0, 1, 0});
+  int plus_x = 0;
+  for (size_t i = 2; i < rest.triangle_count(); ++i) {
+    CAPTURE(i);
+    for (const auto& [posed, at_rest] :
+         {std::pair{two.n0[i], rest.n0[i]}, std::pair{two.n1[i], rest.n1[i]},
+          std::pair{two.n2[i], rest.n2[i]}}) {
+      const glm::vec3 want(turn * glm::dvec4(glm::dvec3(at_rest), 0.0));
+      CHECK(glm::all(glm::epsilonEqual(posed, want, 1e-6f)));
+    }
+    if (rest.n0[i] == glm::vec3(1, 0, 0)) {
+      ++plus_x;
+      CHECK(glm::all(
+          glm::epsilonEqual(two.n0[i], glm::vec3(std::sqrt(0.5f), 0, -std::sqrt(0.5f)), 1e-6f)));
+    }
+  }
+  CHECK(plus_x == 4);  // two triangles of the body's +X face and two of the head's
   // Past the last key: clamped, the same as at the last key.
   CHECK(near(a.at(0, 3.0), a.at(0, 50.0)));
   CHECK_FALSE(near(a.at(0, 3.0), two));
@@ -261,6 +279,37 @@ TEST_CASE("a posed scene is the rest scene with each node's animated transform a
   CHECK(two.lights.size() == 1);
   CHECK(two.lights[0].position == rest.lights[0].position);
   CHECK(near(a.at(std::nullopt, 2.0), rest));
+}
+
+TEST_CASE(
+    "a file's normals are posed by the inverse transpose of the node's matrix: turned and "
+    "stretched, they lean as by hand") {
+  // tests/data/gltf/animated_normals.gltf: a quad in z = 0 with normals leaning away from +Z; at
+  // 1 s its node is turned an eighth about +Z (halfway along a LINEAR quarter turn) and stretched
+  // to scale (2, 1, 1). Points go by M = R S; normals by (M^-1)^T = R S^-1: a normal (a, b, c)
+  // becomes R (a/2, b, c), normalised. Taking M itself would give R (2a, b, c).
+  const host::AnimatedScene a(data_path("animated_normals.gltf"));
+  const host::Scene& rest = a.rest();
+  REQUIRE(rest.triangle_count() == 2);
+  const host::Scene posed = a.at(0, 1.0);
+  const double pi = std::numbers::pi;
+  const glm::dmat3 r(glm::rotate(glm::dmat4(1.0), pi / 4, {0, 0, 1}));
+  const glm::dmat3 s_inv(glm::scale(glm::dmat4(1.0), glm::dvec3(0.5, 1, 1)));
+  for (size_t i = 0; i < 2; ++i) {
+    CAPTURE(i);
+    for (const auto& [p, n] :
+         {std::pair{posed.n0[i], rest.n0[i]}, std::pair{posed.n1[i], rest.n1[i]},
+          std::pair{posed.n2[i], rest.n2[i]}}) {
+      const glm::vec3 want(glm::normalize(r * (s_inv * glm::dvec3(n))));
+      CHECK_MESSAGE(glm::all(glm::epsilonEqual(p, want, 1e-6f)),
+                    str(glm::dvec3(p)) << " != " << str(glm::dvec3(want)));
+    }
+  }
+  // One corner in numbers: (-0.6, 0, 0.8) -> (-0.3, 0, 0.8) / sqrt(0.73), turned 45 degrees:
+  // (-0.3 / sqrt(2), -0.3 / sqrt(2), 0.8) / sqrt(0.73) = (-0.248282, -0.248282, 0.936329).
+  REQUIRE(rest.n0[0] == glm::vec3(-0.6f, 0, 0.8f));
+  CHECK(glm::all(
+      glm::epsilonEqual(posed.n0[0], glm::vec3(-0.248282f, -0.248282f, 0.936329f), 2e-6f)));
 }
 
 TEST_CASE("skinned meshes and morph-target weights are refused with one line naming the feature") {
