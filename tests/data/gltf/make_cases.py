@@ -462,6 +462,10 @@ def textured_cases():
     # KHR_texture_transform: u + 0.5 (and REPEAT would wrap; CLAMP_TO_EDGE is what the sampler says).
     b, d = textured_quad({"uri": png_uri}, transform={"offset": [0.5, 0], "scale": [2, 1]})
     write_gltf("textured_transform.gltf", d, b.bin)
+    # A quarter turn and an offset, as the extension's own example: uv' = (v, 1 - u), the image
+    # turned clockwise on the quad (tests/trace/test_textures.cpp checks the corners' texels).
+    b, d = textured_quad({"uri": png_uri}, transform={"offset": [0, 1], "rotation": math.pi / 2})
+    write_gltf("textured_rotation.gltf", d, b.bin)
     # Bad: a missing file, bytes that are no image, a PNG cut short, a TEXCOORD_0 of VEC3.
     b, d = textured_quad({"uri": "no_such_texture.png"})
     write_gltf("texture_missing.gltf", d, b.bin)
