@@ -254,6 +254,55 @@ TEST_CASE("two far-apart triangles give a root and two leaves with the expected 
   check_invariants(s, bvh, {}, true);
 }
 
+TEST_CASE(
+    "the SAH cost of two far-apart triangles is worked by hand, and grows by the hand-worked "
+    "ratio when a refit brings them together") {
+  // A leaf of one triangle costs a visit and a test: 2. Unpadded boxes, area 2 (xy + yz + zx):
+  // each triangle's [0, 1]^2 x {0}: 2; the root's [0, 101] x [0, 1] x {0}: 202. The root:
+  // 1 + (2 x 2 + 2 x 2) / 202 = 1 + 8/202.
+  Scene s = make_scene({{{100, 0, 0}, {101, 0, 0}, {100, 1, 0}},  //
+                        {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}});
+  Bvh bvh = host::build_bvh(s);
+  REQUIRE(bvh.nodes.size() == 3);
+  CHECK(bvh.sah_cost == doctest::Approx(1.0 + 8.0 / 202.0).epsilon(1e-12));
+  // Triangle 0 moved to x = 0.5: the leaves keep their areas, the root's box shrinks to
+  // [0, 1.5] x [0, 1]: area 3, cost 1 + 8/3, 3.5 times the build's (past --update auto's 1.25).
+  for (auto* p : {&s.p0[0], &s.p1[0], &s.p2[0]}) p->x -= 99.5f;
+  host::refit_bvh(bvh, s);
+  CHECK(bvh.sah_cost == doctest::Approx(1.0 + 8.0 / 3.0).epsilon(1e-12));
+  CHECK(bvh.sah_cost / (1.0 + 8.0 / 202.0) > 3.5);
+}
+
+TEST_CASE("a refitted BVH keeps every invariant: its boxes hold the moved triangles") {
+  for (int n : {2, 17, 333}) {
+    CAPTURE(n);
+    Scene s = random_scene(n, unsigned(n) * 7u + 1u);
+    Bvh bvh = host::build_bvh(s);
+    // Refitting an unmoved scene reproduces the build, boxes and cost.
+    Bvh same_scene = bvh;
+    host::refit_bvh(same_scene, s);
+    CHECK(same(same_scene, bvh));
+    // Every triangle moved by its own random offset (up to 5 on each axis): the topology stays,
+    // the boxes must follow.
+    std::mt19937 rng{unsigned(n)};
+    std::uniform_real_distribution<float> off(-5.0f, 5.0f);
+    for (size_t t = 0; t < s.triangle_count(); ++t) {
+      const glm::vec3 d(off(rng), off(rng), off(rng));
+      s.p0[t] += d;
+      s.p1[t] += d;
+      s.p2[t] += d;
+    }
+    host::refit_bvh(bvh, s);
+    check_invariants(s, bvh, {}, true);
+    check_full_walk(bvh);
+    // The same topology, and no better than a build for the moved scene.
+    const Bvh rebuilt = host::build_bvh(s);
+    CHECK(bvh.lists == same_scene.lists);
+    CHECK(bvh.nodes.size() == same_scene.nodes.size());
+    if (n > 2) CHECK(bvh.sah_cost > rebuilt.sah_cost);
+  }
+}
+
 TEST_CASE("describe names nodes, depth, leaves and the largest leaf") {
   const Scene s = make_scene({{{100, 0, 0}, {101, 0, 0}, {100, 1, 0}},  //
                               {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}});

@@ -84,6 +84,11 @@ TEST_CASE("split rays gives Fresnel's shares, total internal reflection past the
   // Leaving glass of 1.5 the critical angle is asin(1 / 1.5) = 41.8 deg: 45 is past it.
   CHECK(std::asin(1 / 1.5) * 180 / M_PI == doctest::Approx(41.81).epsilon(1e-3));
   CHECK_TEXEL_NEAR(out, 2, 0, 1e-5, glm::vec4(1, 0, 1, 1));
+  // The helper above pinned to known answers (tests/trace/test_optics.cpp works them by hand):
+  // Brewster's angle for n = 1.5 reflects no p light, R = (25/169)/2 = 0.0740, and 45 degrees
+  // from air gives 0.0502399; the s term alone would give 0.1479 and 0.0920.
+  CHECK(fresnel(1 / 1.5, std::cos(std::atan(1.5))) == doctest::Approx(25.0 / 338).epsilon(1e-12));
+  CHECK(fresnel(1 / 1.5, s45) == doctest::Approx(0.0502399).epsilon(1e-6));
   const double f40 = fresnel(1.5, c40);
   CHECK(f40 < 1);
   CHECK_TEXEL_NEAR(out, 3, 0, 1e-4, glm::vec4(f40, 1 - f40, 2, 0));

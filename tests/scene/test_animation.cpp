@@ -100,6 +100,63 @@ TEST_CASE("a cubic spline follows the glTF Hermite form, its tangents scaled by 
   CHECK_NEAR3(host::sample_vec3(two, 5.0), glm::dvec3(0, 1, 0));
 }
 
+TEST_CASE(
+    "a three-key cubic spline inside its second interval at u = 1/4 gives the Hermite sum worked "
+    "by hand from unequal keys and tangents") {
+  // glTF 2.0, Appendix C: between keys k and k+1, with d = t_k+1 - t_k,
+  //   p(u) = (2u^3 - 3u^2 + 1) v_k + d (u^3 - 2u^2 + u) b_k + (-2u^3 + 3u^2) v_k+1
+  //          + d (u^3 - u^2) a_k+1,
+  // a the in-tangents and b the out-tangents. Keys at 0, 1 and 3 s; t = 1.5 s is u = 1/4 of the
+  // second interval (d = 2): h00 = 27/32, h10 = 9/64, h01 = 5/32, h11 = -3/64, so
+  //   p = (27 v_1 + 9 b_1 + 5 v_2 - 3 a_2) / 32      (the tangents' terms times d = 2).
+  // v_1 = (2, -1, 4), b_1 = (1, 3, -2), a_2 = (-4, 2, 5), v_2 = (6, 3, -2):
+  //   x: (54 + 9 + 30 + 12) / 32 = 105/32;  y: (-27 + 27 + 15 - 6) / 32 = 9/32;
+  //   z: (108 - 18 - 10 - 15) / 32 = 65/32.
+  // Key 0, key 1's in-tangent and key 2's out-tangent are decoys far from every answer: an
+  // interval off by one or the wrong tangent of a key moves the result by tens.
+  const std::vector<glm::dvec3> keys = {
+      {50, 50, 50},  {-30, 20, 10}, {40, -60, 70},  // key 0: in, value, out
+      {90, -80, 60}, {2, -1, 4},    {1, 3, -2},     // key 1
+      {-4, 2, 5},    {6, 3, -2},    {-70, 80, 90},  // key 2
+  };
+  const Sampler s = vec3_sampler(Interpolation::cubic_spline, {0, 1, 3}, keys);
+  CHECK_NEAR3(host::sample_vec3(s, 1.5), glm::dvec3(105.0 / 32, 9.0 / 32, 65.0 / 32));
+  // u = 3/4 of the same interval (t = 2.5): h00 = 5/32, h10 = 3/64, h01 = 27/32, h11 = -9/64:
+  //   p = (5 v_1 + 3 b_1 + 27 v_2 - 9 a_2) / 32 = ((10 + 3 + 162 + 36), (-5 + 9 + 81 - 18),
+  //   (20 - 6 - 54 - 45)) / 32 = (211, 67, -85) / 32.
+  CHECK_NEAR3(host::sample_vec3(s, 2.5), glm::dvec3(211.0 / 32, 67.0 / 32, -85.0 / 32));
+  // On the middle key: its value, not a tangent.
+  CHECK_NEAR3(host::sample_vec3(s, 1.0), glm::dvec3(2, -1, 4));
+}
+
+TEST_CASE("a rotation's cubic spline is the same Hermite sum of quaternions, normalised") {
+  // Rotations about +Y only, (x, y, z, w) with x = z = 0. Keys at 0, 1 and 3 s; t = 1.5 s is
+  // u = 1/4 of the second interval, p = (27 v_1 + 9 b_1 + 5 v_2 - 3 a_2) / 32 as above, with
+  // v_1 = identity (0, 0, 0, 1), b_1 = (0, 2/3, 0, -1), a_2 = (0, 2/3, 0, -2/3) and
+  // v_2 = (0, 0.6, 0, 0.8):
+  //   y: (0 + 6 + 3 - 2) / 32 = 7/32;  w: (27 - 9 + 4 + 2) / 32 = 24/32;
+  // length 25/32, so the unit result is (0, 0.28, 0, 0.96): cos(angle/2) = 0.96, a turn taking
+  // +X to (1 - 2 (0.28)^2, 0, -2 (0.28) (0.96)) = (0.8432, 0, -0.5376).
+  Sampler s;
+  s.interpolation = Interpolation::cubic_spline;
+  s.times = {0, 1, 3};
+  s.values = {glm::dvec4(0.5, 0, 0, 0),
+              glm::dvec4(0, 0, 0.6, 0.8),
+              glm::dvec4(0, 0, 0, 3),
+              glm::dvec4(0, 5, 0, 0),
+              glm::dvec4(0, 0, 0, 1),
+              glm::dvec4(0, 2.0 / 3, 0, -1),
+              glm::dvec4(0, 2.0 / 3, 0, -2.0 / 3),
+              glm::dvec4(0, 0.6, 0, 0.8),
+              glm::dvec4(4, 0, 0, 0)};
+  const glm::dquat q = host::sample_rotation(s, 1.5);
+  CHECK(q.x == doctest::Approx(0.0).epsilon(1e-12));
+  CHECK(q.y == doctest::Approx(0.28).epsilon(1e-12));
+  CHECK(q.z == doctest::Approx(0.0).epsilon(1e-12));
+  CHECK(q.w == doctest::Approx(0.96).epsilon(1e-12));
+  CHECK_NEAR3(turn_x(q), glm::dvec3(0.8432, 0, -0.5376));
+}
+
 TEST_CASE("rotations are slerped the short way round and come out unit length") {
   const double pi = std::numbers::pi;
   const glm::dvec4 identity(0, 0, 0, 1);
@@ -187,8 +244,26 @@ TEST_CASE("a posed scene is the rest scene with each node's animated transform a
     const glm::vec3 want2(m * glm::dvec4(glm::dvec3(rest.p2[i]), 1.0));
     CHECK(glm::all(glm::epsilonEqual(two.p2[i], want2, 1e-5f)));
   }
-  // Normals turn with the body: the floor's stay +Y, the body's +X face now faces (1, 0, -1).
+  // Normals turn with the body: the floor's stay +Y, the body's +X face now faces (1, 0, -1),
+  // every body and head normal the rest one turned an eighth about +Y (the scale is uniform).
   CHECK(glm::all(glm::epsilonEqual(two.n0[0], glm::vec3(0, 1, 0), 1e-6f)));
+  const glm::dmat4 turn = glm::rotate(I, pi / 4, {0, 1, 0});
+  int plus_x = 0;
+  for (size_t i = 2; i < rest.triangle_count(); ++i) {
+    CAPTURE(i);
+    for (const auto& [posed, at_rest] :
+         {std::pair{two.n0[i], rest.n0[i]}, std::pair{two.n1[i], rest.n1[i]},
+          std::pair{two.n2[i], rest.n2[i]}}) {
+      const glm::vec3 want(turn * glm::dvec4(glm::dvec3(at_rest), 0.0));
+      CHECK(glm::all(glm::epsilonEqual(posed, want, 1e-6f)));
+    }
+    if (rest.n0[i] == glm::vec3(1, 0, 0)) {
+      ++plus_x;
+      CHECK(glm::all(
+          glm::epsilonEqual(two.n0[i], glm::vec3(std::sqrt(0.5f), 0, -std::sqrt(0.5f)), 1e-6f)));
+    }
+  }
+  CHECK(plus_x == 4);  // two triangles of the body's +X face and two of the head's
   // Past the last key: clamped, the same as at the last key.
   CHECK(near(a.at(0, 3.0), a.at(0, 50.0)));
   CHECK_FALSE(near(a.at(0, 3.0), two));
@@ -208,6 +283,37 @@ TEST_CASE("a posed scene is the rest scene with each node's animated transform a
   CHECK(two.lights.size() == 1);
   CHECK(two.lights[0].position == rest.lights[0].position);
   CHECK(near(a.at(std::nullopt, 2.0), rest));
+}
+
+TEST_CASE(
+    "a file's normals are posed by the inverse transpose of the node's matrix: turned and "
+    "stretched, they lean as by hand") {
+  // tests/data/gltf/animated_normals.gltf: a quad in z = 0 with normals leaning away from +Z; at
+  // 1 s its node is turned an eighth about +Z (halfway along a LINEAR quarter turn) and stretched
+  // to scale (2, 1, 1). Points go by M = R S; normals by (M^-1)^T = R S^-1: a normal (a, b, c)
+  // becomes R (a/2, b, c), normalised. Taking M itself would give R (2a, b, c).
+  const host::AnimatedScene a(data_path("animated_normals.gltf"));
+  const host::Scene& rest = a.rest();
+  REQUIRE(rest.triangle_count() == 2);
+  const host::Scene posed = a.at(0, 1.0);
+  const double pi = std::numbers::pi;
+  const glm::dmat3 r(glm::rotate(glm::dmat4(1.0), pi / 4, {0, 0, 1}));
+  const glm::dmat3 s_inv(glm::scale(glm::dmat4(1.0), glm::dvec3(0.5, 1, 1)));
+  for (size_t i = 0; i < 2; ++i) {
+    CAPTURE(i);
+    for (const auto& [p, n] :
+         {std::pair{posed.n0[i], rest.n0[i]}, std::pair{posed.n1[i], rest.n1[i]},
+          std::pair{posed.n2[i], rest.n2[i]}}) {
+      const glm::vec3 want(glm::normalize(r * (s_inv * glm::dvec3(n))));
+      CHECK_MESSAGE(glm::all(glm::epsilonEqual(p, want, 1e-6f)),
+                    str(glm::dvec3(p)) << " != " << str(glm::dvec3(want)));
+    }
+  }
+  // One corner in numbers: (-0.6, 0, 0.8) -> (-0.3, 0, 0.8) / sqrt(0.73), turned 45 degrees:
+  // (-0.3 / sqrt(2), -0.3 / sqrt(2), 0.8) / sqrt(0.73) = (-0.248282, -0.248282, 0.936329).
+  REQUIRE(rest.n0[0] == glm::vec3(-0.6f, 0, 0.8f));
+  CHECK(glm::all(
+      glm::epsilonEqual(posed.n0[0], glm::vec3(-0.248282f, -0.248282f, 0.936329f), 2e-6f)));
 }
 
 TEST_CASE("skinned meshes and morph-target weights are refused with one line naming the feature") {

@@ -16,7 +16,6 @@
 #include "host/accel/grid2.h"
 #include "host/accel/kdtree.h"
 #include "host/trace/cpu/cpu_tracer.h"
-#include "host/trace/cpu/optics.h"
 #include "host/trace/walks/grid_walk.h"
 #include "kernels/kernels.h"
 
@@ -120,8 +119,21 @@ TEST_CASE(
   const Structures st(slab_scene(thickness, eta));
   for (const host::Accel& accel : st.all()) {
     CAPTURE(accel.name());
-    for (const double theta : {0.0, 0.3, 0.7, 1.1}) {
+    // Normal incidence, 45 degrees, Brewster's angle (tan theta = 1.5) and a steep 1.1 rad, with
+    // each one's reflectance known without optics::meet: ((n - 1)/(n + 1))^2 = 0.04; 0.0502399
+    // (test_optics: the s term (1 - q)^2/(1 + q)^2 with q = sqrt(3.5), the p term its square);
+    // (25/169)/2 (no p term); and Fresnel's sine and tangent form in the angles themselves.
+    const double pi = std::numbers::pi;
+    for (const double theta : {0.0, pi / 4, std::atan(1.5), 1.1}) {
       CAPTURE(theta);
+      const double q = std::sqrt(3.5), rs45 = (1 - q) / (1 + q);
+      const double theta_t = std::asin(std::sin(theta) / double(eta));
+      const double rs = std::sin(theta - theta_t) / std::sin(theta + theta_t);
+      const double rp = std::tan(theta - theta_t) / std::tan(theta + theta_t);
+      const double fresnel = theta == 0.0      ? 0.04
+                             : theta == pi / 4 ? 0.5 * (rs45 * rs45 + rs45 * rs45 * rs45 * rs45)
+                             : theta == 1.1    ? 0.5 * (rs * rs + rp * rp)
+                                               : 25.0 / 338.0;
       const glm::dvec3 o(0.1, 0.2, 0.0);
       const glm::dvec3 d(std::sin(theta), 0.0, -std::cos(theta));
       const std::vector<CpuRay> tree = host::cpu_ray_tree(st.scene, accel, options(4), o, d);
@@ -132,16 +144,13 @@ TEST_CASE(
       REQUIRE(out != nullptr);
       REQUIRE(out->hit >= 4);  // the wall's triangles
       CHECK(glm::length(out->dir - d) < 1e-12);
-      // The light left by the slab is what Fresnel let through twice: t (1 - F) at each face.
-      const host::optics::Interface front = host::optics::meet(std::cos(theta), 1.0 / eta);
-      const host::optics::Interface back = host::optics::meet(front.cos_t, double(eta));
-      CHECK(out->weight ==
-            doctest::Approx((1.0 - front.reflectance) * (1.0 - back.reflectance)).epsilon(1e-12));
+      // The light left by the slab is what Fresnel let through twice: (1 - F) at each face, the
+      // same F inside and out (the back face is met at theta_t from inside: Stokes).
+      CHECK(out->weight == doctest::Approx((1.0 - fresnel) * (1.0 - fresnel)).epsilon(1e-12));
       // Where it lands on the wall, against the line it came in on.
       const glm::dvec3 landing = out->origin + out->dir * out->t;
       const glm::dvec3 rel = landing - o;
       const double shift = glm::length(rel - d * glm::dot(rel, d));
-      const double theta_t = std::asin(std::sin(theta) / double(eta));
       const double analytic = thickness * std::sin(theta - theta_t) / std::cos(theta_t);
       // Each face's offset ε along the normal moves the path by at most ε (tan θ + tan θt) cos θ.
       const double eps = Structures::offset(accel);
@@ -153,18 +162,39 @@ TEST_CASE(
   }
 }
 
-TEST_CASE("The weights of a ray's tree never sum above its own, and a child carries its share") {
-  // Half-mirror half-glass slab (a = 0.4, t = 0.5): all three shares are non-zero, and rays
-  // bounce between the faces until the 1/512 cut-off or the iteration limit ends them.
+TEST_CASE(
+    "The weights of a ray's tree: each child carries R, 1 - R or the reflectance of its parent, "
+    "and they sum to the parent's exactly where no cut-off applies") {
+  // Half-mirror half-glass slab (a = 0.4, t = 0.5, n = 1.7) over a wall that reflects 0.3: all
+  // three shares are non-zero, and rays bounce between the faces until the 1/512 cut-off or the
+  // iteration limit ends them. The faces are parallel, so every glass hit of one camera ray
+  // meets its face at theta from air or at theta_t from glass, with the same Fresnel F (Stokes).
+  // F by hand at normal incidence, 45 degrees and Brewster's angle (test_optics.cpp works these
+  // forms out), and from Fresnel's sine and tangent form at 1.3 rad; never from optics::meet.
   Scene s = slab_scene(0.5, 1.7f);
   s.materials[0].transmission = 0.5f;
   s.materials[0].reflect = 0.4f;
   s.materials[1].reflect = 0.3f;  // the wall reflects too
   const Structures st(std::move(s));
+  const double n = double(1.7f), pi = std::numbers::pi;
+  const double q = std::sqrt(2 * n * n - 1), rs45 = (1 - q) / (1 + q);
+  const double brewster = std::atan(n);
+  auto fresnel = [&](double theta) {
+    if (theta == 0.0) return (n - 1) * (n - 1) / ((n + 1) * (n + 1));
+    if (theta == pi / 4) return 0.5 * (rs45 * rs45 + rs45 * rs45 * rs45 * rs45);
+    if (theta == brewster) return 0.5 * std::pow((n * n - 1) / (n * n + 1), 2);  // no p term
+    const double theta_t = std::asin(std::sin(theta) / n);
+    const double rs = std::sin(theta - theta_t) / std::sin(theta + theta_t);
+    const double rp = std::tan(theta - theta_t) / std::tan(theta + theta_t);
+    return 0.5 * (rs * rs + rp * rp);
+  };
+  const double min_weight = kernels::ReflectedRays{}.min_weight;
+  int exact_sums = 0, cut = 0;
   for (const int bounces : {0, 1, 3, 12}) {
     CAPTURE(bounces);
-    for (const double theta : {0.0, 0.5, 1.3}) {
+    for (const double theta : {0.0, pi / 4, brewster, 1.3}) {
       CAPTURE(theta);
+      const double f = fresnel(theta);
       const glm::dvec3 d(std::sin(theta), 0.0, -std::cos(theta));
       const std::vector<CpuRay> tree =
           host::cpu_ray_tree(st.scene, st.all()[0], options(bounces), glm::dvec3(0.0), d);
@@ -174,19 +204,54 @@ TEST_CASE("The weights of a ray's tree never sum above its own, and a child carr
       double sum = 0.0;
       for (size_t i = 0; i < tree.size(); ++i) {
         const CpuRay& r = tree[i];
+        CAPTURE(i);
         CHECK(r.depth <= bounces);
         sum += r.weight * r.local_share;
         // Its children are the rays one deeper that follow it before anything else at its depth.
         double children = 0.0;
+        const CpuRay *reflected = nullptr, *refracted = nullptr;
         for (size_t j = i + 1; j < tree.size() && tree[j].depth > r.depth; ++j)
-          if (tree[j].depth == r.depth + 1) children += tree[j].weight;
-        CHECK(children + r.weight * r.local_share <= r.weight * (1.0 + 1e-12));
-        if (r.depth > 0) CHECK(r.weight >= kernels::ReflectedRays{}.min_weight);
+          if (tree[j].depth == r.depth + 1) {
+            children += tree[j].weight;
+            CHECK(tree[j].kind != CpuRayKind::total_internal);  // parallel faces: never total
+            (tree[j].kind == CpuRayKind::refracted ? refracted : reflected) = &tree[j];
+          }
+        if (r.depth > 0) CHECK(r.weight >= min_weight);
+        // The shares by hand: glass keeps (1 - t)(1 - a) for its shading, reflects
+        // (1 - t) a + t F and refracts t (1 - F); the wall keeps 1 - a and reflects a.
+        double local = 1.0, reflect = 0.0, refract = 0.0;  // a miss: the background
+        if (r.hit >= 0) {
+          const bool glass = st.scene.material[size_t(r.hit)] == 0;
+          local = glass ? 0.5 * (1.0 - double(0.4f)) : 1.0 - double(0.3f);
+          reflect = glass ? 0.5 * double(0.4f) + 0.5 * f : double(0.3f);
+          refract = glass ? 0.5 * (1.0 - f) : 0.0;
+        }
+        CHECK(r.local_share == doctest::Approx(local).epsilon(1e-12));
+        const bool deeper = r.depth < bounces;
+        const bool keeps_reflected = deeper && reflect > 0 && r.weight * reflect >= min_weight;
+        const bool keeps_refracted = deeper && refract > 0 && r.weight * refract >= min_weight;
+        REQUIRE((reflected != nullptr) == keeps_reflected);
+        REQUIRE((refracted != nullptr) == keeps_refracted);
+        if (reflected)
+          CHECK(reflected->weight == doctest::Approx(r.weight * reflect).epsilon(1e-12));
+        if (refracted)
+          CHECK(refracted->weight == doctest::Approx(r.weight * refract).epsilon(1e-12));
+        if (r.hit < 0 || (keeps_reflected == (reflect > 0) && keeps_refracted == (refract > 0))) {
+          // No cut-off: nothing is lost between a ray and its children.
+          CHECK(children + r.weight * r.local_share == doctest::Approx(r.weight).epsilon(1e-12));
+          ++exact_sums;
+        } else {
+          CHECK(children + r.weight * r.local_share < r.weight);
+          ++cut;
+        }
       }
       CHECK(sum <= 1.0 + 1e-12);
       CHECK(sum > 0.0);
+      if (bounces == 0) CHECK(sum == doctest::Approx(tree[0].local_share).epsilon(1e-12));
     }
   }
+  CHECK(exact_sums > 50);
+  CHECK(cut > 10);
 }
 
 TEST_CASE("An opaque surface keeps the paper's shares: its reflection carries a of the weight") {

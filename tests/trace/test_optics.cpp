@@ -1,6 +1,7 @@
 // Known answers for host/trace/cpu/optics.h, the glass optics of the CPU reference tracer: Fresnel
 // at normal incidence, total internal reflection exactly at the critical angle, Snell's law, the
-// reflectance seen from both sides, and a slab's parallel displacement.
+// reflectance seen from both sides, Brewster's angle and 45 degrees (the s and p terms each by
+// hand), and a slab's parallel displacement.
 #include <doctest/doctest.h>
 
 #include <cmath>
@@ -108,5 +109,41 @@ TEST_CASE("A slab shifts a ray by d sin(theta - theta_t) / cos(theta_t) and keep
     const double theta_t = std::asin(std::sin(theta) / eta);
     CHECK(glm::length(offset) ==
           doctest::Approx(d * std::sin(theta - theta_t) / std::cos(theta_t)).epsilon(1e-13));
+  }
+}
+
+TEST_CASE("At Brewster's angle for n = 1.5 the p-polarised light is not reflected: R = 0.0740") {
+  // tan θB = n. There cos θᵢ = 1/sqrt(1 + n²) and cos θₜ = n/sqrt(1 + n²), so the s amplitude is
+  // (1 - n²)/(1 + n²) = -5/13 and the p amplitude is 0: R = (25/169)/2 = 0.073964..., half the s
+  // term alone (which would give 0.1479). The same from inside, at θ = atan(1/n).
+  const double n = 1.5;
+  const double r_s = 25.0 / 169.0;
+  CHECK(r_s == doctest::Approx(0.147929).epsilon(1e-5));
+  const optics::Interface outside = optics::meet(std::cos(std::atan(n)), 1.0 / n);
+  CHECK(outside.reflectance == doctest::Approx(r_s / 2).epsilon(1e-12));
+  CHECK(outside.reflectance == doctest::Approx(0.0740).epsilon(1e-3));
+  const optics::Interface inside = optics::meet(std::cos(std::atan(1.0 / n)), n);
+  CHECK_FALSE(inside.total);
+  CHECK(inside.reflectance == doctest::Approx(r_s / 2).epsilon(1e-12));
+}
+
+TEST_CASE(
+    "At 45 degrees from air into n = 1.5 the reflectance is 0.0502, the s and p terms by hand") {
+  // cos θᵢ = 1/sqrt(2), n cos θₜ = sqrt(n² - 1/2): the s amplitude is (1 - q)/(1 + q) with
+  // q = sqrt(2n² - 1) = sqrt(3.5), and at 45 degrees the p amplitude is the s amplitude squared
+  // (Abelès): R_s = 0.0920134, R_p = 0.0084665, R = (R_s + R_p)/2 = 0.0502399.
+  const double q = std::sqrt(3.5);
+  const double rs = (1.0 - q) / (1.0 + q);
+  const double expected = 0.5 * (rs * rs + rs * rs * rs * rs);
+  CHECK(expected == doctest::Approx(0.0502399).epsilon(1e-6));
+  const optics::Interface f = optics::meet(std::cos(std::numbers::pi / 4), 1.0 / 1.5);
+  CHECK(f.reflectance == doctest::Approx(expected).epsilon(1e-12));
+  // The textbook angle form, Fresnel's sines and tangents, at a few more angles.
+  for (const double theta : {0.2, 0.7, 1.2, 1.5}) {
+    const double theta_t = std::asin(std::sin(theta) / 1.5);
+    const double s = std::sin(theta - theta_t) / std::sin(theta + theta_t);
+    const double p = std::tan(theta - theta_t) / std::tan(theta + theta_t);
+    CHECK(optics::meet(std::cos(theta), 1.0 / 1.5).reflectance ==
+          doctest::Approx(0.5 * (s * s + p * p)).epsilon(1e-12));
   }
 }

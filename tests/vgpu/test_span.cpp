@@ -53,6 +53,29 @@ struct AddChain {
   }
 };
 
+// Two paths an iteration that meet at the end: one fetch (from the carried coordinate), and
+// twenty dependent additions; their sum is selected and the loop's mask follows.
+struct FetchOrTwenty {
+  static constexpr const char* name = "fetch or twenty";
+  static constexpr const char* paper_name = "-";
+  static constexpr int outputs = 1;
+  template <class L>
+  void operator()(Fragments<L>& f) const {
+    using F = typename L::F;
+    using M = typename L::M;
+    const Vec4<F> s = f.fetch_own(0);
+    F u = s.x;
+    f.loop(8, s.w > F(0.0f), [&](const M& act) {
+      const F a = f.fetch(0, u, F(0.5f)).x;
+      F z = u;
+      for (int i = 0; i < 20; ++i) z = z + F(1.0f);
+      u = select(act, a + z, u);
+      return act;
+    });
+    f.out(0) = {u, u, u, u};
+  }
+};
+
 struct NoLoop {
   static constexpr const char* name = "no loop";
   static constexpr const char* paper_name = "-";
@@ -96,6 +119,56 @@ TEST_CASE("the weight of a fetch decides which path is the longest") {
   const LoopChain light = loop_chain(p.record(), 1);
   CHECK(heavy.fetches * 100 + heavy.operations == 204);
   CHECK(light.fetches + light.operations == 6);
+}
+
+TEST_CASE(
+    "the weight of a fetch decides which of two paths is the longest: one fetch against twenty "
+    "additions, the winner flips past a weight of 21") {
+  // Issue in order from time 0, one unit each: the fetch issues at 1 and is ready at 1 + W; the
+  // first addition issues at 2 (after the fetch), each next one when its operand is ready, the
+  // twentieth ready at 22. The sum issues at max(22, 1 + W); it, the select and the mask are one
+  // unit each. W > 21: the end waits for the fetch, 1 fetch and 4 units (its issue, the sum,
+  // the select, the mask). W < 21: it waits for the additions, no fetch and 25 units.
+  KernelProgram<FetchOrTwenty> p;
+  const Recording r = p.record();
+  for (const int w : {22, 50, 100}) {
+    CAPTURE(w);
+    const LoopChain c = loop_chain(r, w);
+    CHECK(c.fetches == 1);
+    CHECK(c.operations == 4);
+  }
+  for (const int w : {1, 10, 20}) {
+    CAPTURE(w);
+    const LoopChain c = loop_chain(r, w);
+    CHECK(c.fetches == 0);
+    CHECK(c.operations == 25);
+  }
+}
+
+TEST_CASE("a looping pass with a fetch on its longest path counts a fetch per iteration") {
+  // FetchOrTwenty at the default weight (100): 1 fetch and 4 units an iteration; every lane with
+  // w > 0 runs all 8 iterations (its body keeps the mask), the lanes with w = 0 none.
+  Texture in("start", 16, 1, 4);
+  for (int x = 0; x < 16; ++x) in.set(x, 0, 3, x % 4 == 1 ? 1.0f : 0.0f);
+  KernelProgram<FetchOrTwenty> p;
+  const Program::Analysis a = p.analyze();
+  CHECK(a.loop.chain_fetches == 1);
+  CHECK(a.loop.chain_operations == 4);
+  for (int lanes : {1, 8}) {
+    CAPTURE(lanes);
+    Gpu gpu(profile("rtx4090"), 1, lanes);
+    Texture out("out", 16, 1, 4);
+    gpu.use_program(p);
+    gpu.bind_texture(0, in);
+    gpu.set_targets({&out});
+    const PassRecord rec = gpu.draw();
+    CHECK(rec.counters.loop_span_iterations == 8);
+    CHECK(rec.counters.loop_span_fetches == 8);
+    CHECK(rec.counters.loop_span_operations == 8 * 4);
+    // Every iteration of the 4 running lanes fetched its texel: 32 fetches in the loop, and
+    // one fetch_own per fragment before it.
+    CHECK(rec.counters.texture_fetches == 16 + 4 * 8);
+  }
 }
 
 TEST_CASE("a program without a loop has no chain, and analyze fills it for one with a loop") {

@@ -462,6 +462,10 @@ def textured_cases():
     # KHR_texture_transform: u + 0.5 (and REPEAT would wrap; CLAMP_TO_EDGE is what the sampler says).
     b, d = textured_quad({"uri": png_uri}, transform={"offset": [0.5, 0], "scale": [2, 1]})
     write_gltf("textured_transform.gltf", d, b.bin)
+    # A quarter turn and an offset, as the extension's own example: uv' = (v, 1 - u), the image
+    # turned clockwise on the quad (tests/trace/test_textures.cpp checks the corners' texels).
+    b, d = textured_quad({"uri": png_uri}, transform={"offset": [0, 1], "rotation": math.pi / 2})
+    write_gltf("textured_rotation.gltf", d, b.bin)
     # Bad: a missing file, bytes that are no image, a PNG cut short, a TEXCOORD_0 of VEC3.
     b, d = textured_quad({"uri": "no_such_texture.png"})
     write_gltf("texture_missing.gltf", d, b.bin)
@@ -641,6 +645,39 @@ def two_animations_case():
         "asset", "buffers", "bufferViews", "accessors")}), b.bin)
 
 
+def animated_normals_case():
+    # A quad in the plane z = 0 whose file normals lean away from the face normal (+Z), on a node
+    # that turns an eighth of a turn about +Z per second while stretching along its own x (scale
+    # (1, 1, 1) to (3, 1, 1) over [0, 2] s). A stretch changes normals by the inverse transpose,
+    # not by the matrix itself: tests/trace/test_animation_frames.cpp and
+    # tests/scene/test_animation.cpp compare the posed normals with ones made by hand.
+    b = Builder()
+    n = [(-0.6, 0, 0.8), (0.6, 0, 0.8), (0, 0.6, 0.8), (0, -0.6, 0.8)]
+    quad = {"attributes": {"POSITION": b.vec3([(-1, -1, 0), (1, -1, 0), (1, 1, 0), (-1, 1, 0)]),
+                           "NORMAL": b.vec3(n)},
+            "indices": b.indices([0, 1, 2, 0, 2, 3])}
+    s = math.sqrt(0.5)
+    tilt = {"name": "tilt", "samplers": [
+        {"input": floats(b, [0, 2], "SCALAR"),
+         "output": floats(b, [(0, 0, 0, 1), (0, 0, s, s)], "VEC4")},
+        {"input": floats(b, [0, 2], "SCALAR"),
+         "output": floats(b, [(1, 1, 1), (3, 1, 1)], "VEC3")}],
+        "channels": [{"sampler": 0, "target": {"node": 0, "path": "rotation"}},
+                     {"sampler": 1, "target": {"node": 0, "path": "scale"}}]}
+    nodes = [
+        {"name": "pane", "mesh": 0},
+        {"name": "camera", "camera": 0, "translation": [0, 0, 6]},
+        {"name": "light", "translation": [1, 2, 5], "extensions": {"KHR_lights_punctual": {"light": 0}}},
+    ]
+    d = b.doc(scene=0, scenes=[{"nodes": [0, 1, 2]}], nodes=nodes,
+              meshes=[{"primitives": [quad]}],
+              cameras=[{"type": "perspective", "perspective": {"yfov": 0.7, "znear": 0.1}}],
+              extensionsUsed=["KHR_lights_punctual"],
+              extensions={"KHR_lights_punctual": {"lights": [{"type": "point", "intensity": 1}]}},
+              animations=[tilt])
+    write_gltf("animated_normals.gltf", d, b.bin)
+
+
 if __name__ == "__main__":
     textured_cases()
     triangle_cases()
@@ -660,3 +697,4 @@ if __name__ == "__main__":
     modes_case()
     bad_cases()
     animated_case()
+    animated_normals_case()
