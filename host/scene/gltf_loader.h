@@ -33,7 +33,7 @@ struct LoadOptions {
   // Scene::textures_fitted; 0: keep every image as decoded. Either way an image whose header
   // passes kMaxDecodedImageBytes is refused before it is decoded.
   int fit_textures = 0;
-  std::string fit_for;
+  std::string fit_for{};
   // Parse the file's animations too (host/scene/animation.h); load_scene never uses them.
   bool animations = false;
 };
