@@ -223,9 +223,8 @@ class TextureReader {
     std::string fitted;
     for (size_t i = 0; i < images_.size(); ++i) {
       SceneTexture& t = scene_.textures[i];
-      decode(std::move(bytes[i]), t);
-      const glm::ivec2 from(t.width, t.height);
-      for (int k = 0; k < halvings[i]; ++k) {
+      const glm::ivec2 from = decode(std::move(bytes[i]), t, halvings[i] > 0);
+      for (int k = halvings[i] > 0 ? 1 : 0; k < halvings[i]; ++k) {
         t.texels = halve(t.texels, t.width, t.height);
         t.width = std::max(1, t.width / 2);
         t.height = std::max(1, t.height / 2);
@@ -286,8 +285,10 @@ class TextureReader {
     return bytes;
   }
 
-  // Decodes `bytes` into t's texels, linear RGBA.
-  void decode(std::vector<unsigned char> bytes, SceneTexture& t) const {
+  // Decodes `bytes` into t's texels, linear RGBA, halved once on the way where `halved` (level
+  // 1 made from the decoder's texels: the full-size RGBA floats are never held). Returns the
+  // image's own size.
+  glm::ivec2 decode(std::vector<unsigned char> bytes, SceneTexture& t, bool halved) const {
     const std::string& name = t.name;
     if (!options_.read_image)
       fail(path_, name + ": no image decoder was given (LoadOptions::read_image)");
@@ -301,17 +302,26 @@ class TextureReader {
     if (px.width <= 0 || px.height <= 0 || px.channels <= 0 ||
         px.pixels.size() != size_t(px.width) * size_t(px.height) * size_t(px.channels))
       fail(path_, name + ": the decoder returned no texels");
-    t.width = px.width;
-    t.height = px.height;
-    t.texels.resize(size_t(px.width) * size_t(px.height));
     const int ch = px.channels;
-    for (size_t i = 0; i < t.texels.size(); ++i) {
+    auto linear = [&](size_t i) {
       const float* p = px.pixels.data() + i * size_t(ch);
       const glm::vec3 rgb = ch >= 3 ? glm::vec3(p[0], p[1], p[2]) : glm::vec3(p[0]);
       const float a = ch == 2 ? p[1] : ch >= 4 ? p[3] : 1.0f;
-      t.texels[i] =
-          glm::vec4(srgb_to_linear(rgb.r), srgb_to_linear(rgb.g), srgb_to_linear(rgb.b), a);
+      return glm::vec4(srgb_to_linear(rgb.r), srgb_to_linear(rgb.g), srgb_to_linear(rgb.b), a);
+    };
+    if (halved) {
+      t.texels =
+          halve_from([&](int x, int y) { return linear(size_t(y) * size_t(px.width) + size_t(x)); },
+                     px.width, px.height);
+      t.width = std::max(1, px.width / 2);
+      t.height = std::max(1, px.height / 2);
+    } else {
+      t.width = px.width;
+      t.height = px.height;
+      t.texels.resize(size_t(px.width) * size_t(px.height));
+      for (size_t i = 0; i < t.texels.size(); ++i) t.texels[i] = linear(i);
     }
+    return {px.width, px.height};
   }
 
   const std::string& path_;

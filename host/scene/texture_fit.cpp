@@ -87,19 +87,8 @@ std::vector<int> fit_halvings(const std::vector<glm::ivec2>& bases, int max_size
 }
 
 std::vector<glm::vec4> halve(const std::vector<glm::vec4>& src, int width, int height) {
-  const int w = std::max(1, width / 2), h = std::max(1, height / 2);
-  std::vector<glm::vec4> dst(size_t(w) * size_t(h));
-  for (int j = 0; j < h; ++j)
-    for (int i = 0; i < w; ++i) {
-      glm::vec4 sum(0.0f);
-      for (int b = 0; b < 2; ++b)
-        for (int a = 0; a < 2; ++a) {
-          const int x = std::min(2 * i + a, width - 1), y = std::min(2 * j + b, height - 1);
-          sum += src[size_t(y) * size_t(width) + size_t(x)];
-        }
-      dst[size_t(j) * size_t(w) + size_t(i)] = sum * 0.25f;
-    }
-  return dst;
+  return halve_from([&](int x, int y) { return src[size_t(y) * size_t(width) + size_t(x)]; }, width,
+                    height);
 }
 
 }  // namespace host

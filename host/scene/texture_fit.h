@@ -47,4 +47,24 @@ std::vector<int> fit_halvings(const std::vector<glm::ivec2>& bases, int max_size
 // image where a side is 1. The result is max(1, width / 2) x max(1, height / 2).
 std::vector<glm::vec4> halve(const std::vector<glm::vec4>& texels, int width, int height);
 
+// The same step reading texel (x, y) through texel(x, y): the loader halves an image straight
+// from the decoder's texels, never holding the full-size RGBA floats.
+template <class Texel>
+std::vector<glm::vec4> halve_from(Texel&& texel, int width, int height) {
+  const int w = width / 2 > 1 ? width / 2 : 1, h = height / 2 > 1 ? height / 2 : 1;
+  std::vector<glm::vec4> dst(size_t(w) * size_t(h));
+  for (int j = 0; j < h; ++j)
+    for (int i = 0; i < w; ++i) {
+      glm::vec4 sum(0.0f);
+      for (int b = 0; b < 2; ++b)
+        for (int a = 0; a < 2; ++a) {
+          const int x = 2 * i + a < width ? 2 * i + a : width - 1;
+          const int y = 2 * j + b < height ? 2 * j + b : height - 1;
+          sum += texel(x, y);
+        }
+      dst[size_t(j) * size_t(w) + size_t(i)] = sum * 0.25f;
+    }
+  return dst;
+}
+
 }  // namespace host

@@ -243,6 +243,15 @@ TEST_CASE("A texture too large for the atlas is fitted: its base becomes mip lev
         "textures scaled down so that their atlas fits profile test's 8x8 texels: image 0 "
         "(image.png) 8x8 -> 4x4 (1/2 a side, mip level 1 as its base) (--textures refuse: "
         "refuse instead)");
+  // A 4-texel limit halves twice (4x4 needs 6x4, 2x2 needs 3x2): level 2, each texel the mean
+  // of four level-1 texels, e.g. (0, 0): r = (0 + 1 + 0 + 0.5) / 4, g = (0 + 0 + 1 + 1) / 4.
+  o.fit_textures = 4;
+  const host::Scene s2 = host::load_scene(path, o);
+  const host::SceneTexture& t2 = s2.textures[0];
+  REQUIRE(t2.width == 2);
+  REQUIRE(t2.height == 2);
+  CHECK(t2.texels[0] == glm::vec4(0.375f, 0.5f, 1.0f, 1.0f));
+  CHECK(t2.texels[3] == glm::vec4(0.5f, 0.5f, 1.0f, 1.0f));
   std::filesystem::remove_all(std::filesystem::path(path).parent_path());
 }
 
