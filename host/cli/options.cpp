@@ -193,6 +193,13 @@ void add_render_options(CLI::App& render, RenderArgs& a) {
                   "differentials)")
       ->check(CLI::IsMember({"nearest", "bilinear", "trilinear"}))
       ->capture_default_str();
+  render
+      .add_option("--textures", a.textures,
+                  "Base-colour textures larger than the profile's atlas holds: fit (each scaled "
+                  "down by halves, a lower mip level as its base, the largest first; one line "
+                  "says which) or refuse (the render is refused, exit 1)")
+      ->check(CLI::IsMember({"fit", "refuse"}))
+      ->capture_default_str();
   render.add_option("--shadows", a.shadows, "Shadow rays")
       ->check(CLI::IsMember(on_off))
       ->capture_default_str();

@@ -20,6 +20,7 @@ struct RenderArgs {
   int bounces = 2;
   std::string shading = "phong";
   std::string texture_filter = "trilinear";
+  std::string textures = "fit";  // --textures fit|refuse
   std::string shadows = "on";
   std::string grid = "auto";
   std::string accel = "grid";

@@ -483,8 +483,15 @@ int run_render(const RenderArgs& a, bool lanes_given, RenderOutcome* outcome,
   const std::string path = host::resolve_scene(a.scene);
   std::optional<host::AnimatedScene> animated;
   std::vector<size_t> animation;  // the animations played together
+  // Textures fitted to the profile's largest texture (docs/textures.md), whatever the engine,
+  // so that the CPU reference samples what the card would.
+  host::LoadOptions load = host::with_images();
+  if (a.textures == "fit") {
+    load.fit_textures = vgpu::profile(opt.profile).max_texture_size;
+    load.fit_for = "profile " + opt.profile;
+  }
   if (animating) {
-    animated.emplace(path, host::with_images());
+    animated.emplace(path, load);
     animation = played_animations(a, path, *animated);
     animated->check(animation);  // skinned meshes, morph-target weights: one line, exit 2
     if (plan.span_frames) {      // --frames N: over the played animations' keys
@@ -495,8 +502,9 @@ int run_render(const RenderArgs& a, bool lanes_given, RenderOutcome* outcome,
   const nlohmann::ordered_json animation_json =
       animated ? host::animation_json(animated->animations(), animation) : nullptr;
   auto pose_start = std::chrono::steady_clock::now();
-  host::Scene scene =
-      animated ? animated->at(animation, times[0]) : host::load_scene(path, host::with_images());
+  host::Scene scene = animated ? animated->at(animation, times[0]) : host::load_scene(path, load);
+  if (!scene.textures_fitted.empty())
+    std::fprintf(stderr, "vgpu-rt: %s\n", scene.textures_fitted.c_str());
   double pose_ms = animated ? host::ms_since(pose_start) : 0.0;
   const host::Scene& rest = animated ? animated->rest() : scene;  // frames a camera-less file
   const auto t0 = std::chrono::steady_clock::now();

@@ -72,6 +72,8 @@ class OpenScene {
   // The default scene flattened as load_scene() does (gltf_loader.h's rules), with local[n],
   // where set, as node n's local transform instead of the file's.
   Scene flatten(const std::vector<std::optional<glm::dmat4>>& local = {});
+  // The same, once and for the last time: the scene takes the decoded textures (no copy).
+  Scene flatten_last();
   const tinygltf::Model& model() const;
   const std::string& path() const;
   // The nodes the last flatten() walked, in walk order.

@@ -94,15 +94,23 @@ class Loader {
     Scene decoded;
     base_color_ = gltf_detail::read_textures(path_, textures, model_, options_, decoded);
     textures_ = std::move(decoded.textures);
+    textures_fitted_ = std::move(decoded.textures_fitted);
     convert_materials();
     roots_ = root_nodes();
+  }
+
+  Scene flatten_last() {
+    last_ = true;
+    return flatten({});
   }
 
   // One walk of the default scene into a new Scene; `local[n]`, where set, replaces node n's
   // own local transform. Primitives are decoded once, at their first walk.
   Scene flatten(const std::vector<std::optional<glm::dmat4>>& local) {
     scene_ = Scene{};
-    scene_.textures = textures_;
+    // The last flatten (load_scene's only one) takes the texels rather than copying them.
+    scene_.textures = last_ ? std::move(textures_) : textures_;
+    scene_.textures_fitted = textures_fitted_;
     lights_.clear();
     walked_.clear();
     invalid_file_normals_ = 0;
@@ -811,6 +819,8 @@ class Loader {
   std::map<int, std::shared_ptr<const std::vector<glm::vec2>>> uv_cache_;
   const LoadOptions options_;  // a copy: an AnimatedScene outlives the options it was given
   std::vector<SceneTexture> textures_;  // the file's base-colour textures, decoded once
+  std::string textures_fitted_;         // Scene::textures_fitted
+  bool last_ = false;                   // set by flatten_last: the flatten may take textures_
   std::vector<gltf_detail::BaseColorTexture> base_color_;  // per file material
   std::map<std::pair<size_t, size_t>, PrimitiveGeometry> primitives_;
   std::optional<uint32_t> default_material_;
@@ -840,10 +850,14 @@ std::vector<double> OpenScene::read_doubles(int accessor, const std::string& use
   return loader_->read_doubles(accessor, use, components, integers);
 }
 
+Scene OpenScene::flatten_last() {
+  return loader_->flatten_last();
+}
+
 }  // namespace gltf_detail
 
 Scene load_scene(const std::string& path, const LoadOptions& options) {
-  return gltf_detail::OpenScene(path, options).flatten();
+  return gltf_detail::OpenScene(path, options).flatten_last();
 }
 
 }  // namespace host

@@ -28,6 +28,12 @@ struct LoadOptions {
   // Unset: a file whose materials use a texture is refused (the scene room cannot decode images;
   // host/image, above it, can).
   std::function<ImagePixels(const std::vector<unsigned char>&)> read_image{};
+  // Fit the base-colour textures to an atlas at most this many texels a side (a profile's
+  // max_texture_size), by host/scene/texture_fit.h's rule, naming `fit_for` (the profile) in
+  // Scene::textures_fitted; 0: keep every image as decoded. Either way an image whose header
+  // passes kMaxDecodedImageBytes is refused before it is decoded.
+  int fit_textures = 0;
+  std::string fit_for{};
   // Parse the file's animations too (host/scene/animation.h); load_scene never uses them.
   bool animations = false;
 };

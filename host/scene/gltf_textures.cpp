@@ -17,6 +17,7 @@
 
 #include "host/scene/gltf_internal.h"
 #include "host/scene/gltf_loader.h"
+#include "host/scene/texture_fit.h"
 
 namespace host::gltf_detail {
 namespace {
@@ -99,6 +100,7 @@ class TextureReader {
           info["extensions"].contains("KHR_texture_transform"))
         transform(info["extensions"]["KHR_texture_transform"], owner, out[m]);
     }
+    decode_all();
     return out;
   }
 
@@ -185,15 +187,68 @@ class TextureReader {
     }
     const auto key = std::make_tuple(image, ws, wt);
     if (auto it = made_.find(key); it != made_.end()) return it->second;
-    SceneTexture t = decode(image, img);
+    SceneTexture t;  // decoded by decode_all, once every texture's size is known
     t.wrap_s = ws;
     t.wrap_t = wt;
     scene_.textures.push_back(std::move(t));
+    images_.push_back({image, &img});
     return made_[key] = int(scene_.textures.size() - 1);
   }
 
-  SceneTexture decode(int64_t index, const json& img) const {
-    std::string name = "image " + std::to_string(index);
+  // Every used image's bytes and header size first: an image past kMaxDecodedImageBytes is
+  // refused before any is decoded, and the fitting rule (texture_fit.h) decides each
+  // texture's halvings from the sizes alone. Then each image is decoded, halved, and its
+  // bytes and full-size texels let go before the next.
+  void decode_all() {
+    std::vector<std::vector<unsigned char>> bytes(images_.size());
+    std::vector<glm::ivec2> sizes(images_.size(), glm::ivec2(1));
+    for (size_t i = 0; i < images_.size(); ++i) {
+      SceneTexture& t = scene_.textures[i];
+      bytes[i] = image_bytes(images_[i].first, *images_[i].second, t.name);
+      if (const auto size = image_header_size(bytes[i])) {
+        const uint64_t texels = uint64_t(size->x) * uint64_t(size->y);
+        if (texels > kMaxDecodedImageBytes / kDecodedBytesPerTexel)
+          fail(path_, t.name + ": its header says " + std::to_string(size->x) + "x" +
+                          std::to_string(size->y) + " texels, " +
+                          std::to_string(texels * kDecodedBytesPerTexel >> 20) +
+                          " MiB decoded, past the loader's bound of " +
+                          std::to_string(kMaxDecodedImageBytes >> 20) +
+                          " MiB (8192x8192); scale the image down");
+        sizes[i] = *size;
+      }
+    }
+    const int fit = options_.fit_textures;
+    const std::vector<int> halvings =
+        fit > 0 ? fit_halvings(sizes, fit) : std::vector<int>(sizes.size(), 0);
+    std::string fitted;
+    for (size_t i = 0; i < images_.size(); ++i) {
+      SceneTexture& t = scene_.textures[i];
+      const glm::ivec2 from = decode(std::move(bytes[i]), t, halvings[i] > 0);
+      for (int k = halvings[i] > 0 ? 1 : 0; k < halvings[i]; ++k) {
+        t.texels = halve(t.texels, t.width, t.height);
+        t.width = std::max(1, t.width / 2);
+        t.height = std::max(1, t.height / 2);
+      }
+      if (halvings[i] > 0)
+        fitted += std::string(fitted.empty() ? "" : "; ") + t.name + " " + size_text(from) +
+                  " -> " + size_text({t.width, t.height}) + " (1/" +
+                  std::to_string(1 << halvings[i]) + " a side, mip level " +
+                  std::to_string(halvings[i]) + " as its base)";
+    }
+    if (!fitted.empty())
+      scene_.textures_fitted = "textures scaled down so that their atlas fits " + options_.fit_for +
+                               "'s " + std::to_string(fit) + "x" + std::to_string(fit) +
+                               " texels: " + fitted + " (--textures refuse: refuse instead)";
+  }
+
+  static std::string size_text(glm::ivec2 s) {
+    return std::to_string(s.x) + "x" + std::to_string(s.y);
+  }
+
+  // Image `index`'s encoded bytes (a data URI, a file beside the .gltf or a buffer view);
+  // `name` gets its message name, e.g. "image 0 (duck.png)".
+  std::vector<unsigned char> image_bytes(int64_t index, const json& img, std::string& name) const {
+    name = "image " + std::to_string(index);
     std::vector<unsigned char> bytes;
     if (img.contains("uri") && img["uri"].is_string()) {
       const std::string uri = img["uri"].get<std::string>();
@@ -227,31 +282,46 @@ class TextureReader {
     } else {
       fail(path_, name + " has neither a uri nor a bufferView");
     }
+    return bytes;
+  }
+
+  // Decodes `bytes` into t's texels, linear RGBA, halved once on the way where `halved` (level
+  // 1 made from the decoder's texels: the full-size RGBA floats are never held). Returns the
+  // image's own size.
+  glm::ivec2 decode(std::vector<unsigned char> bytes, SceneTexture& t, bool halved) const {
+    const std::string& name = t.name;
     if (!options_.read_image)
       fail(path_, name + ": no image decoder was given (LoadOptions::read_image)");
     ImagePixels px;
     try {
       px = options_.read_image(bytes);
+      std::vector<unsigned char>().swap(bytes);
     } catch (const std::exception& e) {
       fail(path_, name + ": cannot read the image: " + e.what());
     }
     if (px.width <= 0 || px.height <= 0 || px.channels <= 0 ||
         px.pixels.size() != size_t(px.width) * size_t(px.height) * size_t(px.channels))
       fail(path_, name + ": the decoder returned no texels");
-    SceneTexture t;
-    t.name = name;
-    t.width = px.width;
-    t.height = px.height;
-    t.texels.resize(size_t(px.width) * size_t(px.height));
     const int ch = px.channels;
-    for (size_t i = 0; i < t.texels.size(); ++i) {
+    auto linear = [&](size_t i) {
       const float* p = px.pixels.data() + i * size_t(ch);
       const glm::vec3 rgb = ch >= 3 ? glm::vec3(p[0], p[1], p[2]) : glm::vec3(p[0]);
       const float a = ch == 2 ? p[1] : ch >= 4 ? p[3] : 1.0f;
-      t.texels[i] =
-          glm::vec4(srgb_to_linear(rgb.r), srgb_to_linear(rgb.g), srgb_to_linear(rgb.b), a);
+      return glm::vec4(srgb_to_linear(rgb.r), srgb_to_linear(rgb.g), srgb_to_linear(rgb.b), a);
+    };
+    if (halved) {
+      t.texels =
+          halve_from([&](int x, int y) { return linear(size_t(y) * size_t(px.width) + size_t(x)); },
+                     px.width, px.height);
+      t.width = std::max(1, px.width / 2);
+      t.height = std::max(1, px.height / 2);
+    } else {
+      t.width = px.width;
+      t.height = px.height;
+      t.texels.resize(size_t(px.width) * size_t(px.height));
+      for (size_t i = 0; i < t.texels.size(); ++i) t.texels[i] = linear(i);
     }
-    return t;
+    return {px.width, px.height};
   }
 
   const std::string& path_;
@@ -260,6 +330,7 @@ class TextureReader {
   const LoadOptions& options_;
   Scene& scene_;
   std::map<std::tuple<int64_t, WrapMode, WrapMode>, int> made_;
+  std::vector<std::pair<int64_t, const json*>> images_;  // per texture: its image, to decode
 };
 
 }  // namespace

@@ -85,6 +85,9 @@ struct Scene {
   // texture. A triangle whose material has none holds (0, 0).
   std::vector<glm::vec2> uv0, uv1, uv2;
   std::vector<SceneTexture> textures;
+  // One line saying which textures were scaled down to fit the profile and by how much
+  // (LoadOptions::fit_textures); empty when none was.
+  std::string textures_fitted;
   std::optional<Camera> camera;       // first camera node met depth-first, if any
   std::vector<PointLight> lights;     // KHR_lights_punctual point lights, or the default light
   bool default_light = false;         // true when lights holds the documented default

@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "host/scene/texture_fit.h"
+
 namespace host {
 
 MipChain build_mip_chain(const SceneTexture& texture) {
@@ -14,49 +16,20 @@ MipChain build_mip_chain(const SceneTexture& texture) {
     MipChain::Level dst;
     dst.width = std::max(1, src.width / 2);
     dst.height = std::max(1, src.height / 2);
-    dst.texels.resize(size_t(dst.width) * size_t(dst.height));
-    for (int j = 0; j < dst.height; ++j)
-      for (int i = 0; i < dst.width; ++i) {
-        glm::vec4 sum(0.0f);
-        for (int b = 0; b < 2; ++b)
-          for (int a = 0; a < 2; ++a) {
-            const int x = std::min(2 * i + a, src.width - 1),
-                      y = std::min(2 * j + b, src.height - 1);
-            sum += src.texels[size_t(y) * size_t(src.width) + size_t(x)];
-          }
-        dst.texels[size_t(j) * size_t(dst.width) + size_t(i)] = sum * 0.25f;
-      }
+    dst.texels = halve(src.texels, src.width, src.height);  // the fitting's filter too
     chain.levels.push_back(std::move(dst));
   }
   return chain;
 }
 
 TextureAtlas pack_atlas(const std::vector<MipChain>& chains, int max_width) {
+  std::vector<glm::ivec2> bases;
+  for (const MipChain& c : chains) bases.push_back({c.levels[0].width, c.levels[0].height});
+  AtlasLayout layout = layout_atlas(bases, max_width);  // the fitting's layout too
   TextureAtlas atlas;
-  int x = 0, y = 0, shelf = 0;
-  for (const MipChain& c : chains) {
-    const auto& l = c.levels;
-    int stack = 0;
-    for (size_t k = 1; k < l.size(); ++k) stack += l[k].height;
-    const int w = l[0].width + (l.size() > 1 ? l[1].width : 0);
-    const int h = std::max(l[0].height, stack);
-    if (x > 0 && x + w > max_width) {
-      y += shelf;
-      x = 0;
-      shelf = 0;
-    }
-    std::vector<glm::ivec4> rects{{x, y, l[0].width, l[0].height}};
-    int ly = y;
-    for (size_t k = 1; k < l.size(); ++k) {
-      rects.push_back({x + l[0].width, ly, l[k].width, l[k].height});
-      ly += l[k].height;
-    }
-    atlas.rects.push_back(std::move(rects));
-    x += w;
-    shelf = std::max(shelf, h);
-    atlas.width = std::max(atlas.width, x);
-  }
-  atlas.height = y + shelf;
+  atlas.width = layout.width;
+  atlas.height = layout.height;
+  atlas.rects = std::move(layout.rects);
   atlas.texels.assign(size_t(atlas.width) * size_t(atlas.height), glm::vec4(0.0f));
   for (size_t t = 0; t < chains.size(); ++t)
     for (size_t k = 0; k < chains[t].levels.size(); ++k) {

@@ -441,6 +441,36 @@ TEST_CASE("a texture that cannot be read or a UV accessor of the wrong type: one
   }
 }
 
+TEST_CASE(
+    "a texture past the profile's atlas is fitted by default and refused as before with "
+    "--textures refuse") {
+  // A 2048x2048 PNG (18 KB, left half red, right half blue): its chain needs a 3072x2048 atlas,
+  // past r300's 2048. r300 cannot run the textured shader, so the fitted render runs on the CPU
+  // engine (the fit follows --profile on every engine); the refusal is the stream engine's.
+  const std::string scene = std::string(VGPU_TEST_DATA) + "/gltf/texture_2048.gltf";
+  const fs::path out = fresh_dir("textures") / "fit.png";
+  const Outcome fit = run("render " + scene + " -q --stats none --size 8x8 --profile r300 " +
+                          "--engine cpu --out " + out.string());
+  INFO(fit.err);
+  CHECK(fit.status == 0);
+  CHECK(fs::exists(out));
+  CHECK(std::count(fit.err.begin(), fit.err.end(), '\n') == 1);
+  CHECK(fit.err ==
+        "vgpu-rt: textures scaled down so that their atlas fits profile r300's 2048x2048 texels: "
+        "image 0 (texture_2048.png) 2048x2048 -> 1024x1024 (1/2 a side, mip level 1 as its base) "
+        "(--textures refuse: refuse instead)\n");
+  fs::remove(out);
+  // The refusal keeps its message and exit status (1: the profile cannot, the file is sound).
+  const Outcome refuse = run("render " + scene + " -q --stats none --size 8x8 --profile r300 " +
+                             "--textures refuse --out " + out.string());
+  CHECK(refuse.status == 1);
+  check_one_line(refuse, "the scene's textures need a 3072x2048 atlas (mip chains included)",
+                 "profile r300 holds at most 2048x2048 texels in one texture");
+  CHECK_FALSE(fs::exists(out));
+  check_refused("--textures shrink", "--textures", "shrink not in {fit,refuse}");
+  fs::remove_all(out.parent_path());
+}
+
 TEST_CASE("a textured glb renders through the CLI, its JSON naming the textures and the filter") {
   const std::string id = std::to_string(::getpid());
   const fs::path out = fs::temp_directory_path() / ("vgpu_cli_duck_" + id + ".png"),

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "host/scene/texture_fit.h"
 #include "host/trace/textures.h"
 
 namespace host {
@@ -14,32 +15,46 @@ void upload_texture_atlas(vgpu::Device& gpu, const Scene& scene, int scene_width
   const int maxs = gpu.profile().max_texture_size;
   const int sw = scene_width, sh = scene_height;
   const size_t ntri = scene.triangle_count();
-  std::vector<MipChain> chains;
-  size_t levels = 0;
-  for (const SceneTexture& t : scene.textures) {
-    chains.push_back(build_mip_chain(t));
-    levels = std::max(levels, chains.back().levels.size());
-  }
-  const TextureAtlas atlas = pack_atlas(chains, maxs);
-  const std::string why = atlas_refusal(atlas, scene.textures.size(), maxs, gpu.profile().name);
+  // The layout from the sizes alone (pack_atlas's, host/scene/texture_fit.h), then each
+  // chain's levels written straight into the atlas texture, one level kept at a time: no
+  // chain and no second atlas is held beside it (the texels are pack_atlas's, bit for bit).
+  std::vector<glm::ivec2> bases;
+  for (const SceneTexture& t : scene.textures) bases.push_back({t.width, t.height});
+  TextureAtlas size;
+  AtlasLayout layout = layout_atlas(bases, maxs);
+  size.width = layout.width;
+  size.height = layout.height;
+  const std::string why = atlas_refusal(size, scene.textures.size(), maxs, gpu.profile().name);
   if (!why.empty()) throw vgpu::Error(why);
-  out.atlas = gpu.make_texture("texture atlas", atlas.width, atlas.height, 4);
-  for (int y = 0; y < atlas.height; ++y)
-    for (int x = 0; x < atlas.width; ++x) {
-      const glm::vec4& c = atlas.texels[size_t(y) * size_t(atlas.width) + size_t(x)];
-      float* t = out.atlas.texel_mut(x, y);
-      for (int k = 0; k < 4; ++k) t[k] = c[k];
+  out.atlas = gpu.make_texture("texture atlas", layout.width, layout.height, 4);
+  size_t levels = 0;
+  for (size_t i = 0; i < scene.textures.size(); ++i) {
+    const SceneTexture& t = scene.textures[i];
+    const std::vector<glm::ivec4>& rects = layout.rects[i];
+    levels = std::max(levels, rects.size());
+    std::vector<glm::vec4> level;  // level k >= 1; level 0 is read from the scene
+    for (size_t k = 0; k < rects.size(); ++k) {
+      if (k > 0) level = halve(k == 1 ? t.texels : level, rects[k - 1].z, rects[k - 1].w);
+      const std::vector<glm::vec4>& src = k == 0 ? t.texels : level;
+      const glm::ivec4 r = rects[k];
+      for (int y = 0; y < r.w; ++y)
+        for (int x = 0; x < r.z; ++x) {
+          const glm::vec4& c = src[size_t(y) * size_t(r.z) + size_t(x)];
+          float* d = out.atlas.texel_mut(r.x + x, r.y + y);
+          for (int c4 = 0; c4 < 4; ++c4) d[c4] = c[c4];
+        }
     }
+  }
   // The table: per image (row i), its level count and wrap modes, then each level's rectangle.
-  out.table = gpu.make_texture("texture table", int(1 + levels), int(chains.size()), 4);
-  for (size_t i = 0; i < chains.size(); ++i) {
+  out.table = gpu.make_texture("texture table", int(1 + levels), int(bases.size()), 4);
+  for (size_t i = 0; i < bases.size(); ++i) {
     float* head = out.table.texel_mut(0, int(i));
-    head[0] = float(chains[i].levels.size());
+    head[0] = float(layout.rects[i].size());
     head[1] = float(scene.textures[i].wrap_s);
     head[2] = float(scene.textures[i].wrap_t);
-    for (size_t k = 0; k < chains[i].levels.size(); ++k) {
+    for (size_t k = 0; k < layout.rects[i].size(); ++k) {
       float* r = out.table.texel_mut(int(1 + k), int(i));
-      for (int c = 0; c < 4; ++c) r[c] = float(atlas.rects[i][k][c]);
+      for (int c = 0; c < 4; ++c) r[c] = float(layout.rects[i][k][c]);
     }
   }
   out.uvs01 = gpu.make_texture("uvs01", sw, sh, 4);
