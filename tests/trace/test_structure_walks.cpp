@@ -102,7 +102,7 @@ TEST_CASE_TEMPLATE("the walk gives the grid walk's hit ids on every bundled scen
   for (const auto& [name, path] : scenes) {
     CAPTURE(std::string(name));
     const Structures s = test_support::bundled_structures(T::kind, name, 48, 48);
-    crowded += s.g2().crowded;
+    if (const host::Grid2* g2 = s.accel().grid2()) crowded += g2->crowded;
     const host::RenderOptions opt = options(48, 48);
     const host::RenderResult g = stream(s.scene, s.grid_accel(), s.camera, opt);
     const host::RenderResult k = stream(s.scene, s.accel(), s.camera, opt);
