@@ -161,6 +161,19 @@ py::dict profile_dict(const vgpu::Profile& p) {
   d["bus_mbps"] = p.bus_mbps;
   d["max_outputs"] = p.max_outputs;
   d["max_loop_iterations"] = p.max_loop_iterations;
+  // What the cost model prices with (host/model/cost_model.cpp): the arithmetic, texture and
+  // fixed-cost figures, and whether batches of idle fragments can skip a branch's body.
+  d["display"] = p.display;
+  d["pipelines"] = p.pipelines;
+  d["alu_lanes"] = p.alu_lanes;
+  d["alu_per_clock"] = p.alu_per_clock;
+  d["fp32_rate"] = p.fp32_rate;
+  d["texels_per_clock"] = p.texels_per_clock;
+  d["pass_us"] = p.pass_us;
+  d["program_load_us"] = p.program_load_us;
+  d["readback_us"] = p.readback_us;
+  d["dynamic_branching"] = p.branching == vgpu::Branching::dynamic;
+  d["branch_granularity"] = p.branch_granularity;
   return d;
 }
 
@@ -293,6 +306,12 @@ struct PassEvent {
   vgpu::Counters counters, frame_totals;
   std::optional<uint64_t> query;
   std::vector<float> texels;
+  // Per pixel of the target, row by row (empty: not known for this pass). work: the fragments
+  // with work before the pass (the stencil it ran under; empty when every fragment ran); written:
+  // the fragments a counting pass's query counted; iterations: a looping pass's loop count.
+  int mask_width = 0, mask_height = 0;
+  std::vector<uint8_t> work, written;
+  std::vector<uint32_t> iterations;
 };
 
 class PassStepper final : public host::PassObserver {
@@ -346,7 +365,15 @@ class PassStepper final : public host::PassObserver {
     flush();
     trace_.clear();
   }
-  void pass_begin(const vgpu::Stencil*) override { flush(); }
+  void pass_begin(const vgpu::Stencil* mask) override {
+    flush();
+    work_.clear();
+    if (mask) {
+      work_w_ = mask->width();
+      work_h_ = mask->height();
+      work_.assign(mask->row(0), mask->row(0) + size_t(work_w_) * size_t(work_h_));
+    }
+  }
   void pass(const Pass& p) override {
     flush();
     PassEvent e;
@@ -362,12 +389,21 @@ class PassStepper final : public host::PassObserver {
     e.counters = p.record.counters;
     e.frame_totals = p.stats.totals;
     e.texels.assign(p.target.data().begin(), p.target.data().end());
+    // The masks are kept only where they cover the target texel for texel (the looping kernels'
+    // one-fragment passes and the sampling modes' smaller targets are left without).
+    if (!work_.empty() && work_w_ == e.width && work_h_ == e.height) e.work = std::move(work_);
+    work_.clear();
+    if (p.loop_iterations.size() == size_t(e.width) * size_t(e.height))
+      e.iterations.assign(p.loop_iterations.begin(), p.loop_iterations.end());
     pending_ = std::move(e);
   }
-  void query(uint64_t result, const vgpu::Stencil*, const vgpu::FrameStats& s) override {
+  void query(uint64_t result, const vgpu::Stencil* written, const vgpu::FrameStats& s) override {
     if (pending_) {
       pending_->query = result;
       pending_->frame_totals = s.totals;  // the read-back counted
+      if (written && written->width() == pending_->width && written->height() == pending_->height)
+        pending_->written.assign(
+            written->row(0), written->row(0) + size_t(pending_->width) * size_t(pending_->height));
     }
     flush();
   }
@@ -414,6 +450,8 @@ class PassStepper final : public host::PassObserver {
   int iteration_ = 0;
   std::string trace_;  // empty outside a trace (the ray generator's pass)
   uint64_t count_ = 0;
+  std::vector<uint8_t> work_;  // the stencil the coming pass runs under (empty: none)
+  int work_w_ = 0, work_h_ = 0;
 };
 
 py::dict pass_dict(PassEvent&& e) {
@@ -428,6 +466,22 @@ py::dict pass_dict(PassEvent&& e) {
   d["frame_totals"] = counters_dict(e.frame_totals);
   d["query"] = e.query ? py::object(py::int_(*e.query)) : py::object(py::none());
   d["target"] = to_array(std::move(e.texels), {e.height, e.width, e.channels});
+  const auto mask = [&](std::vector<uint8_t>& m) -> py::object {
+    if (m.empty()) return py::none();
+    py::array_t<bool> a({py::ssize_t(e.height), py::ssize_t(e.width)});
+    bool* out = a.mutable_data();
+    for (size_t i = 0; i < m.size(); ++i) out[i] = m[i] != 0;
+    return py::object(std::move(a));
+  };
+  d["work"] = mask(e.work);
+  d["written"] = mask(e.written);
+  if (e.iterations.empty()) {
+    d["iterations"] = py::none();
+  } else {
+    py::array_t<uint32_t> a({py::ssize_t(e.height), py::ssize_t(e.width)});
+    std::copy(e.iterations.begin(), e.iterations.end(), a.mutable_data());
+    d["iterations"] = std::move(a);
+  }
   return d;
 }
 

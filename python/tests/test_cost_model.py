@@ -17,6 +17,20 @@ class CostModelTest(unittest.TestCase):
         for p in vgpu_rt.profiles():
             self.assertGreater(p["core_mhz"], 0)
 
+    def test_a_profile_s_fixed_costs_are_the_ones_the_model_charges(self):
+        totals = self.frame.stats["totals"]
+        for p in vgpu_rt.profiles():
+            got = vgpu_rt.predict(self.frame, p["name"])
+            self.assertAlmostEqual(got["per_pass_ms"], totals["passes"] * p["pass_us"] / 1e3,
+                                   places=6, msg=p["name"])
+            self.assertAlmostEqual(got["readback_ms"],
+                                   totals["query_readbacks"] * p["readback_us"] / 1e3, places=6,
+                                   msg=p["name"])
+            self.assertIsInstance(p["dynamic_branching"], bool)
+        by_name = {p["name"]: p for p in vgpu_rt.profiles()}
+        self.assertFalse(by_name["gf5700"]["dynamic_branching"])  # fp30: no branches
+        self.assertTrue(by_name["gf6600"]["dynamic_branching"])  # fp40
+
     def test_a_render_s_stats_are_priced_exactly_as_the_command_line_prices_them(self):
         s = self.frame.stats
         for name in s["predicted_ms"]:

@@ -78,6 +78,40 @@ class PassesTest(unittest.TestCase):
         self.assertEqual([p.kernel for p in head + rest], [p.kernel for p in self.seen])
         self.assertEqual([p.query for p in head + rest], [p.query for p in self.seen])
 
+    def test_the_pixels_a_counting_pass_wrote_are_its_query_count(self):
+        counted = [p for p in self.seen if p.written is not None]
+        self.assertGreater(len(counted), 0)
+        for p in counted:
+            self.assertEqual(p.written.shape, (16, 16))
+            self.assertEqual(p.written.dtype, np.bool_)
+            self.assertEqual(int(p.written.sum()), p.query, f"pass {p.index} {p.kernel}")
+        # The host steers by those counts: every pass that runs under a stencil runs under one
+        # a counting pass wrote before it (the rays walking, or the rays with triangles to test).
+        written = set()
+        for p in self.seen:
+            if p.work is not None:
+                self.assertIn(p.work.tobytes(), written, f"pass {p.index} {p.kernel}")
+            if p.written is not None:
+                written.add(p.written.tobytes())
+
+    def test_with_masks_each_pass_shades_the_pixels_its_stencil_marks(self):
+        seen = [p for p in vgpu_rt.passes("bunny", size="16x16", bounces=1, masks="on")
+                if p.work is not None]
+        self.assertGreater(len(seen), 0)
+        for p in seen:
+            self.assertEqual(int(p.work.sum()), p.counters["fragments_shaded"],
+                             f"pass {p.index} {p.kernel}")
+
+    def test_a_looping_pass_shows_each_pixel_s_loop_iterations(self):
+        loops = [p for p in vgpu_rt.passes("bunny", size="16x16", bounces=0, kernels="looping",
+                                           profile="gf6600") if p.iterations is not None]
+        self.assertGreater(len(loops), 0)
+        for p in loops:
+            self.assertEqual(p.iterations.shape, (16, 16))
+            self.assertEqual(int(p.iterations.sum()), p.counters["loop_iterations"])
+            self.assertEqual(int(p.iterations.max()), p.counters["loop_span_iterations"])
+            self.assertFalse(p.iterations[~p.work].any(), "no loop where the stencil is off")
+
     def test_a_frame_left_half_way_is_let_go(self):
         steps = vgpu_rt.passes("bunny", **OPTIONS)
         next(steps)

@@ -151,10 +151,17 @@ class Pass:
     iteration (from 1) and trace (primary, shadow or reflected; None outside a trace), counters (the pass's own),
     frame_totals (the frame so far), query (the fragments its occlusion query counted, or None
     when it ran without one), target_name and target, the render target's texels after the pass
-    as a (height, width, channels) float32 array (a copy: later passes rewrite the texture)."""
+    as a (height, width, channels) float32 array (a copy: later passes rewrite the texture).
+
+    The per-pixel state, as (height, width) arrays over the target (copies), as the HTML report
+    shows it: work (bool), the pixels whose fragments had work in the pass, the stencil it ran
+    under (None when it ran without one: every fragment ran); written (bool), the pixels a
+    counting pass's occlusion query counted (None for other passes); iterations (uint32), the
+    loop iterations each fragment of a looping pass ran (None without a loop)."""
 
     __slots__ = ("index", "kernel", "paper_name", "iteration", "trace", "counters",
-                 "frame_totals", "query", "target_name", "target")
+                 "frame_totals", "query", "target_name", "target", "work", "written",
+                 "iterations")
 
     def __init__(self, fields):
         for key in self.__slots__:
@@ -220,7 +227,10 @@ def scenes():
 
 def profiles():
     """The built-in hardware profiles (gf5700, r300, gf6600, rtx4090, h200), each a dict of
-    its main figures: name, core_mhz, mem_gbps, bus_mbps, max_outputs, max_loop_iterations."""
+    its main figures: name, display, core_mhz, mem_gbps, bus_mbps, max_outputs,
+    max_loop_iterations, and what the cost model prices with: pipelines, alu_lanes, alu_per_clock,
+    fp32_rate, texels_per_clock, pass_us, program_load_us, readback_us, dynamic_branching and
+    branch_granularity (fragments that branch together)."""
     return _ext.profiles()
 
 

@@ -35,6 +35,9 @@ class Pass:
     query: Optional[int]
     target_name: str
     target: _Array  # (height, width, channels)
+    work: Optional[_Array]  # (height, width) bool; None: every fragment ran
+    written: Optional[_Array]  # (height, width) bool; None outside counting passes
+    iterations: Optional[_Array]  # (height, width) uint32; None without a loop
 
 class Passes(Iterator[Pass]):
     def __init__(self, scene: Union[str, os.PathLike[str]] = ..., **options: Any) -> None: ...
