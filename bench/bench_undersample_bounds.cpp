@@ -10,6 +10,8 @@
 //   - marcarHuecos' own rule at T (keys, or colour spread > T), and its ranking (keys first, then
 //     spread, largest first) cut at exactly a third of the rays.
 // scripts/docs/sampling.py runs it (--json) for docs/sampling.md's section on these bounds.
+// --images DIR also writes, per scene and threshold, the one-ray image, the rule's image and the
+// CPU tracer's undersample:2 image as PFM files (tests/bench compares them itself).
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cmath>
@@ -17,7 +19,9 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <set>
+#include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "host/accel/grid.h"
@@ -34,6 +38,25 @@ constexpr int kStep = 2;  // the issue's K
 // A channel as the PNG stores it: clamped to [0, 1], 8 bits.
 double as_8bit(double v) {
   return std::round(std::clamp(v, 0.0, 1.0) * 255.0) / 255.0;
+}
+
+// A PFM file (portable float map: "PF", width, height, -1 for little-endian, then RGB floats
+// row by row from the bottom row up).
+bool write_pfm(const std::string& path, int w, int h, const std::vector<float>& rgb) {
+  std::ofstream f(path, std::ios::binary);
+  f << "PF\n" << w << " " << h << "\n-1.0\n";
+  for (int y = h - 1; y >= 0; --y)
+    f.write(reinterpret_cast<const char*>(rgb.data() + size_t(y) * size_t(w) * 3),
+            std::streamsize(size_t(w) * 3 * sizeof(float)));
+  return bool(f);
+}
+
+std::vector<float> to_floats(const std::vector<glm::dvec3>& c) {
+  std::vector<float> rgb;
+  rgb.reserve(c.size() * 3);
+  for (const glm::dvec3& p : c)
+    for (int k = 0; k < 3; ++k) rgb.push_back(float(p[k]));
+  return rgb;
 }
 
 bool changes(const glm::dvec3& a, const glm::dvec3& b) {
@@ -86,9 +109,11 @@ FullRender full_render(const host::Scene& scene, const host::Grid& grid, const h
   return r;
 }
 
+// `images`: a path prefix for the three images (empty: none written); throws std::runtime_error
+// if one cannot be written.
 Bound bound(const std::string& name, const host::Scene& scene, const host::Grid& grid,
             const host::Camera& camera, const host::RenderOptions& opt, const FullRender& full,
-            double threshold) {
+            double threshold, const std::string& images) {
   const int W = opt.width, H = opt.height;
   const size_t n = size_t(W) * size_t(H);
   const std::vector<glm::dvec3>& colour = full.colour;
@@ -159,6 +184,14 @@ Bound bound(const std::string& name, const host::Scene& scene, const host::Grid&
       // The tracer blends its double colours, this its float image's: equal to float rounding.
       if (std::fabs(double(under.rgb[i * 3 + size_t(c)]) - rule_image[i][c]) > 1e-5)
         b.rule_matches_tracer = false;
+  if (!images.empty()) {
+    const std::vector<float>& tracer = under.rgb;
+    for (const auto& [suffix, rgb] :
+         {std::pair{"_full.pfm", to_floats(colour)}, std::pair{"_rule.pfm", to_floats(rule_image)},
+          std::pair{"_tracer.pfm", tracer}})
+      if (!write_pfm(images + suffix, W, H, rgb))
+        throw std::runtime_error(images + suffix + ": could not be written");
+  }
   return b;
 }
 
@@ -173,12 +206,15 @@ int main(int argc, char** argv) {
                                      "bunny-low", "bunny-mirror", "hop",        "sphere-alone",
                                      "teapot",    "textured"};
   std::vector<double> thresholds = {0.1, 0.05, 0.02};
-  std::string json_path;
+  std::string json_path, images_dir;
   app.add_option("--size", size, "Image width and height")->check(CLI::Range(8, 2048));
   app.add_option("--scenes", scenes, "Bundled scene names or glTF files");
   app.add_option("--thresholds", thresholds, "--aa-threshold values")
       ->check(CLI::NonNegativeNumber);
   app.add_option("--json", json_path, "Also write the figures to this JSON file");
+  app.add_option("--images", images_dir,
+                 "Also write each scene and threshold's one-ray, rule and tracer images to this "
+                 "folder, as N_full.pfm, N_rule.pfm and N_tracer.pfm (N: the row, from 0)");
   CLI11_PARSE(app, argc, argv);
 
   std::vector<Bound> rows;
@@ -200,7 +236,14 @@ int main(int argc, char** argv) {
     const FullRender full = full_render(scene, grid, camera, opt);
     for (const double t : thresholds) {
       std::fprintf(stderr, "bench_undersample_bounds: %s, T %g\n", name.c_str(), t);
-      rows.push_back(bound(name, scene, grid, camera, opt, full, t));
+      const std::string images =
+          images_dir.empty() ? "" : images_dir + "/" + std::to_string(rows.size());
+      try {
+        rows.push_back(bound(name, scene, grid, camera, opt, full, t, images));
+      } catch (const std::runtime_error& e) {
+        std::fprintf(stderr, "bench_undersample_bounds: %s\n", e.what());
+        return 1;
+      }
     }
   }
   std::printf("%dx%d, K = %d; shares of the pixels; changed: by more than 1/255 (8-bit)\n", size,

@@ -265,6 +265,16 @@ GlDevice::GlProgram& GlDevice::program_for(const vgpu::Program& p) {
   return *r.gl;
 }
 
+GlDevice::Linked GlDevice::link(const vgpu::Program& p) {
+  ctx_->make_current();
+  const GlProgram& g = program_for(p);
+  Linked l;
+  l.samplers.assign(g.samplers.begin(), g.samplers.end());
+  for (int o = 0; o < p.outputs(); ++o)
+    l.outputs.push_back(glGetFragDataLocation(g.name, ("out" + std::to_string(o)).c_str()));
+  return l;
+}
+
 void GlDevice::dump(unsigned program, const std::string& name, const std::string& source) {
   std::string file = name;
   for (char& c : file)

@@ -66,6 +66,15 @@ class GlDevice final : public vgpu::Device {
   // source (NN_name.glsl) and the driver's program binary (NN_name.bin, glGetProgramBinary:
   // NVIDIA's holds the compiled assembly as text, instruction and register counts included).
   void dump_programs_to(const std::string& dir) { dump_dir_ = dir; }
+  // What the driver made of program p's GLSL, compiled and linked now as the first draw with it
+  // would be (tests ask this of every kernel): the location the driver gave each sampler the
+  // GLSL declares (-1: the driver found it unused and dropped it) and each output out0, out1,
+  // ... (glGetFragDataLocation; -1: the driver knows no such output). Throws vgpu::Error with
+  // the driver's log if the GLSL does not compile or link.
+  struct Linked {
+    std::vector<int> samplers, outputs;
+  };
+  Linked link(const vgpu::Program& p);
 
  private:
   struct GlTexture;

@@ -273,6 +273,57 @@ TEST_CASE(
   CHECK(bvh.sah_cost / (1.0 + 8.0 / 202.0) > 3.5);
 }
 
+TEST_CASE(
+    "--update auto refits while the refitted SAH cost stays within 1.25 times the last build's "
+    "and rebuilds past it, as two triangles move through each other") {
+  // Triangle 1 stays at [0, 1] x [0, 1] (z = 0); triangle 0, the same shape at [d, d + 1],
+  // comes in from d = 100 and passes through it. While the two leaves hold one triangle each
+  // (boxes of area 2, cost 2), the root's box is [0, d + 1] x [0, 1] x {0}, of area 2(d + 1),
+  // and the tree costs 1 + 8 / (2(d + 1)). Auto compares that with the LAST BUILD's cost (not
+  // the last refit's) and rebuilds once it passes kRefitLimit = 1.25 times it.
+  REQUIRE(host::BvhAccel::kRefitLimit == 1.25);
+  Scene s = make_scene({{{100, 0, 0}, {101, 0, 0}, {100, 1, 0}},  //
+                        {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}});
+  const auto accel = host::make_accel(host::AccelKind::bvh, s, {});
+  auto cost_at = [](double d) { return 1.0 + 8.0 / (2.0 * (d + 1.0)); };
+  REQUIRE(accel->bvh() != nullptr);
+  CHECK(accel->bvh()->sah_cost == doctest::Approx(cost_at(100)).epsilon(1e-12));  // 1.0396
+  double d_now = 100;
+  auto move_to = [&](double d) {
+    for (auto* p : {&s.p0[0], &s.p1[0], &s.p2[0]}) p->x += float(d - d_now);
+    d_now = d;
+    return accel->update(s, "auto");
+  };
+  struct Frame {
+    double d;            // triangle 0's left edge
+    const char* action;  // what auto must do
+    double cost;         // the tree's SAH cost afterwards, by hand
+  };
+  // Built at d = 100 (1.0396): d = 30: 1.1290, 1.086 times the build's: refit. d = 14: 1.2667,
+  // 1.218 times: refit (the ratio is just under the limit). d = 11: 1.3333, 1.2825 times: rebuild
+  // (a rule comparing with the last refit's 1.2667 sees 1.053 and refits); the build splits the
+  // two again (a split's 1 + 4/24 beats a leaf's 2 tests), at the same cost. d = 9: 1.4, 1.05
+  // times the new build's: refit (a rule still comparing with the first build's sees 1.347 and
+  // rebuilds). d = 0.5, the triangles overlapping: the refit's root has area 3 and costs
+  // 1 + 8/3 = 3.667, 2.75 times the build's: rebuild, and the build now keeps both triangles
+  // in one leaf (a split's 1 + 4/3 loses to a leaf's 2): 1 visit + 2 tests = 3.
+  const Frame frames[] = {{30, "refit", cost_at(30)},
+                          {14, "refit", cost_at(14)},
+                          {11, "rebuild", cost_at(11)},
+                          {9, "refit", cost_at(9)},
+                          {0.5, "rebuild", 3.0}};
+  for (const Frame& f : frames) {
+    CAPTURE(f.d);
+    CHECK(move_to(f.d) == std::string(f.action));
+    CHECK(accel->bvh()->sah_cost == doctest::Approx(f.cost).epsilon(1e-6));
+    check_invariants(s, *accel->bvh(), {}, false);
+  }
+  CHECK(accel->bvh()->nodes.size() == 1);  // the last build: one leaf of both triangles
+  // The two ratios either side of the limit, from the hand-worked costs.
+  CHECK(cost_at(14) / cost_at(100) < 1.25);
+  CHECK(cost_at(11) / cost_at(100) > 1.25);
+}
+
 TEST_CASE("a refitted BVH keeps every invariant: its boxes hold the moved triangles") {
   for (int n : {2, 17, 333}) {
     CAPTURE(n);

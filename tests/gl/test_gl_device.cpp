@@ -49,11 +49,24 @@ Frame render(const std::string& scene_name, const std::string& device, int size,
   return f;
 }
 
-// The counters a driver can know: every one but the emulator's SIMD model.
+// The counters the GL device takes from the driver: each pass's own GL_SAMPLES_PASSED gives
+// the fragments it discarded, and so the bytes it wrote (its time, device_ms, is the driver's
+// too, and differs from the emulator's by nature).
 bool same_driver_counts(const vgpu::Counters& a, const vgpu::Counters& b) {
+  return a.fragments_discarded == b.fragments_discarded && a.bytes_written == b.bytes_written;
+}
+
+// The counters the GL device copies from the emulator's analysis of the program
+// (vgpu::pass_counters: instructions, fetches, bytes read, ... per fragment drawn): equal
+// whenever the same programs draw the same rectangles from textures of the same formats,
+// whatever the driver computes. lanes_idle and the batch counters are the emulator's SIMD model
+// and stay 0 on the GL device.
+bool same_analysis_counts(const vgpu::Counters& a, const vgpu::Counters& b) {
   for (const auto& [name, field] : vgpu::kCounterFields) {
     const std::string n = name;
-    if (n == "lanes_idle" || n == "idle_in_batch32" || n == "idle_in_batch1024") continue;
+    if (n == "lanes_idle" || n == "idle_in_batch32" || n == "idle_in_batch1024" ||
+        n == "fragments_discarded" || n == "bytes_written")
+      continue;
     if (a.*field != b.*field) return false;
   }
   return true;
@@ -75,20 +88,33 @@ const int kReport = [] {
 
 }  // namespace
 
-TEST_CASE("every kernel's generated GLSL compiles on the GL device and declares its outputs") {
-  for (const auto& p : kernels::all_programs()) {
+TEST_CASE(
+    "every kernel's generated GLSL compiles and links on the GL device, which keeps a sampler "
+    "for each unit the kernel fetches from and an output for each target") {
+  gl::GlDevice& d = gltest::device();
+  for (const auto& p : kernels::all_programs(kernels::Programs::with_looping)) {
     const vgpu::GlslProgram g = vgpu::to_glsl(*p);
     const std::string name = p->name();
     CAPTURE(name);
-    CHECK(g.source.find("layout(location = 0) out vec4 out0;") != std::string::npos);
+    // The driver's word: it compiles and links the text, keeps every sampler (a sampler the
+    // program never reads would be dropped, its location -1) and finds each output where the
+    // GLSL put it.
+    gl::GlDevice::Linked l;
+    REQUIRE_NOTHROW(l = d.link(*p));
     // One sampler per unit the counting run says the kernel fetches from.
     const vgpu::Program::Analysis a = p->analyze();
     int fetched = 0;
     for (int u = 0; u < vgpu::kMaxTextureUnits; ++u) fetched += a.fetches.per_unit[u] > 0;
     CHECK(int(g.units.size()) == fetched);
+    CHECK(int(l.samplers.size()) == fetched);
+    for (const int location : l.samplers) CHECK(location >= 0);
+    REQUIRE(int(l.outputs.size()) == p->outputs());
+    for (int o = 0; o < p->outputs(); ++o) CHECK(l.outputs[size_t(o)] == o);
     // Never more statements than the counting run's instructions (dead ones are dropped), and
-    // a discard exactly in the programs that kill fragments.
-    CHECK(g.statements <= a.instructions + 1);
+    // a discard exactly in the programs that kill fragments. (A looping program's text also
+    // copies its carried values in and out of the loop, statements the counting run does not
+    // count: the bound is for the straight programs.)
+    if (a.loop.loops == 0) CHECK(g.statements <= a.instructions + 1);
     CHECK((g.source.find("discard;") != std::string::npos) == p->idle_discards());
   }
 }
@@ -114,26 +140,34 @@ TEST_CASE("the GL device refuses what it cannot do, naming it") {
 }
 
 TEST_CASE(
-    "every occlusion-query count of a bunny and a bunny-refl frame equals the vgpu's, blocking "
-    "or polling for the result") {
+    "every occlusion-query count and every pass's discarded fragments, as the GL driver counts "
+    "them, equal the vgpu's in a bunny and a bunny-refl frame, blocking or polling for the "
+    "result") {
   for (const auto& [name, wait] : {std::pair{"bunny", "block"}, std::pair{"bunny-refl", "poll"}}) {
     CAPTURE(name);
     CAPTURE(wait);
     const Frame v = render(name, "vgpu", 64, true), g = render(name, "gl", 64, true, false, wait);
     const auto& pv = v.result.stats.passes;
     const auto& pg = g.result.stats.passes;
-    size_t queries = 0;
+    size_t queries = 0, discarding = 0;
     for (size_t i = 0; i < std::min(pv.size(), pg.size()); ++i) {
       CAPTURE(i);
       CAPTURE(pv[i].program);
       REQUIRE(pv[i].program == pg[i].program);
       REQUIRE(pv[i].query_result == pg[i].query_result);
       queries += pv[i].query_result >= 0;
+      // The driver's own count of the pass's discards (its GL_SAMPLES_PASSED), and the rest
+      // as the GL device copies it from the emulator's analysis.
+      CHECK(pg[i].counters.fragments_discarded == pv[i].counters.fragments_discarded);
       CHECK(same_driver_counts(pv[i].counters, pg[i].counters));
+      CHECK(same_analysis_counts(pv[i].counters, pg[i].counters));
+      discarding += pg[i].counters.fragments_discarded > 0;
     }
     REQUIRE(pv.size() == pg.size());
     CHECK(queries == v.result.stats.totals.query_readbacks);
+    CHECK(discarding > 0);  // passes that discard: the driver's counts are not all zero
     CHECK(same_driver_counts(v.result.stats.totals, g.result.stats.totals));
+    CHECK(same_analysis_counts(v.result.stats.totals, g.result.stats.totals));
     CHECK(g.result.stats.totals.device_ms > 0);
     // The image and hit textures read back at the end: counted alike on both devices.
     CHECK(v.result.stats.downloads >= 2);
@@ -156,6 +190,7 @@ TEST_CASE("the fused MRT passes on the GL device give the vgpu's query counts, h
       REQUIRE(pv[i].query_result == pg[i].query_result);
       fused += pv[i].program.find(" + ") != std::string::npos;
       CHECK(same_driver_counts(pv[i].counters, pg[i].counters));
+      CHECK(same_analysis_counts(pv[i].counters, pg[i].counters));
     }
     CHECK(fused > 0);
     gltest::check_same_frame(g.device, "intersections + next triangle", v.result.hit_id,
@@ -245,7 +280,9 @@ TEST_CASE(
   CHECK(scenes >= 8);
 }
 
-TEST_CASE("the textured scene on the GL device matches the vgpu for every texture filter") {
+TEST_CASE(
+    "the textured scene on the GL device matches the vgpu's image for every texture filter, "
+    "and the shader's fetches as the emulator's analysis counts them") {
   const host::Scene scene = host::load_scene(host::resolve_scene("textured"), host::with_images());
   for (vgpu::Filter filter :
        {vgpu::Filter::nearest, vgpu::Filter::bilinear, vgpu::Filter::trilinear}) {
@@ -263,12 +300,15 @@ TEST_CASE("the textured scene on the GL device matches the vgpu for every textur
       host::StreamTracer tracer(scene, grid, opt);
       frames[k] = tracer.render(host::scene_camera(scene));
       if (k) gl_name = tracer.device().description();
-      // The shader's fetches: the same count on both devices (the counting run, not the driver).
       const auto* shader = frames[k].stats.find("shader");
       REQUIRE(shader != nullptr);
     }
+    // The shader's fetches: the emulator's analysis of the program both devices drew (the GL
+    // device copies it; no driver counts fetches), so equal counts say that the filter chose
+    // the same shader on both. The driver's own figures: the frame's discards, and the image.
     CHECK(frames[0].stats.find("shader")->counters.texture_fetches ==
           frames[1].stats.find("shader")->counters.texture_fetches);
+    CHECK(same_driver_counts(frames[0].stats.totals, frames[1].stats.totals));
     gltest::check_same_frame(gl_name, "intersections", frames[0].hit_id, frames[1].hit_id,
                              frames[0].depth, frames[1].depth, frames[0].rgb, frames[1].rgb);
   }

@@ -1,7 +1,7 @@
 // Glass's ray streams (issue 25) on the GL device against the vgpu: the stream passes' GLSL
 // (generated from the same functors), drawn over rectangles of tall textures, give the vgpu's
-// stream lengths, query counts and image; on a hand-made glass slab, on the bundled glass scene
-// and on bunny-refl with --ray-streams on.
+// stream lengths, every pass's query count and the image; on a hand-made glass slab, on the bundled
+// glass scene and on bunny-refl with --ray-streams on.
 #include <doctest/doctest.h>
 
 #include "host/accel/grid.h"
@@ -46,12 +46,29 @@ void check_streams_on_gl(const host::Scene& scene) {
     opt.device = k ? "gl" : "vgpu";
     opt.ray_streams = true;
     opt.threads = 2;
+    opt.keep_pass_records = true;
     const host::Grid grid = host::build_grid(scene, host::GridSpec{});
     host::StreamTracer tracer(scene, grid, opt);
     frames[k] = tracer.render(*scene.camera);
     if (k) gl_name = tracer.device().description();
   }
   REQUIRE(frames[1].streams.on);
+  // Pass by pass, the same programs and the same occlusion-query counts: the GL driver's
+  // GL_SAMPLES_PASSED against the vgpu's count, among them every stream count's (contarRayos,
+  // whose query gives a stream's length).
+  const auto& pv = frames[0].stats.passes;
+  const auto& pg = frames[1].stats.passes;
+  REQUIRE(pv.size() == pg.size());
+  size_t queries = 0, stream_counts = 0;
+  for (size_t i = 0; i < pv.size(); ++i) {
+    CAPTURE(i);
+    REQUIRE(pv[i].program == pg[i].program);
+    CHECK(pv[i].query_result == pg[i].query_result);
+    queries += pg[i].query_result >= 0;
+    stream_counts += pg[i].program == "stream count" && pg[i].query_result >= 0;
+  }
+  CHECK(stream_counts > 0);
+  CHECK(queries == frames[1].stats.totals.query_readbacks);
   REQUIRE(frames[0].streams.levels.size() == frames[1].streams.levels.size());
   for (size_t l = 0; l < frames[0].streams.levels.size(); ++l) {
     CAPTURE(l);
@@ -66,18 +83,24 @@ void check_streams_on_gl(const host::Scene& scene) {
 
 }  // namespace
 
-TEST_CASE("a glass slab's ray streams on the GL device give the vgpu's streams and image") {
+TEST_CASE(
+    "a glass slab's ray streams on the GL device give the vgpu's query counts, streams and "
+    "image") {
   const host::Scene scene = glass_slab();
   check_streams_on_gl(scene);
 }
 
-TEST_CASE("bunny-refl's reflections as ray streams on the GL device give the vgpu's image") {
+TEST_CASE(
+    "bunny-refl's reflections as ray streams on the GL device give the vgpu's query counts "
+    "and image") {
   const host::Scene scene = host::load_scene(host::resolve_scene("bunny-refl"));
   REQUIRE(scene.camera.has_value());
   check_streams_on_gl(scene);
 }
 
-TEST_CASE("the bundled glass scene's ray streams on the GL device give the vgpu's hits and image") {
+TEST_CASE(
+    "the bundled glass scene's ray streams on the GL device give the vgpu's query counts, hits "
+    "and image") {
   const host::Scene scene = host::load_scene(host::resolve_scene("glass"));
   REQUIRE(scene.camera.has_value());
   check_streams_on_gl(scene);

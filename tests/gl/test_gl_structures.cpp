@@ -1,7 +1,9 @@
-// The BVH and two-level grid walks (--accel bvh, --accel grid2) on the GL device against the
-// vgpu: multipass, fused (--mrt on) and looping frames of a bundled scene give the same passes,
-// query counts, hit ids, depths and image (on llvmpipe bit for bit, tests/gl/gl_compare.h),
-// written once for both structures; and the bunny's two-level grid on a driver's texture limit.
+// The BVH, two-level grid and kd-tree walks (--accel bvh, grid2, kdtree) on the GL device
+// against the vgpu: multipass, fused (--mrt on) and looping frames of a bundled scene give the
+// same passes, query counts, hit ids, depths and image (on llvmpipe bit for bit,
+// tests/gl/gl_compare.h), written once for every structure; adaptive and undersampled frames
+// walking the BVH (adaptive) and the kd-tree (undersampled); and the bunny's two-level grid on a
+// driver's texture limit.
 #include <doctest/doctest.h>
 
 #include <algorithm>
@@ -26,6 +28,10 @@ struct Grid2 {
   static constexpr host::AccelKind kind = host::AccelKind::grid2;
   static constexpr const char* prefix = "grid2";
 };
+struct KdTree {
+  static constexpr host::AccelKind kind = host::AccelKind::kdtree;
+  static constexpr const char* prefix = "kd";
+};
 
 struct Frame {
   host::RenderResult result;
@@ -34,10 +40,27 @@ struct Frame {
 
 enum class Variant { multipass, mrt, looping };
 
+// How a frame samples its pixels: one ray through each (the default), adaptive sampling up to
+// `spp` rays (--aa adaptive --spp N), or undersampling on a lattice of every `undersample`-th
+// pixel (--aa undersample:K).
+struct Sampling {
+  int spp = 1;
+  bool adaptive = false;
+  int undersample = 0;
+  bool primary_only = false;  // --bounces 0 --shadows off: the walk of the primary rays alone
+};
+
 Frame render(host::AccelKind kind, const std::string& scene_name, const std::string& device,
-             int size, Variant v, const std::string& profile = "gf6600") {
+             int size, Variant v, const std::string& profile = "gf6600", Sampling sampling = {}) {
   host::RenderOptions opt;
   opt.width = opt.height = size;
+  opt.spp = sampling.spp;
+  opt.adaptive = sampling.adaptive;
+  opt.undersample = sampling.undersample;
+  if (sampling.primary_only) {
+    opt.bounces = 0;
+    opt.shadows = false;
+  }
   opt.device = device;
   opt.threads = 2;
   opt.keep_pass_records = true;
@@ -58,9 +81,10 @@ Frame render(host::AccelKind kind, const std::string& scene_name, const std::str
 
 TYPE_TO_STRING_AS("bvh", Bvh);
 TYPE_TO_STRING_AS("grid2", Grid2);
+TYPE_TO_STRING_AS("kdtree", KdTree);
 
 TEST_CASE_TEMPLATE("frames on the GL device give the vgpu's queries, hit ids, depths and image", T,
-                   Bvh, Grid2) {
+                   Bvh, Grid2, KdTree) {
   const std::string prefix = std::string(T::prefix) + " ";
   for (const Variant v : {Variant::multipass, Variant::mrt, Variant::looping}) {
     CAPTURE(int(v));
@@ -87,6 +111,62 @@ TEST_CASE_TEMPLATE("frames on the GL device give the vgpu's queries, hit ids, de
     gltest::check_same_frame(gf.device, depth_kernel, a.hit_id, b.hit_id, a.depth, b.depth, a.rgb,
                              b.rgb);
   }
+}
+
+namespace {
+
+// A sampled frame walking the structure of `kind` on both devices: the same passes, query counts
+// (adaptive at 4 rays a pixel: marcarPixeles marks the pixels for the 2 x 2 level from the
+// centre frame's colours and surfaces on the GL device's own textures, and so decides every
+// later pass's work and query; undersampling: marcarHuecos picks the gaps to trace from the
+// lattice's colours and surfaces, rellenarHuecos blends the rest), rays per pixel, hit ids and
+// image. Primary rays only (no bounces, no shadows): a multipass walk of the BVH takes about a
+// thousand passes a sample frame, each a draw and a query on llvmpipe.
+void check_sampled_frames(host::AccelKind kind, const std::string& prefix, const std::string& scene,
+                          const Sampling& sampling, int size) {
+  const Frame vf = render(kind, scene, "vgpu", size, Variant::multipass, "", sampling);
+  const Frame gf = render(kind, scene, "gl", size, Variant::multipass, "", sampling);
+  const host::RenderResult &a = vf.result, &b = gf.result;
+  REQUIRE(a.stats.passes.size() == b.stats.passes.size());
+  int marks = 0, walk_passes = 0;
+  for (size_t i = 0; i < a.stats.passes.size(); ++i) {
+    CAPTURE(i);
+    REQUIRE(a.stats.passes[i].program == b.stats.passes[i].program);
+    CHECK(a.stats.passes[i].query_result == b.stats.passes[i].query_result);
+    marks += a.stats.passes[i].program == (sampling.adaptive ? "mark pixels" : "mark gaps");
+    walk_passes += a.stats.passes[i].program.rfind(prefix + " ", 0) == 0;
+  }
+  CHECK(marks == 1);
+  CHECK(walk_passes > 0);
+  CHECK(b.rays_per_pixel == a.rays_per_pixel);
+  // Not a frame where nothing was refined, or everything traced.
+  const auto& n = a.rays_per_pixel;
+  if (sampling.adaptive) {
+    CHECK(std::count(n.begin(), n.end(), 1u) > 0);
+    CHECK(std::count(n.begin(), n.end(), 1u + 4u) > 0);
+  } else {
+    // The lattice holds every second column and row and the last: some gaps are traced
+    // beyond it, others filled.
+    const std::ptrdiff_t side = size / 2 + (size % 2 == 0 ? 1 : 0);
+    CHECK(std::count(n.begin(), n.end(), 0u) > 0);
+    CHECK(std::count(n.begin(), n.end(), 1u) > side * side);
+  }
+  gltest::check_same_frame(gf.device, prefix + " intersections", a.hit_id, b.hit_id, a.depth,
+                           b.depth, a.rgb, b.rgb);
+}
+
+}  // namespace
+
+TEST_CASE(
+    "adaptive frames walking the BVH on the GL device give the vgpu's queries, rays per pixel, "
+    "hit ids and image") {
+  check_sampled_frames(host::AccelKind::bvh, "bvh", "bunny-low", {4, true, 0, true}, 32);
+}
+
+TEST_CASE(
+    "undersampled frames walking the kd-tree on the GL device give the vgpu's queries, rays per "
+    "pixel, hit ids and image") {
+  check_sampled_frames(host::AccelKind::kdtree, "kd", "classic", {1, false, 2, true}, 32);
 }
 
 TEST_CASE("the bunny's two-level grid fits a GL driver whose textures stop at 16384 texels") {

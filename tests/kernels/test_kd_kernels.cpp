@@ -14,6 +14,7 @@
 // x in [2, 6], z in [0, 4].
 #include <array>
 #include <iterator>
+#include <utility>
 #include <vector>
 
 #include "kernel_pass.h"
@@ -260,14 +261,19 @@ namespace {
 // D (+z from (3, 3.5, 1): leaf 4, parallel to triangle 1: no hit); E (done before the walk).
 struct Walk {
   Tree t;
-  Rays r{{{3, 0.5f, 1}, {0.5f, 1, 0.5f}, {3.5f, 1, 1}, {3, 3.5f, 1}, {1, 1, 1}},
-         {{0, 1, 0, 100}, {1, 0, 0, 100}, {-1, 0, 0, 100}, {0, 0, 1, 100}, {1, 0, 0, -1}}};
-  Texture trav, vs = texels("voxel state", 5, 1, std::vector<glm::vec4>(5, {0, 0, 0, kNone}));
-  Texture isect = texels("intersection", 5, 1, std::vector<glm::vec4>(5, kNoHit));
-  Walk() {
+  Rays r;
+  Texture trav, vs, isect;
+  Walk()
+      : Walk(Rays{
+            {{3, 0.5f, 1}, {0.5f, 1, 0.5f}, {3.5f, 1, 1}, {3, 3.5f, 1}, {1, 1, 1}},
+            {{0, 1, 0, 100}, {1, 0, 0, 100}, {-1, 0, 0, 100}, {0, 0, 1, 100}, {1, 0, 0, -1}}}) {}
+  explicit Walk(Rays rays)
+      : r(std::move(rays)),
+        vs(texels("voxel state", r.n, 1, std::vector<glm::vec4>(size_t(r.n), {0, 0, 0, kNone}))),
+        isect(texels("intersection", r.n, 1, std::vector<glm::vec4>(size_t(r.n), kNoHit))) {
     kernels::KdEnter k;
     k.kd = kd_uniforms();
-    trav = ktest::run(k, {&r.origins, &r.rays}, 5, 1);
+    trav = ktest::run(k, {&r.origins, &r.rays}, r.n, 1);
   }
 };
 
@@ -279,10 +285,28 @@ struct State {
   int steps = 0;
 };
 
+// A leaf as a ray reaches it: the node and the segment [tmin, tmax] it is tested over.
+struct LeafVisit {
+  float node, tmin, tmax;
+  bool operator==(const LeafVisit&) const = default;
+};
+using LeafSequences = std::vector<std::vector<LeafVisit>>;  // per ray, in order
+
+// Appends to each ray's sequence the leaf its traversal state holds, if it holds one (y, the
+// list position, at least 0) that is not the last one appended.
+void note_leaves(const Texture& trav, LeafSequences& seq) {
+  for (int i = 0; i < int(seq.size()); ++i) {
+    const glm::vec4 s = ktest::at(trav, i, 0);
+    if (s.x < 0 || s.y < 0) continue;
+    const LeafVisit v{s.x, s.z, s.w};
+    if (seq[size_t(i)].empty() || !(seq[size_t(i)].back() == v)) seq[size_t(i)].push_back(v);
+  }
+}
+
 // The multipass sequence of host/trace/walks/kd_walk.cpp, single kernels: step, load, then the
 // leaf's triangles one per pass (intersections, next triangle) until no ray tests, until no ray
 // walks. With fused, the --mrt on forms (step + load, intersections + next triangle).
-State multipass(const Walk& w, bool fused) {
+State multipass(const Walk& w, bool fused, LeafSequences* leaves = nullptr) {
   const Tree& t = w.t;
   const Rays& r = w.r;
   const kernels::KdUniforms u = kd_uniforms(0.001f);
@@ -312,6 +336,7 @@ State multipass(const Walk& w, bool fused) {
       s.trav = ktest::run(step, {&r.origins, &r.rays, &s.trav, &s.isect, &t.nodes}, r.n, 1);
       s.vs = ktest::run(load, {&s.trav, &s.vs, &t.lists}, r.n, 1);
     }
+    if (leaves) note_leaves(s.trav, *leaves);
     for (int k = 0; any_w_at_least(s.vs, r.n, 0); ++k) {
       REQUIRE(k < 4);
       if (fused) {
@@ -339,8 +364,11 @@ void check_hits(const Texture& isect) {
 }
 
 struct LoopOut {
-  Texture trav{"traversal out", 5, 1, 4}, vs{"voxel state out", 5, 1, 4},
-      isect{"intersection out", 5, 1, 4};
+  explicit LoopOut(int n)
+      : trav("traversal out", n, 1, 4),
+        vs("voxel state out", n, 1, 4),
+        isect("intersection out", n, 1, 4) {}
+  Texture trav, vs, isect;
   vgpu::PassRecord rec;
 };
 
@@ -352,7 +380,7 @@ LoopOut loop_pass(const Walk& w, const Texture& trav, const Texture& vs, const T
   k.steps = steps;
   const vgpu::KernelProgram<kernels::KdLooping> p(k);
   vgpu::Gpu gpu(vgpu::profile("gf6600"), 1, 1);
-  LoopOut o;
+  LoopOut o(w.r.n);
   gpu.use_program(p);
   gpu.unbind_textures();
   const Texture* units[] = {&w.r.origins, &w.r.rays, &trav,   &vs,        &isect,
@@ -467,4 +495,95 @@ TEST_CASE("kd looping push-down restarts at the remembered node, not the root") 
   const LoopOut b = loop_pass(w, a.trav, a.vs, a.isect, 32);
   check_hits(b.isect);
   for (int i = 0; i < 5; ++i) CHECK_TEXEL(b.trav, i, 0, kDone);
+}
+
+TEST_CASE(
+    "kd-restart reaches each ray's leaves in order, over the hand-worked segments, restarting "
+    "past each leaf without a hit") {
+  // Eight rays, each leaf reached given as (node, tmin, tmax), worked by hand on the tree above
+  // (every number a binary fraction, so the kernels' float arithmetic gives them exactly):
+  //   A +y from (3, 0.5, 1): right at the root (no cut), cut at y = 2 (t = 1.5) into the empty
+  //     leaf 3, restart at 1.5: the plane at tmin, far child 4 (triangle 1 at t = 2.5).
+  //   B +x from (0.5, 1, 0.5): cut at x = 2 (t = 1.5), leaf 1 (triangle 0 at t = 0.5).
+  //   C -x from (3.5, 1, 1): cut at x = 2 (t = 1.5), leaf 3 (empty), restart, leaf 1.
+  //   D +z from (3, 3.5, 1): parallel to both planes, leaf 4 to the box's exit (t = 3); no hit.
+  //   E done before the walk: no leaf.
+  //   G (1, 2, 0) from (1.5, 0.5, 1): box exit at y = 4, t = 1.75. Cut at x = 2 (t = 0.5): leaf 1,
+  //     where triangle 0 (x = 1) lies behind the ray; restart at 0.5: the plane at tmin, right;
+  //     cut at y = 2 (t = 0.75): the empty leaf 3; restart at 0.75: leaf 4, where triangle 1
+  //     (y = 3) is met at t = 1.25, at (2.75, 3, 1): u = 0.75/4, v = 1/4.
+  //   P (1, 2, 0) from (2, 0.5, 1), on the plane x = 2: its direction decides, right, the plane
+  //     at t = 0 cuts nothing; box exit at x = 4, t = 2, and y = 4, t = 1.75. Cut at y = 2
+  //     (t = 0.75): leaf 3, restart (the root again sends it right, whole), leaf 4: triangle 1
+  //     at t = 1.25, at (3.25, 3, 1): u = 1.25/4, v = 1/4.
+  //   Q (-2, 0, 1) from (2, 1, 1), on the plane, pointing left: leaf 1 alone, whole (box exit
+  //     at x = 0, t = 1): triangle 0 at t = 0.5, at (1, 1, 1.5): u = 1/4, v = 3/8.
+  // Every leaf without a hit restarts the ray at the leaf's tmax, so each ray's next segment
+  // starts where the last ended.
+  const Walk w(Rays{{{3, 0.5f, 1},
+                     {0.5f, 1, 0.5f},
+                     {3.5f, 1, 1},
+                     {3, 3.5f, 1},
+                     {1, 1, 1},
+                     {1.5f, 0.5f, 1},
+                     {2, 0.5f, 1},
+                     {2, 1, 1}},
+                    {{0, 1, 0, 100},
+                     {1, 0, 0, 100},
+                     {-1, 0, 0, 100},
+                     {0, 0, 1, 100},
+                     {1, 0, 0, -1},
+                     {1, 2, 0, 100},
+                     {1, 2, 0, 100},
+                     {-2, 0, 1, 100}}});
+  const LeafSequences expected = {{{3, 0, 1.5f}, {4, 1.5f, 3.5f}},
+                                  {{1, 0, 1.5f}},
+                                  {{3, 0, 1.5f}, {1, 1.5f, 3.5f}},
+                                  {{4, 0, 3}},
+                                  {},
+                                  {{1, 0, 0.5f}, {3, 0.5f, 0.75f}, {4, 0.75f, 1.75f}},
+                                  {{3, 0, 0.75f}, {4, 0.75f, 1.75f}},
+                                  {{1, 0, 1}}};
+  const std::vector<glm::vec4> hits = {kHitA,
+                                       kHitB,
+                                       kHitC,
+                                       kNoHit,
+                                       kNoHit,
+                                       {1.25f, 0.1875f, 0.25f, 1},
+                                       {1.25f, 0.3125f, 0.25f, 1},
+                                       {0.5f, 0.25f, 0.375f, 0}};
+  auto check = [&](const LeafSequences& got, const Texture& isect) {
+    for (int i = 0; i < w.r.n; ++i) {
+      CAPTURE(i);
+      const auto& g = got[size_t(i)];
+      const auto& e = expected[size_t(i)];
+      REQUIRE(g.size() == e.size());
+      for (size_t k = 0; k < e.size(); ++k) {
+        CAPTURE(k);
+        CHECK(g[k].node == e[k].node);
+        CHECK(g[k].tmin == e[k].tmin);
+        CHECK(g[k].tmax == e[k].tmax);
+      }
+      CHECK_TEXEL_NEAR(isect, i, 0, 1e-6, hits[size_t(i)]);
+    }
+  };
+  for (const bool fused : {false, true}) {  // the single kernels, then the --mrt on forms
+    CAPTURE(fused);
+    LeafSequences seq(size_t(w.r.n));
+    const State s = multipass(w, fused, &seq);
+    check(seq, s.isect);
+  }
+  // The looping kernel one iteration per pass, each pass resuming the last: the same leaves
+  // over the same segments, though its restarts start at the remembered node.
+  LeafSequences seq(size_t(w.r.n));
+  Texture trav = w.trav, vs = w.vs, isect = w.isect;
+  for (int pass = 0; any_x_at_least(trav, w.r.n, 0); ++pass) {
+    REQUIRE(pass < 40);
+    LoopOut o = loop_pass(w, trav, vs, isect, 1);
+    trav = o.trav;
+    vs = o.vs;
+    isect = o.isect;
+    note_leaves(trav, seq);
+  }
+  check(seq, isect);
 }
