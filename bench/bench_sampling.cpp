@@ -29,6 +29,8 @@ struct Mode {
   bool adaptive = false;
   float threshold = 0.1f;
   int undersample = 0;
+  bool object = false;  // --aa-criterion object (kernels/cones.h)
+  float cone_depth = 2.0f;
 };
 
 // The modes docs/sampling.md charts; the first is the one-ray image the others are compared with.
@@ -41,6 +43,14 @@ std::vector<Mode> modes() {
           {"adaptive 16, T 0.1", 16, true, 0.1f},
           {"adaptive 16, T 0.2", 16, true, 0.2f},
           {"adaptive 64, T 0.1", 64, true, 0.1f},
+          // --aa-criterion object (docs/sampling.md's cones section; the page's other tables
+          // leave them out).
+          {"object 16, T 0.05", 16, true, 0.05f, 0, true},
+          {"object 16, T 0.1", 16, true, 0.1f, 0, true},
+          {"object 16, T 0.2", 16, true, 0.2f, 0, true},
+          {"object 16, T 0.3", 16, true, 0.3f, 0, true},
+          {"object 16, T 0.1, cones 1", 16, true, 0.1f, 0, true, 1.0f},
+          {"object 16, T 0.1, cones 4", 16, true, 0.1f, 0, true, 4.0f},
           {"undersample 2", 1, false, 0.1f, 2},
           {"undersample 2, T 0.05", 1, false, 0.05f, 2},
           {"undersample 2, T 0.02", 1, false, 0.02f, 2},
@@ -183,6 +193,8 @@ int main(int argc, char** argv) {
       opt.adaptive = m.adaptive;
       opt.aa_threshold = m.threshold;
       opt.undersample = m.undersample;
+      if (m.object) opt.aa_criterion = host::RenderOptions::AaCriterion::object;
+      opt.cone_depth = m.cone_depth;
       host::StreamTracer tracer(scene, grid, opt);
       host::RenderResult r;
       std::vector<double> ms;

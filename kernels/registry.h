@@ -9,6 +9,7 @@
 #include <memory>
 #include <vector>
 
+#include "kernels/cones.h"
 #include "kernels/kernels.h"
 #include "vgpu/program.h"
 
@@ -28,6 +29,8 @@ using MultipassKernels = KernelList<
     GenerateSampleRays, AccumulateSamples, ResolveSamples,
     // Adaptive supersampling (--aa adaptive): surface keys, marks, the count of marked pixels.
     KeepHits, MarkPixels, MarkedPixels,
+    // Its object-space decision (--aa-criterion object): the cones' keys and depths, their marks.
+    KeepCones, KeepReflected, MarkCones,
     // Adaptive undersampling (--aa undersample:K): the lattice, the gaps to trace, the fill.
     MarkLattice, MarkGaps, FillGaps,
     // The fused programs of --mrt on (kernels/fused.h), two outputs each.

@@ -341,6 +341,21 @@ void add_render_options(CLI::App& render, RenderArgs& a) {
       ->check(kThresholdCheck)
       ->capture_default_str();
   render
+      .add_option("--aa-criterion", a.aa_criterion,
+                  "With --aa adaptive: what marks a pixel for more samples: image (a neighbour "
+                  "hit another surface, or the colour's second difference exceeds "
+                  "--aa-threshold) or object (the same, and where the pixel's cone is crossed by "
+                  "a fold: the hit distances' second difference exceeds --aa-cone-depth cone "
+                  "widths; docs/sampling.md)")
+      ->check(CLI::IsMember({"image", "object"}))
+      ->capture_default_str();
+  render
+      .add_option("--aa-cone-depth", a.aa_cone_depth,
+                  "With --aa-criterion object: the hit distances' second difference along x or y, "
+                  "in widths of the pixel's cone at its hit, that marks a pixel")
+      ->check(CLI::Range(0.0f, 1000.0f))
+      ->capture_default_str();
+  render
       .add_option("--steps-per-pass", a.steps_per_pass,
                   "With --kernels looping: loop iterations per pass before the host's occlusion "
                   "query (the profile's loop limit applies: gf6600 255)")

@@ -49,6 +49,8 @@ struct RenderArgs {
   int spp = 1;
   std::string aa = "none";
   float aa_threshold = 0.1f;
+  std::string aa_criterion = "image";  // --aa-criterion image|object
+  float aa_cone_depth = 2.0f;          // --aa-cone-depth
   bool steps_given = false;
   bool walk_given = false;
   std::string time;       // --time T

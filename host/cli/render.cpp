@@ -112,6 +112,9 @@ RenderPlan parse_render(const RenderArgs& a, bool lanes_given) {
   opt.adaptive = a.aa == "adaptive";
   opt.undersample = a.aa == "adaptive" || a.aa == "none" ? 0 : *parse_aa(a.aa);
   opt.aa_threshold = a.aa_threshold;
+  opt.aa_criterion = a.aa_criterion == "object" ? host::RenderOptions::AaCriterion::object
+                                                : host::RenderOptions::AaCriterion::image;
+  opt.cone_depth = a.aa_cone_depth;
   opt.profile = vgpu::profile(a.profile).name;
   opt.threads = a.threads;
   opt.lanes = a.lanes;

@@ -121,6 +121,11 @@ nlohmann::ordered_json frame_stats_json(const FrameStatsInputs& in) {
                      {"samples_per_pixel_max", most},
                      {"passes_added", cpu ? 0 : r.stats.totals.passes - r.first_frame_passes}};
     if (opt.adaptive) j["sampling"]["threshold"] = opt.aa_threshold;
+    // The object criterion only (the image criterion's JSON stays as it was).
+    if (opt.adaptive && opt.aa_criterion == RenderOptions::AaCriterion::object) {
+      j["sampling"]["criterion"] = "object";
+      j["sampling"]["cone_depth"] = opt.cone_depth;
+    }
     if (opt.undersample > 0) j["sampling"]["k"] = opt.undersample;
   }
   {

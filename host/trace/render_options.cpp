@@ -23,6 +23,9 @@ std::string RenderOptions::refusal(const vgpu::Profile& profile, std::string_vie
   // The command line cannot ask for these two (--aa is one mode); a program can.
   if (undersample < 0 || (undersample > 0 && adaptive))
     return "undersample: K must be 1 or more, with one ray per traced pixel (spp 1, not adaptive)";
+  // The cones decide adaptive sampling's levels (kernels/cones.h); nothing else reads them.
+  if (aa_criterion == AaCriterion::object && !adaptive)
+    return "--aa-criterion object decides where adaptive sampling refines: add --aa adaptive";
   if (mrt && looping)
     return "--mrt on with --kernels looping: the looping program already writes the traversal, "
            "voxel and hit targets in one pass; there are no separate passes left to fuse";

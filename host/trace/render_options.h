@@ -104,6 +104,13 @@ struct RenderOptions {
   // (linear, per channel); a level's samples replace the pixel's earlier ones.
   bool adaptive = false;
   float aa_threshold = 0.1f;
+  // What decides where adaptive supersampling refines (--aa-criterion): image (the surface keys
+  // and the colour, marcarPixeles) or object (the pixels' cones: the keys, the hit distances'
+  // continuity against the cone's width, and the colour; kernels/cones.h).
+  enum class AaCriterion { image, object };
+  AaCriterion aa_criterion = AaCriterion::image;
+  // With the object criterion: the depth's second difference that marks, in cone widths.
+  float cone_depth = 2.0f;
   // Adaptive undersampling (--aa undersample:K, 0: off): one ray through the centre of every
   // K-th pixel in x and y (and the last row and column), then of the pixels between lattice
   // pixels whose surfaces (host/trace/sampling.h) disagree; the rest are blended from the four

@@ -15,6 +15,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
@@ -68,6 +69,10 @@ TEST_CASE("names outside each option's set are refused") {
   check_refused("--precision fp8", "--precision", "fp8 not in {fp32,fp24,fp16,auto}");
   check_refused("--engine gpu", "--engine", "gpu not in {stream,gl,cpu}");
   check_refused("--stats xml", "--stats", "xml not in {table,json,none}");
+  check_refused("--aa adaptive --aa-criterion cones", "--aa-criterion",
+                "cones not in {image,object}");
+  check_refused("--aa-criterion object", "--aa-criterion object",
+                "decides where adaptive sampling refines: add --aa adaptive");
   check_refused("--grid 0", "--grid", "grid resolution '0': each count must be at least 1");
   check_refused("--trace-pixel 3", "--trace-pixel", "expected X,Y (e.g. 128,128), got '3'");
   check_refused("--trace-pixel 300,2", "--trace-pixel", "300,2 is outside the 256x256 image");
@@ -553,4 +558,36 @@ TEST_CASE("--accel bvh renders and its statistics name the structure and the hie
 
 TEST_CASE("an unknown acceleration structure is refused, naming the option and the set") {
   check_refused("--accel magic", "--accel", "magic not in {grid,grid2,bvh,kdtree,auto}");
+}
+
+TEST_CASE("the object criterion's passes are counted and priced, and the statistics name it") {
+  const fs::path dir = fresh_dir("cones");
+  const Outcome o =
+      run("render bunny-refl --size 16x16 --bounces 1 --aa adaptive --spp 4 "
+          "--aa-criterion object --aa-cone-depth 3 -q --stats none --predict "
+          "--stats-json " +
+          (dir / "stats.json").string());
+  REQUIRE(o.status == 0);
+  nlohmann::json j;
+  REQUIRE_NOTHROW(j = nlohmann::json::parse(slurp(dir / "stats.json")));
+  CHECK(j["sampling"]["mode"] == "adaptive");
+  CHECK(j["sampling"]["criterion"] == "object");
+  CHECK(j["sampling"]["cone_depth"] == 3.0);
+  // guardarConos and guardarReflejos once (the centre frame), marcarConos once (one level);
+  // never the image criterion's guardarImpactos or marcarPixeles.
+  std::map<std::string, uint64_t> passes;
+  for (const auto& k : j["kernels"]) passes[k["name"].get<std::string>()] = k["passes"];
+  CHECK(passes["keep cones"] == 1);
+  CHECK(passes["keep reflected"] == 1);
+  CHECK(passes["mark cones"] == 1);
+  CHECK(passes.count("keep hits") == 0);
+  CHECK(passes.count("mark pixels") == 0);
+  // The image criterion's statistics have no criterion (they stay as they were).
+  const Outcome image =
+      run("render bunny-refl --size 16x16 --bounces 1 --aa adaptive --spp 4 -q "
+          "--stats none --stats-json " +
+          (dir / "image.json").string());
+  REQUIRE(image.status == 0);
+  CHECK_FALSE(nlohmann::json::parse(slurp(dir / "image.json"))["sampling"].contains("criterion"));
+  fs::remove_all(dir);
 }

@@ -26,13 +26,14 @@ struct Frame {
 
 Frame render(const std::string& scene_name, const std::string& device, int size, bool keep_passes,
              bool mrt = false, const std::string& readback = "auto", int spp = 1,
-             bool adaptive = false, int undersample = 0) {
+             bool adaptive = false, int undersample = 0, bool object = false) {
   const host::Scene scene = host::load_scene(host::resolve_scene(scene_name), host::with_images());
   host::RenderOptions opt;
   opt.width = opt.height = size;
   opt.spp = spp;
   opt.adaptive = adaptive;
   opt.undersample = undersample;
+  if (object) opt.aa_criterion = host::RenderOptions::AaCriterion::object;
   opt.device = device;
   opt.gl_readback = readback;
   if (mrt) {  // fused two-output passes need a profile with multiple render targets
@@ -241,6 +242,32 @@ TEST_CASE("adaptive sampling's second level on the GL device marks the vgpu's pi
   const auto& n = v.result.rays_per_pixel;
   CHECK(std::count(n.begin(), n.end(), 1u + 4u) > 0);
   CHECK(std::count(n.begin(), n.end(), 1u + 4u + 16u) > 0);
+  CHECK(g.result.rays_per_pixel == v.result.rays_per_pixel);
+  gltest::check_same_frame(g.device, "intersections", v.result.hit_id, g.result.hit_id,
+                           v.result.depth, g.result.depth, v.result.rgb, g.result.rgb);
+}
+
+TEST_CASE("the object criterion on the GL device keeps the vgpu's cones and marks its pixels") {
+  // bunny-refl: the mirror's reflected keys (guardarReflejos) as well as the hit distances; one
+  // level (4 samples), to keep the test short.
+  const Frame v = render("bunny-refl", "vgpu", 24, true, false, "auto", 4, true, 0, true),
+              g = render("bunny-refl", "gl", 24, true, false, "auto", 4, true, 0, true);
+  const auto& pv = v.result.stats.passes;
+  const auto& pg = g.result.stats.passes;
+  REQUIRE(pv.size() == pg.size());
+  int cones = 0;
+  for (size_t i = 0; i < pv.size(); ++i) {
+    CAPTURE(i);
+    REQUIRE(pv[i].program == pg[i].program);
+    REQUIRE(pv[i].query_result == pg[i].query_result);
+    cones += pv[i].program == "mark cones" || pv[i].program == "keep cones" ||
+             pv[i].program == "keep reflected";
+  }
+  CHECK(cones == 3);  // keep cones, keep reflected, then mark cones before the level
+  // Some pixels were refined, not all.
+  const auto& n = v.result.rays_per_pixel;
+  CHECK(std::count(n.begin(), n.end(), 1u + 4u) > 0);
+  CHECK(std::count(n.begin(), n.end(), 1u) > 0);
   CHECK(g.result.rays_per_pixel == v.result.rays_per_pixel);
   gltest::check_same_frame(g.device, "intersections", v.result.hit_id, g.result.hit_id,
                            v.result.depth, g.result.depth, v.result.rgb, g.result.rgb);

@@ -290,8 +290,8 @@ TEST_CASE(
 }
 
 TEST_CASE(
-    "adaptive sampling and undersampling mark the same pixels on every acceleration structure, "
-    "with reflections and shadows, on both engines") {
+    "adaptive sampling (by either criterion) and undersampling mark the same pixels on every "
+    "acceleration structure, with reflections and shadows, on both engines") {
   // bunny-refl: a mirror floor under the bunny, two bounces, shadow rays (the CLI's defaults).
   const host::Scene scene = host::load_scene(host::resolve_scene("bunny-refl"));
   const host::Camera camera = host::scene_camera(scene);
@@ -300,15 +300,18 @@ TEST_CASE(
       host::make_accel(host::AccelKind::grid, scene, params),
       host::make_accel(host::AccelKind::bvh, scene, params),
       host::make_accel(host::AccelKind::kdtree, scene, params)};
-  for (const int mode : {0, 1}) {
-    CAPTURE(mode);  // 0: adaptive up to 16 samples, 1: undersampling, K = 2
+  for (const int mode : {0, 1, 2}) {
+    // 0: adaptive up to 16 samples, 1: undersampling, K = 2, 2: adaptive by the pixels' cones
+    // (--aa-criterion object: the hit distances and the mirror's reflected keys).
+    CAPTURE(mode);
     host::RenderOptions opt;
     opt.width = opt.height = 24;
     opt.profile = "gf6600";
     opt.aa_threshold = 0.1f;
-    if (mode == 0) {
+    if (mode != 1) {
       opt.spp = 16;
       opt.adaptive = true;
+      if (mode == 2) opt.aa_criterion = host::RenderOptions::AaCriterion::object;
     } else {
       opt.undersample = 2;
     }
@@ -325,8 +328,8 @@ TEST_CASE(
       // Some pixels were refined (or traced between the lattice), not all.
       const auto most = *std::max_element(g.rays_per_pixel.begin(), g.rays_per_pixel.end());
       const auto least = *std::min_element(g.rays_per_pixel.begin(), g.rays_per_pixel.end());
-      CHECK(most == (mode == 0 ? 21u : 1u));
-      CHECK(least == (mode == 0 ? 1u : 0u));
+      CHECK(most == (mode != 1 ? 21u : 1u));
+      CHECK(least == (mode != 1 ? 1u : 0u));
       float worst = 0;
       for (size_t i = 0; i < g.rgb.size(); ++i)
         worst = std::max(worst, std::fabs(g.rgb[i] - c.rgb[i]));

@@ -235,17 +235,22 @@ class Tracer {
   }
 
   // The colour through point (jx, jy) of pixel (x, y), in [0, 1)^2 from its top-left corner.
-  glm::dvec3 sample(int x, int y, glm::vec2 j, Hit* primary, Counters& c) const {
-    return radiance(glm::dvec3(cam_.position), primary_.dir(x, y, j.x, j.y), 0, 1.0, primary, c);
+  glm::dvec3 sample(int x, int y, glm::vec2 j, Hit* primary, Counters& c,
+                    Hit* reflected = nullptr) const {
+    return radiance(glm::dvec3(cam_.position), primary_.dir(x, y, j.x, j.y), 0, 1.0, primary, c,
+                    CpuRayKind::primary, reflected);
   }
   // The centre ray of pixel (x, y) for adaptive sampling and undersampling: its colour; its
   // hit's depth and input id into the AOVs; in `key`, the material its triangle has, -1 for a
-  // miss (guardarImpactos' surface key).
-  glm::dvec3 centre(int x, int y, RenderResult& out, int& key, Counters& c) const {
+  // miss (guardarImpactos' surface key); in `reflected_key` (if given), its opaque surface's
+  // reflected ray's (guardarReflejos: -1 for a miss or no reflected ray).
+  glm::dvec3 centre(int x, int y, RenderResult& out, int& key, Counters& c,
+                    int* reflected_key = nullptr) const {
     const size_t i = size_t(y) * size_t(opt_.width) + size_t(x);
-    Hit h;
-    const glm::dvec3 colour = sample(x, y, {0.5f, 0.5f}, &h, c);
+    Hit h, r;
+    const glm::dvec3 colour = sample(x, y, {0.5f, 0.5f}, &h, c, reflected_key ? &r : nullptr);
     key = h.tri < 0 ? -1 : int(scene_.material[size_t(h.tri)]);
+    if (reflected_key) *reflected_key = r.tri < 0 ? -1 : int(scene_.material[size_t(r.tri)]);
     if (h.tri >= 0) {
       out.depth[i] = float(h.t);
       out.hit_id[i] = float(scene_.id[size_t(h.tri)]);
@@ -282,8 +287,10 @@ class Tracer {
   // docs/materials.md): (1 - t)(1 - a) C + ((1 - t) a + t F) L_reflected + t (1 - F) L_refracted.
   // A ray is spawned only if its weight is at least 1/512 and the path has fewer than 1 + bounces
   // surfaces, as rayosReflejados does; `kind` is what spawned this one (cpu_ray_tree's log).
+  // `reflected_out` (if given) gets an opaque surface's reflected ray's hit (tri -1: none).
   glm::dvec3 radiance(const glm::dvec3& o, const glm::dvec3& d, int depth, double w, Hit* hit_out,
-                      Counters& c, CpuRayKind kind = CpuRayKind::primary) const {
+                      Counters& c, CpuRayKind kind = CpuRayKind::primary,
+                      Hit* reflected_out = nullptr) const {
     c.iterations = std::max(c.iterations, depth + 1);
     const Hit h = trace(o, d, kInf, false, c);
     if (hit_out) *hit_out = h;
@@ -340,7 +347,8 @@ class Tracer {
       if (w * a >= min_weight_ && depth + 1 < iterations_) {
         const glm::dvec3 r = glm::normalize(glm::reflect(d, n));
         c.count(c.reflected, depth);
-        colour += a * radiance(lifted, r, depth + 1, w * a, nullptr, c, CpuRayKind::reflected);
+        colour +=
+            a * radiance(lifted, r, depth + 1, w * a, reflected_out, c, CpuRayKind::reflected);
       }
       return colour;
     }
@@ -602,6 +610,13 @@ class Tracer {
   std::vector<MipChain> chains_;  // per Scene::textures entry
   bool has_glass_ = false;        // some material has transmission > 0
   double spread_ = 0;             // angle between neighbouring pixels' rays (base_texel)
+
+ public:
+  // The stream tracer's float of it (marcarConos' uniform: 2 tan(fov / 2) / height).
+  float pixel_spread() const { return 2.0f * std::tan(0.5f * cam_.yfov) / float(opt_.height); }
+  // Whether the stream tracer runs this scene's frames as ray streams (a glass scene, or
+  // --ray-streams on), where no reflected surface keys are kept (kernels/cones.h).
+  bool ray_streams() const { return has_glass_ || opt_.ray_streams; }
 };
 
 // --aa adaptive as the stream tracer runs it (host/trace/stream/stream_tracer.cpp,
@@ -611,14 +626,25 @@ class Tracer {
 void adaptive(const Tracer& tracer, const RenderOptions& opt, unsigned workers,
               std::vector<Counters>& counters, RenderResult& res) {
   const int W = opt.width, H = opt.height;
+  // --aa-criterion object (kernels/cones.h, marcarConos): also where the centre rays' hit
+  // distances (the depth AOV, 0 for a miss) on both sides of a hit bend by more than cone_depth
+  // widths of the pixel's cone at its hit. As the kernel, in float.
+  const bool cones = opt.aa_criterion == RenderOptions::AaCriterion::object;
+  const bool mirrors = cones && !tracer.ray_streams();  // the reflected surface keys
+  const float width_per_t = tracer.pixel_spread() * opt.cone_depth;
+  auto cone_folds = [width_per_t](const std::vector<float>& t, const std::vector<int>& k,
+                                  size_t own, size_t a, size_t b) {
+    return k[own] >= 0 && std::fabs(t[a] + t[b] - 2.0f * t[own]) > t[own] * width_per_t;
+  };
   const size_t n = size_t(W) * size_t(H);
   std::vector<glm::dvec3> estimate(n);
-  std::vector<int> key(n), samples(n, 1);
+  std::vector<int> key(n), samples(n, 1), reflected(n, -1);
   std::vector<uint8_t> candidate(n, 1), marked(n, 0);
   for_each_row(H, workers, [&](unsigned worker, int y) {
     for (int x = 0; x < W; ++x) {
       const size_t i = size_t(y) * size_t(W) + size_t(x);
-      estimate[i] = tracer.centre(x, y, res, key[i], counters[worker]);
+      estimate[i] =
+          tracer.centre(x, y, res, key[i], counters[worker], mirrors ? &reflected[i] : nullptr);
     }
   });
   for (const int side : adaptive_levels(opt.spp)) {
@@ -633,12 +659,13 @@ void adaptive(const Tracer& tracer, const RenderOptions& opt, unsigned workers,
         };
         bool edge = false;
         for (const glm::ivec2 d : {glm::ivec2(-1, 0), {1, 0}, {0, -1}, {0, 1}})
-          edge = edge || key[at(d.x, d.y)] != key[i];
+          edge = edge || key[at(d.x, d.y)] != key[i] || reflected[at(d.x, d.y)] != reflected[i];
         // The colour's second difference along x and along y.
         for (const glm::ivec2 d : {glm::ivec2(1, 0), {0, 1}}) {
           const glm::dvec3 bend =
               glm::abs(estimate[at(-d.x, -d.y)] + estimate[at(d.x, d.y)] - 2.0 * estimate[i]);
           edge = edge || std::max({bend.x, bend.y, bend.z}) > double(opt.aa_threshold);
+          if (cones) edge = edge || cone_folds(res.depth, key, i, at(-d.x, -d.y), at(d.x, d.y));
         }
         marked[i] = candidate[i] && edge;
         count += marked[i];

@@ -64,7 +64,9 @@ void StreamTracer::render_adaptive(const Camera& cam, RenderResult& res, int& it
   const std::vector<int> levels = adaptive_levels(opt_.spp);
   for (size_t l = 0; l < levels.size(); ++l) {
     // marcarPixeles on the current estimate, then pixelesMarcados: how many get more samples.
-    r.pass(s.mark, {&s.marks.current(), &s.result.current()}, s.marks.next());
+    // (marcarConos instead with --aa-criterion object: kernels/cones.h.)
+    r.pass(cones() ? static_cast<const vgpu::Program&>(s.mark_cones) : s.mark,
+           {&s.marks.current(), &s.result.current()}, s.marks.next());
     s.marks.swap();
     if (r.count(s.marked, s.marks.current(), nullptr, nullptr) == 0) break;
     // The level's n x n samples, only in marked pixels, replacing their earlier ones.

@@ -10,6 +10,7 @@
 #include "host/trace/stream/ray_streams.h"
 #include "host/trace/stream/stream_tracer.h"
 #include "host/trace/walks/accel_walk.h"
+#include "kernels/cones.h"
 
 namespace host {
 
@@ -43,6 +44,10 @@ struct StreamTracer::State {
   vgpu::KernelProgram<kernels::KeepHits> keep;
   vgpu::KernelProgram<kernels::MarkPixels> mark;
   vgpu::KernelProgram<kernels::MarkedPixels> marked;
+  // ... or the cones' (--aa-criterion object): keys and hit distances, and their marks.
+  vgpu::KernelProgram<kernels::KeepCones> keep_cones;
+  vgpu::KernelProgram<kernels::KeepReflected> keep_reflected;
+  vgpu::KernelProgram<kernels::MarkCones> mark_cones;
   PingPong<vgpu::Texture> marks;
   vgpu::Texture materials;
   // Adaptive undersampling (--aa undersample:K): the lattice, the gaps, the fill.

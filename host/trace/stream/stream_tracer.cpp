@@ -134,6 +134,8 @@ StreamTracer::StreamTracer(const Scene& scene, const Accel& accel, const RenderO
     for (int i = 0; i < 2; ++i)
       s.marks[i] = gpu.make_texture(std::string("marks ") + (i ? "B" : "A"), W, H, 4, Format::fp32);
     s.mark.kernel.threshold = opt_.aa_threshold;
+    s.mark_cones.kernel.threshold = opt_.aa_threshold;
+    s.mark_cones.kernel.depth_cones = opt_.cone_depth;
     const LatticeUniforms lattice{float(std::max(opt_.undersample, 1)), float(W), float(H)};
     s.mark_lattice.kernel.lattice = lattice;
     s.mark_gaps.kernel.lattice = lattice;
@@ -225,6 +227,8 @@ void StreamTracer::set_uniforms() {
   s.origin.kernel.offset = float(kOffsetOfDiagonal) * diag;
   s.direction.kernel.scene = su;
   s.keep.kernel.scene = su;
+  s.keep_cones.kernel.scene = su;
+  s.keep_reflected.kernel.scene = su;
   s.shader.kernel.texture.on = s.textured;
   s.shader.kernel.texture.filter = opt_.texture_filter;
   if (s.streams) {
@@ -309,6 +313,7 @@ RenderResult StreamTracer::render(const Camera& cam) {
   s.shader.kernel.texture.right = g.right;
   s.shader.kernel.texture.up = g.up;
   s.shader.kernel.texture.spread = 2.0f * g.tan_half_fov / float(H);
+  s.mark_cones.kernel.spread = s.shader.kernel.texture.spread;  // the cones' width per distance
   if (opt_.trace_pixel && opt_.trace_out)
     *opt_.trace_out << "pixel " << opt_.trace_pixel->x << "," << opt_.trace_pixel->y << ":\n";
   int iteration_number = 0;
@@ -365,6 +370,12 @@ void StreamTracer::frame(const Camera& cam, const vgpu::Program& generate, Rende
     Texture& origins = s.origins.current();
     walk_rays(origins, rays, it == 0, cam);
     if (it == 0) primary_hits(res, aovs, keep_hits);
+    // guardarReflejos (--aa-criterion object): the first reflected rays' surface keys.
+    if (it == 1 && keep_hits && cones()) {
+      s.runner->pass(s.keep_reflected, {&s.marks.current(), &s.isect.current(), &s.materials},
+                     s.marks.next());
+      s.marks.swap();
+    }
     Texture& surface = s.origins.next();  // the hit points: the next iteration's origins
     reflection_origin(origins, rays, surface);
     PingPong<Texture*> col(&s.result.current(), &s.result.next());
@@ -403,7 +414,10 @@ void StreamTracer::primary_hits(RenderResult& res, bool aovs, bool keep_hits) {
   State& s = *s_;
   // guardarImpactos: the primary hits' surface keys (--aa adaptive), before later traces
   // overwrite the intersections.
-  if (keep_hits) s.runner->pass(s.keep, {&s.isect.current(), &s.materials}, s.marks.current());
+  // With --aa-criterion object, guardarConos also keeps the hit distances (kernels/cones.h).
+  if (keep_hits)
+    s.runner->pass(cones() ? static_cast<const vgpu::Program&>(s.keep_cones) : s.keep,
+                   {&s.isect.current(), &s.materials}, s.marks.current());
   if (aovs) download_aovs(res);
 }
 

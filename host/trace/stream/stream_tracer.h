@@ -81,6 +81,10 @@ class StreamTracer {
   // After the primary walk: guardarImpactos (with `keep_hits`) writes the hits' surface keys
   // into the current marks; with `aovs`, the hits' depth and id go into res.
   void primary_hits(RenderResult& res, bool aovs, bool keep_hits);
+  // Whether adaptive supersampling decides by the pixels' cones (--aa-criterion object).
+  bool cones() const {
+    return opt_.adaptive && opt_.aa_criterion == RenderOptions::AaCriterion::object;
+  }
   // Reflection origin (inicioReflejo): from the rays and their hits, the hit points and the
   // surface record into `surface`, which the shader reads and the next rays start from.
   void reflection_origin(const vgpu::Texture& origins, const vgpu::Texture& rays,
