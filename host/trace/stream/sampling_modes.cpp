@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "host/trace/sampling.h"
+#include "host/trace/stream/mark_streams.h"
 #include "host/trace/stream/stream_state.h"
 
 namespace host {
@@ -66,7 +67,10 @@ void StreamTracer::render_adaptive(const Camera& cam, RenderResult& res, int& it
     // marcarPixeles on the current estimate, then pixelesMarcados: how many get more samples.
     r.pass(s.mark, {&s.marks.current(), &s.result.current()}, s.marks.next());
     s.marks.swap();
-    if (r.count(s.marked, s.marks.current(), nullptr, nullptr) == 0) break;
+    const uint64_t marked = r.count(s.marked, s.marks.current(), nullptr, nullptr);
+    if (marked == 0) break;
+    // The level's frames trace the marked pixels as a dense stream (MarkStreams).
+    if (s.dense) s.dense->pack(r, s.marks.current(), marked);
     // The level's n x n samples, only in marked pixels, replacing their earlier ones.
     const int n = levels[l] * levels[l];
     s.sample_generate.kernel.gated = true;
@@ -112,6 +116,13 @@ void StreamTracer::render_undersampled(const Camera& cam, RenderResult& res,
   s.marks.make_current(1);  // guardarImpactos writes the lattice frame's keys into marks B
   s.sample_generate.kernel.jitter_x = s.sample_generate.kernel.jitter_y = 0.5f;
   s.sample_generate.kernel.gated = true;
+  if (s.dense) {
+    // The lattice's pixels, counted here (the host knows where they are), as a dense stream.
+    uint64_t lattice = 0;
+    for (int y = 0; y < H; ++y)
+      for (int x = 0; x < W; ++x) lattice += on_lattice(x, y, K, W, H) ? 1 : 0;
+    s.dense->pack(r, s.marks[0], lattice);
+  }
   frame(cam, s.sample_generate, res, true, iteration_number, &s.marks[0], true);
   res.first_frame_passes = gpu.stats().totals.passes;
   gpu.clear(s.sum.current(), {0, 0, 0, 0});
@@ -122,7 +133,8 @@ void StreamTracer::render_undersampled(const Camera& cam, RenderResult& res,
   // the gaps' frame traces them.
   r.pass(s.mark_gaps, {&s.marks[1], &s.sum.current()}, s.marks[0]);
   std::vector<uint8_t> gap(size_t(W) * size_t(H), 0);
-  if (r.count(s.marked, s.marks[0], nullptr, nullptr) > 0) {
+  if (const uint64_t gaps = r.count(s.marked, s.marks[0], nullptr, nullptr); gaps > 0) {
+    if (s.dense) s.dense->pack(r, s.marks[0], gaps);
     const std::vector<float> depth = res.depth, hit_id = res.hit_id;
     frame(cam, s.sample_generate, res, true, iteration_number, &s.marks[0]);
     accumulate_samples(&s.marks[0]);

@@ -79,8 +79,10 @@ class StreamTracer {
   // to the observer as one trace. Leaves each ray's nearest hit in the current intersections.
   void walk_rays(vgpu::Texture& origins, vgpu::Texture& rays, bool primary, const Camera& cam);
   // After the primary walk: guardarImpactos (with `keep_hits`) writes the hits' surface keys
-  // into the current marks; with `aovs`, the hits' depth and id go into res.
-  void primary_hits(RenderResult& res, bool aovs, bool keep_hits);
+  // into the current marks; with `aovs`, the hits' depth and id go into res. `dense_marks`: the
+  // frame traced those marks' pixels as a dense stream, whose hits are gathered back first.
+  void primary_hits(RenderResult& res, bool aovs, bool keep_hits,
+                    const vgpu::Texture* dense_marks = nullptr);
   // Reflection origin (inicioReflejo): from the rays and their hits, the hit points and the
   // surface record into `surface`, which the shader reads and the next rays start from.
   void reflection_origin(const vgpu::Texture& origins, const vgpu::Texture& rays,
@@ -102,8 +104,8 @@ class StreamTracer {
   void shader_pass(const vgpu::Texture& surface, const vgpu::Texture& rays,
                    const vgpu::Texture& colour, const vgpu::Texture& shadow,
                    const vgpu::Texture& origins, vgpu::Texture& out);
-  // The primary hits' depths and input triangle ids into res, from the current intersections.
-  void download_aovs(RenderResult& res);
+  // The primary hits' depths and input triangle ids into res, from `hits` (pixel layout).
+  void download_aovs(RenderResult& res, vgpu::Texture& hits);
   // The sampling modes and their resolve (host/trace/stream/sampling_modes.cpp).
   // acumularMuestras: the current frame's colours (gated: only in the pixels `marks` flags, if
   // given) added into the sum of the sample frames; the sum ping-pongs.
