@@ -5,10 +5,12 @@
 // marks):
 //   compactarMarcados    stream slot j finds the j-th marked pixel by a binary search over the
 //                        inclusive prefix sums of the marks, and writes that pixel's centre;
-//   generadorRayosDensos the sample rays of those pixel centres, one per slot (the same rays
-//                        generadorRayosMuestra gives the marked pixels, to the bit);
-//   reunirMarcados       after the frame, each marked pixel fetches its slot's texel (its
-//                        colour, or its primary hit) back: a gather, no scatter.
+//   generadorRayosDensos the sample rays of those pixel centres, one per slot, several samples
+//                        of a level in one stream (the same rays generadorRayosMuestra gives
+//                        the marked pixels, to the bit);
+//   acumularDensos       after the frame, each marked pixel adds its slot's colour for one
+//                        sample to its sum: a gather, no scatter;
+//   reunirMarcados       the same gather for the primary hits, where a frame keeps them.
 #pragma once
 
 #include "kernels/generate_rays.h"
@@ -47,23 +49,61 @@ struct CompactMarks {
   }
 };
 
-// generadorRayosMuestra for a dense stream: slot j's ray goes through the sample position of the
-// pixel whose centre compactarMarcados wrote there (w 0: a slot past the marked pixels, no ray).
+// generadorRayosMuestra for a dense stream of several samples: slot s holds sample k of the j-th
+// marked pixel, s = k m + j (m marked pixels, sample-major: a whole sample's pixels, then the
+// next sample's). Its ray goes through that pixel's centre (compactarMarcados') moved by sample
+// k's offset from the jitter table, as generadorRayosMuestra's uniform moves the whole frame.
+// Slots past `count` get no ray (tmax -1).
 struct GenerateDenseRays : GenerateRays {
   static constexpr const char* name = "generate dense rays";
   static constexpr const char* paper_name = "generadorRayosDensos (extension)";
-  enum Unit { kPixels };
-  static constexpr std::array<const char*, 1> units{"pixels"};
+  enum Unit { kPixels, kJitters };
+  static constexpr std::array<const char*, 2> units{"pixels", "jitters"};
 
-  float jitter_x = 0.5f, jitter_y = 0.5f;  // as GenerateSampleRays'
+  float stream_width = 1;  // the stream's (and image's) width, texels
+  float marked = 1;        // m, the marked pixels
+  float count = 0;         // live slots: m times the samples this frame traces
+  float first = 0;         // the jitter table's entry of this frame's first sample
+  float table_width = 1;   // the jitter table's width, texels (entry k: x - 0.5, y - 0.5)
 
   template <class L>
   void operator()(Fragments<L>& f) const {
     using F = typename L::F;
-    const Vec4<F> p = f.fetch_own(kPixels);
-    Vec4<F> ray = ray_through<L>(p.x + F(jitter_x - 0.5f), p.y + F(jitter_y - 0.5f));
-    ray.w = select(p.w > F(0.0f), ray.w, F(kNone));
+    const F s = stream_index(f.x, f.y, stream_width);
+    // k = floor(s / m), exact while s stays far below 2^23 (the tracer checks the size).
+    const F k = floor((s + F(0.5f)) / F(marked));
+    const Vec4<F> p = fetch_id(f, kPixels, s - k * F(marked), stream_width);
+    const Vec4<F> j = fetch_id(f, kJitters, k + F(first), table_width);
+    Vec4<F> ray = ray_through<L>(p.x + j.x, p.y + j.y);
+    ray.w = select(s < F(count), ray.w, F(kNone));
     f.out(0) = ray;
+  }
+};
+
+// acumularMuestras for a dense stream: a marked pixel adds the colour of its slot for sample k,
+// k m + (its inclusive sum - 1), to its sum, exactly as acumularMuestras adds a gated frame's
+// (`restart`: the level's first sample replaces the earlier ones); the others keep their sum.
+struct AccumulateDense {
+  static constexpr const char* name = "accumulate dense samples";
+  static constexpr const char* paper_name = "acumularDensos (extension)";
+  static constexpr int outputs = 1;  // -> sample sum
+  enum Unit { kSum, kMarks, kScan, kDense };
+  static constexpr std::array<const char*, 4> units{"sample_sum", "marks", "scan", "dense"};
+
+  float width = 1;  // image width = the stream's width, texels
+  float base = 0;   // k m: the first slot of this sample in the frame's stream
+  bool restart = false;
+
+  template <class L>
+  void operator()(Fragments<L>& f) const {
+    using F = typename L::F;
+    const Vec4<F> sum = f.fetch_own(kSum);
+    const auto marked = f.fetch_own(kMarks).x > F(0.0f);
+    const F slot = F(base) + max(f.fetch_own(kScan).x - F(1.0f), F(0.0f));
+    const Vec4<F> c = fetch_id(f, kDense, slot, width);
+    const Vec4<F> from = restart ? Vec4<F>{F(0.0f), F(0.0f), F(0.0f), F(0.0f)} : sum;
+    const Vec4<F> added = {from.x + c.x, from.y + c.y, from.z + c.z, from.w + F(1.0f)};
+    f.out(0) = select(marked, added, sum);
   }
 };
 

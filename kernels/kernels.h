@@ -97,4 +97,5 @@ extern template class vgpu::KernelProgram<kernels::GatherChildren>;
 extern template class vgpu::KernelProgram<kernels::CompactMarks>;
 extern template class vgpu::KernelProgram<kernels::GenerateDenseRays>;
 extern template class vgpu::KernelProgram<kernels::GatherMarked>;
+extern template class vgpu::KernelProgram<kernels::AccumulateDense>;
 extern template class vgpu::KernelProgram<kernels::ShadowGlass>;

@@ -14,3 +14,4 @@ template class vgpu::KernelProgram<kernels::ShadowGlass>;
 template class vgpu::KernelProgram<kernels::CompactMarks>;
 template class vgpu::KernelProgram<kernels::GenerateDenseRays>;
 template class vgpu::KernelProgram<kernels::GatherMarked>;
+template class vgpu::KernelProgram<kernels::AccumulateDense>;

@@ -41,7 +41,7 @@ using MultipassKernels = KernelList<
     // Glass (an extension, issue 25): the ray streams, their compaction and the gather back.
     SplitRays, ScanStream, CountStream, CompactStream, CopyRows, ShadowGlass, GatherChildren,
     // Sampling that saves time (issue 35): the marked pixels as a dense stream, and back.
-    CompactMarks, GenerateDenseRays, GatherMarked>;
+    CompactMarks, GenerateDenseRays, AccumulateDense, GatherMarked>;
 
 // The looping variant (--kernels looping): each structure's whole walk in one program with a
 // data-dependent loop (kernels/looping_traversal.h and the structures' headers).

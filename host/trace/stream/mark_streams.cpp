@@ -56,11 +56,15 @@ std::string describe(const CompactStats& s) {
   return line;
 }
 
-bool MarkStreams::fits(const vgpu::Profile& profile, int width, int height) {
-  // Pixel indices are float texel addresses, computed in the finest arithmetic the card has.
+bool MarkStreams::fits(const vgpu::Profile& profile, const RenderOptions& opt) {
+  // Slot indices are float texel addresses, and the generator divides them by the marked
+  // pixels' count: exact where the finest arithmetic has a bit to spare.
   const Format f = profile.computes(Format::fp32);
-  const int bits = f == Format::fp16 ? 11 : f == Format::fp24 ? 17 : 24;
-  return uint64_t(width) * uint64_t(height) <= (uint64_t(1) << bits);
+  if (profile.computes(opt.formats.arithmetic(Group::rays)) != f ||
+      profile.computes(opt.formats.arithmetic(Group::colour)) != f)
+    return false;
+  const int bits = f == Format::fp16 ? 10 : f == Format::fp24 ? 16 : 22;
+  return uint64_t(opt.width) * uint64_t(opt.height) <= (uint64_t(1) << bits);
 }
 
 MarkStreams::MarkStreams(vgpu::Device& gpu, const RenderOptions& opt)
@@ -75,11 +79,53 @@ MarkStreams::MarkStreams(vgpu::Device& gpu, const RenderOptions& opt)
   compactor_.set_precision(Format::fp32);
   gatherer_.set_precision(Format::fp32);
   generate.set_precision(opt.formats.arithmetic(Group::rays));
+  accumulator_.set_precision(opt.formats.arithmetic(Group::colour));
 }
 
 vgpu::Rect MarkStreams::rect() const {
-  const uint64_t rows = std::max<uint64_t>(1, (n_ + uint64_t(W_) - 1) / uint64_t(W_));
+  const uint64_t rows = std::max<uint64_t>(1, (count_ + uint64_t(W_) - 1) / uint64_t(W_));
   return {0, 0, W_, int(rows)};
+}
+
+void MarkStreams::set_samples(const std::vector<glm::vec2>& offsets) {
+  const int n = int(std::max<size_t>(offsets.size(), 1));
+  if (jitters_.width() != n) jitters_ = gpu_.make_texture("sample jitters", n, 1, 4, Format::fp32);
+  std::vector<float> texels(size_t(n) * 4, 0.0f);
+  // generadorRayosMuestra adds (jitter - 0.5) to the pixel's centre: the same float here.
+  for (size_t k = 0; k < offsets.size(); ++k) {
+    texels[k * 4] = offsets[k].x - 0.5f;
+    texels[k * 4 + 1] = offsets[k].y - 0.5f;
+  }
+  jitters_.replace(texels);
+  gpu_.upload(jitters_);
+}
+
+int MarkStreams::samples_per_frame() const {
+  return int(std::max<uint64_t>(1, uint64_t(W_) * uint64_t(H_) / std::max<uint64_t>(n_, 1)));
+}
+
+void MarkStreams::frame_begins(int k0, int k1) {
+  count_ = n_ * uint64_t(k1 - k0);
+  kernels::GenerateDenseRays& g = generate.kernel;
+  g.stream_width = float(W_);
+  g.marked = float(std::max<uint64_t>(n_, 1));
+  g.count = float(count_);
+  g.first = float(k0);
+  g.table_width = float(jitters_.width());
+  ++stats.frames;
+  stats.live_rays += count_;
+  stats.slots += rect().area();
+  stats.pixels += uint64_t(W_) * uint64_t(H_) * uint64_t(k1 - k0);
+}
+
+void MarkStreams::accumulate(PassRunner& r, const Texture& sum, const Texture& marks,
+                             const Texture& dense, int k, bool restart, Texture& out) {
+  kernels::AccumulateDense& a = accumulator_.kernel;
+  a.width = float(W_);
+  a.base = float(uint64_t(k) * n_);
+  a.restart = restart;
+  add(r.pass(accumulator_, {&sum, &marks, &scan_.current(), &dense}, out), stats.gather_passes,
+      stats.gather_bytes);
 }
 
 void MarkStreams::pack(PassRunner& r, const Texture& marks, uint64_t n) {
@@ -105,6 +151,7 @@ void MarkStreams::pack(PassRunner& r, const Texture& marks, uint64_t n) {
   c.count = float(n);
   c.sources = float(pixels);
   c.steps = ceil_log2(pixels);
+  count_ = n;
   r.rect = rect();
   add(r.pass(compactor_, {&scan_.current()}, pixels_), stats.compaction_passes,
       stats.compaction_bytes);
@@ -119,15 +166,8 @@ void MarkStreams::gather(PassRunner& r, const Texture& marks, const Texture& den
       stats.gather_bytes);
 }
 
-void MarkStreams::frame_begins() {
-  ++stats.frames;
-  stats.live_rays += n_;
-  stats.slots += rect().area();
-  stats.pixels += uint64_t(W_) * uint64_t(H_);
-}
-
 uint64_t MarkStreams::texture_bytes() const {
-  return scan_[0].bytes() + scan_[1].bytes() + pixels_.bytes();
+  return scan_[0].bytes() + scan_[1].bytes() + pixels_.bytes() + jitters_.bytes();
 }
 
 }  // namespace host

@@ -11,6 +11,7 @@
 #include <glm/glm.hpp>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "host/trace/passes.h"
 #include "host/trace/ping_pong.h"
@@ -28,23 +29,34 @@ class MarkStreams {
  public:
   MarkStreams(vgpu::Device& gpu, const RenderOptions& opt);
 
-  // Whether the profile's arithmetic addresses every pixel of the image exactly (fp24: 2^17
-  // pixels, fp32: 2^24); where it does not, the gated frames run over the whole target.
-  static bool fits(const vgpu::Profile& profile, int width, int height);
+  // Whether the dense streams run bit for bit as the gated frames: the rays' and the colour's
+  // arithmetic are the finest the profile has (their kernels also address the stream), and it
+  // addresses every slot of a W x H stream exactly (fp24: 2^16 pixels, fp32: 2^22). Where not,
+  // the gated frames run over the whole target.
+  static bool fits(const vgpu::Profile& profile, const RenderOptions& opt);
 
   // Packs the pixels `marks` flags (x > 0; `n` of them, as counted): the scan of the flags, then
-  // the dense stream's pixel centres. Frames traced after it draw rect()'s rows.
+  // the dense stream's pixel centres.
   void pack(PassRunner& r, const vgpu::Texture& marks, uint64_t n);
-  // The rows the packed stream fills (at least one).
+  // The sample offsets (host/trace/sampling.h, in [0, 1)) of the samples the next frames trace,
+  // into the jitter table.
+  void set_samples(const std::vector<glm::vec2>& offsets);
+  // How many samples of every packed pixel one frame's stream holds (W H slots at most).
+  int samples_per_frame() const;
+  // The next frame traces samples [k0, k1) of the table for every packed pixel.
+  void frame_begins(int k0, int k1);
+  // The rows the frame's stream fills (at least one): every pass of the frame draws them.
   vgpu::Rect rect() const;
-  uint64_t live() const { return n_; }
   const vgpu::Texture& pixels() const { return pixels_; }
-  // reunirMarcados: `dense`'s texel of each marked pixel's slot into `out` (pixel layout), the
-  // others `fallback`. Draws the whole target (r.rect must be unset).
+  const vgpu::Texture& jitters() const { return jitters_; }
+  // acumularDensos: each packed pixel adds the frame's colour (`dense`) of its sample k (within
+  // the frame) to its sum (`restart`: instead of it).
+  void accumulate(PassRunner& r, const vgpu::Texture& sum, const vgpu::Texture& marks,
+                  const vgpu::Texture& dense, int k, bool restart, vgpu::Texture& out);
+  // reunirMarcados: `dense`'s texel of each packed pixel's slot (its first sample) into `out`
+  // (pixel layout), the others `fallback`. Draws the whole target (r.rect must be unset).
   void gather(PassRunner& r, const vgpu::Texture& marks, const vgpu::Texture& dense,
               vgpu::Texture& out, glm::vec4 fallback);
-  // A gated frame of the packed pixels begins: counted.
-  void frame_begins();
 
   vgpu::KernelProgram<kernels::GenerateDenseRays> generate;
   CompactStats stats;  // this render's; the tracer resets it
@@ -53,12 +65,15 @@ class MarkStreams {
  private:
   vgpu::Device& gpu_;
   int W_, H_;
-  uint64_t n_ = 0;
+  uint64_t n_ = 0;                // pixels packed
+  uint64_t count_ = 0;            // the frame's live slots
   PingPong<vgpu::Texture> scan_;  // current(): the inclusive sums of the last marks packed
   vgpu::Texture pixels_;          // slot j: (x + 0.5, y + 0.5, 0, 1) of the j-th marked pixel
+  vgpu::Texture jitters_;         // entry k: sample k's offset from the pixel's centre
   vgpu::KernelProgram<kernels::ScanStream> scanner_;
   vgpu::KernelProgram<kernels::CompactMarks> compactor_;
   vgpu::KernelProgram<kernels::GatherMarked> gatherer_;
+  vgpu::KernelProgram<kernels::AccumulateDense> accumulator_;
 };
 
 }  // namespace host

@@ -149,7 +149,7 @@ StreamTracer::StreamTracer(const Scene& scene, const Accel& accel, const RenderO
   // Sampling that saves time: the gated frames as dense streams of their marked pixels, where
   // the ray streams do not already move the rays (glass) and --trace-pixel does not follow one.
   if (marking && opt_.compact && !s.streams && !opt_.trace_pixel &&
-      MarkStreams::fits(gpu.profile(), W, H))
+      MarkStreams::fits(gpu.profile(), opt_))
     s.dense = std::make_unique<MarkStreams>(gpu, opt_);
 
   s.shader.kernel.model = opt_.shading;
@@ -361,13 +361,11 @@ void StreamTracer::frame(const Camera& cam, const vgpu::Program& generate, Rende
     return;
   }
   State& s = *s_;
-  // A gated frame whose marks were packed (MarkStreams::pack) traces the dense stream: every
-  // pass draws its rows, and the colours go back to their pixels at the end.
+  // A gated frame whose marks were packed (MarkStreams::pack, frame_begins) traces the dense
+  // stream: every pass draws its rows; the colours stay there for the caller's gather
+  // (acumularDensos).
   const bool dense = marks && s.dense;
-  if (dense) {
-    s.dense->frame_begins();
-    s.runner->rect = s.dense->rect();
-  }
+  if (dense) s.runner->rect = s.dense->rect();
   generate_rays(cam, generate, marks);
   // Each iteration is one ray stream (the primary rays, then each bounce's reflected rays):
   // the walk, inicioReflejo, the shading per light, then the reflected rays of the next one.
@@ -392,12 +390,7 @@ void StreamTracer::frame(const Camera& cam, const vgpu::Program& generate, Rende
     s.rays.swap();
     s.origins.swap();
   }
-  if (dense) {
-    // reunirMarcados: each marked pixel's colour from its slot.
-    s.runner->rect.reset();
-    s.dense->gather(*s.runner, *marks, s.result.current(), s.result.next(), {0, 0, 0, 1});
-    s.result.swap();
-  }
+  s.runner->rect.reset();
 }
 
 void StreamTracer::generate_rays(const Camera& cam, const vgpu::Program& generate,
@@ -408,11 +401,8 @@ void StreamTracer::generate_rays(const Camera& cam, const vgpu::Program& generat
   s.origins.make_current(0);
   gpu_->clear(s.origins.current(), {cam.position.x, cam.position.y, cam.position.z, 0});
   if (marks && s.dense) {
-    // generadorRayosDensos: the sample frame's jitter, through the packed pixels' centres.
-    GenerateDenseRays& d = s.dense->generate.kernel;
-    d.jitter_x = s.sample_generate.kernel.jitter_x;
-    d.jitter_y = s.sample_generate.kernel.jitter_y;
-    s.runner->pass(s.dense->generate, {&s.dense->pixels()}, s.rays.current());
+    // generadorRayosDensos: each slot's sample through its packed pixel.
+    s.runner->pass(s.dense->generate, {&s.dense->pixels(), &s.dense->jitters()}, s.rays.current());
   } else if (marks)
     s.runner->pass(generate, {marks}, s.rays.current());
   else

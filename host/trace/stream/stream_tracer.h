@@ -110,6 +110,13 @@ class StreamTracer {
   // acumularMuestras: the current frame's colours (gated: only in the pixels `marks` flags, if
   // given) added into the sum of the sample frames; the sum ping-pongs.
   void accumulate_samples(const vgpu::Texture* marks);
+  // The same after a gated frame, which may have traced its marked pixels as a dense stream
+  // (then acumularDensos, `restart` as AccumulateSamples' uniform).
+  void accumulate_gated(const vgpu::Texture* marks, bool restart);
+  // One adaptive level with dense streams: the `marked` pixels' n samples each, packed into
+  // as few frames as W x H slots allow, their colours added into the sums.
+  void dense_level(const Camera& cam, RenderResult& res, int& iteration_number, uint64_t marked,
+                   int n);
   // The sampling resolve, the last stage of a frame with several samples per pixel: `resolve`
   // (resolverMuestras, the box filter, or rellenarHuecos, the undersampling fill) turns the
   // sum of the sample frames into the pixels' colours, in the next result texture, which
