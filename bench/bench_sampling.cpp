@@ -37,17 +37,17 @@ struct Mode {
 // The modes docs/sampling.md charts; the first is the one-ray image the others are compared with.
 std::vector<Mode> modes() {
   std::vector<Mode> m = {{"spp 1", 1},
-          {"spp 4", 4},
-          {"spp 16", 16},
-          {"spp 64", 64},
-          {"adaptive 16, T 0.05", 16, true, 0.05f},
-          {"adaptive 16, T 0.1", 16, true, 0.1f},
-          {"adaptive 16, T 0.2", 16, true, 0.2f},
-          {"adaptive 64, T 0.1", 64, true, 0.1f},
-          {"undersample 2", 1, false, 0.1f, 2},
-          {"undersample 2, T 0.05", 1, false, 0.05f, 2},
-          {"undersample 2, T 0.02", 1, false, 0.02f, 2},
-          {"undersample 4", 1, false, 0.1f, 4}};
+                         {"spp 4", 4},
+                         {"spp 16", 16},
+                         {"spp 64", 64},
+                         {"adaptive 16, T 0.05", 16, true, 0.05f},
+                         {"adaptive 16, T 0.1", 16, true, 0.1f},
+                         {"adaptive 16, T 0.2", 16, true, 0.2f},
+                         {"adaptive 64, T 0.1", 64, true, 0.1f},
+                         {"undersample 2", 1, false, 0.1f, 2},
+                         {"undersample 2, T 0.05", 1, false, 0.05f, 2},
+                         {"undersample 2, T 0.02", 1, false, 0.02f, 2},
+                         {"undersample 4", 1, false, 0.1f, 4}};
   // Each adaptive and undersampling mode again as gated frames over the whole target.
   const size_t n = m.size();
   for (size_t i = 0; i < n; ++i)
@@ -102,6 +102,18 @@ struct Row {
   double changed_255 = 0, changed_005 = 0;  // against the one-ray image
   size_t edge_pixels = 0;
 };
+
+// The cost model's ms on the three cards, and the fixed costs of two of them.
+void price(Row& row, const vgpu::FrameStats& stats, const vgpu::Profile& gf5700,
+           const vgpu::Profile& gf6600, const vgpu::Profile& h200) {
+  const host::CostBreakdown c6600 = host::predict(stats, gf6600);
+  const host::CostBreakdown c200 = host::predict(stats, h200);
+  row.gf5700 = host::predict(stats, gf5700).total_ms;
+  row.gf6600 = c6600.total_ms;
+  row.h200 = c200.total_ms;
+  row.gf6600_fixed = c6600.per_pass_ms + c6600.program_load_ms + c6600.readback_ms;
+  row.h200_fixed = c200.per_pass_ms + c200.program_load_ms + c200.readback_ms;
+}
 
 std::vector<std::string> split(const std::string& s) {
   std::vector<std::string> out;
@@ -236,13 +248,7 @@ int main(int argc, char** argv) {
       row.edge_pixels = edge_pixels;
       row.passes = r.stats.totals.passes;
       row.rays_traced = r.rays_traced;
-      row.gf5700 = host::predict(r.stats, gf5700).total_ms;
-      row.gf6600 = host::predict(r.stats, gf6600).total_ms;
-      const host::CostBreakdown c6600 = host::predict(r.stats, gf6600);
-      const host::CostBreakdown c200 = host::predict(r.stats, h200);
-      row.h200 = c200.total_ms;
-      row.gf6600_fixed = c6600.per_pass_ms + c6600.program_load_ms + c6600.readback_ms;
-      row.h200_fixed = c200.per_pass_ms + c200.program_load_ms + c200.readback_ms;
+      price(row, r.stats, gf5700, gf6600, h200);
       row.emulator_ms = ms[ms.size() / 2];
       row.changed_255 = changed(img, one, 1.0 / 255.0 + 1e-9);
       row.changed_005 = changed(img, one, 0.05);

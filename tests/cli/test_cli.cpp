@@ -68,6 +68,7 @@ TEST_CASE("names outside each option's set are refused") {
   check_refused("--precision fp8", "--precision", "fp8 not in {fp32,fp24,fp16,auto}");
   check_refused("--engine gpu", "--engine", "gpu not in {stream,gl,cpu}");
   check_refused("--stats xml", "--stats", "xml not in {table,json,none}");
+  check_refused("--compact maybe", "--compact", "maybe not in {on,off}");
   check_refused("--grid 0", "--grid", "grid resolution '0': each count must be at least 1");
   check_refused("--trace-pixel 3", "--trace-pixel", "expected X,Y (e.g. 128,128), got '3'");
   check_refused("--trace-pixel 300,2", "--trace-pixel", "300,2 is outside the 256x256 image");
