@@ -753,8 +753,8 @@ def time_targets(rows):
     lo = min(floor.values())
     out += ["", f"- Adaptive 16 meets its target on {sum(adaptive_met)} of {len(adaptive_met)} "
             "scenes and cards: a level's samples of "
-            "the marked pixels share frames, so it runs a handful of frames instead of 20 "
-            "(1 + 4 + 16 with gated frames), each over the rows its rays fill.",
+            "the marked pixels share frames, so it runs a handful of frames instead of 21 "
+            "(the centre frame, then 4 + 16 gated frames), each over the rows its rays fill.",
             "- Undersampling does not, and cannot while it runs two frames one after the other: "
             "the lattice frame's marks decide the gaps' frame, and each frame's walk runs as many "
             "passes as the longest ray's path needs, however few rays it holds. Each pass pays "
