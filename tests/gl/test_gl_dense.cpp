@@ -23,8 +23,8 @@ TEST_CASE(
     std::string gl_name;
     for (int k = 0; k < 3; ++k) {
       host::RenderOptions opt;
-      opt.width = 32;
-      opt.height = 24;
+      opt.width = 24;
+      opt.height = 16;
       opt.spp = mode == 0 ? 16 : 1;
       opt.adaptive = mode == 0;
       opt.undersample = mode == 0 ? 0 : 2;
