@@ -31,30 +31,44 @@ struct Mode {
   int undersample = 0;
   bool object = false;  // --aa-criterion object (kernels/cones.h)
   float cone_depth = 2.0f;
+  // Dense streams (RenderOptions::compact); false: the gated frames over the whole target, as
+  // before issue 35 (the same image, the old cost).
+  bool compact = true;
 };
 
 // The modes docs/sampling.md charts; the first is the one-ray image the others are compared with.
 std::vector<Mode> modes() {
-  return {{"spp 1", 1},
-          {"spp 4", 4},
-          {"spp 16", 16},
-          {"spp 64", 64},
-          {"adaptive 16, T 0.05", 16, true, 0.05f},
-          {"adaptive 16, T 0.1", 16, true, 0.1f},
-          {"adaptive 16, T 0.2", 16, true, 0.2f},
-          {"adaptive 64, T 0.1", 64, true, 0.1f},
-          // --aa-criterion object (docs/sampling.md's cones section; the page's other tables
-          // leave them out).
-          {"object 16, T 0.05", 16, true, 0.05f, 0, true},
-          {"object 16, T 0.1", 16, true, 0.1f, 0, true},
-          {"object 16, T 0.2", 16, true, 0.2f, 0, true},
-          {"object 16, T 0.3", 16, true, 0.3f, 0, true},
-          {"object 16, T 0.1, cones 1", 16, true, 0.1f, 0, true, 1.0f},
-          {"object 16, T 0.1, cones 4", 16, true, 0.1f, 0, true, 4.0f},
-          {"undersample 2", 1, false, 0.1f, 2},
-          {"undersample 2, T 0.05", 1, false, 0.05f, 2},
-          {"undersample 2, T 0.02", 1, false, 0.02f, 2},
-          {"undersample 4", 1, false, 0.1f, 4}};
+  std::vector<Mode> m = {{"spp 1", 1},
+                         {"spp 4", 4},
+                         {"spp 16", 16},
+                         {"spp 64", 64},
+                         {"adaptive 16, T 0.05", 16, true, 0.05f},
+                         {"adaptive 16, T 0.1", 16, true, 0.1f},
+                         {"adaptive 16, T 0.2", 16, true, 0.2f},
+                         {"adaptive 64, T 0.1", 64, true, 0.1f},
+                         // --aa-criterion object (docs/sampling.md's cones section; the
+                         // page's other tables leave them out).
+                         {"object 16, T 0.05", 16, true, 0.05f, 0, true},
+                         {"object 16, T 0.1", 16, true, 0.1f, 0, true},
+                         {"object 16, T 0.2", 16, true, 0.2f, 0, true},
+                         {"object 16, T 0.3", 16, true, 0.3f, 0, true},
+                         {"object 16, T 0.1, cones 1", 16, true, 0.1f, 0, true, 1.0f},
+                         {"object 16, T 0.1, cones 4", 16, true, 0.1f, 0, true, 4.0f},
+                         {"undersample 2", 1, false, 0.1f, 2},
+                         {"undersample 2, T 0.05", 1, false, 0.05f, 2},
+                         {"undersample 2, T 0.02", 1, false, 0.02f, 2},
+                         {"undersample 4", 1, false, 0.1f, 4}};
+  // Each adaptive and undersampling mode again as gated frames over the whole target (the
+  // object criterion's modes only dense: their section compares rays, not time).
+  const size_t n = m.size();
+  for (size_t i = 0; i < n; ++i)
+    if ((m[i].adaptive || m[i].undersample > 0) && !m[i].object) {
+      Mode g = m[i];
+      g.label += ", gated";
+      g.compact = false;
+      m.push_back(g);
+    }
+  return m;
 }
 
 // An image as the PNG writer stores it: each channel clamped to [0, 1] and rounded to 8 bits,
@@ -94,9 +108,23 @@ struct Row {
   double rays_mean = 0, rays_max = 0, rms = 0, edge_rms = 0;
   uint64_t passes = 0, rays_traced = 0;
   double gf5700 = 0, gf6600 = 0, h200 = 0, emulator_ms = 0;
+  // Of gf6600's and h200's ms: the fixed costs (passes, program loads, query read-backs).
+  double gf6600_fixed = 0, h200_fixed = 0;
   double changed_255 = 0, changed_005 = 0;  // against the one-ray image
   size_t edge_pixels = 0;
 };
+
+// The cost model's ms on the three cards, and the fixed costs of two of them.
+void price(Row& row, const vgpu::FrameStats& stats, const vgpu::Profile& gf5700,
+           const vgpu::Profile& gf6600, const vgpu::Profile& h200) {
+  const host::CostBreakdown c6600 = host::predict(stats, gf6600);
+  const host::CostBreakdown c200 = host::predict(stats, h200);
+  row.gf5700 = host::predict(stats, gf5700).total_ms;
+  row.gf6600 = c6600.total_ms;
+  row.h200 = c200.total_ms;
+  row.gf6600_fixed = c6600.per_pass_ms + c6600.program_load_ms + c6600.readback_ms;
+  row.h200_fixed = c200.per_pass_ms + c200.program_load_ms + c200.readback_ms;
+}
 
 std::vector<std::string> split(const std::string& s) {
   std::vector<std::string> out;
@@ -195,6 +223,7 @@ int main(int argc, char** argv) {
       opt.undersample = m.undersample;
       if (m.object) opt.aa_criterion = host::RenderOptions::AaCriterion::object;
       opt.cone_depth = m.cone_depth;
+      opt.compact = m.compact;
       host::StreamTracer tracer(scene, grid, opt);
       host::RenderResult r;
       std::vector<double> ms;
@@ -232,9 +261,7 @@ int main(int argc, char** argv) {
       row.edge_pixels = edge_pixels;
       row.passes = r.stats.totals.passes;
       row.rays_traced = r.rays_traced;
-      row.gf5700 = host::predict(r.stats, gf5700).total_ms;
-      row.gf6600 = host::predict(r.stats, gf6600).total_ms;
-      row.h200 = host::predict(r.stats, h200).total_ms;
+      price(row, r.stats, gf5700, gf6600, h200);
       row.emulator_ms = ms[ms.size() / 2];
       row.changed_255 = changed(img, one, 1.0 / 255.0 + 1e-9);
       row.changed_005 = changed(img, one, 0.05);
@@ -303,10 +330,12 @@ int main(int argc, char** argv) {
                     "{\"scene\": \"%s\", \"mode\": \"%s\", \"rays_mean\": %.6g, \"rays_max\": "
                     "%.6g, \"rms\": %.6g, \"edge_rms\": %.6g, \"edge_pixels\": %zu, \"passes\": "
                     "%llu, \"rays_traced\": %llu, \"gf5700\": %.6g, \"gf6600\": %.6g, \"h200\": "
-                    "%.6g, \"emulator_ms\": %.6g, \"changed_255\": %.6g, \"changed_005\": %.6g}",
+                    "%.6g, \"emulator_ms\": %.6g, \"changed_255\": %.6g, \"changed_005\": %.6g, "
+                    "\"gf6600_fixed\": %.6g, \"h200_fixed\": %.6g}",
                     r.scene.c_str(), r.mode.c_str(), r.rays_mean, r.rays_max, r.rms, r.edge_rms,
                     r.edge_pixels, (unsigned long long)r.passes, (unsigned long long)r.rays_traced,
-                    r.gf5700, r.gf6600, r.h200, r.emulator_ms, r.changed_255, r.changed_005);
+                    r.gf5700, r.gf6600, r.h200, r.emulator_ms, r.changed_255, r.changed_005,
+                    r.gf6600_fixed, r.h200_fixed);
       f << line << (i + 1 < rows.size() ? ",\n" : "\n");
     }
     f << "]}\n";

@@ -6,6 +6,7 @@
 
 #include "kernels/accumulate_samples.h"
 #include "kernels/bvh.h"
+#include "kernels/compact_marks.h"
 #include "kernels/compact_stream.h"
 #include "kernels/copy_rows.h"
 #include "kernels/count_stream.h"
@@ -93,4 +94,8 @@ extern template class vgpu::KernelProgram<kernels::CountStream>;
 extern template class vgpu::KernelProgram<kernels::CompactStream>;
 extern template class vgpu::KernelProgram<kernels::CopyRows>;
 extern template class vgpu::KernelProgram<kernels::GatherChildren>;
+extern template class vgpu::KernelProgram<kernels::CompactMarks>;
+extern template class vgpu::KernelProgram<kernels::GenerateDenseRays>;
+extern template class vgpu::KernelProgram<kernels::GatherMarked>;
+extern template class vgpu::KernelProgram<kernels::AccumulateDense>;
 extern template class vgpu::KernelProgram<kernels::ShadowGlass>;

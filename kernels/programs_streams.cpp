@@ -10,3 +10,8 @@ template class vgpu::KernelProgram<kernels::CompactStream>;
 template class vgpu::KernelProgram<kernels::CopyRows>;
 template class vgpu::KernelProgram<kernels::GatherChildren>;
 template class vgpu::KernelProgram<kernels::ShadowGlass>;
+// Sampling that saves time (issue 35): compactarMarcados, generadorRayosDensos, reunirMarcados.
+template class vgpu::KernelProgram<kernels::CompactMarks>;
+template class vgpu::KernelProgram<kernels::GenerateDenseRays>;
+template class vgpu::KernelProgram<kernels::GatherMarked>;
+template class vgpu::KernelProgram<kernels::AccumulateDense>;

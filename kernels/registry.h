@@ -42,7 +42,9 @@ using MultipassKernels = KernelList<
     // The two-level grid walk (an extension, kernels/grid2.h): --accel grid2; its fused forms.
     Grid2Enter, Grid2Step, Grid2LoadCell, Grid2Intersections, Grid2StepLoad, Grid2IntersectNext,
     // Glass (an extension, issue 25): the ray streams, their compaction and the gather back.
-    SplitRays, ScanStream, CountStream, CompactStream, CopyRows, ShadowGlass, GatherChildren>;
+    SplitRays, ScanStream, CountStream, CompactStream, CopyRows, ShadowGlass, GatherChildren,
+    // Sampling that saves time (issue 35): the marked pixels as a dense stream, and back.
+    CompactMarks, GenerateDenseRays, AccumulateDense, GatherMarked>;
 
 // The looping variant (--kernels looping): each structure's whole walk in one program with a
 // data-dependent loop (kernels/looping_traversal.h and the structures' headers).

@@ -249,6 +249,13 @@ void add_render_options(CLI::App& render, RenderArgs& a) {
                   "transmissive material; on, the paper's reflections through them too")
       ->check(CLI::IsMember({"auto", "on"}))
       ->capture_default_str();
+  render
+      .add_option("--compact", a.compact,
+                  "Sampling that saves time (docs/sampling.md): --aa adaptive's and undersample's "
+                  "gated frames trace their marked pixels packed into a dense stream (the same "
+                  "image); off: over the whole target, to compare")
+      ->check(CLI::IsMember(on_off))
+      ->capture_default_str();
   render.add_option("--stats", a.stats, "Statistics on stdout")
       ->check(CLI::IsMember({"table", "json", "none"}))
       ->capture_default_str();

@@ -30,6 +30,7 @@ struct RenderArgs {
   std::string masks = "off";
   std::string mrt = "off";
   std::string ray_streams = "auto";
+  std::string compact = "on";
   std::string stats = "table";
   std::string stats_json;
   std::string stats_csv;

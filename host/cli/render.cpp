@@ -38,6 +38,7 @@
 #include "host/trace/sampling.h"
 #include "host/trace/stream/accel_choice.h"
 #include "host/trace/stream/devices.h"
+#include "host/trace/stream/mark_streams.h"
 #include "host/trace/stream/ray_streams.h"
 #include "host/trace/stream/stream_tracer.h"
 #include "vgpu/vgpu.h"
@@ -105,6 +106,7 @@ RenderPlan parse_render(const RenderArgs& a, bool lanes_given) {
   opt.masks = a.masks == "on";
   opt.mrt = a.mrt == "on";
   opt.ray_streams = a.ray_streams == "on";
+  opt.compact = a.compact == "on";
   opt.looping = a.kernels == "looping";
   opt.steps_per_pass = a.steps_per_pass;
   opt.batch_walk = a.walk == "batches";
@@ -291,6 +293,7 @@ void print_table(const RenderArgs& a, const RenderPlan& plan, const host::Scene&
               r.iterations, a.shading.c_str(), a.shadows.c_str(), a.masks.c_str(), a.mrt.c_str());
   if (!cpu) std::cout << "formats (texture and arithmetic, per group):\n" << describe(opt.formats);
   if (r.streams.on) std::cout << host::describe(r.streams);
+  if (r.compact.on) std::cout << host::describe(r.compact);
   std::printf("initialization %.1f ms (grid %.1f ms), render %.1f ms (%s)\n", init_ms,
               accel.grid_build_ms(), r.render_ms,
               cpu            ? "host CPU"

@@ -12,6 +12,7 @@
 
 #include "host/model/cost_model.h"
 #include "host/model/formats.h"
+#include "host/trace/stream/mark_streams.h"
 #include "host/trace/stream/ray_streams.h"
 #include "host/trace/walks/grid_walk.h"
 #include "vgpu/vgpu.h"
@@ -102,6 +103,7 @@ nlohmann::ordered_json frame_stats_json(const FrameStatsInputs& in) {
                 {"glass_shadow_crossings", cpu_stats.glass_shadow_crossings}};
   j["rays_traced"] = r.rays_traced;
   if (r.streams.on) j["streams"] = to_json(r.streams);  // glass's ray streams
+  if (r.compact.on) j["compact"] = to_json(r.compact);  // the sampling modes' dense streams
   j["rays_unfinished"] = r.rays_unfinished;
   // Supersampling (--spp): samples per pixel and the passes it added to the first sample frame.
   {

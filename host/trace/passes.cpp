@@ -59,7 +59,7 @@ const vgpu::PassRecord& PassRunner::pass(const vgpu::Program& p,
   set_work(work);
   const bool traced = traces_pixel(work);
   if (opt_.observer) opt_.observer->pass_begin(work);
-  const vgpu::PassRecord& rec = gpu_.draw();
+  const vgpu::PassRecord& rec = rect ? gpu_.draw(*rect) : gpu_.draw();
   // The observer sees the first target (a fused pass's other targets are the same pass).
   if (opt_.observer)
     opt_.observer->pass(

@@ -5,6 +5,7 @@
 #include <array>
 #include <cstdint>
 #include <initializer_list>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -75,6 +76,9 @@ class PassRunner {
   uint32_t own_only_units(const vgpu::Program& p);
 
   WalkCounts counts;  // this frame's; the host loop resets it
+  // The rows every pass and count draws (a dense stream of marked pixels fills only its first
+  // rows: host/trace/stream/mark_streams.h); nullopt: the whole target.
+  std::optional<vgpu::Rect> rect;
 
  private:
   vgpu::Device& gpu_;

@@ -120,6 +120,12 @@ struct RenderOptions {
   // reflections through the same streams, compaction and gather back. A scene with a
   // transmissive material always runs them.
   bool ray_streams = false;
+  // Sampling that saves time (--compact, host/trace/stream/mark_streams.h): a gated sample
+  // frame (--aa adaptive's levels, --aa undersample's lattice and gaps) traces its marked pixels
+  // packed into a dense stream, its passes drawing only the rows they fill, and the colours
+  // return to their pixels by a gather. The images are the gated frames'; off runs the gated
+  // frames over the whole target, as before, to compare.
+  bool compact = true;
   std::optional<glm::ivec2> trace_pixel;  // print every pass this pixel took part in
   std::ostream* trace_out = nullptr;
   bool keep_pass_records = false;
@@ -158,6 +164,22 @@ struct StreamStats {
   uint64_t shadow_continued = 0;  // shadow rays continued past a glass surface
 };
 
+// The dense streams of marked pixels (RenderOptions::compact): what one render packed, traced
+// and gathered back.
+struct CompactStats {
+  bool on = false;         // some gated frame ran as a dense stream
+  uint64_t packs = 0;      // sets of marks packed (one per adaptive level, two for undersampling)
+  uint64_t frames = 0;     // gated frames traced as dense streams
+  uint64_t live_rays = 0;  // marked pixels those frames traced (their primary rays)
+  uint64_t slots = 0;      // fragments per pass those frames drew (whole rows), summed
+  uint64_t pixels = 0;     // fragments per pass the gated frames would have drawn, summed
+  // Passes and bytes (read + written) by job: sumaPrefijos over the marks; compactarMarcados;
+  // reunirMarcados (colours, and the primary hits where a frame keeps them).
+  uint64_t scan_passes = 0, scan_bytes = 0;
+  uint64_t compaction_passes = 0, compaction_bytes = 0;
+  uint64_t gather_passes = 0, gather_bytes = 0;
+};
+
 struct RenderResult {
   int width = 0, height = 0;
   std::vector<float> rgb;     // width*height*3, linear, row 0 = top
@@ -174,7 +196,8 @@ struct RenderResult {
   // Primary rays per pixel where they differ between pixels (--aa adaptive); empty: `samples`
   // in every pixel.
   std::vector<uint32_t> rays_per_pixel;
-  StreamStats streams;  // glass's ray streams; streams.on false: the paper's frame
+  StreamStats streams;   // glass's ray streams; streams.on false: the paper's frame
+  CompactStats compact;  // the sampling modes' dense streams; compact.on false: none ran
 };
 
 }  // namespace host

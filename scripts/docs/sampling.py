@@ -77,7 +77,39 @@ size, so the profile's texture limits (4096 x 4096 on both cards) bind only the 
 
 On these cards a pass costs every fragment of the target (the FX) or every fragment the early-z
 test lets through (the 6, with `--masks on`), so a gated frame that traces a tenth of the
-pixels still runs all the passes its walk needs; the tables show the consequence.
+pixels would still run all the passes its walk needs over the whole target (the rows marked
+*gated* below, `--compact off`: how the modes ran before issue 35).
+
+## Sampling that saves time: the marked pixels as a dense stream
+
+The adaptive levels and the undersampling lattice and gaps (`--compact on`, the default) trace
+only the pixels the marks flag, packed into the first rows of the frame's textures, with the
+stream reduction glass's ray streams use (Horn, GPU Gems 2 ch. 36):
+
+1. `sumaPrefijos` over the marks: log2(W H) passes leave each pixel the count of marked pixels
+   up to and including it.
+2. `compactarMarcados`: slot j of the dense stream finds the j-th marked pixel by a binary search
+   over those sums (a fixed number of dependent fetches, no loop: the FX runs it) and keeps its
+   centre. Once per set of marks.
+3. `generadorRayosDensos`: the sample rays of those pixels, slot after slot. An adaptive level's
+   n samples of m marked pixels go into one stream, sample after sample (slot k m + j holds
+   sample k of pixel j, its offset from a small table), as many samples per frame as W H slots
+   hold: a level that marks a tenth of the pixels traces its 16 samples in two frames, not 16.
+4. The frame: every pass of the walk, the shading, the shadow and the reflected rays draws only
+   the rows the stream fills (a rectangle from the top of the target; the counts and the early-z
+   masks see only those fragments).
+5. `acumularDensos`: each marked pixel adds its slot's colour for sample k to its sum, one pass
+   per sample as `acumularMuestras` did, in the same order, so the sums have the same bits;
+   `reunirMarcados` brings the undersampling frames' primary hits back to their pixels the same
+   way (for the surface keys and the depth and id AOVs).
+
+The rays are the gated frames' rays, the sums the same additions: the images, depths and ids
+are the same bits (tested on every structure, both emulator walks, any thread count and the GL
+device). What changes is the cost: fewer fragments per pass, and for adaptive sampling fewer
+frames, so fewer passes, program loads and query read-backs. `--compact off` runs the gated
+frames, to compare. The statistics table's `dense streams` line and the JSON's `compact` object
+count the frames, the live rays, the share of the target their passes drew, and the scan,
+compaction and gather passes.
 """.split("\n")
 
 RULES = """## Where adaptive sampling spends its rays
@@ -215,6 +247,7 @@ def adaptive_verdict(rs):
     rays (5.6 primary rays per pixel)."""
     u16 = rs["spp 16"]
     return u16, [r for k, r in rs.items() if k.startswith("adaptive 16")
+                 and not k.endswith(", gated")
                  and r["rms"] <= 1.5 * u16["rms"] and r["rays_mean"] <= 0.35 * 16]
 
 
@@ -305,6 +338,54 @@ H200_PROSE = """**What the differences say about the model's pricing of sampling
   predicted against 1.84 measured, bunny 2.08 against 1.81). The other modes moved little
   with the warm-up (spp:1 to adaptive:16 within 9% of the control): their frames came after
   shorter idle stretches."""
+
+
+COMPACT_BEGIN, COMPACT_END = "<!-- h200-compact:begin -->", "<!-- h200-compact:end -->"
+
+
+def h200_compact(paths):
+    """The dense streams measured on an H200 (scripts/h200/compact_sampling.sh, bench_gl): per
+    scene and mode, the warm GL frame's wall time beside the h200 prediction from the emulator's
+    statistics of the same frame, and each mode's cost against its baseline, measured and
+    predicted."""
+    rows = {}
+    device = ""
+    for path in paths:
+        j = json.load(open(path))
+        device = j.get("renderer", device)
+        for f in j["frames"]:
+            key = (f["scene"], f["sampling"])
+            if f["engine"] == "stream":
+                rows.setdefault(key, {})["predicted"] = f["predicted_h200"]["total_ms"]
+            else:
+                rows.setdefault(key, {}).update(wall=f["wall_ms"], gpu=f["gpu_ms"],
+                                                passes=f["passes"])
+    names = {"spp:1": "spp 1", "spp:16": "spp 16", "adaptive:16": "adaptive 16, dense",
+             "adaptive:16:gated": "adaptive 16, gated", "undersample:2": "undersample 2, dense",
+             "undersample:2:gated": "undersample 2, gated"}
+    base = {"spp:1": None, "spp:16": None, "adaptive:16": "spp:16", "adaptive:16:gated": "spp:16",
+            "undersample:2": "spp:1", "undersample:2:gated": "spp:1"}
+    out = ["## Sampling that saves time, measured on an H200",
+           "",
+           f"`scripts/h200/compact_sampling.sh` on {device}: the GL device, warm frames (2 s of "
+           "frames before timing, median of 5) at 256x256, the CLI's defaults (shadows, 2 "
+           "bounces), the paper's grid and multipass kernels; beside each, the cost model's h200 "
+           "time from the emulator's statistics of the same frame "
+           "(results/sampling/compact_h200_*.json). Against: undersampling against spp 1, "
+           "adaptive against spp 16.", "",
+           "| scene | mode | passes | wall ms | predicted ms | predicted - wall | against, "
+           "measured | against, predicted |", "|---|---|---:|---:|---:|---:|---:|---:|"]
+    for (scene, mode), r in rows.items():
+        if "wall" not in r or "predicted" not in r:
+            continue
+        b = rows.get((scene, base[mode])) if base[mode] else None
+        against = (f"{r['wall'] / b['wall']:.2f}x | {r['predicted'] / b['predicted']:.2f}x"
+                   if b else " | ")
+        out.append(f"| {scene} | {names.get(mode, mode)} | {r['passes']:,} | {r['wall']:,.1f} | "
+                   f"{r['predicted']:,.1f} | {100 * (r['predicted'] / r['wall'] - 1):+.0f}% | "
+                   f"{against} |")
+    out += ["", COMPACT_PROSE]
+    return "\n".join(out)
 
 
 def looping_again(warm, control, clocks):
@@ -399,9 +480,25 @@ def h200(paths, clocks, looping=None, control=None, looping_clocks=None):
     return "\n".join(out)
 
 
+# What the measured dense-stream frames say (results/sampling/compact_h200_*.json, one device
+# run; kept with the script so that a rewrite of the section keeps it).
+COMPACT_PROSE = """- *Adaptive 16* on the GPU: 0.22x uniform 16 on classic and 0.14x on bunny (predicted 0.22x and
+  0.13x), against 1.34x and 1.27x as gated frames: the target (0.5x) is met on the card, and
+  the model's figures stay within 5% of the wall times.
+- *Undersampling (K = 2)* is cheaper than as gated frames (classic 333 ms against 575 ms,
+  bunny 99 against 173), but still dearer than the one-ray frame on the card (1.17x and 1.13x),
+  where the model predicts 0.83x and 0.90x: its dense frames are priced 26% and 24% under their
+  wall time, outside the model's band (-7% to +3% for the other multipass frames). Their GPU
+  time is a third of their wall time (96 of 333 ms on classic): the rest is the host's and
+  the query read-backs' share, about as many passes and read-backs as the one-ray frame's twice
+  (12,547 passes and 4,369 read-backs against 6,917 and 2,409), which the fixed costs the h200
+  profile fits on full frames price low when each pass draws a few rows."""
+
+
 def plot_chart(main_rows, scenes, size):
     """docs/sampling.png: per scene, each mode's RMS error against its modeled gf6600 time,
-    the Pareto front outlined."""
+    the Pareto front outlined; each gated mode (before the dense streams) hollow, joined to its
+    dense twin (the same image)."""
     fig, axes = plt.subplots(1, len(scenes), figsize=(4.2 * len(scenes), 4.2), sharey=False)
     markers = {"spp": "o", "adaptive": "s", "undersample": "^"}
     colours = {"spp": "tab:blue", "adaptive": "tab:orange", "undersample": "tab:green"}
@@ -409,8 +506,16 @@ def plot_chart(main_rows, scenes, size):
         rs = [r for r in main_rows if r["scene"] == scene]
         pts = [(r["gf6600"], r["rms"]) for r in rs]
         front = pareto(pts)
+        by_mode = {r["mode"]: r for r in rs}
         for i, r in enumerate(rs):
             kind = r["mode"].split()[0]
+            if r["mode"].endswith(", gated"):
+                ax.scatter(r["gf6600"] / 1000, r["rms"], marker=markers[kind], s=30,
+                           facecolors="none", edgecolors=colours[kind], lw=0.8)
+                twin = by_mode[r["mode"][:-len(", gated")]]
+                ax.plot([r["gf6600"] / 1000, twin["gf6600"] / 1000], [r["rms"], twin["rms"]],
+                        color=colours[kind], lw=0.5, ls=":")
+                continue
             ax.scatter(r["gf6600"] / 1000, r["rms"], marker=markers[kind],
                        s=60 if i in front else 30, color=colours[kind],
                        edgecolors="black" if i in front else "none")
@@ -422,7 +527,8 @@ def plot_chart(main_rows, scenes, size):
         # Labels from the top down, each moved down past the labels already placed near it (in
         # points on the page), so that clustered modes stay readable.
         placed = []
-        for r in sorted(rs, key=lambda r: -r["rms"]):
+        for r in sorted((r for r in rs if not r["mode"].endswith(", gated")),
+                        key=lambda r: -r["rms"]):
             x, y = ax.transData.transform((r["gf6600"] / 1000, r["rms"])) * 72 / fig.dpi
             dy = 3
             while any(abs(y + dy - py) < 7 and abs(x - px) < 75 for px, py in placed):
@@ -437,7 +543,8 @@ def plot_chart(main_rows, scenes, size):
     axes[0].set_ylabel("RMS error against 256 samples")
     axes[0].legend(loc="lower left", fontsize=7)
     fig.suptitle("Sampling modes: error against modeled time (circles: --spp; squares: "
-                 "--aa adaptive; triangles: --aa undersample; outlined: on the Pareto front)",
+                 "--aa adaptive; triangles: --aa undersample; outlined: on the Pareto front; "
+                 "hollow, dotted to their dense twins: the gated frames of before)",
                  fontsize=9)
     fig.tight_layout()
     fig.savefig(os.path.join(ROOT, "docs/sampling.png"), dpi=110)
@@ -462,6 +569,10 @@ def parse_args():
     ap.add_argument("--h200-clocks", metavar="CSV",
                     default=os.path.join(ROOT, "results", "sampling", "streams_sampling_h200_clocks.csv"),
                     help="nvidia-smi's clock log of the same run")
+    ap.add_argument("--h200-compact", nargs="+", metavar="FILE",
+                    help="bench_gl JSON of the dense streams on an H200 "
+                    "(results/sampling/compact_h200_*.json): only rewrite docs/sampling.md's "
+                    "section on them")
     ap.add_argument("--h200-looping", nargs="+", metavar="FILE",
                     help="bench_gl JSON of the looping frames run again with --warmup-ms "
                     "(results/sampling/sampling_h200_looping*.json): the section's looping rows")
@@ -489,7 +600,10 @@ def measure(args, scenes, others):
                                      "0", "--modes", "undersample", "--scenes",
                                      ",".join(scenes + others)], work, "changed")["rows"]
         bounds = bounds_section(args.bounds_bench, work, args.changed_size)
-    return main_rows, other_rows, changed, bounds
+        timed = bench(args.bench, ["--size", str(TIME_SIZE), "--reps", "1", "--ref-spp", "0",
+                                   "--modes", "spp 16,adaptive 16,undersample 2", "--scenes",
+                                   TIME_SCENES], work, "time")["rows"]
+    return main_rows, other_rows, changed, bounds, timed
 
 
 def intro(args):
@@ -584,7 +698,8 @@ def undersample_target(scenes, others, changed, changed_size):
            "|---|---|---:|---:|---:|:-:|"]
     for scene in scenes + others:
         for r in changed:
-            if r["scene"] == scene and r["mode"].startswith("undersample 2"):
+            if (r["scene"] == scene and r["mode"].startswith("undersample 2")
+                    and not r["mode"].endswith(", gated")):
                 met = r["changed_255"] <= 0.01 and r["rays_mean"] <= 1 / 3
                 out.append(f"| {scene} | {r['mode']} | {r['rays_mean']:.3f} | "
                            f"{100 * r['changed_255']:.2f}% | {100 * r['changed_005']:.2f}% | "
@@ -604,12 +719,55 @@ def undersample_target(scenes, others, changed, changed_size):
             "more than 0.05, undersampling changes at most "
             f"{100 * max(r['changed_005'] for r in changed if r['mode'] == 'undersample 2'):.2f}%"
             " of the pixels of any scene at the default T 0.1."]
-    out += ["", "Why the modeled time does not follow the rays: a gated sample frame gives rays "
-            "only to marked pixels, but its walk runs every pass until the last marked ray is "
-            "done, over the whole target, and the frame's shading passes run too. On the "
-            "GeForce FX every fragment runs every pass, so the saved rays save nothing there; "
-            "with early-z masks (`--masks on`) unmarked fragments cost nothing, but passes, "
-            "program loads and query read-backs stay.", ""]
+    return out
+
+
+TIME_SIZE = 256
+TIME_SCENES = "classic,bunny"
+
+
+def time_targets(rows):
+    """Sampling that saves time against its targets at 256x256: undersampling (K = 2) at most
+    0.5x the one-ray frame's modeled time, adaptive 16 (T 0.1) at most 0.5x uniform 16's, on
+    gf6600 and h200, dense and gated."""
+    out = ["", "**Sampling that saves time** (issue 35): at "
+           f"{TIME_SIZE}x{TIME_SIZE}, modeled time on gf6600 and h200, the CLI's defaults "
+           "(shadows on), undersampling (K = 2) at most 0.5x the one-ray frame, adaptive 16 at "
+           "most 0.5x uniform 16 samples. Dense: `--compact on`; gated: `--compact off`, as "
+           "before.", "",
+           "| scene | profile | spp 1 ms | undersample 2: dense / gated ms | dense / spp 1 | "
+           "met | spp 16 ms | adaptive 16, T 0.1: dense / gated ms | dense / spp 16 | met |",
+           "|---|---|---:|---:|---:|:-:|---:|---:|---:|:-:|"]
+    floor, adaptive_met = {}, []
+    for scene in TIME_SCENES.split(","):
+        rs = {r["mode"]: r for r in rows if r["scene"] == scene}
+        for prof in ("gf6600", "h200"):
+            one, u16 = rs["spp 1"][prof], rs["spp 16"][prof]
+            us, usg = rs["undersample 2"][prof], rs["undersample 2, gated"][prof]
+            ad, adg = rs["adaptive 16, T 0.1"][prof], rs["adaptive 16, T 0.1, gated"][prof]
+            adaptive_met.append(ad <= 0.5 * u16)
+            out.append(f"| {scene} | {prof} | {one:,.1f} | {us:,.1f} / {usg:,.1f} | "
+                       f"{us / one:.2f}x | {'yes' if us <= 0.5 * one else 'no'} | {u16:,.1f} | "
+                       f"{ad:,.1f} / {adg:,.1f} | {ad / u16:.2f}x | "
+                       f"{'yes' if adaptive_met[-1] else 'no'} |")
+            floor[(scene, prof)] = rs["undersample 2"][prof + "_fixed"] / one
+    lo = min(floor.values())
+    out += ["", f"- Adaptive 16 meets its target on {sum(adaptive_met)} of {len(adaptive_met)} "
+            "scenes and cards: a level's samples of "
+            "the marked pixels share frames, so it runs a handful of frames instead of 21 "
+            "(the centre frame, then 4 + 16 gated frames), each over the rows its rays fill.",
+            "- Undersampling does not, and cannot while it runs two frames one after the other: "
+            "the lattice frame's marks decide the gaps' frame, and each frame's walk runs as many "
+            "passes as the longest ray's path needs, however few rays it holds. Each pass pays "
+            "the card's fixed costs (a pass, a program load, a query read-back per step of the "
+            "walk), and those of the undersampled render alone are "
+            f"{lo:.2f}x the one-ray frame's whole time or more ("
+            + ", ".join(f"{sc} {p} {v:.2f}x" for (sc, p), v in floor.items()) +
+            "), above 0.5x before any fragment is shaded. The dense streams cut the pass work "
+            "(the lattice a quarter of the fragments, the gaps fewer), which is what brings "
+            "undersampling from dearer than the one-ray frame to about its price on the H200; "
+            "a cheaper undersampling needs fewer passes per frame (the looping walk), or a way "
+            "to decide the gaps without a second walk.", ""]
     return out
 
 
@@ -621,6 +779,10 @@ def main():
                                bounds_section(args.bounds_bench, work, args.changed_size))
         print("sampling.py: wrote docs/sampling.md's bounds section", file=sys.stderr)
         return
+    if args.h200_compact:
+        hf.replace_section(DOC, COMPACT_BEGIN, COMPACT_END, h200_compact(args.h200_compact))
+        print("sampling.py: wrote docs/sampling.md's dense-stream H200 section", file=sys.stderr)
+        return
     if args.h200:
         hf.replace_section(DOC, H200_BEGIN, H200_END,
                            h200(args.h200, args.h200_clocks, args.h200_looping,
@@ -629,7 +791,7 @@ def main():
         return
     scenes = args.scenes.split(",")
     others = [s for s in args.other_scenes.split(",") if s]
-    main_rows, other_rows, changed, bounds = measure(args, scenes, others)
+    main_rows, other_rows, changed, bounds, timed = measure(args, scenes, others)
 
     plot_chart(main_rows, scenes, args.size)
 
@@ -637,6 +799,7 @@ def main():
     out += scene_tables(scenes, others, main_rows, other_rows)
     out += adaptive_target(scenes, others, main_rows, other_rows)
     out += undersample_target(scenes, others, changed, args.changed_size)
+    out += time_targets(timed)
     # Measured once by hand (session 9, bench_sampling), kept here so that a regeneration keeps it.
     out += [TRIED_BEND, ""]
     out += [BOUNDS_BEGIN, bounds, BOUNDS_END, ""]
@@ -645,6 +808,9 @@ def main():
     if cones:
         out += [cones, ""]
     kept = hf.section(DOC, H200_BEGIN, H200_END)  # measured on other hardware: kept as it is
+    if kept:
+        out += [kept, ""]
+    kept = hf.section(DOC, COMPACT_BEGIN, COMPACT_END)
     if kept:
         out += [kept, ""]
     with open(DOC, "w") as f:

@@ -73,6 +73,7 @@ TEST_CASE("names outside each option's set are refused") {
                 "cones not in {image,object}");
   check_refused("--aa-criterion object", "--aa-criterion object",
                 "decides where adaptive sampling refines: add --aa adaptive");
+  check_refused("--compact maybe", "--compact", "maybe not in {on,off}");
   check_refused("--grid 0", "--grid", "grid resolution '0': each count must be at least 1");
   check_refused("--trace-pixel 3", "--trace-pixel", "expected X,Y (e.g. 128,128), got '3'");
   check_refused("--trace-pixel 300,2", "--trace-pixel", "300,2 is outside the 256x256 image");

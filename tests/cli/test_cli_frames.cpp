@@ -422,6 +422,36 @@ TEST_CASE("with --accel bvh or kdtree every frame rebuilds the structure and upl
   fs::remove_all(dir);
 }
 
+TEST_CASE(
+    "dense streams write their frames and costs in the statistics table, the JSON and the "
+    "report; --compact off writes none") {
+  const fs::path dir = fresh_dir("dense");
+  const std::string json = (dir / "d.json").string(), html = (dir / "d.html").string();
+  const Outcome o =
+      run("render classic --size 24x24 --aa undersample:2 --stats table -q "
+          "--stats-json " +
+          json + " --report " + html);
+  INFO(o.err);
+  REQUIRE(o.status == 0);
+  // The lattice frame and the gaps' frame.
+  CHECK(o.out.find("dense streams: 2 gated frames") != std::string::npos);
+  const nlohmann::json j = nlohmann::json::parse(slurp(json));
+  REQUIRE(j.contains("compact"));
+  CHECK(j["compact"]["frames"] == 2);
+  CHECK(j["compact"]["packs"] == 2);
+  CHECK(j["compact"]["slots"].get<uint64_t>() < j["compact"]["pixels"].get<uint64_t>());
+  CHECK(j["compact"]["compaction"]["passes"] == 2);
+  const std::string page = slurp(html);
+  CHECK(page.find("\"compact\":{\"packs\"") != std::string::npos);
+  CHECK(page.find("Dense streams: ${fmt(c.frames)}") != std::string::npos);
+  REQUIRE(run("render classic --size 24x24 --aa undersample:2 --compact off -q --stats none "
+              "--stats-json " +
+              json)
+              .status == 0);
+  CHECK_FALSE(nlohmann::json::parse(slurp(json)).contains("compact"));
+  fs::remove_all(dir);
+}
+
 TEST_CASE("ray streams write their levels and costs in the statistics, and refuse a traced pixel") {
   const fs::path dir =
       fs::temp_directory_path() / ("vgpu_cli_streams_" + std::to_string(::getpid()));

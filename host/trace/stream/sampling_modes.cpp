@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "host/trace/sampling.h"
+#include "host/trace/stream/mark_streams.h"
 #include "host/trace/stream/stream_state.h"
 
 namespace host {
@@ -23,6 +24,42 @@ void StreamTracer::accumulate_samples(const Texture* marks) {
   else
     s.runner->pass(s.accumulate, {&s.sum.current(), &s.result.current()}, s.sum.next());
   s.sum.swap();
+}
+
+void StreamTracer::accumulate_gated(const Texture* marks, bool restart) {
+  State& s = *s_;
+  if (!s.dense) {
+    accumulate_samples(marks);
+    return;
+  }
+  // The frame traced its marked pixels as a dense stream: acumularDensos gathers its colours.
+  s.dense->accumulate(*s.runner, s.sum.current(), *marks, s.result.current(), 0, restart,
+                      s.sum.next());
+  s.sum.swap();
+}
+
+void StreamTracer::dense_level(const Camera& cam, RenderResult& res, int& iteration_number,
+                               uint64_t marked, int n) {
+  State& s = *s_;
+  MarkStreams& d = *s.dense;
+  // The level's n samples of every marked pixel, as few frames as the stream's W x H slots
+  // allow: each frame traces a run of whole samples (sample-major), then adds each sample's
+  // colours into the marked pixels' sums in the gated frames' order (acumularDensos).
+  d.pack(*s.runner, s.marks.current(), marked);
+  std::vector<glm::vec2> offsets(static_cast<size_t>(n));
+  for (int k = 0; k < n; ++k) offsets[size_t(k)] = sample_offset(n, k, opt_.sample_seed);
+  d.set_samples(offsets);
+  const int per = d.samples_per_frame();
+  for (int k0 = 0; k0 < n; k0 += per) {
+    const int k1 = std::min(n, k0 + per);
+    d.frame_begins(k0, k1);
+    frame(cam, s.sample_generate, res, false, iteration_number, &s.marks.current());
+    for (int k = k0; k < k1; ++k) {
+      d.accumulate(*s.runner, s.sum.current(), s.marks.current(), s.result.current(), k - k0,
+                   k == 0, s.sum.next());
+      s.sum.swap();
+    }
+  }
 }
 
 void StreamTracer::resolve_samples(const vgpu::Program& resolve) {
@@ -68,9 +105,15 @@ void StreamTracer::render_adaptive(const Camera& cam, RenderResult& res, int& it
     r.pass(cones() ? static_cast<const vgpu::Program&>(s.mark_cones) : s.mark,
            {&s.marks.current(), &s.result.current()}, s.marks.next());
     s.marks.swap();
-    if (r.count(s.marked, s.marks.current(), nullptr, nullptr) == 0) break;
+    const uint64_t marked = r.count(s.marked, s.marks.current(), nullptr, nullptr);
+    if (marked == 0) break;
     // The level's n x n samples, only in marked pixels, replacing their earlier ones.
     const int n = levels[l] * levels[l];
+    if (s.dense) {
+      dense_level(cam, res, iteration_number, marked, n);
+      resolve_samples(s.resolve);
+      continue;
+    }
     s.sample_generate.kernel.gated = true;
     s.accumulate.kernel.gated = true;
     for (int k = 0; k < n; ++k) {
@@ -114,20 +157,33 @@ void StreamTracer::render_undersampled(const Camera& cam, RenderResult& res,
   s.marks.make_current(1);  // guardarImpactos writes the lattice frame's keys into marks B
   s.sample_generate.kernel.jitter_x = s.sample_generate.kernel.jitter_y = 0.5f;
   s.sample_generate.kernel.gated = true;
+  if (s.dense) {
+    // The lattice's pixels, counted here (the host knows where they are), as a dense stream.
+    uint64_t lattice = 0;
+    for (int y = 0; y < H; ++y)
+      for (int x = 0; x < W; ++x) lattice += on_lattice(x, y, K, W, H) ? 1 : 0;
+    s.dense->pack(r, s.marks[0], lattice);
+    s.dense->set_samples({glm::vec2(0.5f)});
+    s.dense->frame_begins(0, 1);
+  }
   frame(cam, s.sample_generate, res, true, iteration_number, &s.marks[0], true);
   res.first_frame_passes = gpu.stats().totals.passes;
   gpu.clear(s.sum.current(), {0, 0, 0, 0});
   s.accumulate.kernel.gated = true;
   s.accumulate.kernel.restart = false;
-  accumulate_samples(&s.marks[0]);
+  accumulate_gated(&s.marks[0], false);
   // marcarHuecos into marks A (the lattice flags are done with), pixelesMarcados counts them;
   // the gaps' frame traces them.
   r.pass(s.mark_gaps, {&s.marks[1], &s.sum.current()}, s.marks[0]);
   std::vector<uint8_t> gap(size_t(W) * size_t(H), 0);
-  if (r.count(s.marked, s.marks[0], nullptr, nullptr) > 0) {
+  if (const uint64_t gaps = r.count(s.marked, s.marks[0], nullptr, nullptr); gaps > 0) {
+    if (s.dense) {
+      s.dense->pack(r, s.marks[0], gaps);
+      s.dense->frame_begins(0, 1);
+    }
     const std::vector<float> depth = res.depth, hit_id = res.hit_id;
     frame(cam, s.sample_generate, res, true, iteration_number, &s.marks[0]);
-    accumulate_samples(&s.marks[0]);
+    accumulate_gated(&s.marks[0], false);
     // The AOVs: the gaps' from this frame, the lattice's from the first.
     gpu.download(s.marks[0]);
     for (size_t i = 0; i < gap.size(); ++i) {

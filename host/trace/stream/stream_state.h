@@ -7,6 +7,7 @@
 #include "host/trace/passes.h"
 #include "host/trace/ping_pong.h"
 #include "host/trace/stream/atlas_upload.h"
+#include "host/trace/stream/mark_streams.h"
 #include "host/trace/stream/ray_streams.h"
 #include "host/trace/stream/stream_tracer.h"
 #include "host/trace/walks/accel_walk.h"
@@ -59,6 +60,9 @@ struct StreamTracer::State {
   std::unique_ptr<PassRunner> runner;
   // Glass (or --ray-streams on): the frame as ray streams (host/trace/stream/ray_streams.h).
   std::unique_ptr<RayStreams> streams;
+  // The sampling modes' gated frames as dense streams of their marked pixels (--compact on;
+  // host/trace/stream/mark_streams.h).
+  std::unique_ptr<MarkStreams> dense;
 };
 
 }  // namespace host

@@ -17,6 +17,7 @@
 #include "host/trace/sampling.h"
 #include "host/trace/stream/atlas_upload.h"
 #include "host/trace/stream/devices.h"
+#include "host/trace/stream/mark_streams.h"
 #include "host/trace/stream/ray_streams.h"
 #include "host/trace/stream/stream_state.h"
 #include "host/trace/textures.h"
@@ -147,6 +148,11 @@ StreamTracer::StreamTracer(const Scene& scene, const Accel& accel, const RenderO
   s.isect_mask = Stencil(W, H, 1);
   s.walk->make_state(gpu, {{&s.v[0], &s.v[1], &s.v[2]}, &s.isect, &s.grid_mask, &s.isect_mask});
   s.runner = std::make_unique<PassRunner>(gpu, opt_, s.counter);
+  // Sampling that saves time: the gated frames as dense streams of their marked pixels, where
+  // the ray streams do not already move the rays (glass) and --trace-pixel does not follow one.
+  if (marking && opt_.compact && !s.streams && !opt_.trace_pixel &&
+      MarkStreams::fits(gpu.profile(), opt_))
+    s.dense = std::make_unique<MarkStreams>(gpu, opt_);
 
   s.shader.kernel.model = opt_.shading;
   s.shader.kernel.shadows = opt_.shadows;
@@ -280,6 +286,7 @@ uint64_t StreamTracer::texture_bytes() const {
     for (const Texture* t : {&s_->base.uvs01, &s_->base.uvs2, &s_->base.table, &s_->base.atlas})
       b += t->bytes();
   if (s_->streams) b += s_->streams->texture_bytes();  // grows with the frame's levels
+  if (s_->dense) b += s_->dense->texture_bytes();
   return b;
 }
 
@@ -295,6 +302,7 @@ RenderResult StreamTracer::render(const Camera& cam) {
   PassRunner& r = *s.runner;
   r.counts = {};
   if (s.streams) s.streams->stats = {};
+  if (s.dense) s.dense->stats = {};
   const int W = opt_.width, H = opt_.height;
   RenderResult res;
   res.width = W;
@@ -319,6 +327,7 @@ RenderResult StreamTracer::render(const Camera& cam) {
   int iteration_number = 0;
   // The sample frames' generator takes the same camera (its jitter and gate are set per frame).
   static_cast<GenerateRays&>(s.sample_generate.kernel) = g;
+  if (s.dense) static_cast<GenerateRays&>(s.dense->generate.kernel) = g;
   // One frame of the pipeline (frame()), or a sampling mode's frames, each mode ending in the
   // sampling resolve (resolve_samples) that combines its sample frames into the pixels.
   if (opt_.undersample > 0) {
@@ -345,6 +354,7 @@ RenderResult StreamTracer::render(const Camera& cam) {
   res.rays_unfinished = r.counts.rays_unfinished;
   res.batch_walk = r.counts.batch_walk;
   if (s.streams) res.streams = s.streams->stats;
+  if (s.dense) res.compact = s.dense->stats;
   res.render_ms = ms_since(t0);
   return res;
 }
@@ -356,6 +366,11 @@ void StreamTracer::frame(const Camera& cam, const vgpu::Program& generate, Rende
     return;
   }
   State& s = *s_;
+  // A gated frame whose marks were packed (MarkStreams::pack, frame_begins) traces the dense
+  // stream: every pass draws its rows; the colours stay there for the caller's gather
+  // (acumularDensos).
+  const bool dense = marks && s.dense;
+  if (dense) s.runner->rect = s.dense->rect();
   generate_rays(cam, generate, marks);
   // Each iteration is one ray stream (the primary rays, then each bounce's reflected rays):
   // the walk, inicioReflejo, the shading per light, then the reflected rays of the next one.
@@ -369,8 +384,9 @@ void StreamTracer::frame(const Camera& cam, const vgpu::Program& generate, Rende
     Texture& rays = s.rays.current();
     Texture& origins = s.origins.current();
     walk_rays(origins, rays, it == 0, cam);
-    if (it == 0) primary_hits(res, aovs, keep_hits);
-    // guardarReflejos (--aa-criterion object): the first reflected rays' surface keys.
+    if (it == 0) primary_hits(res, aovs, keep_hits, dense ? marks : nullptr);
+    // guardarReflejos (--aa-criterion object): the first reflected rays' surface keys. The
+    // criterion is adaptive sampling's, whose centre frame (the one keeping hits) is never dense.
     if (it == 1 && keep_hits && cones()) {
       s.runner->pass(s.keep_reflected, {&s.marks.current(), &s.isect.current(), &s.materials},
                      s.marks.next());
@@ -386,6 +402,7 @@ void StreamTracer::frame(const Camera& cam, const vgpu::Program& generate, Rende
     s.rays.swap();
     s.origins.swap();
   }
+  s.runner->rect.reset();
 }
 
 void StreamTracer::generate_rays(const Camera& cam, const vgpu::Program& generate,
@@ -395,7 +412,10 @@ void StreamTracer::generate_rays(const Camera& cam, const vgpu::Program& generat
   // left them).
   s.origins.make_current(0);
   gpu_->clear(s.origins.current(), {cam.position.x, cam.position.y, cam.position.z, 0});
-  if (marks)
+  if (marks && s.dense) {
+    // generadorRayosDensos: each slot's sample through its packed pixel.
+    s.runner->pass(s.dense->generate, {&s.dense->pixels(), &s.dense->jitters()}, s.rays.current());
+  } else if (marks)
     s.runner->pass(generate, {marks}, s.rays.current());
   else
     s.runner->pass(generate, {}, s.rays.current());
@@ -410,15 +430,30 @@ void StreamTracer::walk_rays(Texture& origins, Texture& rays, bool primary, cons
   if (opt_.observer) opt_.observer->trace_end();
 }
 
-void StreamTracer::primary_hits(RenderResult& res, bool aovs, bool keep_hits) {
+void StreamTracer::primary_hits(RenderResult& res, bool aovs, bool keep_hits,
+                                const Texture* dense_marks) {
   State& s = *s_;
-  // guardarImpactos: the primary hits' surface keys (--aa adaptive), before later traces
-  // overwrite the intersections.
-  // With --aa-criterion object, guardarConos also keeps the hit distances (kernels/cones.h).
-  if (keep_hits)
-    s.runner->pass(cones() ? static_cast<const vgpu::Program&>(s.keep_cones) : s.keep,
-                   {&s.isect.current(), &s.materials}, s.marks.current());
-  if (aovs) download_aovs(res);
+  // guardarImpactos: the primary hits' surface keys (--aa adaptive, undersampling's lattice),
+  // before later traces overwrite the intersections. With --aa-criterion object, guardarConos
+  // also keeps the hit distances (kernels/cones.h).
+  const vgpu::Program& keep =
+      cones() ? static_cast<const vgpu::Program&>(s.keep_cones) : s.keep;
+  Texture* hits = &s.isect.current();
+  if (dense_marks && (aovs || keep_hits)) {
+    // A dense stream's hits go back to their pixels first (reunirMarcados, the unmarked pixels
+    // no hit), into the intersection pair's other texture, which the walk rewrites before
+    // reading.
+    const std::optional<vgpu::Rect> rows = s.runner->rect;
+    s.runner->rect.reset();
+    s.dense->gather(*s.runner, *dense_marks, s.isect.current(), s.isect.next(),
+                    {kFar, 0, 0, kNone});
+    hits = &s.isect.next();
+    if (keep_hits) s.runner->pass(keep, {hits, &s.materials}, s.marks.current());
+    s.runner->rect = rows;
+  } else if (keep_hits) {
+    s.runner->pass(keep, {hits, &s.materials}, s.marks.current());
+  }
+  if (aovs) download_aovs(res, *hits);
 }
 
 void StreamTracer::reflection_origin(const Texture& origins, const Texture& rays,
@@ -492,8 +527,7 @@ void StreamTracer::shader_pass(const Texture& surface, const Texture& rays, cons
                    out);
 }
 
-void StreamTracer::download_aovs(RenderResult& res) {
-  Texture& hits = s_->isect.current();
+void StreamTracer::download_aovs(RenderResult& res, Texture& hits) {
   const int W = opt_.width, H = opt_.height;
   gpu_->download(hits);
   res.depth.assign(size_t(W) * H, 0.0f);

@@ -79,8 +79,10 @@ class StreamTracer {
   // to the observer as one trace. Leaves each ray's nearest hit in the current intersections.
   void walk_rays(vgpu::Texture& origins, vgpu::Texture& rays, bool primary, const Camera& cam);
   // After the primary walk: guardarImpactos (with `keep_hits`) writes the hits' surface keys
-  // into the current marks; with `aovs`, the hits' depth and id go into res.
-  void primary_hits(RenderResult& res, bool aovs, bool keep_hits);
+  // into the current marks; with `aovs`, the hits' depth and id go into res. `dense_marks`: the
+  // frame traced those marks' pixels as a dense stream, whose hits are gathered back first.
+  void primary_hits(RenderResult& res, bool aovs, bool keep_hits,
+                    const vgpu::Texture* dense_marks = nullptr);
   // Whether adaptive supersampling decides by the pixels' cones (--aa-criterion object).
   bool cones() const {
     return opt_.adaptive && opt_.aa_criterion == RenderOptions::AaCriterion::object;
@@ -106,12 +108,19 @@ class StreamTracer {
   void shader_pass(const vgpu::Texture& surface, const vgpu::Texture& rays,
                    const vgpu::Texture& colour, const vgpu::Texture& shadow,
                    const vgpu::Texture& origins, vgpu::Texture& out);
-  // The primary hits' depths and input triangle ids into res, from the current intersections.
-  void download_aovs(RenderResult& res);
+  // The primary hits' depths and input triangle ids into res, from `hits` (pixel layout).
+  void download_aovs(RenderResult& res, vgpu::Texture& hits);
   // The sampling modes and their resolve (host/trace/stream/sampling_modes.cpp).
   // acumularMuestras: the current frame's colours (gated: only in the pixels `marks` flags, if
   // given) added into the sum of the sample frames; the sum ping-pongs.
   void accumulate_samples(const vgpu::Texture* marks);
+  // The same after a gated frame, which may have traced its marked pixels as a dense stream
+  // (then acumularDensos, `restart` as AccumulateSamples' uniform).
+  void accumulate_gated(const vgpu::Texture* marks, bool restart);
+  // One adaptive level with dense streams: the `marked` pixels' n samples each, packed into
+  // as few frames as W x H slots allow, their colours added into the sums.
+  void dense_level(const Camera& cam, RenderResult& res, int& iteration_number, uint64_t marked,
+                   int n);
   // The sampling resolve, the last stage of a frame with several samples per pixel: `resolve`
   // (resolverMuestras, the box filter, or rellenarHuecos, the undersampling fill) turns the
   // sum of the sample frames into the pixels' colours, in the next result texture, which

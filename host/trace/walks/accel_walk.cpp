@@ -150,7 +150,7 @@ void ListWalk::walk_looping(PassRunner& r, const vgpu::Program& p, Texture& orig
     r.set_work(sh_.grid_mask);
     const bool traced = r.traces_pixel(sh_.grid_mask);
     if (opt_.observer) opt_.observer->pass_begin(sh_.grid_mask);
-    const vgpu::PassRecord& rec = gpu.draw();
+    const vgpu::PassRecord& rec = r.rect ? gpu.draw(*r.rect) : gpu.draw();
     if (opt_.observer)
       opt_.observer->pass({p, rec, trav, gpu.branch_flags(), gpu.stats(), gpu.loop_iterations()});
     trav_.swap();

@@ -370,11 +370,12 @@ bool run_in_batches(PassRunner& r, Walk& walk, typename Walk::Cursor& c) {
   std::array<BatchWalker::MaskOut, WriteBack::kMax> masks{};
   for (int k = 0; k < wb.nmasks; ++k)
     masks[size_t(k)] = {wb.masks[size_t(k)], wb.masks[size_t(k)]->row_mut(0)};
+  // A dense stream's walk (PassRunner::rect) covers only the rows it fills.
+  const int W = opt.width, H = r.rect ? r.rect->y1 : opt.height;
+  const int tiles_x = (W + 31) / 32, tiles_y = (H + 31) / 32;
   std::vector<std::unique_ptr<BatchWalker>> walkers;
   for (int k = 0; k < gpu->threads(); ++k)
-    walkers.push_back(
-        std::make_unique<BatchWalker>(*gpu, programs, opt.masks, opt.width, opt.height));
-  const int W = opt.width, H = opt.height, tiles_x = (W + 31) / 32, tiles_y = (H + 31) / 32;
+    walkers.push_back(std::make_unique<BatchWalker>(*gpu, programs, opt.masks, W, H));
   // An error on a worker thread (a binding the check let through) reaches the caller.
   std::mutex failed_mu;
   std::exception_ptr failed;
