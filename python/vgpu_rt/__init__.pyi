@@ -128,6 +128,9 @@ def render(
     update: Optional[str] = ...,
     report_frame: Optional[int] = ...,
     textures: Optional[str] = ...,
+    aa_criterion: Optional[str] = ...,
+    aa_cone_depth: Optional[float] = ...,
+    compact: Union[str, bool, None] = ...,
 ) -> Frame: ...
 def passes(scene: Union[str, os.PathLike[str]] = "bunny", **options: Any) -> Passes: ...
 def scenes() -> dict[str, str]: ...
