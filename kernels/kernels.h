@@ -5,6 +5,7 @@
 #pragma once
 
 #include "kernels/accumulate_samples.h"
+#include "kernels/beams.h"
 #include "kernels/bvh.h"
 #include "kernels/compact_stream.h"
 #include "kernels/copy_rows.h"
@@ -94,3 +95,6 @@ extern template class vgpu::KernelProgram<kernels::CompactStream>;
 extern template class vgpu::KernelProgram<kernels::CopyRows>;
 extern template class vgpu::KernelProgram<kernels::GatherChildren>;
 extern template class vgpu::KernelProgram<kernels::ShadowGlass>;
+extern template class vgpu::KernelProgram<kernels::BeamMarch>;
+extern template class vgpu::KernelProgram<kernels::BeamEntry>;
+extern template class vgpu::KernelProgram<kernels::BeamsMissed>;

@@ -104,6 +104,8 @@ RenderPlan parse_render(const RenderArgs& a, bool lanes_given) {
                                                         : vgpu::Filter::trilinear;
   opt.masks = a.masks == "on";
   opt.mrt = a.mrt == "on";
+  opt.beams = a.beams == "on";
+  opt.beam_tile = a.beam_tile;
   opt.ray_streams = a.ray_streams == "on";
   opt.looping = a.kernels == "looping";
   opt.steps_per_pass = a.steps_per_pass;
@@ -156,6 +158,14 @@ RenderPlan parse_render(const RenderArgs& a, bool lanes_given) {
                        " needs --engine stream (the cpu engine is a double-precision reference "
                        "without passes, lanes or masks)");
   }
+  if (opt.beams && a.engine != "stream")
+    throw UsageError("--beams on needs --engine stream (the beam passes run on the emulator)");
+  if (opt.beams && a.accel != "grid")
+    throw UsageError("--beams on: beams are walked through the uniform grid only (--accel grid)");
+  if (opt.beams && (a.precision != "fp32" || !a.formats.empty()))
+    throw UsageError("--beams on needs fp32 ray state (no --precision or --formats): the beam "
+                     "entry reaches the voxel the walk would only where both round as fp32");
+  if (a.beam_tile != 8 && !opt.beams) throw UsageError("--beam-tile needs --beams on");
   if (a.steps_given && !opt.looping) throw UsageError("--steps-per-pass needs --kernels looping");
   // Animation (issue 23): the frames' times, and what several frames need.
   const bool animating = plan.animating = !a.time.empty() || !a.frames.empty();

@@ -339,6 +339,9 @@ RenderResult StreamTracer::render(const Camera& cam) {
   res.rays_traced = r.counts.rays_traced;
   res.rays_unfinished = r.counts.rays_unfinished;
   res.batch_walk = r.counts.batch_walk;
+  res.beam_passes = r.counts.beam_passes;
+  res.beam_tiles = r.counts.beam_tiles;
+  res.beam_tiles_missed = r.counts.beam_tiles_missed;
   if (s.streams) res.streams = s.streams->stats;
   res.render_ms = ms_since(t0);
   return res;
@@ -384,6 +387,13 @@ void StreamTracer::generate_rays(const Camera& cam, const vgpu::Program& generat
   // left them).
   s.origins.make_current(0);
   gpu_->clear(s.origins.current(), {cam.position.x, cam.position.y, cam.position.z, 0});
+  // Beams over tiles march the same rays: the generator's camera, and a sample frame's jitter.
+  if (&generate == &s.sample_generate) {
+    const GenerateSampleRays& k = s.sample_generate.kernel;
+    s.walk->set_camera(k, k.jitter_x - 0.5f, k.jitter_y - 0.5f);
+  } else {
+    s.walk->set_camera(s.generate.kernel, 0.0f, 0.0f);
+  }
   if (marks)
     s.runner->pass(generate, {marks}, s.rays.current());
   else
