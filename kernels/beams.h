@@ -92,26 +92,42 @@ struct BeamMarch {
     const Vec3<F> cube_hi{F(g.lo.x) + (v.x + k) * F(g.cell.x) - mg,
                           F(g.lo.y) + (v.y + k) * F(g.cell.y) - mg,
                           F(g.lo.z) + (v.z + k) * F(g.cell.z) - mg};
-    // Where corner ray d leaves the box [blo, bhi], or -1 if it is not inside at t.
-    auto leaves = [&](const Vec3<F>& d, const Vec3<F>& blo, const Vec3<F>& bhi) {
-      F tn, tf;
-      ray_box_segment(e, d, blo, bhi, F(kFar), tn, tf);
-      return select((tn <= t) && (tf >= t), tf, F(-1.0f));
-    };
-    auto all_leave = [&](const Vec3<F>& blo, const Vec3<F>& bhi) {
-      return min(min(leaves(d00, blo, bhi), leaves(d10, blo, bhi)),
-                 min(leaves(d01, blo, bhi), leaves(d11, blo, bhi)));
-    };
-    const F inf = F(kFar);
+    // Per corner ray: its direction's reciprocal (shared by every box), and where it leaves the
+    // cube, or -1 if it is not inside at t.
+    const Vec3<F> ds[4] = {d00, d10, d01, d11};
+    Vec3<F> inv[4];
+    for (int i = 0; i < 4; ++i)
+      inv[i] = Vec3<F>{F(1.0f) / ds[i].x, F(1.0f) / ds[i].y, F(1.0f) / ds[i].z};
+    auto axis_of = [](const Vec3<F>& v, int a) -> const F& { return a == 0 ? v.x : a == 1 ? v.y : v.z; };
+    F cube = F(kFar);
+    for (int i = 0; i < 4; ++i) {
+      F tn = F(-kFar), tf = F(kFar);
+      for (int a = 0; a < 3; ++a) {
+        const F ea = axis_of(e, a), ia = axis_of(inv[i], a);
+        const F t0 = (axis_of(cube_lo, a) - ea) * ia, t1 = (axis_of(cube_hi, a) - ea) * ia;
+        tn = max(tn, min(t0, t1));
+        tf = min(tf, max(t0, t1));
+      }
+      cube = min(cube, select((tn <= t) && (tf >= t), tf, F(-1.0f)));
+    }
+    F out = select(k >= F(1.0f), cube, F(-1.0f));
+    // The half-spaces beyond each face of the grid box (by the margin): a corner is inside while
+    // its coordinate stays beyond the face, for ever if it moves away from it.
     const glm::vec3 hi = g.lo + g.cell * g.res;
-    F out = select(k >= F(1.0f), all_leave(cube_lo, cube_hi), F(-1.0f));
-    const Vec3<F> far_lo = splat<F>(glm::vec3(-kFar)), far_hi = splat<F>(glm::vec3(kFar));
-    out = max(out, all_leave(far_lo, Vec3<F>{F(g.lo.x) - mg, inf, inf}));
-    out = max(out, all_leave(Vec3<F>{F(hi.x) + mg, -inf, -inf}, far_hi));
-    out = max(out, all_leave(far_lo, Vec3<F>{inf, F(g.lo.y) - mg, inf}));
-    out = max(out, all_leave(Vec3<F>{-inf, F(hi.y) + mg, -inf}, far_hi));
-    out = max(out, all_leave(far_lo, Vec3<F>{inf, inf, F(g.lo.z) - mg}));
-    out = max(out, all_leave(Vec3<F>{-inf, -inf, F(hi.z) + mg}, far_hi));
+    for (int a = 0; a < 3; ++a)
+      for (int side = 0; side < 2; ++side) {
+        const float plane = side ? hi[a] + u.margin : g.lo[a] - u.margin;
+        F leave = F(kFar);
+        for (int i = 0; i < 4; ++i) {
+          const F da = axis_of(ds[i], a), ea = axis_of(e, a);
+          const F now = ea + da * t;
+          const auto inside = side ? now >= F(plane) : now <= F(plane);
+          const auto towards = side ? da < F(0.0f) : da > F(0.0f);
+          const F cross = (F(plane) - ea) * axis_of(inv[i], a);
+          leave = min(leave, select(inside, select(towards, cross, F(kFar)), F(-1.0f)));
+        }
+        out = max(out, leave);
+      }
     // cos(theta) from below, theta the widest corner angle.
     const F cosw = min(min(dot(axis, d00), dot(axis, d10)), min(dot(axis, d01), dot(axis, d11)));
     const F reach = out * cosw * F(0.9999f);
