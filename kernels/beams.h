@@ -24,7 +24,7 @@ namespace kernels {
 // What the beam passes and the beam entry share: the primary rays' camera (the ray generator's
 // uniforms, and where in the pixel the frame's sample lies), the tile size and the grid.
 struct BeamUniforms {
-  GenerateRays camera;             // the primary rays' generator (its width and height: pixels)
+  GenerateRays camera;               // the primary rays' generator (its width and height: pixels)
   float offset_x = 0, offset_y = 0;  // sample position - pixel centre, pixels (jittered frames)
   glm::vec3 eye{0.0f};
   float tile = 8;  // pixels per tile side
@@ -82,7 +82,8 @@ struct BeamMarch {
     auto cell_of = [&](const F& qa, float lo, float cell, float res) {
       return min(max(floor((qa - F(lo)) / F(cell)), F(0.0f)), F(res - 1.0f));
     };
-    const Vec3<F> v{cell_of(q.x, g.lo.x, g.cell.x, g.res.x), cell_of(q.y, g.lo.y, g.cell.y, g.res.y),
+    const Vec3<F> v{cell_of(q.x, g.lo.x, g.cell.x, g.res.x),
+                    cell_of(q.y, g.lo.y, g.cell.y, g.res.y),
                     cell_of(q.z, g.lo.z, g.cell.z, g.res.z)};
     const F k = f.fetch(kDistances, v.x * F(g.res.y) + v.y + F(0.5f), v.z + F(0.5f)).x;
     const F mg = F(u.margin);
@@ -98,7 +99,9 @@ struct BeamMarch {
     Vec3<F> inv[4];
     for (int i = 0; i < 4; ++i)
       inv[i] = Vec3<F>{F(1.0f) / ds[i].x, F(1.0f) / ds[i].y, F(1.0f) / ds[i].z};
-    auto axis_of = [](const Vec3<F>& v, int a) -> const F& { return a == 0 ? v.x : a == 1 ? v.y : v.z; };
+    auto axis_of = [](const Vec3<F>& v, int a) -> const F& {
+      return a == 0 ? v.x : a == 1 ? v.y : v.z;
+    };
     F cube = F(kFar);
     for (int i = 0; i < 4; ++i) {
       F tn = F(-kFar), tf = F(kFar);
@@ -165,8 +168,8 @@ struct BeamEntry {
     const Vec4<F> ray = f.fetch_own(kRays);
     const Vec3<F> o = splat<F>(u.eye), d = ray.xyz();
     const Vec4<F> entry = grid_entry<L>(o, d, ray.w, g);
-    const Vec4<F> b = f.fetch(kBeams, floor(f.x / F(u.tile)) + F(0.5f),
-                              floor(f.y / F(u.tile)) + F(0.5f));
+    const Vec4<F> b =
+        f.fetch(kBeams, floor(f.x / F(u.tile)) + F(0.5f), floor(f.y / F(u.tile)) + F(0.5f));
     const F ts = b.y;
     // The voxel holding the ray's point at ts, and how deep inside it the point lies.
     const Vec3<F> p = o + d * ts;
@@ -184,8 +187,9 @@ struct BeamEntry {
       const F boundary = F(lo) + (va + select(da > F(0.0f), F(0.0f), F(1.0f))) * F(cell);
       return select(da == F(0.0f), F(-kFar), (boundary - oa) / da);
     };
-    const F te = max(max(face(o.x, d.x, v.x, g.lo.x, g.cell.x), face(o.y, d.y, v.y, g.lo.y, g.cell.y)),
-                     face(o.z, d.z, v.z, g.lo.z, g.cell.z));
+    const F te =
+        max(max(face(o.x, d.x, v.x, g.lo.x, g.cell.x), face(o.y, d.y, v.y, g.lo.y, g.cell.y)),
+            face(o.z, d.z, v.z, g.lo.z, g.cell.z));
     const auto entered = entry.x >= F(0.0f);
     const auto moved = entered && deep(rel.x, v.x, g.res.x) && deep(rel.y, v.y, g.res.y) &&
                        deep(rel.z, v.z, g.res.z) && (te > entry.w + F(u.margin)) && (te <= ts);

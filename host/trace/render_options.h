@@ -165,10 +165,10 @@ struct RenderResult {
   std::vector<float> hit_id;  // input triangle id of the primary hit, -1 where it misses
   vgpu::FrameStats stats;
   double render_ms = 0;
-  int iterations = 0;               // ray-tracing iterations run (primary included)
-  uint64_t rays_traced = 0;         // rays entering a trace (primary, reflected, shadow)
-  uint64_t rays_unfinished = 0;     // rays stopped by the pass cap (only under reduced precision)
-  bool batch_walk = false;          // the grid walks ran in batches (RenderOptions::batch_walk)
+  int iterations = 0;            // ray-tracing iterations run (primary included)
+  uint64_t rays_traced = 0;      // rays entering a trace (primary, reflected, shadow)
+  uint64_t rays_unfinished = 0;  // rays stopped by the pass cap (only under reduced precision)
+  bool batch_walk = false;       // the grid walks ran in batches (RenderOptions::batch_walk)
   // Beams over tiles (RenderOptions::beams): beam passes, tiles marched, tiles that missed.
   uint64_t beam_passes = 0, beam_tiles = 0, beam_tiles_missed = 0;
   int samples = 1;                  // sample frames rendered (RenderOptions::spp)

@@ -91,8 +91,8 @@ TEST_CASE("beam march moves each beam to where its first corner ray leaves an em
   const Texture distances = scalars("beam distances", 16, 4, k);
   // Tile 0 starts at the eye, off the grid; tile 1 stands in voxel (2, 2, 0), which holds a
   // triangle; tile 2 in the empty voxel (2, 2, 1); tile 3 past the grid's far face.
-  const Texture beams = texels("beams", 4, 1,
-                               {{0, 0, 0, 0}, {0, 5.5f, 0, 4}, {0, 6.5f, 0, 2}, {0, 20, 0, 7}});
+  const Texture beams =
+      texels("beams", 4, 1, {{0, 0, 0, 0}, {0, 5.5f, 0, 4}, {0, 6.5f, 0, 2}, {0, 20, 0, 7}});
   kernels::BeamMarch march;
   march.beams = beam_uniforms();
   const Texture out = ktest::run(march, {&beams, &distances}, 4, 1);
@@ -107,8 +107,8 @@ TEST_CASE("beam march moves each beam to where its first corner ray leaves an em
   // Tile 2: the cube of voxels one step around (2, 2, 1) is empty: [1, 4) x [1, 4) x [0, 3).
   const Tile t2 = tile(2);
   const double exit2 =
-      first_exit(t2, 6.5, glm::dvec3(1 + m, 1 + m, m), glm::dvec3(4 - m, 4 - m, 3 - m)) *
-      t2.cosw * 0.9999;
+      first_exit(t2, 6.5, glm::dvec3(1 + m, 1 + m, m), glm::dvec3(4 - m, 4 - m, 3 - m)) * t2.cosw *
+      0.9999;
   CHECK(exit2 > 7.5);
   CHECK_TEXEL_NEAR(out, 2, 0, 1e-5, glm::vec4(0, float(exit2), 0, 3));
   // Tile 3: beyond the far face and moving away: the half-space holds it for ever, the beam
@@ -140,12 +140,24 @@ TEST_CASE("beam entry starts a ray at the traversal state the 3D-DDA reaches, or
   // Pixels (x, y) of the 8x2 image; tile 0 (x 0-1) stopped at t = 8.1, tile 1 (x 2-3) missed,
   // tile 2 (x 4-5) stopped before the grid (t = 2), tile 3 (x 6-7) at t = 8.1 too.
   const Texture rays = texels("rays", 8, 2,
-                              {{d0, kFar}, {d1, kFar}, {d0, kFar}, {d1, kFar},  //
-                               {d0, kFar}, {d1, kFar}, {d3, kFar}, {d0, kFar},  //
-                               {d2, kFar}, {d3, kNone}, {d0, kFar}, {d1, kFar},  //
-                               {d0, kFar}, {d1, kFar}, {d0, kNone}, {d1, kFar}});
-  const Texture beams = texels("beams", 4, 1,
-                               {{-1, 8.1f, 0, 5}, {-1, 1e30f, 1, 3}, {-1, 2.0f, 0, 1}, {-1, 8.1f, 0, 4}});
+                              {{d0, kFar},
+                               {d1, kFar},
+                               {d0, kFar},
+                               {d1, kFar},  //
+                               {d0, kFar},
+                               {d1, kFar},
+                               {d3, kFar},
+                               {d0, kFar},  //
+                               {d2, kFar},
+                               {d3, kNone},
+                               {d0, kFar},
+                               {d1, kFar},  //
+                               {d0, kFar},
+                               {d1, kFar},
+                               {d0, kNone},
+                               {d1, kFar}});
+  const Texture beams = texels(
+      "beams", 4, 1, {{-1, 8.1f, 0, 5}, {-1, 1e30f, 1, 3}, {-1, 2.0f, 0, 1}, {-1, 8.1f, 0, 4}});
   kernels::BeamEntry entry;
   entry.beams = u;
   const Texture out = ktest::run(entry, {&rays, &beams}, 8, 2);
@@ -154,7 +166,8 @@ TEST_CASE("beam entry starts a ray at the traversal state the 3D-DDA reaches, or
   init.eye = e;
   init.grid = u.grid;
   const Texture entered = ktest::run(init, {&rays}, 8, 2);
-  const Texture no_hit = texels("intersection", 8, 2, std::vector<glm::vec4>(16, {kFar, 0, 0, kNone}));
+  const Texture no_hit =
+      texels("intersection", 8, 2, std::vector<glm::vec4>(16, {kFar, 0, 0, kNone}));
   const Texture origins = texels("origins", 8, 2, std::vector<glm::vec4>(16, glm::vec4(e, 0)));
   kernels::Traversal step;
   step.grid = u.grid;

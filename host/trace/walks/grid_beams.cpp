@@ -69,8 +69,12 @@ uint64_t GridBeams::set_grid(vgpu::Device& gpu, const Grid& grid, const kernels:
   return bytes;
 }
 
-int GridBeams::tiles_x() const { return (opt_.width + opt_.beam_tile - 1) / opt_.beam_tile; }
-int GridBeams::tiles_y() const { return (opt_.height + opt_.beam_tile - 1) / opt_.beam_tile; }
+int GridBeams::tiles_x() const {
+  return (opt_.width + opt_.beam_tile - 1) / opt_.beam_tile;
+}
+int GridBeams::tiles_y() const {
+  return (opt_.height + opt_.beam_tile - 1) / opt_.beam_tile;
+}
 
 void GridBeams::make_state(vgpu::Device& gpu) {
   beams_ = {gpu.make_texture("beams A", tiles_x(), tiles_y(), 4),
