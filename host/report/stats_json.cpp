@@ -104,8 +104,9 @@ nlohmann::ordered_json frame_stats_json(const FrameStatsInputs& in) {
   if (r.streams.on) j["streams"] = to_json(r.streams);  // glass's ray streams
   j["rays_unfinished"] = r.rays_unfinished;
   // Beams over tiles (--beams on): the tile size, beam passes (rayosHaz), tiles marched over the
-  // frame's primary traces, and tiles whose whole beam missed the grid.
-  if (!cpu && !gl)
+  // frame's primary traces, and tiles whose whole beam missed the grid. Absent with beams off,
+  // so such a frame's JSON is what it was before beams.
+  if (!cpu && !gl && opt.beams)
     j["beams"] = {{"on", opt.beams},
                   {"tile", opt.beam_tile},
                   {"passes", r.beam_passes},

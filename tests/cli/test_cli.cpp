@@ -573,8 +573,7 @@ TEST_CASE("beams on renders the same image and its JSON counts tiles, beam passe
   INFO("vgpu-rt render --beams on -> " << o.err);
   REQUIRE(o.status == 0);
   CHECK(slurp(dir / "image.png") == image_off);
-  CHECK(off["beams"]["on"] == false);
-  CHECK(off["beams"]["passes"] == 0);
+  CHECK(!off.contains("beams"));
   const nlohmann::json& b = on["beams"];
   CHECK(b["on"] == true);
   CHECK(b["tile"] == 8);
