@@ -5,6 +5,7 @@
 #pragma once
 
 #include "kernels/accumulate_samples.h"
+#include "kernels/beams.h"
 #include "kernels/bvh.h"
 #include "kernels/compact_marks.h"
 #include "kernels/compact_stream.h"
@@ -99,3 +100,6 @@ extern template class vgpu::KernelProgram<kernels::GenerateDenseRays>;
 extern template class vgpu::KernelProgram<kernels::GatherMarked>;
 extern template class vgpu::KernelProgram<kernels::AccumulateDense>;
 extern template class vgpu::KernelProgram<kernels::ShadowGlass>;
+extern template class vgpu::KernelProgram<kernels::BeamMarch>;
+extern template class vgpu::KernelProgram<kernels::BeamEntry>;
+extern template class vgpu::KernelProgram<kernels::BeamsMissed>;

@@ -244,6 +244,16 @@ void add_render_options(CLI::App& render, RenderArgs& a) {
       ->check(CLI::IsMember(on_off))
       ->capture_default_str();
   render
+      .add_option("--beams", a.beams,
+                  "Beams over tiles (issue 35, docs/groups.md): passes of one fragment per tile "
+                  "march each tile's beam through empty space, and the primary rays start where "
+                  "it stopped; the same image. --accel grid, fp32, stream engine")
+      ->check(CLI::IsMember(on_off))
+      ->capture_default_str();
+  render.add_option("--beam-tile", a.beam_tile, "With --beams on: pixels per tile side")
+      ->check(CLI::Range(1, 256))
+      ->capture_default_str();
+  render
       .add_option("--ray-streams", a.ray_streams,
                   "Ray streams (glass, docs/materials.md): auto, only for a scene with a "
                   "transmissive material; on, the paper's reflections through them too")

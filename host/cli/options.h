@@ -29,6 +29,8 @@ struct RenderArgs {
   int lanes = vgpu::kLanes;
   std::string masks = "off";
   std::string mrt = "off";
+  std::string beams = "off";
+  int beam_tile = 8;
   std::string ray_streams = "auto";
   std::string compact = "on";
   std::string stats = "table";

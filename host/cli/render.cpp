@@ -105,6 +105,8 @@ RenderPlan parse_render(const RenderArgs& a, bool lanes_given) {
                                                         : vgpu::Filter::trilinear;
   opt.masks = a.masks == "on";
   opt.mrt = a.mrt == "on";
+  opt.beams = a.beams == "on";
+  opt.beam_tile = a.beam_tile;
   opt.ray_streams = a.ray_streams == "on";
   opt.compact = a.compact == "on";
   opt.looping = a.kernels == "looping";
@@ -161,6 +163,15 @@ RenderPlan parse_render(const RenderArgs& a, bool lanes_given) {
                        " needs --engine stream (the cpu engine is a double-precision reference "
                        "without passes, lanes or masks)");
   }
+  if (opt.beams && a.engine != "stream")
+    throw UsageError("--beams on needs --engine stream (the beam passes run on the emulator)");
+  if (opt.beams && a.accel != "grid")
+    throw UsageError("--beams on: beams are walked through the uniform grid only (--accel grid)");
+  if (opt.beams && (a.precision != "fp32" || !a.formats.empty()))
+    throw UsageError(
+        "--beams on needs fp32 ray state (no --precision or --formats): the beam "
+        "entry reaches the voxel the walk would only where both round as fp32");
+  if (a.beam_tile != 8 && !opt.beams) throw UsageError("--beam-tile needs --beams on");
   if (a.steps_given && !opt.looping) throw UsageError("--steps-per-pass needs --kernels looping");
   // Animation (issue 23): the frames' times, and what several frames need.
   const bool animating = plan.animating = !a.time.empty() || !a.frames.empty();
@@ -292,6 +303,11 @@ void print_table(const RenderArgs& a, const RenderPlan& plan, const host::Scene&
               cpu ? "engine" : "profile", cpu ? "cpu" : opt.profile.c_str(), r.width, r.height,
               r.iterations, a.shading.c_str(), a.shadows.c_str(), a.masks.c_str(), a.mrt.c_str());
   if (!cpu) std::cout << "formats (texture and arithmetic, per group):\n" << describe(opt.formats);
+  if (opt.beams)
+    std::printf("beams %dx%d: %llu tiles, %llu beam passes, %llu tiles missed the grid\n",
+                opt.beam_tile, opt.beam_tile, static_cast<unsigned long long>(r.beam_tiles),
+                static_cast<unsigned long long>(r.beam_passes),
+                static_cast<unsigned long long>(r.beam_tiles_missed));
   if (r.streams.on) std::cout << host::describe(r.streams);
   if (r.compact.on) std::cout << host::describe(r.compact);
   std::printf("initialization %.1f ms (grid %.1f ms), render %.1f ms (%s)\n", init_ms,

@@ -105,6 +105,15 @@ nlohmann::ordered_json frame_stats_json(const FrameStatsInputs& in) {
   if (r.streams.on) j["streams"] = to_json(r.streams);  // glass's ray streams
   if (r.compact.on) j["compact"] = to_json(r.compact);  // the sampling modes' dense streams
   j["rays_unfinished"] = r.rays_unfinished;
+  // Beams over tiles (--beams on): the tile size, beam passes (rayosHaz), tiles marched over the
+  // frame's primary traces, and tiles whose whole beam missed the grid. Absent with beams off,
+  // so such a frame's JSON is what it was before beams.
+  if (!cpu && !gl && opt.beams)
+    j["beams"] = {{"on", opt.beams},
+                  {"tile", opt.beam_tile},
+                  {"passes", r.beam_passes},
+                  {"tiles", r.beam_tiles},
+                  {"tiles_missed", r.beam_tiles_missed}};
   // Supersampling (--spp): samples per pixel and the passes it added to the first sample frame.
   {
     double mean = double(r.samples);

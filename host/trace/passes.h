@@ -20,6 +20,9 @@ struct WalkCounts {
   uint64_t rays_traced = 0;      // rays entering a trace
   uint64_t rays_unfinished = 0;  // rays stopped by a walk's pass cap (reduced precision)
   bool batch_walk = false;       // a walk of this frame ran in batches (host/trace/walks/walk.h)
+  // Beams over tiles (--beams on, host/trace/walks/grid_beams.h): passes of rayosHaz, tiles
+  // marched (over the frame's primary traces) and tiles whose whole beam missed the grid.
+  uint64_t beam_passes = 0, beam_tiles = 0, beam_tiles_missed = 0;
 };
 
 // The state a batch walk hands back to the textures and masks: each ping-pong pair of state

@@ -29,6 +29,18 @@ std::string RenderOptions::refusal(const vgpu::Profile& profile, std::string_vie
   if (mrt && looping)
     return "--mrt on with --kernels looping: the looping program already writes the traversal, "
            "voxel and hit targets in one pass; there are no separate passes left to fuse";
+  if (beams && beam_tile < 1) return "--beam-tile: a tile is 1 pixel wide or more";
+  // A tile's beam bounds its pixels' rays; a dense stream packs the marked pixels' rays into
+  // rows where neighbours are no longer neighbours.
+  if (beams && compact && (adaptive || undersample > 0))
+    return "--beams on: a dense stream's rays are packed, not laid out by tile: add --compact off";
+  // Beams start a ray in the voxel the walk would reach, found with fp32 arithmetic: exact only
+  // where the ray state and the traversal are fp32 too.
+  if (beams && (formats[Group::rays] != vgpu::Format::fp32 ||
+                formats[Group::traversal] != vgpu::Format::fp32 ||
+                formats.arithmetic(Group::traversal) != vgpu::Format::fp32))
+    return "--beams on: needs fp32 rays and traversal (texels and arithmetic): the beam entry "
+           "reaches the voxel the walk would only where both round as fp32";
   // The fused programs' outputs against the profile's limit, and their groups' formats.
   if (mrt) return mrt_refusal(profile, formats);
   return {};

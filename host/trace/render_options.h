@@ -93,6 +93,13 @@ struct RenderOptions {
   // where it applies: the vgpu at 8 lanes, with host_shortcut or masks, the multipass kernels,
   // no observer and no trace_pixel; elsewhere the walk runs pass by pass.
   bool batch_walk = true;
+  // Beams over tiles (an extension, issue 35; docs/groups.md): before the primary rays walk the
+  // grid, passes of one fragment per beam_tile x beam_tile tile march each tile's beam through
+  // empty space, and every pixel's ray starts where its tile's beam stopped. The same hits,
+  // depths and images as without (only where each walk begins changes). The uniform grid only,
+  // fp32 ray state, the emulator (refusal() says so).
+  bool beams = false;
+  int beam_tile = 8;
   // Supersampling (host/trace/sampling.h): rays per pixel, a square from 1 to 256, on a
   // stratified, jittered grid drawn from sample_seed; the box filter resolves them. 1: one ray
   // through each pixel's centre, the paper's image.
@@ -187,10 +194,12 @@ struct RenderResult {
   std::vector<float> hit_id;  // input triangle id of the primary hit, -1 where it misses
   vgpu::FrameStats stats;
   double render_ms = 0;
-  int iterations = 0;               // ray-tracing iterations run (primary included)
-  uint64_t rays_traced = 0;         // rays entering a trace (primary, reflected, shadow)
-  uint64_t rays_unfinished = 0;     // rays stopped by the pass cap (only under reduced precision)
-  bool batch_walk = false;          // the grid walks ran in batches (RenderOptions::batch_walk)
+  int iterations = 0;            // ray-tracing iterations run (primary included)
+  uint64_t rays_traced = 0;      // rays entering a trace (primary, reflected, shadow)
+  uint64_t rays_unfinished = 0;  // rays stopped by the pass cap (only under reduced precision)
+  bool batch_walk = false;       // the grid walks ran in batches (RenderOptions::batch_walk)
+  // Beams over tiles (RenderOptions::beams): beam passes, tiles marched, tiles that missed.
+  uint64_t beam_passes = 0, beam_tiles = 0, beam_tiles_missed = 0;
   int samples = 1;                  // sample frames rendered (RenderOptions::spp)
   uint64_t first_frame_passes = 0;  // passes of the first sample frame (the rest is sampling's)
   // Primary rays per pixel where they differ between pixels (--aa adaptive); empty: `samples`

@@ -590,5 +590,33 @@ TEST_CASE("the object criterion's passes are counted and priced, and the statist
           (dir / "image.json").string());
   REQUIRE(image.status == 0);
   CHECK_FALSE(nlohmann::json::parse(slurp(dir / "image.json"))["sampling"].contains("criterion"));
+}
+
+TEST_CASE("beams are refused where they cannot apply, one line and exit 2") {
+  check_refused("--beams on --accel bvh", "--beams on", "uniform grid only");
+  check_refused("--beams on --engine cpu", "--beams on", "needs --engine stream");
+  check_refused("--beams on --precision fp16", "--beams on", "needs fp32 ray state");
+  check_refused("--beam-tile 4", "--beam-tile", "needs --beams on");
+  check_refused("--beams maybe", "--beams", "maybe not in {on,off}");
+  check_refused("--beams on --aa adaptive --spp 4", "--beams on", "add --compact off");
+}
+
+TEST_CASE("beams on renders the same image and its JSON counts tiles, beam passes and misses") {
+  const fs::path dir = fs::temp_directory_path() / ("vgpu_cli_beams_" + std::to_string(::getpid()));
+  Outcome o;
+  const nlohmann::json off = render_json("--bounces 0", dir, o);
+  REQUIRE(o.status == 0);
+  const std::string image_off = slurp(dir / "image.png");
+  const nlohmann::json on = render_json("--bounces 0 --beams on", dir, o);
+  INFO("vgpu-rt render --beams on -> " << o.err);
+  REQUIRE(o.status == 0);
+  CHECK(slurp(dir / "image.png") == image_off);
+  CHECK(!off.contains("beams"));
+  const nlohmann::json& b = on["beams"];
+  CHECK(b["on"] == true);
+  CHECK(b["tile"] == 8);
+  CHECK(b["tiles"] == 16);  // 32x32 in 8x8 tiles
+  CHECK(b["passes"].get<uint64_t>() > 0);
+  CHECK(b["tiles_missed"].get<uint64_t>() < 16);
   fs::remove_all(dir);
 }

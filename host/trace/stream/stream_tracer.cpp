@@ -353,6 +353,9 @@ RenderResult StreamTracer::render(const Camera& cam) {
   res.rays_traced = r.counts.rays_traced;
   res.rays_unfinished = r.counts.rays_unfinished;
   res.batch_walk = r.counts.batch_walk;
+  res.beam_passes = r.counts.beam_passes;
+  res.beam_tiles = r.counts.beam_tiles;
+  res.beam_tiles_missed = r.counts.beam_tiles_missed;
   if (s.streams) res.streams = s.streams->stats;
   if (s.dense) res.compact = s.dense->stats;
   res.render_ms = ms_since(t0);
@@ -412,6 +415,13 @@ void StreamTracer::generate_rays(const Camera& cam, const vgpu::Program& generat
   // left them).
   s.origins.make_current(0);
   gpu_->clear(s.origins.current(), {cam.position.x, cam.position.y, cam.position.z, 0});
+  // Beams over tiles march the same rays: the generator's camera, and a sample frame's jitter.
+  if (&generate == &s.sample_generate) {
+    const GenerateSampleRays& k = s.sample_generate.kernel;
+    s.walk->set_camera(k, k.jitter_x - 0.5f, k.jitter_y - 0.5f);
+  } else {
+    s.walk->set_camera(s.generate.kernel, 0.0f, 0.0f);
+  }
   if (marks && s.dense) {
     // generadorRayosDensos: each slot's sample through its packed pixel.
     s.runner->pass(s.dense->generate, {&s.dense->pixels(), &s.dense->jitters()}, s.rays.current());
@@ -436,8 +446,7 @@ void StreamTracer::primary_hits(RenderResult& res, bool aovs, bool keep_hits,
   // guardarImpactos: the primary hits' surface keys (--aa adaptive, undersampling's lattice),
   // before later traces overwrite the intersections. With --aa-criterion object, guardarConos
   // also keeps the hit distances (kernels/cones.h).
-  const vgpu::Program& keep =
-      cones() ? static_cast<const vgpu::Program&>(s.keep_cones) : s.keep;
+  const vgpu::Program& keep = cones() ? static_cast<const vgpu::Program&>(s.keep_cones) : s.keep;
   Texture* hits = &s.isect.current();
   if (dense_marks && (aovs || keep_hits)) {
     // A dense stream's hits go back to their pixels first (reunirMarcados, the unmarked pixels

@@ -52,6 +52,11 @@ class AccelWalk {
   // nearest hits in the current intersection texture.
   virtual void trace(PassRunner& r, vgpu::Texture& origins, vgpu::Texture& rays, bool primary,
                      glm::vec3 eye) = 0;
+  // The primary rays' camera (the generator's uniforms) and the sample's offset from the pixel
+  // centre, in pixels, before each frame's primary trace: what beams over tiles march
+  // (RenderOptions::beams). A walk without beams ignores it.
+  virtual void set_camera(const kernels::GenerateRays& /*camera*/, float /*offset_x*/,
+                          float /*offset_y*/) {}
 };
 
 // The arithmetic of a looping program, which does the traversal, voxel and hits groups' work:

@@ -81,7 +81,9 @@ GridWalk::GridWalk(vgpu::Device& gpu, const Grid& grid, const RenderOptions& opt
   if (opt_.mrt)
     compute_in({{&intersect_next_, Group::hits}, {&traverse_update_, Group::traversal}});
   looping_.set_precision(looping_arithmetic(opt_.formats));
+  if (opt_.beams) beams_ = std::make_unique<GridBeams>(opt_);
   set_grid(gpu, grid, scene_width, nullptr);
+  if (beams_) statics_.push_back(&beams_->distances());
 }
 
 uint64_t GridWalk::set_grid(vgpu::Device& gpu, const Grid& grid, float scene_width,
@@ -164,17 +166,21 @@ uint64_t GridWalk::set_grid(vgpu::Device& gpu, const Grid& grid, float scene_wid
   looping_.kernel.grid = g;
   looping_.kernel.scene = su;
   looping_.kernel.steps = opt_.steps_per_pass;
+  if (beams_) return bytes + beams_->set_grid(gpu, grid, g, uploaded);
   return bytes;
 }
 
 void GridWalk::make_state(vgpu::Device& gpu, const Shared& shared) {
   make_pairs(gpu, shared, "traversal", "voxel state");
+  if (beams_) beams_->make_state(gpu);
 }
 
 void GridWalk::trace(PassRunner& r, Texture& origins, Texture& rays, bool primary, glm::vec3 eye) {
   clear(r.device());
   // Enter the grid.
-  if (primary) {
+  if (primary && beams_) {
+    beams_->enter(r, rays, eye, trav_.next());
+  } else if (primary) {
     init_.kernel.eye = eye;
     r.pass(init_, {&rays}, trav_.next());
   } else {

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -12,6 +13,7 @@
 #include "host/trace/passes.h"
 #include "host/trace/render_options.h"
 #include "host/trace/walks/accel_walk.h"
+#include "host/trace/walks/grid_beams.h"
 #include "kernels/kernels.h"
 #include "vgpu/vgpu.h"
 
@@ -66,6 +68,9 @@ class GridWalk : public ListWalk {
   // hits in the current intersection texture.
   void trace(PassRunner& r, vgpu::Texture& origins, vgpu::Texture& rays, bool primary,
              glm::vec3 eye) override;
+  void set_camera(const kernels::GenerateRays& camera, float offset_x, float offset_y) override {
+    if (beams_) beams_->set_camera(camera, offset_x, offset_y);
+  }
 
   // The multipass walk (one voxel step and one triangle per pass), written once for every way
   // it runs (host/trace/walks/walk.h). Cursor and write_back are ListWalk's; its per-pixel state is
@@ -87,6 +92,8 @@ class GridWalk : public ListWalk {
   vgpu::KernelProgram<kernels::IntersectNext> intersect_next_;
   vgpu::KernelProgram<kernels::TraverseUpdate> traverse_update_;
   vgpu::KernelProgram<kernels::LoopingTraversal> looping_;
+  // Beams over tiles (RenderOptions::beams; null: off).
+  std::unique_ptr<GridBeams> beams_;
 };
 
 // The grid spec to build for a profile: an automatic resolution is shrunk in x and y until the

@@ -1,0 +1,130 @@
+// Beams over tiles for the uniform grid (host/trace/walks/grid_beams.h): the beam distances
+// built on the host with the grid, and the passes that march the tiles' beams before the walk.
+#include "host/trace/walks/grid_beams.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "host/trace/walks/accel_walk.h"
+
+namespace host {
+
+using vgpu::Texture;
+
+std::vector<float> beam_distances(const Grid& grid, float cap) {
+  const glm::ivec3 r = grid.res;
+  std::vector<float> d(grid.voxels(), cap);
+  for (size_t v = 0; v < grid.voxels(); ++v)
+    if (grid.start[v + 1] > grid.start[v]) d[v] = 0.0f;
+  // A voxel's distance is one more than its nearest neighbour's: the forward scan takes the 13
+  // neighbours already visited (lower z, or the same z and lower y, or the same row to the left),
+  // the backward scan the other 13.
+  auto scan = [&](int sign) {
+    const int n = int(grid.voxels());
+    for (int i = 0; i < n; ++i) {
+      const int v = sign > 0 ? i : n - 1 - i;
+      const int x = v % r.x, y = (v / r.x) % r.y, z = v / (r.x * r.y);
+      float best = d[size_t(v)];
+      for (int dz = -1; dz <= 1; ++dz)
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dx = -1; dx <= 1; ++dx) {
+            const int order = dz != 0 ? dz : dy != 0 ? dy : dx;
+            if (order * sign >= 0) continue;  // only neighbours this scan has visited
+            const int nx = x + dx, ny = y + dy, nz = z + dz;
+            if (nx < 0 || ny < 0 || nz < 0 || nx >= r.x || ny >= r.y || nz >= r.z) continue;
+            best = std::min(best, d[grid.index(nx, ny, nz)] + 1.0f);
+          }
+      d[size_t(v)] = std::min(best, cap);
+    }
+  };
+  scan(1);
+  scan(-1);
+  return d;
+}
+
+uint64_t GridBeams::set_grid(vgpu::Device& gpu, const Grid& grid, const kernels::GridUniforms& g,
+                             std::vector<std::string>* uploaded) {
+  const glm::ivec3 r = grid.res;
+  // The same layout as the voxel pointers: voxel (X, Y, Z) at texel (X * sizeY + Y, Z).
+  if (!uploaded || distances_.width() != r.x * r.y || distances_.height() != r.z)
+    distances_ = gpu.make_texture("beam distances", r.x * r.y, r.z, 1);
+  const std::vector<float> d = beam_distances(grid);
+  std::vector<float> texels(size_t(r.x) * size_t(r.y) * size_t(r.z));
+  for (int z = 0; z < r.z; ++z)
+    for (int y = 0; y < r.y; ++y)
+      for (int x = 0; x < r.x; ++x)
+        texels[size_t(z) * size_t(r.x * r.y) + size_t(x * r.y + y)] = d[grid.index(x, y, z)];
+  const uint64_t bytes = replace_texels(gpu, {{&distances_, &texels}}, uploaded);
+  kernels::BeamUniforms& u = march_.kernel.beams;
+  u.grid = g;
+  u.min_cell = std::min({g.cell.x, g.cell.y, g.cell.z});
+  // Rounding of points and faces is a few ulps of the grid's coordinates: keep a thousandth of a
+  // cell, and step on only by half a cell or more.
+  u.margin = 1e-3f * u.min_cell;
+  u.min_step = 0.5f * u.min_cell;
+  u.tile = float(opt_.beam_tile);
+  box_lo_ = g.lo;
+  box_hi_ = g.lo + g.cell * g.res;
+  entry_.kernel.beams = u;
+  return bytes;
+}
+
+int GridBeams::tiles_x() const {
+  return (opt_.width + opt_.beam_tile - 1) / opt_.beam_tile;
+}
+int GridBeams::tiles_y() const {
+  return (opt_.height + opt_.beam_tile - 1) / opt_.beam_tile;
+}
+
+void GridBeams::make_state(vgpu::Device& gpu) {
+  beams_ = {gpu.make_texture("beams A", tiles_x(), tiles_y(), 4),
+            gpu.make_texture("beams B", tiles_x(), tiles_y(), 4)};
+  counter_ = gpu.make_texture("beam counter", tiles_x(), tiles_y(), 1);
+}
+
+uint64_t GridBeams::state_bytes() const {
+  return beams_[0].bytes() + beams_[1].bytes() + counter_.bytes();
+}
+
+void GridBeams::set_camera(const kernels::GenerateRays& camera, float offset_x, float offset_y) {
+  for (kernels::BeamUniforms* u : {&march_.kernel.beams, &entry_.kernel.beams}) {
+    u->camera = camera;
+    u->offset_x = offset_x;
+    u->offset_y = offset_y;
+  }
+}
+
+void GridBeams::enter(PassRunner& r, Texture& rays, glm::vec3 eye, Texture& traversal) {
+  vgpu::Device& gpu = r.device();
+  kernels::BeamUniforms& u = march_.kernel.beams;
+  u.eye = eye;
+  // The farthest corner of the grid box from the eye: past it, a beam has left the box behind.
+  float far = 0.0f;
+  for (int c = 0; c < 8; ++c) {
+    const glm::vec3 corner{c & 1 ? box_hi_.x : box_lo_.x, c & 2 ? box_hi_.y : box_lo_.y,
+                           c & 4 ? box_hi_.z : box_lo_.z};
+    far = std::max(far, glm::length(corner - eye));
+  }
+  u.far = far * 1.0001f + u.margin;
+  entry_.kernel.beams = u;
+  // Every beam starts at the eye, marching.
+  beams_.make_current(0);
+  gpu.clear(beams_.current(), {0, 0, 0, 0});
+  WalkCounts& n = r.counts;
+  n.beam_tiles += uint64_t(tiles_x()) * uint64_t(tiles_y());
+  uint64_t marching = 1;
+  for (int pass = 0; pass < kMaxPasses && marching > 0; ++pass) {
+    r.pass(march_, {&beams_.current(), &distances_}, beams_.next());
+    beams_.swap();
+    ++n.beam_passes;
+    gpu.begin_query();
+    r.pass(marching_, {&beams_.current()}, counter_);
+    marching = gpu.end_query();
+  }
+  gpu.begin_query();
+  r.pass(missed_, {&beams_.current()}, counter_);
+  n.beam_tiles_missed += gpu.end_query();
+  r.pass(entry_, {&rays, &beams_.current()}, traversal);
+}
+
+}  // namespace host

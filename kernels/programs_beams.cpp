@@ -1,0 +1,7 @@
+// The compiled programs of beams over tiles (kernels/beams.h): rayosHaz, inicioHaz and the count
+// of tiles that miss (every lane family of each is compiled here, once).
+#include "kernels/kernels.h"
+
+template class vgpu::KernelProgram<kernels::BeamMarch>;
+template class vgpu::KernelProgram<kernels::BeamEntry>;
+template class vgpu::KernelProgram<kernels::BeamsMissed>;
