@@ -173,6 +173,7 @@ std::vector<std::string> profile_names() {
 }  // namespace
 
 void add_animation_options(CLI::App& render, RenderArgs& a);
+void add_sampling_options(CLI::App& render, RenderArgs& a);
 
 void add_render_options(CLI::App& render, RenderArgs& a) {
   const std::vector<std::string> on_off{"on", "off"};
@@ -331,6 +332,21 @@ void add_render_options(CLI::App& render, RenderArgs& a) {
       ->check(CLI::IsMember({"batches", "passes"}))
       ->each([&a](const std::string&) { a.walk_given = true; })
       ->capture_default_str();
+  add_sampling_options(render, a);
+  render
+      .add_option("--steps-per-pass", a.steps_per_pass,
+                  "With --kernels looping: loop iterations per pass before the host's occlusion "
+                  "query (the profile's loop limit applies: gf6600 255)")
+      ->check(CLI::Range(1, 4096))
+      ->each([&a](const std::string&) { a.steps_given = true; })
+      ->capture_default_str();
+  render.add_flag("--predict", a.predict,
+                  "Print the cost model's predicted time for --profile, with its breakdown");
+  add_animation_options(render, a);
+}
+
+// The sampling options: rays per pixel, and where adaptive modes trace more or fewer.
+void add_sampling_options(CLI::App& render, RenderArgs& a) {
   render
       .add_option("--spp", a.spp,
                   "Rays per pixel, a square: a stratified, jittered n x n grid in each pixel "
@@ -372,16 +388,6 @@ void add_render_options(CLI::App& render, RenderArgs& a) {
                   "in widths of the pixel's cone at its hit, that marks a pixel")
       ->check(CLI::Range(0.0f, 1000.0f))
       ->capture_default_str();
-  render
-      .add_option("--steps-per-pass", a.steps_per_pass,
-                  "With --kernels looping: loop iterations per pass before the host's occlusion "
-                  "query (the profile's loop limit applies: gf6600 255)")
-      ->check(CLI::Range(1, 4096))
-      ->each([&a](const std::string&) { a.steps_given = true; })
-      ->capture_default_str();
-  render.add_flag("--predict", a.predict,
-                  "Print the cost model's predicted time for --profile, with its breakdown");
-  add_animation_options(render, a);
 }
 
 // The animation options (issue 23; issue 34: every animation plays by default).
