@@ -34,16 +34,9 @@ struct CompactMarks {
   void operator()(Fragments<L>& f) const {
     using F = typename L::F;
     const F j = stream_index(f.x, f.y, width);
-    F lo = F(0.0f), hi = F(sources - 1.0f);
-    for (int s = 0; s < steps; ++s) {
-      const F mid = floor((lo + hi) * F(0.5f));
-      const auto left = fetch_id(f, kScan, mid, width).x > j;
-      hi = select(left, mid, hi);
-      lo = select(left, lo, mid + F(1.0f));
-    }
     // The first pixel whose inclusive sum passes j is the j-th marked one.
     F u, v;
-    id_to_texel(min(lo, F(sources - 1.0f)), width, u, v);
+    id_to_texel(scan_search(f, kScan, j, sources, steps, width), width, u, v);
     const F zero = F(0.0f);
     f.out(0) = select(j < F(count), Vec4<F>{u, v, zero, F(1.0f)}, Vec4<F>{zero, zero, zero, zero});
   }

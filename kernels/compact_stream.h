@@ -35,14 +35,7 @@ struct CompactStream {
     using F = typename L::F;
     const F j = stream_index(f.x, f.y, width);
     const auto live = j < F(count);
-    F lo = F(0.0f), hi = F(sources - 1.0f);
-    for (int s = 0; s < steps; ++s) {
-      const F mid = floor((lo + hi) * F(0.5f));
-      const auto left = fetch_id(f, kScan, mid, width).x > j;
-      hi = select(left, mid, hi);
-      lo = select(left, lo, mid + F(1.0f));
-    }
-    const F i = min(lo, F(sources - 1.0f));
+    const F i = scan_search(f, kScan, j, sources, steps, width);
     const Vec4<F> split = fetch_id(f, kSplit, i, width);
     const F first_slot = fetch_id(f, kScan, i, width).x - split.z;
     const auto reflected = (j - first_slot < F(0.5f)) && (split.x > F(0.0f));

@@ -48,4 +48,22 @@ inline F stream_index(const F& x, const F& y, float width) {
   return (y - F(0.5f)) * F(width) + (x - F(0.5f));
 }
 
+// Stream reduction's gather (Horn, GPU Gems 2 ch. 36): the first entry i of an inclusive prefix
+// sum (texture unit `scan`, `sources` entries, a stream `width` wide) whose sum passes j, found
+// by a binary search of `steps` = ceil(log2(sources)) dependent fetches (a fixed count: no
+// data-dependent loop, so the FX runs it). It is the element that output slot j gathers from.
+template <class L>
+inline typename L::F scan_search(const Fragments<L>& f, int scan, const typename L::F& j,
+                                 float sources, int steps, float width) {
+  using F = typename L::F;
+  F lo = F(0.0f), hi = F(sources - 1.0f);
+  for (int s = 0; s < steps; ++s) {
+    const F mid = floor((lo + hi) * F(0.5f));
+    const auto left = fetch_id(f, scan, mid, width).x > j;
+    hi = select(left, mid, hi);
+    lo = select(left, lo, mid + F(1.0f));
+  }
+  return min(lo, F(sources - 1.0f));
+}
+
 }  // namespace kernels
