@@ -305,7 +305,7 @@ TEST_CASE(
     // (--aa-criterion object: the hit distances and the mirror's reflected keys).
     CAPTURE(mode);
     host::RenderOptions opt;
-    opt.width = opt.height = 24;
+    opt.width = opt.height = 16;
     opt.profile = "gf6600";
     opt.aa_threshold = 0.1f;
     if (mode != 1) {
@@ -321,7 +321,7 @@ TEST_CASE(
       CAPTURE(std::string(a.name()));
       const host::RenderResult g = host::StreamTracer(scene, a, opt).render(camera);
       const host::RenderResult c = host::render_cpu(scene, a, camera, opt);
-      REQUIRE(g.rays_per_pixel.size() == 24 * 24);
+      REQUIRE(g.rays_per_pixel.size() == 16 * 16);
       CHECK(g.rays_per_pixel == c.rays_per_pixel);
       if (first.empty()) first = g.rays_per_pixel;
       CHECK(g.rays_per_pixel == first);
