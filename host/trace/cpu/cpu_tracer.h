@@ -31,6 +31,10 @@ struct CpuStats {
   // critical angle (a part of `reflected`). reflected + refracted is every secondary ray cast.
   std::vector<uint64_t> reflected, refracted, total_internal;
   uint64_t glass_shadow_crossings = 0;  // glass surfaces shadow rays went through (each a ray)
+  // Beams over tiles (--beams on, host/trace/cpu/cpu_beams.h), over every sample position's
+  // beams: tiles, tiles whose beam missed the grid, the passes a GPU would have run (per sample
+  // position, the most steps one tile's beam took) and the march steps of every tile.
+  uint64_t beam_tiles = 0, beam_tiles_missed = 0, beam_passes = 0, beam_steps = 0;
 };
 
 // The kinds of ray in a pixel's ray tree.
