@@ -63,7 +63,9 @@ struct CpuRay {
 //     together; in each voxel every listed triangle is tested (Moller-Trumbore, two-sided) and
 //     the nearest hit is kept only if its t lies in the voxel's [t_enter, t_exit] widened by
 //     t_slack = 1e-5 * grid diagonal (the stream tracer's rule); the walk ends at the first voxel
-//     with such a hit, or when it leaves the grid;
+//     with such a hit, or when it leaves the grid; with beams over tiles (options.beams), a
+//     primary ray's walk starts where its tile's beam stopped, in the state the walk would reach
+//     there (host/trace/cpu/cpu_beams.h), and a ray of a tile whose beam missed hits nothing;
 //   - shading: kernels::Shader's models and constants (ambient 0.1 x kd, specular 0.5, exponent
 //     32, atten_dist = 0.5 * grid diagonal), evaluated at the exact hit point with the shading
 //     normal interpolated by the hit's barycentrics; background black; with no lights, only the
