@@ -4,7 +4,8 @@
 // emulator's host ms and the cost model's predictions for the same counters; and the fixed
 // costs of one pass, one query read-back and one program switch, measured on tiny passes.
 // Frames can run glass's ray streams (--ray-streams) and the sampling modes (--sampling), each
-// priced beside its measurement like the paper's frame.
+// priced beside its measurement like the paper's frame, and with beams over tiles (--beams on,
+// docs/groups.md).
 // Needs no OpenImageIO and no display: it runs on any machine with EGL (llvmpipe, NVIDIA).
 #include <CLI/CLI.hpp>
 #include <algorithm>
@@ -289,6 +290,7 @@ struct FrameRun {
   vgpu::FrameStats stats;
   uint64_t rays_traced = 0;
   bool streams = false;  // the frame ran as ray streams (--ray-streams on, or a glass scene)
+  uint64_t beam_passes = 0, beam_tiles = 0, beam_tiles_missed = 0;  // --beams on: the last frame's
   std::string device;
   int warmup_frames = 0;    // frames after the compiling one, run before timing (--warmup-ms)
   double warmup_ms = 0;     // their wall time, ms
@@ -337,6 +339,9 @@ FrameRun run_frames(const host::Scene& scene, const host::Accel& accel, const ho
     fr.stats = res.stats;
     fr.rays_traced = res.rays_traced;
     fr.streams = res.streams.on;
+    fr.beam_passes = res.beam_passes;
+    fr.beam_tiles = res.beam_tiles;
+    fr.beam_tiles_missed = res.beam_tiles_missed;
   }
   fr.timed_to_s = unix_s();
   return fr;
@@ -354,7 +359,7 @@ struct Args {
   std::vector<std::string> variants = {"multipass"};
   std::vector<std::string> accels = {"grid"};
   int bounces = 2;
-  std::vector<std::string> ray_streams = {"off"}, sampling = {"spp:1"};
+  std::vector<std::string> ray_streams = {"off"}, sampling = {"spp:1"}, beams = {"off"};
   bool shadows = false, no_fixed = false, latency = false;
 };
 
@@ -426,6 +431,11 @@ void add_options(CLI::App& app, Args& a) {
                              t + "'";
           },
           "MODE", "sampling"))
+      ->capture_default_str();
+  app.add_option("--beams", a.beams,
+                 "Per frame: off, on (beams over tiles, 8x8 pixels, before the primary rays' "
+                 "walk: docs/groups.md; the uniform grid only)")
+      ->check(CLI::IsMember({"off", "on"}))
       ->capture_default_str();
   app.add_flag("--shadows", a.shadows, "Shadow rays in the frames (off: Table 1's setting)");
   app.add_flag("--no-fixed", a.no_fixed, "Skip the fixed-cost passes (frames only)");
@@ -532,7 +542,7 @@ json kernel_json(const FrameRun& fr, const vgpu::FrameStats::ProgramTotals& p, b
 
 // What one frame configuration names, beside its measurements.
 struct FrameKey {
-  std::string scene, accel, variant, streams, mode, engine;
+  std::string scene, accel, variant, streams, mode, engine, beams;
   int size = 0;
 };
 
@@ -547,6 +557,10 @@ json frame_json(const FrameKey& key, const host::RenderOptions& opt, const Frame
             {"ray_streams", key.streams},
             {"streams_ran", fr.streams},
             {"sampling", key.mode},
+            {"beams", key.beams},
+            {"beam_passes", fr.beam_passes},
+            {"beam_tiles", fr.beam_tiles},
+            {"beam_tiles_missed", fr.beam_tiles_missed},
             {"size", key.size},
             {"engine", key.engine},
             {"device", fr.device},
@@ -578,9 +592,10 @@ json frame_json(const FrameKey& key, const host::RenderOptions& opt, const Frame
     for (const auto& [k, v] : host::predict(fr.stats, hp, params_for(hp)).items()) h200[k] = v;
     f["predicted_h200"] = h200;
   }
-  std::printf("%-14s %4dx%-4d %-6s %-9s %-7s streams %-3s %-13s wall %9.1f ms", key.scene.c_str(),
-              key.size, key.size, key.accel.c_str(), key.variant.c_str(), key.engine.c_str(),
-              key.streams.c_str(), key.mode.c_str(), median(fr.wall));
+  std::printf("%-14s %4dx%-4d %-6s %-9s %-7s streams %-3s %-13s beams %-3s wall %9.1f ms",
+              key.scene.c_str(), key.size, key.size, key.accel.c_str(), key.variant.c_str(),
+              key.engine.c_str(), key.streams.c_str(), key.mode.c_str(), key.beams.c_str(),
+              median(fr.wall));
   if (gl)
     std::printf("  gpu %9.1f ms  wait %8.1f ms  warm-up %d frames", median(fr.gpu), median(fr.wait),
                 fr.warmup_frames);
@@ -621,19 +636,23 @@ void scene_frames(const Args& a, const host::Scene& scene, int size,
       opt.profile = variant == "multipass" ? "gf5700" : "h200";
       for (const std::string& streams : a.ray_streams)
         for (const std::string& mode : a.sampling)
-          for (const std::string& engine : engines) {
-            opt.ray_streams = streams == "on";
-            parse_sampling(mode, opt);  // checked when parsed
-            const bool gl = engine != "stream";
-            opt.device = gl ? "gl" : "vgpu";
-            opt.gl_readback = engine == "gl-poll" ? "poll" : "block";
-            const std::string dump = a.dump_programs.empty() ? ""
-                                                             : a.dump_programs + "/" + scene.name +
-                                                                   "_" + accel_name + "_" + variant;
-            const FrameRun fr = run_frames(scene, accel, cam, opt, a.runs, a.warmup_ms, dump);
-            const FrameKey key{scene.name, accel_name, variant, streams, mode, engine, size};
-            frames.push_back(frame_json(key, opt, fr, a.runs));
-          }
+          for (const std::string& beams : a.beams)
+            for (const std::string& engine : engines) {
+              opt.ray_streams = streams == "on";
+              opt.beams = beams == "on";
+              parse_sampling(mode, opt);  // checked when parsed
+              const bool gl = engine != "stream";
+              opt.device = gl ? "gl" : "vgpu";
+              opt.gl_readback = engine == "gl-poll" ? "poll" : "block";
+              const std::string dump =
+                  a.dump_programs.empty()
+                      ? ""
+                      : a.dump_programs + "/" + scene.name + "_" + accel_name + "_" + variant;
+              const FrameRun fr = run_frames(scene, accel, cam, opt, a.runs, a.warmup_ms, dump);
+              const FrameKey key{scene.name, accel_name, variant, streams,
+                                 mode,       engine,     beams,   size};
+              frames.push_back(frame_json(key, opt, fr, a.runs));
+            }
     }
 }
 
@@ -661,6 +680,12 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {  // --help exits 0; a bad option 2, as vgpu-rt does
     return app.exit(e) == 0 ? 0 : 2;
+  }
+  const bool beams_on = std::count(a.beams.begin(), a.beams.end(), "on") > 0;
+  if (beams_on && std::any_of(a.accels.begin(), a.accels.end(),
+                              [](const std::string& s) { return s != "grid"; })) {
+    std::fprintf(stderr, "bench_gl: --beams on walks the uniform grid only (--accel grid)\n");
+    return 2;
   }
   if (a.latency && a.wait_mode == "none") {
     std::fprintf(stderr,

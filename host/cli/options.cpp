@@ -248,7 +248,7 @@ void add_render_options(CLI::App& render, RenderArgs& a) {
       .add_option("--beams", a.beams,
                   "Beams over tiles (issue 35, docs/groups.md): passes of one fragment per tile "
                   "march each tile's beam through empty space, and the primary rays start where "
-                  "it stopped; the same image. --accel grid, fp32, stream engine")
+                  "it stopped; the same image. --accel grid, fp32; every engine (stream, gl, cpu)")
       ->check(CLI::IsMember(on_off))
       ->capture_default_str();
   render.add_option("--beam-tile", a.beam_tile, "With --beams on: pixels per tile side")

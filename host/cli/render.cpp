@@ -163,8 +163,6 @@ RenderPlan parse_render(const RenderArgs& a, bool lanes_given) {
                        " needs --engine stream (the cpu engine is a double-precision reference "
                        "without passes, lanes or masks)");
   }
-  if (opt.beams && a.engine != "stream")
-    throw UsageError("--beams on needs --engine stream (the beam passes run on the emulator)");
   if (opt.beams && a.accel != "grid")
     throw UsageError("--beams on: beams are walked through the uniform grid only (--accel grid)");
   if (opt.beams && (a.precision != "fp32" || !a.formats.empty()))

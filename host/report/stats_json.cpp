@@ -108,12 +108,16 @@ nlohmann::ordered_json frame_stats_json(const FrameStatsInputs& in) {
   // Beams over tiles (--beams on): the tile size, beam passes (rayosHaz), tiles marched over the
   // frame's primary traces, and tiles whose whole beam missed the grid. Absent with beams off,
   // so such a frame's JSON is what it was before beams.
-  if (!cpu && !gl && opt.beams)
+  if (opt.beams) {
     j["beams"] = {{"on", opt.beams},
                   {"tile", opt.beam_tile},
                   {"passes", r.beam_passes},
                   {"tiles", r.beam_tiles},
                   {"tiles_missed", r.beam_tiles_missed}};
+    // The CPU tracer marches the same beams one tile at a time: the passes are the most steps
+    // one tile's beam ran (what the passes would have been), and it also counts every step.
+    if (cpu) j["beams"]["steps"] = cpu_stats.beam_steps;
+  }
   // Supersampling (--spp): samples per pixel and the passes it added to the first sample frame.
   {
     double mean = double(r.samples);

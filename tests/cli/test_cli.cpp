@@ -594,14 +594,15 @@ TEST_CASE("the object criterion's passes are counted and priced, and the statist
 
 TEST_CASE("beams are refused where they cannot apply, one line and exit 2") {
   check_refused("--beams on --accel bvh", "--beams on", "uniform grid only");
-  check_refused("--beams on --engine cpu", "--beams on", "needs --engine stream");
   check_refused("--beams on --precision fp16", "--beams on", "needs fp32 ray state");
   check_refused("--beam-tile 4", "--beam-tile", "needs --beams on");
   check_refused("--beams maybe", "--beams", "maybe not in {on,off}");
   check_refused("--beams on --aa adaptive --spp 4", "--beams on", "add --compact off");
 }
 
-TEST_CASE("beams on renders the same image and its JSON counts tiles, beam passes and misses") {
+TEST_CASE(
+    "beams on renders the same image on the emulator and the CPU tracer, and their JSON counts "
+    "the same tiles, beam passes and misses") {
   const fs::path dir = fs::temp_directory_path() / ("vgpu_cli_beams_" + std::to_string(::getpid()));
   Outcome o;
   const nlohmann::json off = render_json("--bounces 0", dir, o);
@@ -618,5 +619,21 @@ TEST_CASE("beams on renders the same image and its JSON counts tiles, beam passe
   CHECK(b["tiles"] == 16);  // 32x32 in 8x8 tiles
   CHECK(b["passes"].get<uint64_t>() > 0);
   CHECK(b["tiles_missed"].get<uint64_t>() < 16);
+  // The CPU tracer marches the same beams (the same counts) and counts their steps; its image
+  // is its own with beams off.
+  const nlohmann::json cpu_off = render_json("--bounces 0 --engine cpu", dir, o);
+  REQUIRE(o.status == 0);
+  const std::string cpu_image_off = slurp(dir / "image.png");
+  const nlohmann::json cpu_on = render_json("--bounces 0 --engine cpu --beams on", dir, o);
+  INFO("vgpu-rt render --engine cpu --beams on -> " << o.err);
+  REQUIRE(o.status == 0);
+  CHECK(slurp(dir / "image.png") == cpu_image_off);
+  CHECK(!cpu_off.contains("beams"));
+  REQUIRE(cpu_on.contains("beams"));
+  const nlohmann::json& c = cpu_on["beams"];
+  for (const char* key : {"on", "tile", "passes", "tiles", "tiles_missed"}) CHECK(c[key] == b[key]);
+  CHECK(c["steps"].get<uint64_t>() >= c["tiles"].get<uint64_t>());
+  CHECK(cpu_on["cpu"]["voxel_steps"].get<uint64_t>() <
+        cpu_off["cpu"]["voxel_steps"].get<uint64_t>());
   fs::remove_all(dir);
 }

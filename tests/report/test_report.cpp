@@ -7,15 +7,18 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
 
+#include "host/accel/accel.h"
 #include "host/accel/grid.h"
 #include "host/image/image_io.h"
 #include "host/report/report.h"
+#include "host/report/stats_json.h"
 #include "host/scene/camera.h"
 #include "host/scene/gltf_loader.h"
 #include "host/scene/scene.h"
@@ -433,4 +436,39 @@ TEST_CASE("the loop iterations map adds up to the looping kernels' iterations, p
   host::FrameRecorder multi(48, 40, false, 0);
   render(multi, false);
   for (const uint32_t v : multi.loop_iterations()) CHECK(v == 0);
+}
+
+TEST_CASE(
+    "the stats JSON counts beams on every engine, the CPU tracer's steps too, and only "
+    "with beams on") {
+  const host::Scene scene = host::load_scene(host::resolve_scene("sphere-alone"));
+  const std::unique_ptr<host::Accel> accel =
+      host::make_accel(host::AccelKind::grid, scene, host::AccelParams{});
+  const std::string path = "sphere-alone.gltf", words = "-";
+  host::RenderResult r;
+  r.width = r.height = 16;
+  r.beam_passes = 7;
+  r.beam_tiles = 4;
+  r.beam_tiles_missed = 1;
+  host::CpuStats cpu;
+  cpu.beam_steps = 11;
+  for (const std::string engine : {"stream", "gl", "cpu"})
+    for (const bool beams : {false, true}) {
+      CAPTURE(engine);
+      CAPTURE(beams);
+      host::RenderOptions opt;
+      opt.width = opt.height = 16;
+      opt.beams = beams;
+      const nlohmann::ordered_json j =
+          host::frame_stats_json({scene, path, engine, nullptr, *accel, nullptr, opt, r, cpu, words,
+                                  words, words, words, 0.0});
+      REQUIRE(j.contains("beams") == beams);
+      if (!beams) continue;
+      const auto& b = j["beams"];
+      CHECK(b["passes"] == 7);
+      CHECK(b["tiles"] == 4);
+      CHECK(b["tiles_missed"] == 1);
+      CHECK(b.contains("steps") == (engine == "cpu"));
+      if (engine == "cpu") CHECK(b["steps"] == 11);
+    }
 }

@@ -6,11 +6,13 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <stdexcept>
 #include <thread>
 #include <vector>
 
 #include "host/common/parallel.h"
+#include "host/trace/cpu/cpu_beams.h"
 #include "host/trace/cpu/optics.h"
 #include "host/trace/sampling.h"
 #include "host/trace/textures.h"
@@ -132,6 +134,17 @@ class Tracer {
     for (const SceneTexture& t : scene.textures) chains_.push_back(build_mip_chain(t));
     for (const Material& m : scene.materials) has_glass_ = has_glass_ || m.transmission > 0.0f;
     spread_ = 2.0 * primary_.t / double(opt.height);
+    // Beams over tiles: for the uniform grid's walk only (the options refuse the others).
+    if (opt.beams && grid_ && !bvh_ && !kd_ && !grid2_)
+      beams_ = std::make_unique<CpuBeams>(*grid_, camera, opt);
+  }
+
+  const CpuBeams* beams() const { return beams_.get(); }
+  // Where the primary ray of pixel (x, y) through point j of it starts (null: beams are off).
+  const CpuBeamStart* beam_start(int x, int y, glm::vec2 j, CpuBeamStart& s) const {
+    if (!beams_) return nullptr;
+    s = beams_->start(x, y, j);
+    return &s;
   }
 
   // The base-colour texel of hit h of the ray o + t d, as kernels/base_color.h filters it: the
@@ -166,9 +179,10 @@ class Tracer {
   }
 
   // The nearest valid hit along o + t d, 0 < t < tmax (d unit, world space). any_hit: stop at
-  // the first valid hit (shadow rays only need to know whether one exists).
-  Hit trace(const glm::dvec3& o, const glm::dvec3& d, double tmax, bool any_hit,
-            Counters& c) const {
+  // the first valid hit (shadow rays only need to know whether one exists). `beam` (a primary
+  // ray's, with beams over tiles): the whole tile misses, or the walk may start further on.
+  Hit trace(const glm::dvec3& o, const glm::dvec3& d, double tmax, bool any_hit, Counters& c,
+            const CpuBeamStart* beam = nullptr) const {
     ++c.rays;
     if (bvh_) return trace_bvh(o, d, tmax, any_hit, c);
     if (kd_) return trace_kd(o, d, tmax, any_hit, c);
@@ -188,6 +202,7 @@ class Tracer {
     }
     if (!(tnear <= tfar)) return best;
     ++c.entered;
+    if (beam && beam->missed) return best;  // its tile's beam left the grid box behind
 
     // Amanatides & Woo set-up: the entry voxel, the t of the next boundary per axis, and the t
     // between two boundaries per axis.
@@ -207,6 +222,8 @@ class Tracer {
     }
 
     double t_enter = tnear;
+    // Start where the tile's beam stopped: the walk's own state there, or at the entry.
+    if (beam) cpu_dda_skip(*grid_, o, d, double(beam->t), vox, step, t_next, t_delta, t_enter);
     for (;;) {
       ++c.voxel_steps;
       const double t_exit = std::min({t_next.x, t_next.y, t_next.z});
@@ -237,8 +254,9 @@ class Tracer {
   // The colour through point (jx, jy) of pixel (x, y), in [0, 1)^2 from its top-left corner.
   glm::dvec3 sample(int x, int y, glm::vec2 j, Hit* primary, Counters& c,
                     Hit* reflected = nullptr) const {
+    CpuBeamStart s;
     return radiance(glm::dvec3(cam_.position), primary_.dir(x, y, j.x, j.y), 0, 1.0, primary, c,
-                    CpuRayKind::primary, reflected);
+                    CpuRayKind::primary, reflected, beam_start(x, y, j, s));
   }
   // The centre ray of pixel (x, y) for adaptive sampling and undersampling: its colour; its
   // hit's depth and input id into the AOVs; in `key`, the material its triangle has, -1 for a
@@ -263,14 +281,17 @@ class Tracer {
     const size_t idx = size_t(y) * size_t(opt_.width) + size_t(x);
     Hit primary;
     glm::dvec3 colour(0.0);
+    CpuBeamStart s;
     if (opt_.spp <= 1) {
-      colour = radiance(glm::dvec3(cam_.position), primary_.dir(x, y), 0, 1.0, &primary, c);
+      colour = radiance(glm::dvec3(cam_.position), primary_.dir(x, y), 0, 1.0, &primary, c,
+                        CpuRayKind::primary, nullptr, beam_start(x, y, {0.5f, 0.5f}, s));
     } else {
       // The stream tracer's sample positions; the AOVs are the first sample's, as there.
-      for (int s = 0; s < opt_.spp; ++s) {
-        const glm::vec2 j = sample_offset(opt_.spp, s, opt_.sample_seed);
+      for (int k = 0; k < opt_.spp; ++k) {
+        const glm::vec2 j = sample_offset(opt_.spp, k, opt_.sample_seed);
         colour += radiance(glm::dvec3(cam_.position), primary_.dir(x, y, j.x, j.y), 0, 1.0,
-                           s == 0 ? &primary : nullptr, c);
+                           k == 0 ? &primary : nullptr, c, CpuRayKind::primary, nullptr,
+                           beam_start(x, y, j, s));
       }
       colour /= double(opt_.spp);
     }
@@ -287,12 +308,13 @@ class Tracer {
   // docs/materials.md): (1 - t)(1 - a) C + ((1 - t) a + t F) L_reflected + t (1 - F) L_refracted.
   // A ray is spawned only if its weight is at least 1/512 and the path has fewer than 1 + bounces
   // surfaces, as rayosReflejados does; `kind` is what spawned this one (cpu_ray_tree's log).
-  // `reflected_out` (if given) gets an opaque surface's reflected ray's hit (tri -1: none).
+  // `reflected_out` (if given) gets an opaque surface's reflected ray's hit (tri -1: none);
+  // `beam` (a primary ray's): where its walk may start (trace).
   glm::dvec3 radiance(const glm::dvec3& o, const glm::dvec3& d, int depth, double w, Hit* hit_out,
                       Counters& c, CpuRayKind kind = CpuRayKind::primary,
-                      Hit* reflected_out = nullptr) const {
+                      Hit* reflected_out = nullptr, const CpuBeamStart* beam = nullptr) const {
     c.iterations = std::max(c.iterations, depth + 1);
-    const Hit h = trace(o, d, kInf, false, c);
+    const Hit h = trace(o, d, kInf, false, c, beam);
     if (hit_out) *hit_out = h;
     const size_t logged = log_ ? log_->size() : 0;
     if (log_) log_->push_back(CpuRay{depth, kind, o, d, w, h.tri, h.t, 1.0});
@@ -607,9 +629,10 @@ class Tracer {
   // kernels::Shader's and rayosReflejados' constants, so both tracers read them from one place.
   glm::dvec3 ambient_, background_;
   double specular_ = 0, min_weight_ = 0;
-  std::vector<MipChain> chains_;  // per Scene::textures entry
-  bool has_glass_ = false;        // some material has transmission > 0
-  double spread_ = 0;             // angle between neighbouring pixels' rays (base_texel)
+  std::vector<MipChain> chains_;     // per Scene::textures entry
+  bool has_glass_ = false;           // some material has transmission > 0
+  double spread_ = 0;                // angle between neighbouring pixels' rays (base_texel)
+  std::unique_ptr<CpuBeams> beams_;  // beams over tiles (RenderOptions::beams), or null
 
  public:
   // The stream tracer's float of it (marcarConos' uniform: 2 tan(fov / 2) / height).
@@ -812,6 +835,13 @@ RenderResult render_cpu(const Scene& scene, const Accel& accel, const Camera& ca
   }
   for (auto* kind : {&total.reflected, &total.refracted, &total.total_internal})
     kind->resize(size_t(std::max(res.iterations, 1)), 0);  // one entry per iteration run
+  if (const CpuBeams* beams = tracer.beams()) {
+    const CpuBeamCounts b = beams->counts();
+    res.beam_tiles = total.beam_tiles = b.tiles;
+    res.beam_tiles_missed = total.beam_tiles_missed = b.tiles_missed;
+    res.beam_passes = total.beam_passes = b.passes;
+    total.beam_steps = b.steps;
+  }
   if (stats) *stats = total;
   if (res.rays_per_pixel.empty()) res.samples = std::max(options.spp, 1);
   res.render_ms = ms_since(t0);

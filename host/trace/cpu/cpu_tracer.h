@@ -31,6 +31,10 @@ struct CpuStats {
   // critical angle (a part of `reflected`). reflected + refracted is every secondary ray cast.
   std::vector<uint64_t> reflected, refracted, total_internal;
   uint64_t glass_shadow_crossings = 0;  // glass surfaces shadow rays went through (each a ray)
+  // Beams over tiles (--beams on, host/trace/cpu/cpu_beams.h), over every sample position's
+  // beams: tiles, tiles whose beam missed the grid, the passes a GPU would have run (per sample
+  // position, the most steps one tile's beam took) and the march steps of every tile.
+  uint64_t beam_tiles = 0, beam_tiles_missed = 0, beam_passes = 0, beam_steps = 0;
 };
 
 // The kinds of ray in a pixel's ray tree.
@@ -59,7 +63,9 @@ struct CpuRay {
 //     together; in each voxel every listed triangle is tested (Moller-Trumbore, two-sided) and
 //     the nearest hit is kept only if its t lies in the voxel's [t_enter, t_exit] widened by
 //     t_slack = 1e-5 * grid diagonal (the stream tracer's rule); the walk ends at the first voxel
-//     with such a hit, or when it leaves the grid;
+//     with such a hit, or when it leaves the grid; with beams over tiles (options.beams), a
+//     primary ray's walk starts where its tile's beam stopped, in the state the walk would reach
+//     there (host/trace/cpu/cpu_beams.h), and a ray of a tile whose beam missed hits nothing;
 //   - shading: kernels::Shader's models and constants (ambient 0.1 x kd, specular 0.5, exponent
 //     32, atten_dist = 0.5 * grid diagonal), evaluated at the exact hit point with the shading
 //     normal interpolated by the hit's barycentrics; background black; with no lights, only the

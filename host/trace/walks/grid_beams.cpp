@@ -42,30 +42,47 @@ std::vector<float> beam_distances(const Grid& grid, float cap) {
   return d;
 }
 
-uint64_t GridBeams::set_grid(vgpu::Device& gpu, const Grid& grid, const kernels::GridUniforms& g,
-                             std::vector<std::string>* uploaded) {
+std::vector<float> beam_distance_texels(const Grid& grid) {
   const glm::ivec3 r = grid.res;
-  // The same layout as the voxel pointers: voxel (X, Y, Z) at texel (X * sizeY + Y, Z).
-  if (!uploaded || distances_.width() != r.x * r.y || distances_.height() != r.z)
-    distances_ = gpu.make_texture("beam distances", r.x * r.y, r.z, 1);
   const std::vector<float> d = beam_distances(grid);
   std::vector<float> texels(size_t(r.x) * size_t(r.y) * size_t(r.z));
   for (int z = 0; z < r.z; ++z)
     for (int y = 0; y < r.y; ++y)
       for (int x = 0; x < r.x; ++x)
         texels[size_t(z) * size_t(r.x * r.y) + size_t(x * r.y + y)] = d[grid.index(x, y, z)];
-  const uint64_t bytes = replace_texels(gpu, {{&distances_, &texels}}, uploaded);
-  kernels::BeamUniforms& u = march_.kernel.beams;
+  return texels;
+}
+
+void set_beam_grid(kernels::BeamUniforms& u, const kernels::GridUniforms& g, int tile) {
   u.grid = g;
   u.min_cell = std::min({g.cell.x, g.cell.y, g.cell.z});
   // Rounding of points and faces is a few ulps of the grid's coordinates: keep a thousandth of a
   // cell, and step on only by half a cell or more.
   u.margin = 1e-3f * u.min_cell;
   u.min_step = 0.5f * u.min_cell;
-  u.tile = float(opt_.beam_tile);
-  box_lo_ = g.lo;
-  box_hi_ = g.lo + g.cell * g.res;
-  entry_.kernel.beams = u;
+  u.tile = float(tile);
+}
+
+float beam_far(const kernels::BeamUniforms& u, glm::vec3 eye) {
+  const glm::vec3 lo = u.grid.lo, hi = u.grid.lo + u.grid.cell * u.grid.res;
+  float far = 0.0f;
+  for (int c = 0; c < 8; ++c) {
+    const glm::vec3 corner{c & 1 ? hi.x : lo.x, c & 2 ? hi.y : lo.y, c & 4 ? hi.z : lo.z};
+    far = std::max(far, glm::length(corner - eye));
+  }
+  return far * 1.0001f + u.margin;
+}
+
+uint64_t GridBeams::set_grid(vgpu::Device& gpu, const Grid& grid, const kernels::GridUniforms& g,
+                             std::vector<std::string>* uploaded) {
+  const glm::ivec3 r = grid.res;
+  // The same layout as the voxel pointers: voxel (X, Y, Z) at texel (X * sizeY + Y, Z).
+  if (!uploaded || distances_.width() != r.x * r.y || distances_.height() != r.z)
+    distances_ = gpu.make_texture("beam distances", r.x * r.y, r.z, 1);
+  const std::vector<float> texels = beam_distance_texels(grid);
+  const uint64_t bytes = replace_texels(gpu, {{&distances_, &texels}}, uploaded);
+  set_beam_grid(march_.kernel.beams, g, opt_.beam_tile);
+  entry_.kernel.beams = march_.kernel.beams;
   return bytes;
 }
 
@@ -98,14 +115,8 @@ void GridBeams::enter(PassRunner& r, Texture& rays, glm::vec3 eye, Texture& trav
   vgpu::Device& gpu = r.device();
   kernels::BeamUniforms& u = march_.kernel.beams;
   u.eye = eye;
-  // The farthest corner of the grid box from the eye: past it, a beam has left the box behind.
-  float far = 0.0f;
-  for (int c = 0; c < 8; ++c) {
-    const glm::vec3 corner{c & 1 ? box_hi_.x : box_lo_.x, c & 2 ? box_hi_.y : box_lo_.y,
-                           c & 4 ? box_hi_.z : box_lo_.z};
-    far = std::max(far, glm::length(corner - eye));
-  }
-  u.far = far * 1.0001f + u.margin;
+  // Past the farthest corner of the grid box from the eye, a beam has left the box behind.
+  u.far = beam_far(u, eye);
   entry_.kernel.beams = u;
   // Every beam starts at the eye, marching.
   beams_.make_current(0);

@@ -24,6 +24,16 @@ namespace host {
 // count as empty. Two raster scans (forward, backward) over the 26 neighbours: exact for this
 // distance.
 std::vector<float> beam_distances(const Grid& grid, float cap = 1024.0f);
+// beam_distances laid out as the beam march fetches them: voxel (X, Y, Z) at texel
+// (X * res.y + Y, Z) of a res.x * res.y by res.z texture of one channel (the voxel pointers'
+// layout).
+std::vector<float> beam_distance_texels(const Grid& grid);
+// The march's and the entry's uniforms that come from the grid (its uniforms `g`, the margin and
+// the shortest step) and the tile size; the camera, the offset, the eye and `far` are the
+// frame's (beam_far).
+void set_beam_grid(kernels::BeamUniforms& u, const kernels::GridUniforms& g, int tile);
+// BeamUniforms::far for a beam from `eye`: just past the grid box's farthest corner.
+float beam_far(const kernels::BeamUniforms& u, glm::vec3 eye);
 
 class GridBeams {
  public:
@@ -54,7 +64,6 @@ class GridBeams {
   vgpu::Texture distances_;
   PingPong<vgpu::Texture> beams_;
   vgpu::Texture counter_;
-  glm::vec3 box_lo_{0.0f}, box_hi_{0.0f};
   vgpu::KernelProgram<kernels::BeamMarch> march_;
   vgpu::KernelProgram<kernels::BeamEntry> entry_;
   vgpu::KernelProgram<kernels::RaysInGrid> marching_;
