@@ -48,7 +48,9 @@ int main(int argc, char** argv) {
   app.add_option("--ref-spp", ref_spp, "Samples per pixel of the reference")
       ->check(CLI::Range(1, 1024));
   app.add_option("--scenes", scenes, "Bundled scene names or glTF files");
-  app.add_option("--out", out_dir, "Folder for the files (it must exist)")->required();
+  app.add_option("--out", out_dir, "Folder for the files (it must exist)")
+      ->required()
+      ->check(CLI::ExistingDirectory);
   CLI11_PARSE(app, argc, argv);
 
   nlohmann::json index = {{"size", size}, {"ref_spp", ref_spp}, {"fields", kFields}};
