@@ -175,6 +175,19 @@ def budget_rule(t, budgets, cost):
     return mark
 
 
+# The budgets' costs per pixel: one, one where the centre ray hit, the rays the centre ray traced.
+def pixels(d):
+    return np.ones_like(d["t"])
+
+
+def hits(d):
+    return (d["key"] >= 0) * 1.0
+
+
+def centre_rays(d):
+    return d["rays0"]
+
+
 RULES = [
     # label, rule, 4 x 4 level's ray scale, what it stands for
     ("image, T 0.05", image_rule(0.05), 1.0, "built (--aa-criterion image)"),
@@ -187,14 +200,17 @@ RULES = [
     ("contrast keys, T 0.2", contrast_keys_rule(0.2), 1.0, "key edges weighted by contrast"),
     ("pair, T 0.05, eps 0.05", pair_rule(0.05, 0.05), 1.0, "level 2 where the 2x2 samples moved"),
     ("pair, T 0.1, eps 0.05", pair_rule(0.1, 0.05), 1.0, "level 2 where the 2x2 samples moved"),
-    ("pixel budget 20%, 20%", budget_rule(0.05, (0.2, 0.2), lambda d: np.ones_like(d["t"])), 1.0,
+    ("pixel budget 20%, 20%", budget_rule(0.05, (0.2, 0.2), pixels), 1.0,
      "marked pixels counted by queries"),
-    ("hit budget 30%, 22%", budget_rule(0.05, (0.3, 0.22), lambda d: (d["key"] >= 0) * 1.0),
-     1.0, "marked pixels that hit, counted"),
-    ("ray budget 24%, 22%", budget_rule(0.05, (0.24, 0.22), lambda d: d["rays0"]), 1.0,
+    ("hit budget 30%, 22%", budget_rule(0.05, (0.3, 0.22), hits), 1.0,
+     "marked pixels that hit, counted"),
+    ("ray budget 24%, 22%", budget_rule(0.05, (0.24, 0.22), centre_rays), 1.0,
      "each pixel's centre-ray rays"),
     ("object, T 0.05, keep 2x2", object_rule(0.05), 0.75, "4x4 level traces 12 new samples"),
     ("image, T 0.1, keep 2x2", image_rule(0.1), 0.75, "4x4 level traces 12 new samples"),
+    ("hit budget 30%, 24%, keep 2x2", budget_rule(0.05, (0.3, 0.24), hits), 0.75, "both"),
+    ("hit budget 30%, 28%, keep 2x2", budget_rule(0.05, (0.3, 0.28), hits), 0.75, "both"),
+    ("pixel budget 30%, 28%, keep 2x2", budget_rule(0.05, (0.3, 0.28), pixels), 0.75, "both"),
 ]
 # The built rules' labels in bench_sampling's rows (results/sampling/cones.json).
 MEASURED = {"image, T 0.05": "adaptive 16, T 0.05", "image, T 0.1": "adaptive 16, T 0.1",
@@ -274,14 +290,22 @@ meets all ten, though narrowly: every scene spends at most what the target allow
 34.2% of the rays), the scenes that need less spend less, and hop and textured end at 1.43x and
 1.41x; with the 4 x 4 level's budget at 20% instead of 22%, hop is at 1.63x.
 Keeping the 2 x 2 samples in the 4 x 4 level brings hop and classic under 35% with the object
-criterion at T 0.05 (9 of 10; textured stays at 46%).
+criterion at T 0.05 (9 of 10; textured stays at 46%). Together with the budget of pixels that
+hit, it meets all ten with room on both limits and for more than one budget (30% then 28%:
+textured 1.32x with 32.9% of the rays, hop 33.0%, bunny-refl 1.23x; 30% then 24%: textured 1.45x,
+hop 30.1%), where the pixel count alone leaves textured at 38.7% (30% then 28%).
 
 So the default does not change (`--aa-criterion image`, `--aa-threshold 0.1`), and no
-`--aa adaptive` output changes. What would meet the target is the ray budget, which needs what
-the stream engines do not keep: each pixel's ray count in the centre frame (a count texture
-that the primary, shadow and reflected walks add into), then a weighted count per step of the
-binary search (a sum by reduction passes, not one occlusion query), on the emulator, the GL
-device and the CPU tracer alike."""
+`--aa adaptive` output changes. Two builds would meet the target. The nearer: a 4 x 4 level
+that keeps the 2 x 2 samples (its offsets the 12 strata the 2 x 2 samples left empty, its sums
+added to theirs rather than restarted, in the gated and dense frames and the CPU tracer alike)
+with each level's threshold found by binary search, one counting pass and query per step over
+the pixels that hit (a score in the marks, a threshold uniform in pixelesMarcados); its
+figures here are estimates (the 16 samples would be another pattern), to be measured once
+built. The other: the ray budget, which needs what the stream engines do not keep, each
+pixel's ray count in the centre frame (a count texture that the primary, shadow and reflected
+walks add into), and a weighted count per search step (a sum by reduction passes, not one
+occlusion query)."""
 
 
 def fmt_pair(e, r):
@@ -321,9 +345,9 @@ def check_against_bench(results, names):
 
 def chart(results, names):
     panels = [label for label, _, _, _ in RULES if label in (
-        "image, T 0.1", "object, T 0.05", "contrast keys, T 0.1", "pair, T 0.05, eps 0.05",
-        "pixel budget 20%, 20%", "hit budget 30%, 22%", "ray budget 24%, 22%",
-        "object, T 0.05, keep 2x2")]
+        "image, T 0.1", "object, T 0.05", "pair, T 0.05, eps 0.05", "pixel budget 20%, 20%",
+        "hit budget 30%, 22%", "ray budget 24%, 22%", "object, T 0.05, keep 2x2",
+        "hit budget 30%, 28%, keep 2x2")]
     fig, axes = plt.subplots(2, 4, figsize=(16, 8.4), sharex=True, sharey=True)
     colours = plt.cm.tab10(np.linspace(0, 1, 10))
     for ax, label in zip(axes.ravel(), panels):
