@@ -2,13 +2,14 @@
 // can be tried offline without a render per rule. For each scene (128 x 128 by default, the
 // CLI's defaults, as bench_sampling) the CPU tracer traces every pixel's centre ray and every
 // level of --spp 16 (2 x 2, then 4 x 4) as if every pixel were refined (cpu_adaptive_levels),
-// with the rays each traced, and the 256-sample reference. A rule then picks, per pixel, the
+// with the rays each traced, the 4 x 4 level that would keep the 2 x 2 samples and trace only
+// the 12 others (its kept level), and the 256-sample reference. A rule then picks, per pixel, the
 // last level it reaches: its image is that level's estimate, its rays the sum of its levels'.
 // scripts/docs/sampling_rules.py reads the files and writes docs/sampling.md's section on the
 // rules it tried.
 //
 // Output in --out, per scene (N its place in --scenes, from 0): N.f32, float32 little-endian, per
-// pixel (row-major, row 0 the top) the 18 values of `kFields`; and index.json: the size, the
+// pixel (row-major, row 0 the top) the 22 values of `kFields`; and index.json: the size, the
 // fields, and per scene its file and pixel spread (the angle between neighbouring pixels' rays,
 // marcarConos' uniform).
 #include <CLI/CLI.hpp>
@@ -29,9 +30,10 @@
 namespace {
 
 const std::vector<std::string> kFields = {
-    "centre_r",    "centre_g", "centre_b", "key",   "reflected_key", "depth",
-    "centre_rays", "l2_r",     "l2_g",     "l2_b",  "l2_rays",       "l4_r",
-    "l4_g",        "l4_b",     "l4_rays",  "ref_r", "ref_g",         "ref_b"};
+    "centre_r",    "centre_g", "centre_b", "key",        "reflected_key", "depth",
+    "centre_rays", "l2_r",     "l2_g",     "l2_b",       "l2_rays",       "l4_r",
+    "l4_g",        "l4_b",     "l4_rays",  "ref_r",      "ref_g",         "ref_b",
+    "l4kept_r",    "l4kept_g", "l4kept_b", "l4kept_rays"};
 
 }  // namespace
 
@@ -91,6 +93,8 @@ int main(int argc, char** argv) {
         data.push_back(float(lv.level_rays[l][i]));
       }
       for (int c = 0; c < 3; ++c) data.push_back(ref.rgb[i * 3 + size_t(c)]);
+      for (int c = 0; c < 3; ++c) data.push_back(lv.kept[1][i * 3 + size_t(c)]);
+      data.push_back(float(lv.kept_rays[1][i]));
     }
     const std::string file = std::to_string(index["scenes"].size()) + ".f32";
     std::ofstream f(out_dir + "/" + file, std::ios::binary);

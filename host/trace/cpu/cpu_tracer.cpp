@@ -777,6 +777,16 @@ CpuAdaptiveLevels cpu_adaptive_levels(const Scene& scene, const Accel& accel, co
   out.centre_rays.assign(n, 0);
   out.level.assign(out.sides.size(), std::vector<float>(n * 3, 0.0f));
   out.level_rays.assign(out.sides.size(), std::vector<uint32_t>(n, 0));
+  // The kept levels' samples (sampling.h): level l's set is the first l + 1 lists together.
+  const size_t levels = out.sides.size();
+  const std::vector<std::vector<glm::vec2>> added =
+      kept_level_samples(options.spp, options.sample_seed);
+  out.kept.assign(levels, {});
+  out.kept_rays.assign(levels, {});
+  for (size_t l = 1; l < added.size(); ++l) {
+    out.kept[l].assign(n * 3, 0.0f);
+    out.kept_rays[l].assign(n, 0);
+  }
   RenderResult aov;  // the centre rays' depths land here
   aov.depth.assign(n, 0.0f);
   aov.hit_id.assign(n, -1.0f);
@@ -804,6 +814,21 @@ CpuAdaptiveLevels cpu_adaptive_levels(const Scene& scene, const Accel& accel, co
         sum /= double(m);
         out.level_rays[l][i] = uint32_t(c.entered - before);
         for (int ch = 0; ch < 3; ++ch) out.level[l][i * 3 + size_t(ch)] = float(sum[ch]);
+      }
+      // The kept levels: the earlier samples traced again (their rays not counted), then the
+      // new ones.
+      for (size_t l = 1; l < added.size(); ++l) {
+        glm::dvec3 sum(0.0);
+        Counters again;
+        size_t count = 0;
+        for (size_t e = 0; e < l; ++e)
+          for (const glm::vec2 o : added[e]) sum += tracer.sample(x, y, o, nullptr, again);
+        before = c.entered;
+        for (const glm::vec2 o : added[l]) sum += tracer.sample(x, y, o, nullptr, c);
+        for (size_t e = 0; e <= l; ++e) count += added[e].size();
+        sum /= double(count);
+        out.kept_rays[l][i] = uint32_t(c.entered - before);
+        for (int ch = 0; ch < 3; ++ch) out.kept[l][i * 3 + size_t(ch)] = float(sum[ch]);
       }
     }
   });

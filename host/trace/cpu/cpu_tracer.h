@@ -103,6 +103,13 @@ struct CpuAdaptiveLevels {
   // Per level, then per pixel: the level's mean colour (rgb) and the rays it traced.
   std::vector<std::vector<float>> level;
   std::vector<std::vector<uint32_t>> level_rays;
+  // Per level, a level that keeps the samples of the one before (a proposal, not a mode): its
+  // n x n strata that hold none of them get a sample each (sample_offset(n * n, stratum)), and
+  // the estimate is the mean of the kept and the new samples; kept_rays counts the new ones'
+  // rays. Empty for the first level, and where the earlier samples do not fall one to a
+  // stratum (the side not doubling, as spp 9's 2 then 3).
+  std::vector<std::vector<float>> kept;
+  std::vector<std::vector<uint32_t>> kept_rays;
 };
 CpuAdaptiveLevels cpu_adaptive_levels(const Scene& scene, const Accel& accel, const Camera& camera,
                                       const RenderOptions& options);
