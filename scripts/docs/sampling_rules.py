@@ -257,7 +257,8 @@ the surface keys, reflected keys and hit distances; the budgets also from counti
 - **budgets**: every pixel gets a score (its largest colour step at a key, reflected key or
   fold edge, or its bend); each level refines the highest scores above T 0.05 while their cost
   stays under a share of the whole image's cost at that level. A card finds that threshold by
-  binary search with one counting pass and query per step. *pixel*: the cost is one per pixel
+  binary search with one counting pass and query per step (here the exact threshold, the
+  first score left out, which enough steps reach). *pixel*: the cost is one per pixel
   (what a query counts); *hit*: one per pixel whose centre ray hit something; *ray*: the rays
   the pixel's centre ray traced (primary, shadow, reflected), which the stream engines do not
   keep per pixel.
@@ -339,8 +340,8 @@ def check_against_bench(results, names):
             e, r = results[label][n]
             worst_e = max(worst_e, abs(e - m["rms"] / u["rms"]))
             worst_r = max(worst_r, abs(r - m["rays_traced"] / u["rays_traced"]))
-    return [f"The check: the six built rules simulated here against bench_sampling's renders "
-            f"(the stream engine, results/sampling/cones.json) on the ten scenes differ by at "
+    return [f"The check: the six built rules simulated here against bench_sampling's renders\n"
+            f"(the stream engine, results/sampling/cones.json) on the ten scenes differ by at\n"
             f"most {worst_e:.3f} in RMS over uniform 16's and {100 * worst_r:.2f} points in "
             f"the share of its rays."]
 
