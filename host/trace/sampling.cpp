@@ -57,6 +57,26 @@ std::vector<int> adaptive_levels(int spp) {
   return levels;
 }
 
+std::vector<std::vector<glm::vec2>> kept_level_samples(int spp, uint64_t seed) {
+  std::vector<std::vector<glm::vec2>> added;
+  std::vector<glm::vec2> held;  // every sample so far
+  for (const int side : adaptive_levels(spp)) {
+    const int m = side * side;
+    std::vector<uint8_t> taken(size_t(m), 0);
+    for (const glm::vec2 o : held) {
+      uint8_t& t = taken[size_t(int(o.y * float(side)) * side + int(o.x * float(side)))];
+      if (t) return added;  // two earlier samples in one stratum
+      t = 1;
+    }
+    std::vector<glm::vec2> level;
+    for (int k = 0; k < m; ++k)
+      if (!taken[size_t(k)]) level.push_back(sample_offset(m, k, seed));
+    held.insert(held.end(), level.begin(), level.end());
+    added.push_back(level);
+  }
+  return added;
+}
+
 uint32_t adaptive_rays(int spp, int samples) {
   uint32_t rays = 1;
   for (const int side : adaptive_levels(spp)) {

@@ -26,6 +26,15 @@ glm::vec2 sample_offset(int spp, int s, uint64_t seed);
 // grid, doubling from 2 and ending at sqrt(spp) (spp 16: 2, 4; spp 9: 2, 3; spp 1: none).
 std::vector<int> adaptive_levels(int spp);
 
+// Adaptive levels that keep the samples before them (a proposal, not a mode: docs/sampling.md,
+// "One default for every scene"; cpu_adaptive_levels' kept levels): per level, the offsets of the
+// samples it adds. The first level adds its own n x n (sample_offset(n * n, k)); each later one
+// adds one sample in each of its n x n strata that the samples before leave empty (the stratum's
+// sample_offset), so that the set stays one sample to a stratum. The list stops before the first
+// level whose earlier samples do not fall one to a stratum (a side that does not double, as
+// spp 9's 2 then 3); spp 16: 4 offsets, then 12.
+std::vector<std::vector<glm::vec2>> kept_level_samples(int spp, uint64_t seed);
+
 // The primary rays a pixel took under adaptive supersampling when its final sample count is
 // `samples` (1: the centre ray alone; n*n: every level up to side n, after the centre ray).
 uint32_t adaptive_rays(int spp, int samples);

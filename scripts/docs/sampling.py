@@ -807,6 +807,10 @@ def main():
     cones = hf.section(DOC, "<!-- cones:begin -->", "<!-- cones:end -->")
     if cones:
         out += [cones, ""]
+    # The rules tried offline for one default (scripts/docs/sampling_rules.py): kept as it is.
+    rules = hf.section(DOC, "<!-- rules:begin -->", "<!-- rules:end -->")
+    if rules:
+        out += [rules, ""]
     kept = hf.section(DOC, H200_BEGIN, H200_END)  # measured on other hardware: kept as it is
     if kept:
         out += [kept, ""]

@@ -92,6 +92,34 @@ RenderResult render_cpu(const Scene& scene, const Grid& grid, const Camera& came
 RenderResult render_cpu(const Scene& scene, const Accel& accel, const Camera& camera,
                         const RenderOptions& options, CpuStats* stats = nullptr);
 
+// Every pixel's samples as --aa adaptive would trace them if every pixel were refined at every
+// level: the centre ray (its colour, surface key, reflected surface key, hit distance) and each
+// level's n x n estimate, each with the rays it traced (RenderResult::rays_traced's count, shadow
+// and reflected rays included). A rule of where to refine can then be tried offline: a pixel's
+// image is the estimate of the last level the rule gave it, its rays the sum of its levels'
+// (bench_mark_rules and scripts/docs/sampling_rules.py). The estimates are render_cpu's: the
+// centre its spp 1 colour, level n its spp n x n colour, bit for bit.
+struct CpuAdaptiveLevels {
+  int width = 0, height = 0;
+  std::vector<int> sides;  // adaptive_levels(options.spp): 2, 4 for spp 16
+  // Per pixel, row-major (colours rgb): the centre ray's.
+  std::vector<float> centre, depth;     // depth: hit distance, 0 for a miss
+  std::vector<int> key, reflected_key;  // -1: a miss (or, reflected, no reflected ray)
+  std::vector<uint32_t> centre_rays;
+  // Per level, then per pixel: the level's mean colour (rgb) and the rays it traced.
+  std::vector<std::vector<float>> level;
+  std::vector<std::vector<uint32_t>> level_rays;
+  // Per level, a level that keeps the samples of the one before (a proposal, not a mode): its
+  // n x n strata that hold none of them get a sample each (sample_offset(n * n, stratum)), and
+  // the estimate is the mean of the kept and the new samples; kept_rays counts the new ones'
+  // rays. Empty for the first level, and where the earlier samples do not fall one to a
+  // stratum (the side not doubling, as spp 9's 2 then 3).
+  std::vector<std::vector<float>> kept;
+  std::vector<std::vector<uint32_t>> kept_rays;
+};
+CpuAdaptiveLevels cpu_adaptive_levels(const Scene& scene, const Accel& accel, const Camera& camera,
+                                      const RenderOptions& options);
+
 // Every ray the CPU tracer traces for one camera ray from `origin` along the unit `dir` (shadow
 // rays aside), depth-first in the order traced: the tree of docs/materials.md's glass model, with
 // each ray's weight. A ray's weight is w times its parent's share; the weights of its hit's local
