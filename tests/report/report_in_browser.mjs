@@ -112,7 +112,6 @@ try {
     if (t.grey) check(t.hits === 0, `grey tile ${t.tx},${t.ty} has no hit (${t.hits})`);
     else check(t.start <= t.nearest, `tile ${t.tx},${t.ty}: rays start at ${t.start}, before the nearest hit ${t.nearest}`);
   }
-  if (process.env.BEAMS_SHOT) await page.locator("#beams").screenshot({ path: process.env.BEAMS_SHOT });
 } finally {
   await browser.close();
 }
