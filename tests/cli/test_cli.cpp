@@ -674,3 +674,16 @@ TEST_CASE("beams auto renders the same image, and its JSON and table say what it
   CHECK(table.out.find("beams 8x8: 16 tiles") != std::string::npos);
   fs::remove_all(dir);
 }
+
+TEST_CASE("the kernels command lists the three beam kernels and prints each one's GLSL") {
+  const Outcome list = run("kernels");
+  REQUIRE(list.status == 0);
+  for (const char* name : {"beam-march", "beams-missed", "beam-entry"}) {
+    CAPTURE(name);
+    CHECK(list.out.find(std::string("\n") + name + " ") != std::string::npos);
+    const Outcome glsl = run(std::string("kernels ") + name + " --glsl");
+    CHECK(glsl.status == 0);
+    CHECK(glsl.out.find("void main()") != std::string::npos);
+  }
+  CHECK(list.out.find("rayosHaz (extension)") != std::string::npos);
+}
