@@ -157,8 +157,8 @@ BeamsChoice choose_beams(const Scene& scene, const Accel& accel, const RenderOpt
     return c;
   }
   // The probes: the frame's primary trace at its full size, without and with beams. Smaller
-  // probes mislead here (hop, glass and sphere were predicted cheaper with beams from 64x64
-  // probes, and are dearer at 256x256): a multipass walk runs as many passes as its slowest ray,
+  // probes mislead here (glass and sphere were predicted cheaper with beams from 64x64 probes,
+  // and are dearer at 256x256): a multipass walk runs as many passes as its slowest ray,
   // and which rays are slowest changes with the image's size and the tiles' footprint. Beams
   // change the primary trace alone, so the rest of the frame is left out of both.
   RenderOptions probe = probe_options(options);
