@@ -144,8 +144,8 @@ BeamsChoice choose_beams(const Scene& scene, const Accel& accel, const RenderOpt
   RenderOptions with = options;
   with.beams = true;
   std::string refused;
-  // The GL device runs the emulator's passes, so the emulator's probes price its frame too; the
-  // CPU tracer has no passes for the cost model to price.
+  // The GL device runs the emulator's passes and counts the same statistics, so its probes are
+  // priced alike; the CPU tracer has no passes for the cost model to price.
   if (engine == "cpu")
     refused = "the cost model prices passes, and the cpu engine runs none";
   else if (accel.kind() != AccelKind::grid)
