@@ -1,6 +1,7 @@
 // The one list of every kernel, in the order a frame first runs them: the paper's programs,
-// then supersampling's, the fused programs of --mrt on, each acceleration structure's walk and
-// glass's ray streams; the looping variant's programs (--kernels looping) come last.
+// then supersampling's, the fused programs of --mrt on, each acceleration structure's walk,
+// glass's ray streams, the dense streams and the beams over tiles; the looping variant's
+// programs (--kernels looping) come last.
 // `vgpu-rt kernels` lists and prints them (host/cli/commands.cpp), the report embeds their
 // GLSL (host/report/report.cpp) and the GL device's tests compile each one (tests/gl). What each
 // kernel is, and its paper name: kernels/README.md.
@@ -44,7 +45,9 @@ using MultipassKernels = KernelList<
     // Glass (an extension, issue 25): the ray streams, their compaction and the gather back.
     SplitRays, ScanStream, CountStream, CompactStream, CopyRows, ShadowGlass, GatherChildren,
     // Sampling that saves time (issue 35): the marked pixels as a dense stream, and back.
-    CompactMarks, GenerateDenseRays, AccumulateDense, GatherMarked>;
+    CompactMarks, GenerateDenseRays, AccumulateDense, GatherMarked,
+    // Beams over tiles (issue 35, kernels/beams.h): --beams on, one fragment per tile.
+    BeamMarch, BeamsMissed, BeamEntry>;
 
 // The looping variant (--kernels looping): each structure's whole walk in one program with a
 // data-dependent loop (kernels/looping_traversal.h and the structures' headers).

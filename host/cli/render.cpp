@@ -87,6 +87,7 @@ struct RenderPlan {
   std::vector<double> times;       // the frames' times (one frame: {0} or --time)
   bool span_frames = false;        // --frames N: times spread over the played animations' keys
   bool animating = false, cpu = false, gl = false;
+  std::optional<host::BeamsChoice> beams_choice;  // --beams auto's, made at initialization
 };
 
 // Parse: the options into a plan, refusing what cannot run before any work (UsageError, exit 2).
@@ -169,7 +170,8 @@ RenderPlan parse_render(const RenderArgs& a, bool lanes_given) {
     throw UsageError(
         "--beams on needs fp32 ray state (no --precision or --formats): the beam "
         "entry reaches the voxel the walk would only where both round as fp32");
-  if (a.beam_tile != 8 && !opt.beams) throw UsageError("--beam-tile needs --beams on");
+  if (a.beam_tile != 8 && a.beams == "off")
+    throw UsageError("--beam-tile needs --beams on or auto");
   if (a.steps_given && !opt.looping) throw UsageError("--steps-per-pass needs --kernels looping");
   // Animation (issue 23): the frames' times, and what several frames need.
   const bool animating = plan.animating = !a.time.empty() || !a.frames.empty();
@@ -297,6 +299,9 @@ void print_table(const RenderArgs& a, const RenderPlan& plan, const host::Scene&
   if (const std::string line = accel.describe(); !line.empty()) std::printf("%s\n", line.c_str());
   if (choice)
     std::printf("accel auto: %s (probes %.0f ms)\n", choice->why.c_str(), choice->probe_ms);
+  if (plan.beams_choice)
+    std::printf("beams auto: %s (probes %.0f ms)\n", plan.beams_choice->why.c_str(),
+                plan.beams_choice->probe_ms);
   std::printf("%s %s, %dx%d, %d iteration(s), %s shading, shadows %s, masks %s, mrt %s\n",
               cpu ? "engine" : "profile", cpu ? "cpu" : opt.profile.c_str(), r.width, r.height,
               r.iterations, a.shading.c_str(), a.shadows.c_str(), a.masks.c_str(), a.mrt.c_str());
@@ -564,6 +569,10 @@ int run_render(const RenderArgs& a, bool lanes_given, RenderOutcome* outcome,
   const std::unique_ptr<host::Accel> walked = std::move(built[chosen]);
   built.clear();  // the structures not chosen
   host::Accel& accel = *walked;
+  if (a.beams == "auto") {  // on the structure walked, with its formats
+    plan.beams_choice = host::choose_beams(scene, accel, opt, camera_for(scene), a.engine);
+    opt.beams = plan.beams_choice->on;
+  }
   std::optional<host::StreamTracer> tracer;
   if (!cpu) tracer.emplace(scene, accel, opt);
   const double init_ms =
@@ -574,7 +583,8 @@ int run_render(const RenderArgs& a, bool lanes_given, RenderOutcome* outcome,
   auto record = [&](double frame_init_ms) {
     return host::frame_stats_json({scene, path, a.engine, tracer ? &*tracer : nullptr, accel,
                                    choice ? &*choice : nullptr, opt, r, cpu_stats, a.shading,
-                                   a.texture_filter, a.kernels, a.precision, frame_init_ms});
+                                   a.texture_filter, a.kernels, a.precision, frame_init_ms,
+                                   plan.beams_choice ? &*plan.beams_choice : nullptr});
   };
 
   // Frame by frame: the scene posed, the structure rebuilt, the static textures that changed

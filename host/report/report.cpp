@@ -19,6 +19,7 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <sstream>
 
 #include "host/image/image_io.h"
@@ -399,6 +400,11 @@ void write_report(const std::string& path, const FrameRecorder& rec, const Rende
                {"idle", pack(rec.idle_passes())},
                {"loops", pack(rec.loop_iterations())},
                {"rays", pack(rays)}};
+  // Beams over tiles (--beams on, or auto when it chose beams): where each tile's rays started.
+  if (const BeamMap& b = res.beam_map; !b.start.empty())
+    d["beam_map"] = {{"tiles_x", b.tiles_x},   {"tiles_y", b.tiles_y},
+                     {"tile", b.tile},         {"start", pack(b.start)},
+                     {"steps", pack(b.steps)}, {"missed", pack(b.missed)}};
   auto wave = json::array();
   for (const auto& w : rec.wavefront()) wave.push_back(pack(w));
   d["wavefront"] = std::move(wave);
@@ -415,8 +421,13 @@ void write_report(const std::string& path, const FrameRecorder& rec, const Rende
       {"stride", rec.history_stride()}, {"pixels", std::move(px)}, {"states", std::move(states)}};
   // Each kernel's fragment program as GLSL, generated from its functor (default uniforms), as
   // `vgpu-rt kernels NAME --glsl` prints it.
+  // Only the kernels the frame ran: the kernels table shows no others, and the page stays small.
+  std::set<std::string> ran;
+  if (run.contains("kernels") && run["kernels"].is_array())
+    for (const json& k : run["kernels"]) ran.insert(k.value("name", std::string()));
   json glsl = json::object();
-  for (const auto& p : kernels::all_programs()) glsl[p->name()] = vgpu::to_glsl(*p, true).source;
+  for (const auto& p : kernels::all_programs())
+    if (ran.empty() || ran.count(p->name())) glsl[p->name()] = vgpu::to_glsl(*p, true).source;
   d["glsl"] = std::move(glsl);
 
   std::string data = d.dump();

@@ -118,6 +118,20 @@ nlohmann::ordered_json frame_stats_json(const FrameStatsInputs& in) {
     // one tile's beam ran (what the passes would have been), and it also counts every step.
     if (cpu) j["beams"]["steps"] = cpu_stats.beam_steps;
   }
+  // --beams auto: what it chose and why; with beams off, {"on": false} and the choice alone.
+  if (const BeamsChoice* bc = in.beams_choice) {
+    nlohmann::ordered_json& b = j["beams"];
+    if (!opt.beams) b["on"] = false;
+    nlohmann::ordered_json au = {{"profile", opt.profile}, {"probed", bc->probed}};
+    if (bc->probed) {
+      au["probe"] = {bc->probe_width, bc->probe_height};
+      au["primary_ms"] = {{"off", bc->off_ms}, {"on", bc->on_ms}};  // the probes, predicted
+      au["probe_ms"] = bc->probe_ms;
+      au["probe_model_ms"] = bc->probe_model_ms;
+    }
+    au["why"] = bc->why;
+    b["auto"] = au;
+  }
   // Supersampling (--spp): samples per pixel and the passes it added to the first sample frame.
   {
     double mean = double(r.samples);

@@ -33,6 +33,7 @@ struct FrameStatsInputs {
   const std::string& kernels;
   const std::string& precision;
   double init_ms;  // initialization charged to this frame (the first), else 0
+  const BeamsChoice* beams_choice = nullptr;  // --beams auto's choice, else nullptr
 };
 
 nlohmann::ordered_json frame_stats_json(const FrameStatsInputs& in);

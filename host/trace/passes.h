@@ -23,6 +23,7 @@ struct WalkCounts {
   // Beams over tiles (--beams on, host/trace/walks/grid_beams.h): passes of rayosHaz, tiles
   // marched (over the frame's primary traces) and tiles whose whole beam missed the grid.
   uint64_t beam_passes = 0, beam_tiles = 0, beam_tiles_missed = 0;
+  BeamMap beam_map;  // the frame's first primary trace's tiles, when an observer follows it
 };
 
 // The state a batch walk hands back to the textures and masks: each ping-pong pair of state

@@ -187,6 +187,17 @@ struct CompactStats {
   uint64_t gather_passes = 0, gather_bytes = 0;
 };
 
+// Where each tile's rays started in a frame's first primary trace with beams (the report's tile
+// map, docs/groups.md): the beam texture's texels once the march is over, tile (x, y) at
+// y * tiles_x + x, row 0 at the top of the image as the image's rows. Empty with beams off, or
+// when no pass observer follows the frame (only the report and the pass-by-pass views read it).
+struct BeamMap {
+  int tiles_x = 0, tiles_y = 0, tile = 0;  // tiles across, down, and pixels per tile side
+  std::vector<float> start;                // the ray parameter t where the tile's rays start
+  std::vector<float> steps;                // the march's steps (empty boxes crossed)
+  std::vector<uint8_t> missed;             // 1 where the whole tile missed the grid
+};
+
 struct RenderResult {
   int width = 0, height = 0;
   std::vector<float> rgb;     // width*height*3, linear, row 0 = top
@@ -200,6 +211,7 @@ struct RenderResult {
   bool batch_walk = false;       // the grid walks ran in batches (RenderOptions::batch_walk)
   // Beams over tiles (RenderOptions::beams): beam passes, tiles marched, tiles that missed.
   uint64_t beam_passes = 0, beam_tiles = 0, beam_tiles_missed = 0;
+  BeamMap beam_map;
   int samples = 1;                  // sample frames rendered (RenderOptions::spp)
   uint64_t first_frame_passes = 0;  // passes of the first sample frame (the rest is sampling's)
   // Primary rays per pixel where they differ between pixels (--aa adaptive); empty: `samples`

@@ -1,7 +1,9 @@
 // A screenshot of a vgpu-rt HTML report in headless chromium (the one in docs/ comes from here):
 //   node scripts/docs/report_screenshot.mjs REPORT.html OUT.png [--pixel X,Y] [--trace N] [--hide-idle] [--height PX]
+//                                           [--element SELECTOR]
 // --trace N zooms the timeline to trace N (0-based), --hide-idle hides the idle bars, --height
-// cuts the page to its first PX pixels (default: the whole page). Needs scripts/setup.sh's JS.
+// cuts the page to its first PX pixels (default: the whole page), --element shoots one element
+// alone (e.g. "#beams", the tile map's section). Needs scripts/setup.sh's JS.
 import path from "node:path";
 import { createRequire } from "node:module";
 
@@ -22,7 +24,8 @@ try {
   if (opt("--trace")) await page.selectOption("#t-trace", opt("--trace"));
   if (args.includes("--hide-idle")) await page.evaluate(() => window.report.hideIdle());
   const h = opt("--height");
-  await page.screenshot({ path: out, fullPage: true, clip: h ? { x: 0, y: 0, width: 1320, height: +h } : undefined });
+  if (opt("--element")) await page.locator(opt("--element")).screenshot({ path: out });
+  else await page.screenshot({ path: out, fullPage: true, clip: h ? { x: 0, y: 0, width: 1320, height: +h } : undefined });
   if (failed) process.exitCode = 1;
 } finally {
   await browser.close();

@@ -596,7 +596,7 @@ TEST_CASE("beams are refused where they cannot apply, one line and exit 2") {
   check_refused("--beams on --accel bvh", "--beams on", "uniform grid only");
   check_refused("--beams on --precision fp16", "--beams on", "needs fp32 ray state");
   check_refused("--beam-tile 4", "--beam-tile", "needs --beams on");
-  check_refused("--beams maybe", "--beams", "maybe not in {on,off}");
+  check_refused("--beams maybe", "--beams", "maybe not in {off,on,auto}");
   check_refused("--beams on --aa adaptive --spp 4", "--beams on", "add --compact off");
 }
 
@@ -636,4 +636,54 @@ TEST_CASE(
   CHECK(cpu_on["cpu"]["voxel_steps"].get<uint64_t>() <
         cpu_off["cpu"]["voxel_steps"].get<uint64_t>());
   fs::remove_all(dir);
+}
+
+TEST_CASE("beams auto renders the same image, and its JSON and table say what it chose and why") {
+  const fs::path dir = fs::temp_directory_path() / ("vgpu_cli_auto_" + std::to_string(::getpid()));
+  Outcome o;
+  render_json("--bounces 0", dir, o);
+  REQUIRE(o.status == 0);
+  const std::string image_off = slurp(dir / "image.png");
+  // The low bunny at 32x32: beams are predicted 0.90x of the primary trace (tests/trace).
+  const nlohmann::json on = render_json("--bounces 0 --beams auto --beam-tile 8", dir, o);
+  INFO("vgpu-rt render --beams auto -> " << o.err);
+  REQUIRE(o.status == 0);
+  CHECK(slurp(dir / "image.png") == image_off);
+  const nlohmann::json& b = on["beams"];
+  CHECK(b["on"] == true);
+  CHECK(b["tiles"] == 16);
+  const nlohmann::json& au = b["auto"];
+  CHECK(au["probed"] == true);
+  CHECK(au["probe"] == nlohmann::json::array({32, 32}));
+  CHECK(au["primary_ms"]["on"].get<double>() < au["primary_ms"]["off"].get<double>());
+  CHECK(au["why"].get<std::string>().rfind("on: ", 0) == 0);
+  // Where beams cannot run, off without a word on stderr, and the JSON says why.
+  const nlohmann::json bvh = render_json("--bounces 0 --beams auto --accel bvh", dir, o);
+  REQUIRE(o.status == 0);
+  CHECK(o.err.empty());
+  CHECK(bvh["beams"]["on"] == false);
+  CHECK_FALSE(bvh["beams"].contains("tiles"));
+  CHECK(bvh["beams"]["auto"]["probed"] == false);
+  CHECK(bvh["beams"]["auto"]["why"].get<std::string>().find("uniform grid only") !=
+        std::string::npos);
+  // The statistics table's summary names the choice.
+  const Outcome table = run("render bunny-low --size 32x32 -q --bounces 0 --beams auto --out " +
+                            (dir / "image.png").string());
+  REQUIRE(table.status == 0);
+  CHECK(table.out.find("beams auto: on: primary rays") != std::string::npos);
+  CHECK(table.out.find("beams 8x8: 16 tiles") != std::string::npos);
+  fs::remove_all(dir);
+}
+
+TEST_CASE("the kernels command lists the three beam kernels and prints each one's GLSL") {
+  const Outcome list = run("kernels");
+  REQUIRE(list.status == 0);
+  for (const char* name : {"beam-march", "beams-missed", "beam-entry"}) {
+    CAPTURE(name);
+    CHECK(list.out.find(std::string("\n") + name + " ") != std::string::npos);
+    const Outcome glsl = run(std::string("kernels ") + name + " --glsl");
+    CHECK(glsl.status == 0);
+    CHECK(glsl.out.find("void main()") != std::string::npos);
+  }
+  CHECK(list.out.find("rayosHaz (extension)") != std::string::npos);
 }

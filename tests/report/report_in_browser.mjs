@@ -3,7 +3,8 @@
 // pixel of the image and compares the history the page shows with that pixel's --trace-pixel
 // output, line by line, and compares the timeline's sums with the --stats-json totals; the
 // predicted-time table shows the statistics' predictions, the looping passes' longest lanes on
-// the h200 in a looping frame.
+// the h200 in a looping frame; a frame with beams draws its tile map where the image has its
+// tiles (grey where a tile missed the grid and none of its pixels hits).
 // Usage: node report_in_browser.mjs VGPU_RT WORK_DIR
 import { execFileSync } from "node:child_process";
 import fs from "node:fs";
@@ -75,6 +76,42 @@ try {
   const lb = JSON.parse(fs.readFileSync(lstats, "utf8")).predicted_breakdown;
   check(lb.h200.latency_ms > 0 && Math.abs((await cell("latency_ms", "h200")) - lb.h200.latency_ms) < 0.001, `the h200's longest lanes: ${lb.h200.latency_ms} ms`);
   check(await cell("latency_ms", "gf6600") === 0, "no latency on gf6600, whose latencies are not modeled");
+
+  // A frame with beams: the tile map's squares, as the page drew them, against the image's own
+  // hits and depths (48x32 in 8x8 tiles: 6 across, 4 down, so a map drawn down its columns
+  // fails). A grey square's tile missed the grid: none of its pixels hits; any other square's
+  // rays start no farther than its nearest hit; the grey squares are the JSON's missed tiles.
+  const bhtml = path.join(work, "beams.html"), bstats = path.join(work, "beams.json");
+  execFileSync(vgpu, ["render", "bunny-low", "--size", "48x32", "--quiet", "--stats", "none", "--threads", "2",
+    "--bounces", "0", "--shadows", "off", "--beams", "on", "--report", bhtml, "--stats-json", bstats]);
+  await page.goto("file://" + path.resolve(bhtml));
+  await page.waitForFunction(() => document.body.dataset.ready === "1" || document.body.dataset.error, null, { timeout: 60000 });
+  check(errors.length === 0 && !(await page.evaluate(() => document.body.dataset.error)), `no script errors in the beams frame's report (${errors.join("; ")})`);
+  check(await page.isVisible("#beams"), "the tile map's section is shown for a frame with beams");
+  const tiles = await page.evaluate(async () => {
+    const c = document.getElementById("beam-map"), px = +c.dataset.tilePx, ctx = c.getContext("2d");
+    const hit = await unpack(D.hit, Float32Array), depth = await unpack(D.depth, Float32Array);
+    const start = await unpack(D.beam_map.start, Float32Array);
+    const out = [];
+    for (let ty = 0; ty < 4; ++ty)
+      for (let tx = 0; tx < 6; ++tx) {
+        const p = ctx.getImageData(tx * px + 1, ty * px + 1, 1, 1).data;
+        let hits = 0, nearest = Infinity;
+        for (let y = ty * 8; y < ty * 8 + 8; ++y)
+          for (let x = tx * 8; x < tx * 8 + 8; ++x)
+            if (hit[y * W + x] >= 0) { ++hits; nearest = Math.min(nearest, depth[y * W + x]); }
+        out.push({ tx, ty, grey: p[0] === 200 && p[1] === 200 && p[2] === 200, hits, nearest, start: start[ty * 6 + tx] });
+      }
+    return { dims: c.dataset.tiles, out };
+  });
+  check(tiles.dims === "6x4", `the map is 6x4 tiles (${tiles.dims})`);
+  const greys = tiles.out.filter(t => t.grey);
+  const bj = JSON.parse(fs.readFileSync(bstats, "utf8")).beams;
+  check(greys.length === bj.tiles_missed && greys.length > 0 && greys.length < 24, `${greys.length} grey tiles, ${bj.tiles_missed} missed`);
+  for (const t of tiles.out) {
+    if (t.grey) check(t.hits === 0, `grey tile ${t.tx},${t.ty} has no hit (${t.hits})`);
+    else check(t.start <= t.nearest, `tile ${t.tx},${t.ty}: rays start at ${t.start}, before the nearest hit ${t.nearest}`);
+  }
 } finally {
   await browser.close();
 }

@@ -51,12 +51,8 @@ double full_frame_ms(const CostBreakdown& b, double scale) {
          scale * (b.arithmetic_ms + b.texture_ms + b.memory_ms + b.download_ms);
 }
 
-}  // namespace
-
-AccelChoice choose_accel(const Scene& scene, const std::vector<AccelCandidate>& candidates,
-                         const RenderOptions& options, const Camera& camera) {
-  const auto t0 = std::chrono::steady_clock::now();
-  AccelChoice c;
+// The options of a probe frame: a quarter of the size in x and y (at least 16x16), quiet.
+RenderOptions probe_options(const RenderOptions& options) {
   RenderOptions probe = options;
   probe.width = std::min(options.width, std::max(16, options.width / 4));
   probe.height = std::min(options.height, std::max(16, options.height / 4));
@@ -65,10 +61,25 @@ AccelChoice choose_accel(const Scene& scene, const std::vector<AccelCandidate>& 
   probe.trace_pixel.reset();
   probe.trace_out = nullptr;
   probe.keep_pass_records = true;
+  return probe;
+}
+
+// The full frame's pixels over the probe's.
+double probe_scale(const RenderOptions& options, const RenderOptions& probe) {
+  return double(options.width) * double(options.height) /
+         (double(probe.width) * double(probe.height));
+}
+
+}  // namespace
+
+AccelChoice choose_accel(const Scene& scene, const std::vector<AccelCandidate>& candidates,
+                         const RenderOptions& options, const Camera& camera) {
+  const auto t0 = std::chrono::steady_clock::now();
+  AccelChoice c;
+  RenderOptions probe = probe_options(options);
   c.probe_width = probe.width;
   c.probe_height = probe.height;
-  const double scale =
-      double(options.width) * double(options.height) / (double(probe.width) * double(probe.height));
+  const double scale = probe_scale(options, probe);
   const vgpu::Profile& profile = vgpu::profile(options.profile);
   std::string refused;
   double best = 0;
@@ -118,6 +129,64 @@ AccelChoice choose_accel(const Scene& scene, const std::vector<AccelCandidate>& 
                 others.empty() ? "nothing else" : others.c_str(), probe.width, probe.height,
                 kept ? " (the grid is kept unless another is predicted 10% cheaper)" : "",
                 refused.empty() ? "" : "; refused: ", refused.c_str());
+  c.why = line;
+  c.probe_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  return c;
+}
+
+BeamsChoice choose_beams(const Scene& scene, const Accel& accel, const RenderOptions& options,
+                         const Camera& camera, std::string_view engine) {
+  const auto t0 = std::chrono::steady_clock::now();
+  BeamsChoice c;
+  const vgpu::Profile& profile = vgpu::profile(options.profile);
+  // Where --beams on would be refused, off, saying why (no probe runs).
+  RenderOptions with = options;
+  with.beams = true;
+  std::string refused;
+  // The GL device runs the emulator's passes and counts the same statistics, so its probes are
+  // priced alike; the CPU tracer has no passes for the cost model to price.
+  if (engine == "cpu")
+    refused = "the cost model prices passes, and the cpu engine runs none";
+  else if (accel.kind() != AccelKind::grid)
+    refused = "beams walk the uniform grid only, and this frame walks " + std::string(accel.name());
+  else
+    refused = with.refusal(profile);
+  if (!refused.empty()) {
+    c.why = "off: " + refused;
+    return c;
+  }
+  // The probes: the frame's primary trace at its full size, without and with beams. Smaller
+  // probes mislead here (glass and sphere were predicted cheaper with beams from 64x64 probes,
+  // and are dearer at 256x256): a multipass walk runs as many passes as its slowest ray,
+  // and which rays are slowest changes with the image's size and the tiles' footprint. Beams
+  // change the primary trace alone, so the rest of the frame is left out of both.
+  RenderOptions probe = probe_options(options);
+  probe.width = options.width;
+  probe.height = options.height;
+  probe.bounces = 0;
+  probe.shadows = false;
+  probe.spp = 1;
+  probe.adaptive = false;
+  probe.undersample = 0;
+  c.probed = true;
+  c.probe_width = probe.width;
+  c.probe_height = probe.height;
+  for (const bool on : {false, true}) {
+    probe.beams = on;
+    StreamTracer tracer(scene, accel, probe);
+    const RenderResult r = tracer.render(camera);
+    const CostBreakdown b = predict(r.stats, profile);
+    (on ? c.on_ms : c.off_ms) = b.total_ms;
+    c.probe_model_ms += b.total_ms;
+  }
+  c.on = c.on_ms < (1.0 - kAutoBeamsMargin) * c.off_ms;
+  char line[320];
+  std::snprintf(line, sizeof line,
+                "%s: primary rays %.1f ms with beams (%.2fx), %.1f ms without, predicted on %s "
+                "from %dx%d probes (on only where at least %.0f%% cheaper)",
+                c.on ? "on" : "off", c.on_ms, c.on_ms / c.off_ms, c.off_ms, profile.name.c_str(),
+                probe.width, probe.height, 100.0 * kAutoBeamsMargin);
   c.why = line;
   c.probe_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();

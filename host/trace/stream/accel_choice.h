@@ -12,6 +12,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "host/accel/accel.h"
@@ -60,5 +61,33 @@ struct AccelCandidate {
 };
 AccelChoice choose_accel(const Scene& scene, const std::vector<AccelCandidate>& candidates,
                          const RenderOptions& options, const Camera& camera);
+
+// --beams auto: beams are kept only where the primary trace with beams is predicted at least this
+// share cheaper than without. The probes price the primary trace exactly (they are it), so the
+// margin only keeps near ties off (stadium: 1.00x), where the beam passes and the texture they
+// need buy nothing, and leaves room for what the probes leave out (--spp's jittered frames).
+inline constexpr double kAutoBeamsMargin = 0.02;
+
+// --beams auto's choice, made once at initialization from two probe frames of the primary trace
+// alone (bounces 0, shadows off, one sample) at the frame's full size, beams off and on, priced
+// by the cost model on options.profile.
+struct BeamsChoice {
+  bool on = false;
+  bool probed = false;  // false: beams could not run here, so off without probes
+  int probe_width = 0, probe_height = 0;
+  double off_ms = 0, on_ms = 0;  // the primary trace's predicted time without and with beams
+  double probe_ms = 0;           // host wall time of the probes
+  // The probes' own modeled time (off_ms + on_ms): what deciding would cost where the probes ran
+  // on the card ahead of the frame.
+  double probe_model_ms = 0;
+  std::string why;  // one sentence
+};
+// `options` as the frame would run with beams off; `engine` the command line's (stream, cpu or
+// gl: the probes run on the frame's device; the GL device counts the emulator's statistics). Beams
+// off without probes wherever `--beams on` would be refused (another structure than the grid, or
+// RenderOptions::refusal with beams: non-fp32 ray state, dense streams) and on the cpu engine,
+// whose frame has no passes to price; `why` then says which.
+BeamsChoice choose_beams(const Scene& scene, const Accel& accel, const RenderOptions& options,
+                         const Camera& camera, std::string_view engine);
 
 }  // namespace host

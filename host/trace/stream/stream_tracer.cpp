@@ -356,6 +356,7 @@ RenderResult StreamTracer::render(const Camera& cam) {
   res.beam_passes = r.counts.beam_passes;
   res.beam_tiles = r.counts.beam_tiles;
   res.beam_tiles_missed = r.counts.beam_tiles_missed;
+  res.beam_map = std::move(r.counts.beam_map);
   if (s.streams) res.streams = s.streams->stats;
   if (s.dense) res.compact = s.dense->stats;
   res.render_ms = ms_since(t0);

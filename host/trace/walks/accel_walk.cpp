@@ -95,7 +95,7 @@ uint64_t ListWalk::static_bytes() const {
 }
 
 uint64_t ListWalk::texture_bytes() const {
-  return static_bytes() + state_bytes();
+  return static_bytes() + state_bytes() + extra_bytes();
 }
 
 uint64_t ListWalk::state_bytes() const {

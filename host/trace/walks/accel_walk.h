@@ -131,6 +131,9 @@ class ListWalk : public AccelWalk {
   void make_pairs(vgpu::Device& gpu, const WalkShared& shared, const std::string& trav_name,
                   const std::string& state_name);
   uint64_t state_bytes() const;  // both pairs
+  // A walk's textures other than its statics and both pairs (the grid's beam textures), counted
+  // by texture_bytes().
+  virtual uint64_t extra_bytes() const { return 0; }
   // Before a trace's entry pass: no hit yet, no list position.
   void clear(vgpu::Device& gpu);
   // The looping variant, after the entry pass: every ray the entry left walking is marked in

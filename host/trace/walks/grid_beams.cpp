@@ -111,6 +111,21 @@ void GridBeams::set_camera(const kernels::GenerateRays& camera, float offset_x, 
   }
 }
 
+BeamMap beam_map(const vgpu::Texture& beams, int tile) {
+  BeamMap m;
+  m.tiles_x = beams.width();
+  m.tiles_y = beams.height();
+  m.tile = tile;
+  for (int y = 0; y < m.tiles_y; ++y)
+    for (int x = 0; x < m.tiles_x; ++x) {
+      const float* b = beams.texel(x, y);
+      m.start.push_back(b[1]);
+      m.steps.push_back(b[3]);
+      m.missed.push_back(b[2] > 0.0f ? 1 : 0);
+    }
+  return m;
+}
+
 void GridBeams::enter(PassRunner& r, Texture& rays, glm::vec3 eye, Texture& traversal) {
   vgpu::Device& gpu = r.device();
   kernels::BeamUniforms& u = march_.kernel.beams;
@@ -135,6 +150,10 @@ void GridBeams::enter(PassRunner& r, Texture& rays, glm::vec3 eye, Texture& trav
   gpu.begin_query();
   r.pass(missed_, {&beams_.current()}, counter_);
   n.beam_tiles_missed += gpu.end_query();
+  // The report's tile map: the first primary trace's beams, read from the emulator's host memory
+  // (no download is issued, so the frame's statistics are those of a frame without a report).
+  if (n.beam_map.start.empty() && opt_.observer && dynamic_cast<vgpu::Gpu*>(&gpu))
+    n.beam_map = beam_map(beams_.current(), opt_.beam_tile);
   r.pass(entry_, {&rays, &beams_.current()}, traversal);
 }
 

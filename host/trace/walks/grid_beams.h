@@ -35,6 +35,10 @@ void set_beam_grid(kernels::BeamUniforms& u, const kernels::GridUniforms& g, int
 // BeamUniforms::far for a beam from `eye`: just past the grid box's farthest corner.
 float beam_far(const kernels::BeamUniforms& u, glm::vec3 eye);
 
+// The tile map of a beam texture after the march (kernels/beams.h's layout: y = t, z = missed,
+// w = steps), `tile` pixels per tile side.
+BeamMap beam_map(const vgpu::Texture& beams, int tile);
+
 class GridBeams {
  public:
   // Most beam passes a frame runs (a beam still marching then starts where it got to).

@@ -78,6 +78,10 @@ class GridWalk : public ListWalk {
   template <class X>
   void walk(X& x, Cursor& c);
 
+ protected:
+  // The beam texture pair and the beam passes' counting target (the beam distances are a static).
+  uint64_t extra_bytes() const override { return beams_ ? beams_->state_bytes() : 0; }
+
  private:
   glm::ivec3 res_;
   int max_list_ = 0;  // longest voxel list: a ray tests at most this many triangles per voxel
