@@ -163,8 +163,10 @@ RenderPlan parse_render(const RenderArgs& a, bool lanes_given) {
                        " needs --engine stream (the cpu engine is a double-precision reference "
                        "without passes, lanes or masks)");
   }
-  if (opt.beams && a.accel != "grid")
-    throw UsageError("--beams on: beams are walked through the uniform grid only (--accel grid)");
+  if (opt.beams && a.accel != "grid" && a.accel != "bvh")
+    throw UsageError(
+        "--beams on: beams are walked through the uniform grid and the BVH only (--accel grid "
+        "or bvh)");
   if (opt.beams && (a.precision != "fp32" || !a.formats.empty()))
     throw UsageError(
         "--beams on needs fp32 ray state (no --precision or --formats): the beam "
