@@ -27,6 +27,9 @@ namespace kernels {
 struct BvhUniforms : ListUniforms {
   float node_width = 1;  // width of the two node textures, texels
   float nodes = 1;       // node count: a node index at or past it ends the walk
+  // Whether traversal z may carry an earlier end (beams over tiles): off, the programs test the
+  // node count alone, instruction for instruction as before beams.
+  bool ends = false;
 };
 
 // Whether the ray o + t d, 0 <= t <= tfar, meets the box [lo, hi] (the slab test,
@@ -52,14 +55,14 @@ inline Vec4<typename L::F> bvh_step(const Fragments<L>& f, int unit_lo, int unit
   const auto meets = ray_meets_box(o, d, lo.xyz(), hi.xyz(), tfar);
   const auto leaf = hi.w >= F(0.0f);
   // Past the last node of the walk (the tree's, or the beam's subtree's): the walk is done.
-  const F end = select(trav.z > F(0.0f), trav.z, F(bvh.nodes));
+  const F end = bvh.ends ? select(trav.z > F(0.0f), trav.z, F(bvh.nodes)) : F(bvh.nodes);
   const auto over = trav.x >= end;
   const F next = select(meets && !leaf, trav.x + F(1.0f), lo.w);
   const F entered = select(meets && leaf, hi.w, F(kNone));
   // An escape of -1 (after the last node) becomes the node count: the leaf entered now is still
   // tested, and the next step ends the walk.
   const F next_or_end = select(next < F(0.0f), F(bvh.nodes), next);
-  const Vec4<F> stepped{next_or_end, entered, trav.z, F(0.0f)};
+  const Vec4<F> stepped{next_or_end, entered, bvh.ends ? trav.z : F(0.0f), F(0.0f)};
   const Vec4<F> done{F(kNone), F(kNone), F(0.0f), F(0.0f)};
   return select(walking, select(over, done, stepped), trav);
 }
@@ -212,7 +215,7 @@ struct BvhLooping {
       const F first = list_entry(f, kLists, stepped.y, bvh);
       vs = select(testing, Vec4<F>{pos, F(0.0f), F(0.0f), tri},
                   select(load, Vec4<F>{stepped.y, F(0.0f), F(0.0f), first}, vs));
-      trav = select(stepping, Vec4<F>{stepped.x, F(kNone), trav.z, F(0.0f)}, trav);
+      trav = select(stepping, Vec4<F>{stepped.x, F(kNone), stepped.z, F(0.0f)}, trav);
       return (trav.x >= F(0.0f)) || (vs.w >= F(0.0f));
     });
     f.out(0) = trav;

@@ -144,10 +144,19 @@ TEST_CASE("bvh step ends a walk at the end its traversal carries, else at the no
   const Texture isect = texels("intersection", 4, 1, {none, none, none, none});
   kernels::BvhStep k;
   k.bvh = bvh_uniforms();
+  k.bvh.ends = true;
   const Texture out =
       ktest::run(k, {&origins, &rays, &trav, &isect, &tree.lo, &tree.hi}, 4, 1, glm::vec4(7));
   CHECK_TEXEL(out, 0, 0, glm::vec4(4, 6, 4, 0));
   CHECK_TEXEL(out, 1, 0, glm::vec4(kNone, kNone, 0, 0));
   CHECK_TEXEL(out, 2, 0, glm::vec4(5, 3, 0, 0));
   CHECK_TEXEL(out, 3, 0, glm::vec4(2, kNone, 5, 0));
+  // Without beams (ends off) z is not read: the walk ends at the node count alone, z cleared.
+  k.bvh.ends = false;
+  const Texture plain =
+      ktest::run(k, {&origins, &rays, &trav, &isect, &tree.lo, &tree.hi}, 4, 1, glm::vec4(7));
+  CHECK_TEXEL(plain, 0, 0, glm::vec4(4, 6, 0, 0));
+  CHECK_TEXEL(plain, 1, 0, glm::vec4(5, 3, 0, 0));
+  CHECK_TEXEL(plain, 2, 0, glm::vec4(5, 3, 0, 0));
+  CHECK_TEXEL(plain, 3, 0, glm::vec4(2, kNone, 0, 0));
 }

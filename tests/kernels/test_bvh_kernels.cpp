@@ -63,9 +63,8 @@ struct StepCase {
 
 const glm::vec4 kO(0.5f, 0.5f, 0.5f, 0);
 const std::vector<StepCase> kStepCases = {
-    // 0: the root is met: an inner node sends the ray to node + 1 (its y and w are cleared, its
-    // z, the walk's end, kept)
-    {kO, kPx, {0, 1, 9, 9}, kNoHit, {1, kNone, 9, 0}},
+    // 0: the root is met: an inner node sends the ray to node + 1 (its y is cleared)
+    {kO, kPx, {0, 1, 9, 9}, kNoHit, {1, kNone, 0, 0}},
     // 1: L met: on to its left child, node 2
     {kO, kPx, {1, kNone, 0, 0}, kNoHit, {2, kNone, 0, 0}},
     // 2: leaf A met: on to its escape (3), y = A's list start

@@ -56,6 +56,7 @@ uint64_t BvhWalk::set_bvh(vgpu::Device& gpu, const Bvh& bvh, float scene_width,
   u.node_width = float(nw);
   u.nodes = float(nodes_);
   u.list_width = float(lw);
+  u.ends = beams_ != nullptr;  // beams over tiles end a ray's walk at its tile node's escape
   const SceneUniforms su{scene_width};
   step_.kernel.bvh = u;
   load_.kernel.bvh = u;
