@@ -9,7 +9,10 @@
 //   interseccionesBVH (ext.)   one triangle per pass, nearest kept   (intersecciones' place)
 // with proximoTriangulo, rayosIntersectando and rayosEnGrilla as the grid has them. Traversal
 // state (kernels/layout.h): x = next node to visit (nodes count: past the last one, the walk is
-// over at the next step; -1: done), y = list position of a leaf just entered (-1: none).
+// over at the next step; -1: done), y = list position of a leaf just entered (-1: none),
+// z = where the walk ends: 0 for the node count (the whole tree), else the escape of the node a
+// beam over tiles started the ray at (kernels/bvh_beams.h): in the depth-first layout a node's
+// subtree is the index range [node, escape), so the walk covers exactly that subtree.
 // A hit does not end the walk early (the order is fixed, not front to back), but a box farther
 // than the nearest hit so far is missed.
 #pragma once
@@ -24,6 +27,9 @@ namespace kernels {
 struct BvhUniforms : ListUniforms {
   float node_width = 1;  // width of the two node textures, texels
   float nodes = 1;       // node count: a node index at or past it ends the walk
+  // Whether traversal z may carry an earlier end (beams over tiles): off, the programs test the
+  // node count alone, instruction for instruction as before beams.
+  bool ends = false;
 };
 
 // Whether the ray o + t d, 0 <= t <= tfar, meets the box [lo, hi] (the slab test,
@@ -48,13 +54,15 @@ inline Vec4<typename L::F> bvh_step(const Fragments<L>& f, int unit_lo, int unit
   const Vec4<F> hi = fetch_id(f, unit_hi, trav.x, bvh.node_width);
   const auto meets = ray_meets_box(o, d, lo.xyz(), hi.xyz(), tfar);
   const auto leaf = hi.w >= F(0.0f);
-  const auto over = trav.x >= F(bvh.nodes);  // past the last node: the walk is done
+  // Past the last node of the walk (the tree's, or the beam's subtree's): the walk is done.
+  const F end = bvh.ends ? select(trav.z > F(0.0f), trav.z, F(bvh.nodes)) : F(bvh.nodes);
+  const auto over = trav.x >= end;
   const F next = select(meets && !leaf, trav.x + F(1.0f), lo.w);
   const F entered = select(meets && leaf, hi.w, F(kNone));
   // An escape of -1 (after the last node) becomes the node count: the leaf entered now is still
   // tested, and the next step ends the walk.
   const F next_or_end = select(next < F(0.0f), F(bvh.nodes), next);
-  const Vec4<F> stepped{next_or_end, entered, F(0.0f), F(0.0f)};
+  const Vec4<F> stepped{next_or_end, entered, bvh.ends ? trav.z : F(0.0f), F(0.0f)};
   const Vec4<F> done{F(kNone), F(kNone), F(0.0f), F(0.0f)};
   return select(walking, select(over, done, stepped), trav);
 }
@@ -207,7 +215,7 @@ struct BvhLooping {
       const F first = list_entry(f, kLists, stepped.y, bvh);
       vs = select(testing, Vec4<F>{pos, F(0.0f), F(0.0f), tri},
                   select(load, Vec4<F>{stepped.y, F(0.0f), F(0.0f), first}, vs));
-      trav = select(stepping, Vec4<F>{stepped.x, F(kNone), F(0.0f), F(0.0f)}, trav);
+      trav = select(stepping, Vec4<F>{stepped.x, F(kNone), stepped.z, F(0.0f)}, trav);
       return (trav.x >= F(0.0f)) || (vs.w >= F(0.0f));
     });
     f.out(0) = trav;

@@ -7,6 +7,7 @@
 #include "kernels/accumulate_samples.h"
 #include "kernels/beams.h"
 #include "kernels/bvh.h"
+#include "kernels/bvh_beams.h"
 #include "kernels/compact_marks.h"
 #include "kernels/compact_stream.h"
 #include "kernels/copy_rows.h"
@@ -103,3 +104,6 @@ extern template class vgpu::KernelProgram<kernels::ShadowGlass>;
 extern template class vgpu::KernelProgram<kernels::BeamMarch>;
 extern template class vgpu::KernelProgram<kernels::BeamEntry>;
 extern template class vgpu::KernelProgram<kernels::BeamsMissed>;
+extern template class vgpu::KernelProgram<kernels::BvhBeamDescend>;
+extern template class vgpu::KernelProgram<kernels::BvhBeamEnter>;
+extern template class vgpu::KernelProgram<kernels::BvhBeamsDescending>;

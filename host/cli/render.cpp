@@ -164,8 +164,10 @@ RenderPlan parse_render(const RenderArgs& a, bool lanes_given) {
                        " needs --engine stream (the cpu engine is a double-precision reference "
                        "without passes, lanes or masks)");
   }
-  if (opt.beams && a.accel != "grid")
-    throw UsageError("--beams on: beams are walked through the uniform grid only (--accel grid)");
+  if (opt.beams && a.accel != "grid" && a.accel != "bvh")
+    throw UsageError(
+        "--beams on: beams are walked through the uniform grid and the BVH only (--accel grid "
+        "or bvh)");
   if (opt.beams && (a.precision != "fp32" || !a.formats.empty()))
     throw UsageError(
         "--beams on needs fp32 ray state (no --precision or --formats): the beam "
@@ -307,7 +309,7 @@ void print_table(const RenderArgs& a, const RenderPlan& plan, const host::Scene&
               r.iterations, a.shading.c_str(), a.shadows.c_str(), a.masks.c_str(), a.mrt.c_str());
   if (!cpu) std::cout << "formats (texture and arithmetic, per group):\n" << describe(opt.formats);
   if (opt.beams)
-    std::printf("beams %dx%d: %llu tiles, %llu beam passes, %llu tiles missed the grid\n",
+    std::printf("beams %dx%d: %llu tiles, %llu beam passes, %llu tiles missed the scene\n",
                 opt.beam_tile, opt.beam_tile, static_cast<unsigned long long>(r.beam_tiles),
                 static_cast<unsigned long long>(r.beam_passes),
                 static_cast<unsigned long long>(r.beam_tiles_missed));

@@ -96,8 +96,9 @@ struct RenderOptions {
   // Beams over tiles (an extension, issue 35; docs/groups.md): before the primary rays walk the
   // grid, passes of one fragment per beam_tile x beam_tile tile march each tile's beam through
   // empty space, and every pixel's ray starts where its tile's beam stopped. The same hits,
-  // depths and images as without (only where each walk begins changes). The uniform grid only,
-  // fp32 ray state, the emulator (refusal() says so).
+  // depths and images as without (only where each walk begins changes). Through the BVH, each
+  // tile's beam descends to the first node it cannot narrow down and its rays start there. The
+  // uniform grid and the BVH, fp32 ray state (refusal() says so); every engine.
   bool beams = false;
   int beam_tile = 8;
   // Supersampling (host/trace/sampling.h): rays per pixel, a square from 1 to 256, on a

@@ -593,7 +593,7 @@ TEST_CASE("the object criterion's passes are counted and priced, and the statist
 }
 
 TEST_CASE("beams are refused where they cannot apply, one line and exit 2") {
-  check_refused("--beams on --accel bvh", "--beams on", "uniform grid only");
+  check_refused("--beams on --accel kdtree", "--beams on", "the uniform grid and the BVH only");
   check_refused("--beams on --precision fp16", "--beams on", "needs fp32 ray state");
   check_refused("--beam-tile 4", "--beam-tile", "needs --beams on");
   check_refused("--beams maybe", "--beams", "maybe not in {off,on,auto}");

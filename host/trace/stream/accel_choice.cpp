@@ -149,7 +149,10 @@ BeamsChoice choose_beams(const Scene& scene, const Accel& accel, const RenderOpt
   if (engine == "cpu")
     refused = "the cost model prices passes, and the cpu engine runs none";
   else if (accel.kind() != AccelKind::grid)
-    refused = "beams walk the uniform grid only, and this frame walks " + std::string(accel.name());
+    refused =
+        "auto probes beams on the uniform grid only (through the BVH they cost more on every "
+        "scene measured: docs/groups.md), and this frame walks " +
+        std::string(accel.name());
   else
     refused = with.refusal(profile);
   if (!refused.empty()) {

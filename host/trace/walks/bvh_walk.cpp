@@ -17,6 +17,7 @@ using vgpu::Texture;
 BvhWalk::BvhWalk(vgpu::Device& gpu, const Bvh& bvh, const RenderOptions& options, float scene_width)
     : ListWalk(options, {&nodes_lo_, &nodes_hi_, &lists_}) {
   compute_in_groups(enter_, step_, step_load_, load_, intersect_, intersect_next_, looping_);
+  if (options.beams) beams_ = std::make_unique<BvhBeams>(options);
   set_bvh(gpu, bvh, scene_width, nullptr);
 }
 
@@ -55,6 +56,7 @@ uint64_t BvhWalk::set_bvh(vgpu::Device& gpu, const Bvh& bvh, float scene_width,
   u.node_width = float(nw);
   u.nodes = float(nodes_);
   u.list_width = float(lw);
+  u.ends = beams_ != nullptr;  // beams over tiles end a ray's walk at its tile node's escape
   const SceneUniforms su{scene_width};
   step_.kernel.bvh = u;
   load_.kernel.bvh = u;
@@ -66,6 +68,7 @@ uint64_t BvhWalk::set_bvh(vgpu::Device& gpu, const Bvh& bvh, float scene_width,
   looping_.kernel.bvh = u;
   looping_.kernel.scene = su;
   looping_.kernel.steps = opt_.steps_per_pass;
+  if (beams_) beams_->set_bvh(bvh, u);
   return bytes;
 }
 
@@ -76,12 +79,17 @@ uint64_t BvhWalk::rebuild(vgpu::Device& gpu, const Accel& accel, float scene_wid
 
 void BvhWalk::make_state(vgpu::Device& gpu, const WalkShared& shared) {
   make_pairs(gpu, shared, "bvh traversal", "leaf state");
+  if (beams_) beams_->make_state(gpu);
 }
 
-void BvhWalk::trace(PassRunner& r, Texture& origins, Texture& rays, bool, glm::vec3) {
+void BvhWalk::trace(PassRunner& r, Texture& origins, Texture& rays, bool primary, glm::vec3 eye) {
   clear(r.device());
-  // Every ray starts at the root (primary and secondary alike: the walk needs no entry point).
-  r.pass(enter_, {&rays}, trav_.next());
+  // Every ray starts at the root (secondary rays, and primary rays without beams); with beams
+  // over tiles, a primary ray starts at the node its tile's beam descended to.
+  if (primary && beams_)
+    beams_->enter(r, rays, eye, nodes_lo_, nodes_hi_, trav_.next());
+  else
+    r.pass(enter_, {&rays}, trav_.next());
   trav_.swap();
   if (opt_.looping) {
     // A ray iterates once per node and once per triangle of each leaf it enters, plus once to

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -11,6 +12,7 @@
 #include "host/trace/passes.h"
 #include "host/trace/render_options.h"
 #include "host/trace/walks/accel_walk.h"
+#include "host/trace/walks/bvh_beams.h"
 #include "kernels/kernels.h"
 #include "vgpu/vgpu.h"
 
@@ -46,6 +48,12 @@ class BvhWalk : public ListWalk {
                    std::vector<std::string>& uploaded) override;
   void trace(PassRunner& r, vgpu::Texture& origins, vgpu::Texture& rays, bool primary,
              glm::vec3 eye) override;
+  void set_camera(const kernels::GenerateRays& camera, float offset_x, float offset_y) override {
+    if (beams_) beams_->set_camera(camera, offset_x, offset_y);
+  }
+  // Beams over tiles (RenderOptions::beams; null: off).
+  const BvhBeams* beams() const { return beams_.get(); }
+  uint64_t extra_bytes() const override { return beams_ ? beams_->state_bytes() : 0; }
 
   // The multipass walk (host/trace/walks/walk.h); Cursor and write_back are ListWalk's.
   template <class X>
@@ -61,6 +69,7 @@ class BvhWalk : public ListWalk {
   vgpu::KernelProgram<kernels::BvhStepLoad> step_load_;
   vgpu::KernelProgram<kernels::BvhIntersectNext> intersect_next_;
   vgpu::KernelProgram<kernels::BvhLooping> looping_;
+  std::unique_ptr<BvhBeams> beams_;
 };
 
 }  // namespace host

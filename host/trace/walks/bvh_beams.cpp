@@ -1,0 +1,85 @@
+// Beams over tiles through the BVH (host/trace/walks/bvh_beams.h): the descent's passes and the
+// beam entry.
+#include "host/trace/walks/bvh_beams.h"
+
+#include <algorithm>
+#include <vector>
+
+#include "host/trace/walks/grid_beams.h"
+
+namespace host {
+
+using vgpu::Texture;
+
+void BvhBeams::set_bvh(const Bvh& bvh, const kernels::BvhUniforms& u) {
+  descend_.kernel.u.bvh = u;
+  entry_.kernel.tile = float(opt_.beam_tile);
+  descend_.kernel.u.beams.tile = float(opt_.beam_tile);
+  // The levels of the tree: a node's children lie one level below it (the right child is where
+  // the left child's subtree ends). Parents come before their children in the layout.
+  std::vector<int> level(bvh.nodes.size(), 1);
+  depth_ = 1;
+  for (size_t i = 0; i < bvh.nodes.size(); ++i) {
+    depth_ = std::max(depth_, level[i]);
+    const int32_t escape = bvh.nodes[i].escape;
+    if (bvh.nodes[i].count > 0 || i + 1 >= bvh.nodes.size() || size_t(escape) == i + 1) continue;
+    level[i + 1] = level[i] + 1;
+    const int32_t right = bvh.nodes[i + 1].escape;
+    if (right > 0 && size_t(right) < bvh.nodes.size()) level[size_t(right)] = level[i] + 1;
+  }
+  // The frustum test's margin: far above the rounding of the pixels' rays and of the plane
+  // test over the scene's extent, far below any gap worth skipping.
+  const glm::vec3 extent = bvh.nodes.empty() ? glm::vec3(1.0f) : bvh.nodes[0].hi - bvh.nodes[0].lo;
+  descend_.kernel.u.beams.margin = 1e-4f * std::max(1.0f, glm::length(extent));
+}
+
+int BvhBeams::tiles_x() const {
+  return (opt_.width + opt_.beam_tile - 1) / opt_.beam_tile;
+}
+int BvhBeams::tiles_y() const {
+  return (opt_.height + opt_.beam_tile - 1) / opt_.beam_tile;
+}
+
+void BvhBeams::make_state(vgpu::Device& gpu) {
+  beams_ = {gpu.make_texture("bvh beams A", tiles_x(), tiles_y(), 4),
+            gpu.make_texture("bvh beams B", tiles_x(), tiles_y(), 4)};
+  counter_ = gpu.make_texture("bvh beam counter", tiles_x(), tiles_y(), 1);
+}
+
+uint64_t BvhBeams::state_bytes() const {
+  return beams_[0].bytes() + beams_[1].bytes() + counter_.bytes();
+}
+
+void BvhBeams::set_camera(const kernels::GenerateRays& camera, float offset_x, float offset_y) {
+  kernels::BeamUniforms& u = descend_.kernel.u.beams;
+  u.camera = camera;
+  u.offset_x = offset_x;
+  u.offset_y = offset_y;
+}
+
+void BvhBeams::enter(PassRunner& r, Texture& rays, glm::vec3 eye, Texture& nodes_lo,
+                     Texture& nodes_hi, Texture& traversal) {
+  vgpu::Device& gpu = r.device();
+  descend_.kernel.u.beams.eye = eye;
+  // Every beam starts at the root, descending (y = 0).
+  beams_.make_current(0);
+  gpu.clear(beams_.current(), {0, 0, 0, 0});
+  WalkCounts& n = r.counts;
+  n.beam_tiles += uint64_t(tiles_x()) * uint64_t(tiles_y());
+  uint64_t descending = 1;
+  // A beam moves down one level per pass and stops at a leaf at the latest.
+  for (int pass = 0; pass < depth_ && descending > 0; ++pass) {
+    r.pass(descend_, {&beams_.current(), &nodes_lo, &nodes_hi}, beams_.next());
+    beams_.swap();
+    ++n.beam_passes;
+    gpu.begin_query();
+    r.pass(descending_, {&beams_.current()}, counter_);
+    descending = gpu.end_query();
+  }
+  gpu.begin_query();
+  r.pass(missed_, {&beams_.current()}, counter_);
+  n.beam_tiles_missed += gpu.end_query();
+  r.pass(entry_, {&rays, &beams_.current()}, traversal);
+}
+
+}  // namespace host

@@ -1,0 +1,51 @@
+// Beams over tiles for the BVH's primary rays (an extension, issue 35; docs/groups.md): the beam
+// texture (one texel per tile), the passes that descend each tile's beam from the root to the
+// first node it cannot narrow down (rayosHazBVH, with an occlusion query per pass), and the pass
+// that starts each pixel's ray at its tile's node, its walk ending at that node's escape
+// (inicioHazBVH). The BVH walk (bvh_walk.cpp) runs them in place of inicioBVH.
+#pragma once
+
+#include <cstdint>
+
+#include "host/accel/bvh.h"
+#include "host/trace/passes.h"
+#include "host/trace/ping_pong.h"
+#include "host/trace/render_options.h"
+#include "kernels/kernels.h"
+#include "vgpu/vgpu.h"
+
+namespace host {
+
+class BvhBeams {
+ public:
+  explicit BvhBeams(const RenderOptions& options) : opt_(options) {}
+  // The hierarchy's uniforms (its node texture's width, its node count) and the frustum test's
+  // margin, from the size of the root's box.
+  void set_bvh(const Bvh& bvh, const kernels::BvhUniforms& u);
+  // The beam texture pair and the descent's counting target, one texel per tile.
+  void make_state(vgpu::Device& gpu);
+  // The primary rays' camera and the sample's offset from the pixel centre (pixels).
+  void set_camera(const kernels::GenerateRays& camera, float offset_x, float offset_y);
+  // The descent passes (at most one per level of the tree), then inicioHazBVH: the primary rays'
+  // traversal state into `traversal`.
+  void enter(PassRunner& r, vgpu::Texture& rays, glm::vec3 eye, vgpu::Texture& nodes_lo,
+             vgpu::Texture& nodes_hi, vgpu::Texture& traversal);
+
+  uint64_t state_bytes() const;
+  int tiles_x() const;
+  int tiles_y() const;
+  // The beam texture after the last frame's descent (per tile: node, end, missed, depth).
+  const vgpu::Texture& beams() const { return beams_.current(); }
+
+ private:
+  const RenderOptions& opt_;
+  int depth_ = 1;  // levels of the tree: the most passes a descent needs
+  PingPong<vgpu::Texture> beams_;
+  vgpu::Texture counter_;
+  vgpu::KernelProgram<kernels::BvhBeamDescend> descend_;
+  vgpu::KernelProgram<kernels::BvhBeamEnter> entry_;
+  vgpu::KernelProgram<kernels::BvhBeamsDescending> descending_;
+  vgpu::KernelProgram<kernels::BeamsMissed> missed_;
+};
+
+}  // namespace host
