@@ -34,6 +34,7 @@ struct Mode {
   // Dense streams (RenderOptions::compact); false: the gated frames over the whole target, as
   // before issue 35 (the same image, the old cost).
   bool compact = true;
+  bool budget = false;  // --aa-criterion budget (kernels/cone_budget.h), its default shares
 };
 
 // The modes docs/sampling.md charts; the first is the one-ray image the others are compared with.
@@ -54,15 +55,18 @@ std::vector<Mode> modes() {
                          {"object 16, T 0.3", 16, true, 0.3f, 0, true},
                          {"object 16, T 0.1, cones 1", 16, true, 0.1f, 0, true, 1.0f},
                          {"object 16, T 0.1, cones 4", 16, true, 0.1f, 0, true, 4.0f},
+                         // --aa-criterion budget, its defaults (T 0.05, 30% then 28% of
+                         // the pixels that hit; the 4x4 level keeps the 2x2 samples).
+                         {"budget 16", 16, true, 0.05f, 0, false, 2.0f, true, true},
                          {"undersample 2", 1, false, 0.1f, 2},
                          {"undersample 2, T 0.05", 1, false, 0.05f, 2},
                          {"undersample 2, T 0.02", 1, false, 0.02f, 2},
                          {"undersample 4", 1, false, 0.1f, 4}};
   // Each adaptive and undersampling mode again as gated frames over the whole target (the
-  // object criterion's modes only dense: their section compares rays, not time).
+  // object and budget criteria's modes only dense: their section compares rays, not time).
   const size_t n = m.size();
   for (size_t i = 0; i < n; ++i)
-    if ((m[i].adaptive || m[i].undersample > 0) && !m[i].object) {
+    if ((m[i].adaptive || m[i].undersample > 0) && !m[i].object && !m[i].budget) {
       Mode g = m[i];
       g.label += ", gated";
       g.compact = false;
@@ -222,6 +226,7 @@ int main(int argc, char** argv) {
       opt.aa_threshold = m.threshold;
       opt.undersample = m.undersample;
       if (m.object) opt.aa_criterion = host::RenderOptions::AaCriterion::object;
+      if (m.budget) opt.aa_criterion = host::RenderOptions::AaCriterion::budget;
       opt.cone_depth = m.cone_depth;
       opt.compact = m.compact;
       host::StreamTracer tracer(scene, grid, opt);

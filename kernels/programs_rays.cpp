@@ -1,9 +1,11 @@
 // The compiled programs of the ray kernels: generadorRayos, rayosSombra, inicioReflejo,
 // direccionReflejo, shader, rayosReflejados, and supersampling's generadorRayosMuestra,
 // acumularMuestras, resolverMuestras, and adaptive sampling's guardarImpactos,
-// marcarPixeles, pixelesMarcados, guardarConos, guardarReflejos, marcarConos, and undersampling's
-// marcarReticula, marcarHuecos, rellenarHuecos (kernels/kernels.h declares them; every lane family
-// of each is compiled here, once).
+// marcarPixeles, pixelesMarcados, guardarConos, guardarReflejos, marcarConos, puntuarConos,
+// pixelesPuntuados, cortarPuntajes, and undersampling's marcarReticula, marcarHuecos,
+// rellenarHuecos (kernels/kernels.h declares them; every lane family of each is compiled here,
+// once).
+#include "kernels/cone_budget.h"
 #include "kernels/cones.h"
 #include "kernels/kernels.h"
 
@@ -22,6 +24,9 @@ template class vgpu::KernelProgram<kernels::MarkedPixels>;
 template class vgpu::KernelProgram<kernels::KeepCones>;
 template class vgpu::KernelProgram<kernels::KeepReflected>;
 template class vgpu::KernelProgram<kernels::MarkCones>;
+template class vgpu::KernelProgram<kernels::ScoreCones>;
+template class vgpu::KernelProgram<kernels::ScoredHits>;
+template class vgpu::KernelProgram<kernels::CutScores>;
 template class vgpu::KernelProgram<kernels::MarkLattice>;
 template class vgpu::KernelProgram<kernels::MarkGaps>;
 template class vgpu::KernelProgram<kernels::FillGaps>;

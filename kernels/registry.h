@@ -10,6 +10,7 @@
 #include <memory>
 #include <vector>
 
+#include "kernels/cone_budget.h"
 #include "kernels/cones.h"
 #include "kernels/kernels.h"
 #include "vgpu/program.h"
@@ -32,6 +33,8 @@ using MultipassKernels = KernelList<
     KeepHits, MarkPixels, MarkedPixels,
     // Its object-space decision (--aa-criterion object): the cones' keys and depths, their marks.
     KeepCones, KeepReflected, MarkCones,
+    // Its budget (--aa-criterion budget): the cones' scores, the count above a value, the cut.
+    ScoreCones, ScoredHits, CutScores,
     // Adaptive undersampling (--aa undersample:K): the lattice, the gaps to trace, the fill.
     MarkLattice, MarkGaps, FillGaps,
     // The fused programs of --mrt on (kernels/fused.h), two outputs each.

@@ -372,21 +372,33 @@ void add_sampling_options(CLI::App& render, RenderArgs& a) {
                   "With --aa adaptive: the colour's second difference (linear, per channel, "
                   "along x or y) that marks a pixel for more samples; with --aa undersample: the "
                   "colour difference between lattice pixels that has the pixels between traced "
-                  "(and twice the largest second difference the blend corrects)")
-      ->check(kThresholdCheck)
-      ->capture_default_str();
+                  "(and twice the largest second difference the blend corrects); with "
+                  "--aa-criterion budget: the least score that can refine. Default 0.1, with "
+                  "--aa-criterion budget 0.05")
+      ->check(kThresholdCheck);
   render
       .add_option("--aa-criterion", a.aa_criterion,
                   "With --aa adaptive: what marks a pixel for more samples: image (a neighbour "
                   "hit another surface, or the colour's second difference exceeds "
                   "--aa-threshold) or object (the same, and where the pixel's cone is crossed by "
                   "a fold: the hit distances' second difference exceeds --aa-cone-depth cone "
-                  "widths; docs/sampling.md)")
-      ->check(CLI::IsMember({"image", "object"}))
+                  "widths) or budget (the object criterion's edges as a score, the colour step "
+                  "across them; each level refines the highest scores above --aa-threshold, as "
+                  "many pixels that hit as --aa-budget allows, and the 4x4 level keeps the 2x2 "
+                  "samples; docs/sampling.md). Default budget")
+      ->check(CLI::IsMember({"image", "object", "budget"}));
+  render
+      .add_option("--aa-budget", a.aa_budget,
+                  "With --aa-criterion budget: per level, the percentage of the image's pixels "
+                  "that hit that the level may refine (pixels that miss cost nothing); the last "
+                  "repeats for deeper levels, e.g. 30,28")
+      ->delimiter(',')
+      ->check(CLI::Range(0.0f, 100.0f))
       ->capture_default_str();
   render
       .add_option("--aa-cone-depth", a.aa_cone_depth,
-                  "With --aa-criterion object: the hit distances' second difference along x or y, "
+                  "With --aa-criterion object or budget: the hit distances' second difference "
+                  "along x or y, "
                   "in widths of the pixel's cone at its hit, that marks a pixel")
       ->check(CLI::Range(0.0f, 1000.0f))
       ->capture_default_str();

@@ -51,9 +51,10 @@ struct RenderArgs {
   int steps_per_pass = 32;
   int spp = 1;
   std::string aa = "none";
-  float aa_threshold = 0.1f;
-  std::string aa_criterion = "image";  // --aa-criterion image|object
-  float aa_cone_depth = 2.0f;          // --aa-cone-depth
+  std::optional<float> aa_threshold;        // --aa-threshold; 0.1, with the budget criterion 0.05
+  std::optional<std::string> aa_criterion;  // --aa-criterion image|object|budget (budget)
+  std::vector<float> aa_budget{30.0f, 28.0f};  // --aa-budget, percent per level
+  float aa_cone_depth = 2.0f;                  // --aa-cone-depth
   bool steps_given = false;
   bool walk_given = false;
   std::string time;       // --time T

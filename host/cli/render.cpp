@@ -116,9 +116,18 @@ RenderPlan parse_render(const RenderArgs& a, bool lanes_given) {
   opt.spp = a.spp;
   opt.adaptive = a.aa == "adaptive";
   opt.undersample = a.aa == "adaptive" || a.aa == "none" ? 0 : *parse_aa(a.aa);
+  // --aa-criterion: budget unless given; only adaptive sampling reads it.
+  const std::string criterion = a.aa_criterion.value_or("budget");
+  if (a.aa_criterion && criterion != "image" && !opt.adaptive)
+    throw UsageError("--aa-criterion " + criterion +
+                     " decides where adaptive sampling refines: add --aa adaptive");
+  opt.aa_criterion = criterion == "object"   ? host::RenderOptions::AaCriterion::object
+                     : criterion == "budget" ? host::RenderOptions::AaCriterion::budget
+                                             : host::RenderOptions::AaCriterion::image;
+  // Unset: 0.1, or the budget's floor 0.05 (RenderOptions::threshold).
   opt.aa_threshold = a.aa_threshold;
-  opt.aa_criterion = a.aa_criterion == "object" ? host::RenderOptions::AaCriterion::object
-                                                : host::RenderOptions::AaCriterion::image;
+  opt.aa_budget.clear();
+  for (const float b : a.aa_budget) opt.aa_budget.push_back(b / 100.0f);
   opt.cone_depth = a.aa_cone_depth;
   opt.profile = vgpu::profile(a.profile).name;
   opt.threads = a.threads;
@@ -313,6 +322,15 @@ void print_table(const RenderArgs& a, const RenderPlan& plan, const host::Scene&
                 opt.beam_tile, opt.beam_tile, static_cast<unsigned long long>(r.beam_tiles),
                 static_cast<unsigned long long>(r.beam_passes),
                 static_cast<unsigned long long>(r.beam_tiles_missed));
+  // --aa-criterion budget: each level's threshold and budget (kernels/cone_budget.h).
+  for (size_t l = 0; l < r.budget_levels.size(); ++l) {
+    const auto& b = r.budget_levels[l];
+    std::printf(
+        "aa budget level %zu: at most %llu pixels that hit, threshold %.6g (%llu counting "
+        "passes)\n",
+        l + 1, static_cast<unsigned long long>(b.budget), double(b.threshold),
+        static_cast<unsigned long long>(b.steps));
+  }
   if (r.streams.on) std::cout << host::describe(r.streams);
   if (r.compact.on) std::cout << host::describe(r.compact);
   std::printf("initialization %.1f ms (grid %.1f ms), render %.1f ms (%s)\n", init_ms,

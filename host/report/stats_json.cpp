@@ -7,6 +7,7 @@
 #include "host/report/stats_json.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 
@@ -149,11 +150,23 @@ nlohmann::ordered_json frame_stats_json(const FrameStatsInputs& in) {
                      {"samples_per_pixel_mean", mean},
                      {"samples_per_pixel_max", most},
                      {"passes_added", cpu ? 0 : r.stats.totals.passes - r.first_frame_passes}};
-    if (opt.adaptive) j["sampling"]["threshold"] = opt.aa_threshold;
-    // The object criterion only (the image criterion's JSON stays as it was).
-    if (opt.adaptive && opt.aa_criterion == RenderOptions::AaCriterion::object) {
-      j["sampling"]["criterion"] = "object";
+    if (opt.adaptive) j["sampling"]["threshold"] = opt.threshold();
+    // The object and budget criteria only (the image criterion's JSON stays as it was).
+    if (opt.adaptive && opt.aa_criterion != RenderOptions::AaCriterion::image) {
+      const bool budget = opt.aa_criterion == RenderOptions::AaCriterion::budget;
+      j["sampling"]["criterion"] = budget ? "budget" : "object";
       j["sampling"]["cone_depth"] = opt.cone_depth;
+      if (budget) {
+        nlohmann::ordered_json shares = nlohmann::ordered_json::array();
+        for (const float b : opt.aa_budget) shares.push_back(std::round(double(b) * 1e6) / 1e6);
+        j["sampling"]["budget_shares"] = std::move(shares);
+        nlohmann::ordered_json levels = nlohmann::ordered_json::array();
+        for (const RenderResult::BudgetLevel& b : r.budget_levels)
+          levels.push_back({{"threshold", b.threshold},
+                            {"budget_pixels", b.budget},
+                            {"counting_passes", b.steps}});
+        j["sampling"]["budget_levels"] = std::move(levels);
+      }
     }
     if (opt.undersample > 0) j["sampling"]["k"] = opt.undersample;
   }

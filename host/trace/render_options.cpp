@@ -23,9 +23,14 @@ std::string RenderOptions::refusal(const vgpu::Profile& profile, std::string_vie
   // The command line cannot ask for these two (--aa is one mode); a program can.
   if (undersample < 0 || (undersample > 0 && adaptive))
     return "undersample: K must be 1 or more, with one ray per traced pixel (spp 1, not adaptive)";
-  // The cones decide adaptive sampling's levels (kernels/cones.h); nothing else reads them.
-  if (aa_criterion == AaCriterion::object && !adaptive)
-    return "--aa-criterion object decides where adaptive sampling refines: add --aa adaptive";
+  // The budget's shares of the pixels that hit (kernels/cone_budget.h).
+  if (adaptive && aa_criterion == AaCriterion::budget) {
+    if (aa_budget.empty()) return "--aa-budget: give one share or more";
+    for (const float b : aa_budget)
+      if (!(b > 0.0f && b <= 1.0f))
+        return "--aa-budget: each share is a percentage of the pixels that hit, above 0 and at "
+               "most 100";
+  }
   if (mrt && looping)
     return "--mrt on with --kernels looping: the looping program already writes the traversal, "
            "voxel and hit targets in one pass; there are no separate passes left to fuse";

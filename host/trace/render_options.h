@@ -111,12 +111,23 @@ struct RenderOptions {
   // hit another surface (material, or a miss) or differs in colour by more than aa_threshold
   // (linear, per channel); a level's samples replace the pixel's earlier ones.
   bool adaptive = false;
-  float aa_threshold = 0.1f;
+  // The threshold (--aa-threshold; threshold() reads it): unset, 0.1, or with the budget
+  // criterion 0.05 (the least score that can refine).
+  std::optional<float> aa_threshold;
+  float threshold() const {
+    return aa_threshold.value_or(adaptive && aa_criterion == AaCriterion::budget ? 0.05f : 0.1f);
+  }
   // What decides where adaptive supersampling refines (--aa-criterion): image (the surface keys
-  // and the colour, marcarPixeles) or object (the pixels' cones: the keys, the hit distances'
-  // continuity against the cone's width, and the colour; kernels/cones.h).
-  enum class AaCriterion { image, object };
-  AaCriterion aa_criterion = AaCriterion::image;
+  // and the colour, marcarPixeles), object (the pixels' cones: the keys, the hit distances'
+  // continuity against the cone's width, and the colour; kernels/cones.h) or budget (the cones'
+  // evidence as a score, each level refining the highest scores above aa_threshold within a
+  // share of the image's pixels that hit, and the second level keeping the first's samples;
+  // kernels/cone_budget.h).
+  enum class AaCriterion { image, object, budget };
+  AaCriterion aa_criterion = AaCriterion::budget;
+  // With the budget criterion: per level, the share of the image's pixels that hit that the
+  // level may refine (the last share repeats for deeper levels), each in (0, 1].
+  std::vector<float> aa_budget = {0.30f, 0.28f};
   // With the object criterion: the depth's second difference that marks, in cone widths.
   float cone_depth = 2.0f;
   // Adaptive undersampling (--aa undersample:K, 0: off): one ray through the centre of every
@@ -218,6 +229,14 @@ struct RenderResult {
   // Primary rays per pixel where they differ between pixels (--aa adaptive); empty: `samples`
   // in every pixel.
   std::vector<uint32_t> rays_per_pixel;
+  // --aa-criterion budget: per level run, the threshold the budget's search found (the scores
+  // above it refined), the pixels that hit the level could refine at most, and the counting
+  // passes the search ran.
+  struct BudgetLevel {
+    float threshold = 0;
+    uint64_t budget = 0, steps = 0;
+  };
+  std::vector<BudgetLevel> budget_levels;
   StreamStats streams;   // glass's ray streams; streams.on false: the paper's frame
   CompactStats compact;  // the sampling modes' dense streams; compact.on false: none ran
 };

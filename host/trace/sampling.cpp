@@ -2,6 +2,7 @@
 #include "host/trace/sampling.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 
 namespace host {
@@ -84,6 +85,36 @@ uint32_t adaptive_rays(int spp, int samples) {
     rays += uint32_t(side * side);
   }
   return rays;
+}
+
+uint32_t adaptive_rays(int spp, int samples, size_t kept) {
+  uint32_t rays = 1;
+  int before = 0;  // the samples the pixel held before the level
+  const std::vector<int> levels = adaptive_levels(spp);
+  for (size_t l = 0; l < levels.size(); ++l) {
+    const int m = levels[l] * levels[l];
+    if (m > samples) break;
+    rays += uint32_t(l > 0 && l < kept ? m - before : m);
+    before = m;
+  }
+  return rays;
+}
+
+BudgetSearch budget_threshold(float floor, uint64_t budget,
+                              const std::function<uint64_t(float)>& count) {
+  BudgetSearch r{floor, 1};
+  if (count(floor) <= budget) return r;
+  // An upper end that fits (scores are colour steps: rarely above 1).
+  float hi = std::max(1.0f, 2.0f * floor);
+  for (++r.counts; count(hi) > budget; ++r.counts) hi *= 2.0f;
+  auto lo_bits = std::bit_cast<uint32_t>(floor), hi_bits = std::bit_cast<uint32_t>(hi);
+  while (hi_bits - lo_bits > 1) {
+    const uint32_t mid = lo_bits + (hi_bits - lo_bits) / 2;
+    ++r.counts;
+    (count(std::bit_cast<float>(mid)) <= budget ? hi_bits : lo_bits) = mid;
+  }
+  r.threshold = std::bit_cast<float>(hi_bits);
+  return r;
 }
 
 bool on_lattice(int x, int y, int k, int width, int height) {

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <glm/glm.hpp>
 #include <string>
 #include <vector>
@@ -26,18 +27,35 @@ glm::vec2 sample_offset(int spp, int s, uint64_t seed);
 // grid, doubling from 2 and ending at sqrt(spp) (spp 16: 2, 4; spp 9: 2, 3; spp 1: none).
 std::vector<int> adaptive_levels(int spp);
 
-// Adaptive levels that keep the samples before them (a proposal, not a mode: docs/sampling.md,
-// "One default for every scene"; cpu_adaptive_levels' kept levels): per level, the offsets of the
-// samples it adds. The first level adds its own n x n (sample_offset(n * n, k)); each later one
-// adds one sample in each of its n x n strata that the samples before leave empty (the stratum's
-// sample_offset), so that the set stays one sample to a stratum. The list stops before the first
-// level whose earlier samples do not fall one to a stratum (a side that does not double, as
-// spp 9's 2 then 3); spp 16: 4 offsets, then 12.
+// Adaptive levels that keep the samples before them (--aa-criterion budget's levels, and
+// cpu_adaptive_levels' kept levels; docs/sampling.md, "One default for every scene"): per level,
+// the offsets of the samples it adds. The first level adds its own n x n (sample_offset(n * n, k));
+// each later one adds one sample in each of its n x n strata that the samples before leave empty
+// (the stratum's sample_offset), so that the set stays one sample to a stratum. The list stops
+// before the first level whose earlier samples do not fall one to a stratum (a side that does not
+// double, as spp 9's 2 then 3); spp 16: 4 offsets, then 12.
 std::vector<std::vector<glm::vec2>> kept_level_samples(int spp, uint64_t seed);
 
 // The primary rays a pixel took under adaptive supersampling when its final sample count is
 // `samples` (1: the centre ray alone; n*n: every level up to side n, after the centre ray).
 uint32_t adaptive_rays(int spp, int samples);
+// The same where the first `kept` levels keep the samples before them (kept_level_samples(spp,
+// seed).size() of them, --aa-criterion budget): a kept level after the first traces only its
+// new samples (spp 16, 16 samples: 1 + 4 + 12 rays, not 1 + 4 + 16).
+uint32_t adaptive_rays(int spp, int samples, size_t kept);
+
+// --aa-criterion budget's search (kernels/cone_budget.h): the least threshold t >= floor (floor
+// >= 0) with count(t) <= budget, where count(t) (one counting pass and occlusion query on a
+// card: the pixels that hit scoring above t) falls as t rises and changes only at the pixels'
+// scores. Positive floats order as their bit patterns, so a binary search over the bits ends on
+// the exact threshold: the first score a ranking of the scores, highest first, leaves out. The
+// threshold and how many counts the search asked for.
+struct BudgetSearch {
+  float threshold = 0;
+  uint64_t counts = 0;
+};
+BudgetSearch budget_threshold(float floor, uint64_t budget,
+                              const std::function<uint64_t(float)>& count);
 
 // Undersampling's lattice (--aa undersample:K): whether pixel (x, y) of a W x H image is traced
 // first (x a multiple of K or the last column, y likewise), and the lattice pixels around it

@@ -48,6 +48,14 @@ class RenderTest(unittest.TestCase):
         self.assertTrue(np.all(f.hit[~missed] < f.stats["input_triangles"]))
         self.assertGreater(float(f.image[~missed].max()), 0.0)
 
+    def test_a_list_option_goes_to_the_command_line_as_its_comma_separated_word(self):
+        f = vgpu_rt.render("bunny-refl", size=(16, 16), bounces=0, aa="adaptive", spp=16,
+                           aa_budget=(25, 20))
+        sampling = f.stats["sampling"]
+        self.assertEqual(sampling["criterion"], "budget")
+        self.assertEqual(sampling["budget_shares"], [0.25, 0.2])
+        self.assertEqual(len(sampling["budget_levels"]), 2)
+
     @unittest.skipUnless(CLI, "VGPU_RT_CLI names the vgpu-rt executable")
     def test_the_stats_are_the_dict_the_command_line_writes_for_the_same_frame(self):
         with tempfile.TemporaryDirectory() as tmp:

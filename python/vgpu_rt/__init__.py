@@ -94,6 +94,8 @@ def _word(name, value):
         if len(value) != 2:
             raise ValueError(f"{name}: expected two numbers, got {value!r}")
         return ("{}x{}" if name == "size" else "{},{}").format(*value)
+    if isinstance(value, (tuple, list)) and name == "aa_budget":
+        return ",".join(str(v) for v in value)  # percentages per level, e.g. (30, 28)
     return str(value)
 
 

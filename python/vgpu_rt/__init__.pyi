@@ -130,6 +130,7 @@ def render(
     textures: Optional[str] = ...,
     aa_criterion: Optional[str] = ...,
     aa_cone_depth: Optional[float] = ...,
+    aa_budget: Union[str, Sequence[float], None] = ...,
     compact: Union[str, bool, None] = ...,
     beams: Union[str, bool, None] = ...,
     beam_tile: Optional[int] = ...,

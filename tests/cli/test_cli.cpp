@@ -70,9 +70,14 @@ TEST_CASE("names outside each option's set are refused") {
   check_refused("--engine gpu", "--engine", "gpu not in {stream,gl,cpu}");
   check_refused("--stats xml", "--stats", "xml not in {table,json,none}");
   check_refused("--aa adaptive --aa-criterion cones", "--aa-criterion",
-                "cones not in {image,object}");
+                "cones not in {image,object,budget}");
   check_refused("--aa-criterion object", "--aa-criterion object",
                 "decides where adaptive sampling refines: add --aa adaptive");
+  check_refused("--aa-criterion budget", "--aa-criterion budget",
+                "decides where adaptive sampling refines: add --aa adaptive");
+  check_refused("--aa adaptive --spp 16 --aa-budget 30,0", "--aa-budget",
+                "each share is a percentage of the pixels that hit, above 0 and at most 100");
+  check_refused("--aa adaptive --spp 16 --aa-budget 130", "--aa-budget", "130");
   check_refused("--compact maybe", "--compact", "maybe not in {on,off}");
   check_refused("--grid 0", "--grid", "grid resolution '0': each count must be at least 1");
   check_refused("--trace-pixel 3", "--trace-pixel", "expected X,Y (e.g. 128,128), got '3'");
@@ -586,10 +591,49 @@ TEST_CASE("the object criterion's passes are counted and priced, and the statist
   // The image criterion's statistics have no criterion (they stay as they were).
   const Outcome image =
       run("render bunny-refl --size 16x16 --bounces 1 --aa adaptive --spp 4 -q "
-          "--stats none --stats-json " +
+          "--aa-criterion image --stats none --stats-json " +
           (dir / "image.json").string());
   REQUIRE(image.status == 0);
   CHECK_FALSE(nlohmann::json::parse(slurp(dir / "image.json"))["sampling"].contains("criterion"));
+}
+
+TEST_CASE(
+    "adaptive sampling decides by the budget unless told otherwise, and its search's passes are "
+    "counted, priced and named in the statistics") {
+  const fs::path dir = fresh_dir("budget");
+  const Outcome o =
+      run("render bunny-refl --size 24x24 --bounces 1 --aa adaptive --spp 16 --aa-budget 25,20 "
+          "--stats-json " +
+          (dir / "stats.json").string());
+  REQUIRE(o.status == 0);
+  nlohmann::json j;
+  REQUIRE_NOTHROW(j = nlohmann::json::parse(slurp(dir / "stats.json")));
+  CHECK(j["sampling"]["criterion"] == "budget");
+  CHECK(j["sampling"]["threshold"].get<double>() == doctest::Approx(0.05));
+  CHECK(j["sampling"]["budget_shares"][0].get<double>() == doctest::Approx(0.25));
+  CHECK(j["sampling"]["budget_shares"][1].get<double>() == doctest::Approx(0.20));
+  const auto& levels = j["sampling"]["budget_levels"];
+  REQUIRE(levels.size() == 2);
+  // Each level: puntuarConos and cortarPuntajes once, pixelesPuntuados once per search step
+  // (the first level's count of every pixel that hits among them).
+  std::map<std::string, uint64_t> passes;
+  for (const auto& k : j["kernels"]) passes[k["name"].get<std::string>()] = k["passes"];
+  CHECK(passes["score cones"] == 2);
+  CHECK(passes["cut scores"] == 2);
+  CHECK(passes["scored hits"] == levels[0]["counting_passes"].get<uint64_t>() +
+                                     levels[1]["counting_passes"].get<uint64_t>());
+  CHECK(passes["keep cones"] == 1);
+  CHECK(passes.count("mark pixels") == 0);
+  CHECK(levels[1]["budget_pixels"].get<uint64_t>() < levels[0]["budget_pixels"].get<uint64_t>());
+  CHECK(levels[0]["threshold"].get<double>() >= 0.05 - 1e-7);
+  // The kept 4 x 4 level: 17 rays at most, not 21.
+  CHECK(j["sampling"]["samples_per_pixel_max"] == 17);
+  // The table says what each level's search found.
+  CHECK(o.out.find("aa budget level 1: at most") != std::string::npos);
+  CHECK(o.out.find("aa budget level 2: at most") != std::string::npos);
+  // Priced, the search's read-backs with the rest.
+  CHECK(j["predicted_ms"]["gf6600"].get<double>() > 0);
+  CHECK(j["totals"]["query_readbacks"].get<uint64_t>() >= passes["scored hits"]);
 }
 
 TEST_CASE("beams are refused where they cannot apply, one line and exit 2") {

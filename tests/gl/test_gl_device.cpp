@@ -26,14 +26,15 @@ struct Frame {
 
 Frame render(const std::string& scene_name, const std::string& device, int size, bool keep_passes,
              bool mrt = false, const std::string& readback = "auto", int spp = 1,
-             bool adaptive = false, int undersample = 0, bool object = false) {
+             bool adaptive = false, int undersample = 0,
+             host::RenderOptions::AaCriterion criterion = host::RenderOptions::AaCriterion::image) {
   const host::Scene scene = host::load_scene(host::resolve_scene(scene_name), host::with_images());
   host::RenderOptions opt;
   opt.width = opt.height = size;
   opt.spp = spp;
   opt.adaptive = adaptive;
   opt.undersample = undersample;
-  if (object) opt.aa_criterion = host::RenderOptions::AaCriterion::object;
+  opt.aa_criterion = criterion;
   opt.device = device;
   opt.gl_readback = readback;
   if (mrt) {  // fused two-output passes need a profile with multiple render targets
@@ -252,8 +253,9 @@ TEST_CASE("adaptive sampling's second level on the GL device marks the vgpu's pi
 TEST_CASE("the object criterion on the GL device keeps the vgpu's cones and marks its pixels") {
   // bunny-refl: the mirror's reflected keys (guardarReflejos) as well as the hit distances; one
   // level (4 samples), to keep the test short.
-  const Frame v = render("bunny-refl", "vgpu", 24, true, false, "auto", 4, true, 0, true),
-              g = render("bunny-refl", "gl", 24, true, false, "auto", 4, true, 0, true);
+  const auto object = host::RenderOptions::AaCriterion::object;
+  const Frame v = render("bunny-refl", "vgpu", 24, true, false, "auto", 4, true, 0, object),
+              g = render("bunny-refl", "gl", 24, true, false, "auto", 4, true, 0, object);
   const auto& pv = v.result.stats.passes;
   const auto& pg = g.result.stats.passes;
   REQUIRE(pv.size() == pg.size());
@@ -270,6 +272,40 @@ TEST_CASE("the object criterion on the GL device keeps the vgpu's cones and mark
   const auto& n = v.result.rays_per_pixel;
   CHECK(std::count(n.begin(), n.end(), 1u + 4u) > 0);
   CHECK(std::count(n.begin(), n.end(), 1u) > 0);
+  CHECK(g.result.rays_per_pixel == v.result.rays_per_pixel);
+  gltest::check_same_frame(g.device, "intersections", v.result.hit_id, g.result.hit_id,
+                           v.result.depth, g.result.depth, v.result.rgb, g.result.rgb);
+}
+
+TEST_CASE(
+    "the budget criterion on the GL device counts the vgpu's scores at every step of its search "
+    "and marks its pixels at both levels") {
+  // bunny-refl, spp 16: the 2 x 2 level, then the 4 x 4 level's 12 new samples added to them.
+  const auto budget = host::RenderOptions::AaCriterion::budget;
+  const Frame v = render("bunny-refl", "vgpu", 24, true, false, "auto", 16, true, 0, budget),
+              g = render("bunny-refl", "gl", 24, true, false, "auto", 16, true, 0, budget);
+  const auto& pv = v.result.stats.passes;
+  const auto& pg = g.result.stats.passes;
+  REQUIRE(pv.size() == pg.size());
+  uint64_t counts = 0;
+  for (size_t i = 0; i < pv.size(); ++i) {
+    CAPTURE(i);
+    REQUIRE(pv[i].program == pg[i].program);
+    REQUIRE(pv[i].query_result == pg[i].query_result);
+    counts += pv[i].program == "scored hits";
+  }
+  REQUIRE(v.result.budget_levels.size() == 2);
+  REQUIRE(g.result.budget_levels.size() == 2);
+  uint64_t steps = 0;
+  for (size_t l = 0; l < 2; ++l) {
+    CHECK(g.result.budget_levels[l].threshold == v.result.budget_levels[l].threshold);
+    CHECK(g.result.budget_levels[l].budget == v.result.budget_levels[l].budget);
+    steps += v.result.budget_levels[l].steps;
+  }
+  CHECK(counts == steps);
+  // Pixels at every stage: one ray, 1 + 4, and 1 + 4 + 12 (the kept level).
+  const auto& n = v.result.rays_per_pixel;
+  for (const uint32_t rays : {1u, 5u, 17u}) CHECK(std::count(n.begin(), n.end(), rays) > 0);
   CHECK(g.result.rays_per_pixel == v.result.rays_per_pixel);
   gltest::check_same_frame(g.device, "intersections", v.result.hit_id, g.result.hit_id,
                            v.result.depth, g.result.depth, v.result.rgb, g.result.rgb);

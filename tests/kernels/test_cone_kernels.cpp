@@ -1,8 +1,10 @@
 // Kernel tests for the object-space decision of adaptive sampling (kernels/cones.h):
-// guardarConos, guardarReflejos and marcarConos, each run as one real pass on hand-made texels.
+// guardarConos, guardarReflejos and marcarConos, and the budget's puntuarConos, pixelesPuntuados
+// and cortarPuntajes (kernels/cone_budget.h), each run as one real pass on hand-made texels.
 #include <doctest/doctest.h>
 
 #include "kernel_pass.h"
+#include "kernels/cone_budget.h"
 #include "kernels/cones.h"
 
 using ktest::texels;
@@ -110,4 +112,118 @@ TEST_CASE(
   const Texture outc = ktest::run(k, {&mc, &cc}, 4, 1, glm::vec4(9.0f));
   const float markedc[4] = {0, 1, 1, 0};
   for (int x = 0; x < 4; ++x) CHECK_TEXEL(outc, x, 0, glm::vec4(markedc[x], -1, 0, -1));
+}
+
+TEST_CASE(
+    "score cones scores a candidate by the largest colour step behind an edge its cone sees, or "
+    "its colour's bend, and keeps scores above the threshold only") {
+  // A 7 x 1 row at t 10 on surface 5 (spread 0.01, 2 cone widths: a fold needs a depth bend
+  // over 0.2), threshold 0.05. Red steps 0 -> 0.3 between pixels 1 and 2; pixel 4 sees
+  // reflected surface 9 and is 0.02 bluer than its neighbours; pixel 6 is no candidate.
+  //  0: flat (bend 0), score 0;  1: red bend 0 + 0.3 - 0 = 0.3;  2: 0 + 0.3 - 0.6: 0.3;
+  //  3: the step to 4 (another reflected key) 0.02, the blue bend 0.6 + 0.62 - 1.2 = 0.02: 0.02;
+  //  4: steps of 0.02 to both sides, the bend 0.6 + 0.6 - 1.24: 0.04;  5: as 3, 0.02;
+  //  6: no candidate: 0, whatever it scores.
+  // At threshold 0.05 only 1 and 2 keep theirs; at 0.01 all do.
+  std::vector<glm::vec4> marks, colour;
+  for (int x = 0; x < 7; ++x) {
+    marks.push_back({x == 6 ? 0 : 1, 5, 10, x == 4 ? 9 : -1});
+    colour.push_back({x >= 2 ? 0.3f : 0.0f, 0.5f, x == 4 ? 0.62f : 0.6f, 1});
+  }
+  const Texture m = texels("marks", 7, 1, marks), c = texels("colour", 7, 1, colour);
+  kernels::ScoreCones k;
+  k.threshold = 0.05f;
+  k.spread = 0.01f;
+  k.depth_cones = 2.0f;
+  const Texture out = ktest::run(k, {&m, &c}, 7, 1, glm::vec4(9.0f));
+  const float score[7] = {0, 0.3f, 0.3f, 0, 0, 0, 0};
+  for (int x = 0; x < 7; ++x) {
+    CAPTURE(x);
+    CHECK_TEXEL_NEAR(out, x, 0, 1e-5f, glm::vec4(score[x], 5, 10, x == 4 ? 9 : -1));
+  }
+  k.threshold = 0.01f;
+  const Texture low = ktest::run(k, {&m, &c}, 7, 1, glm::vec4(9.0f));
+  const float score_low[7] = {0, 0.3f, 0.3f, 0.02f, 0.04f, 0.02f, 0};
+  for (int x = 0; x < 7; ++x) {
+    CAPTURE(x);
+    CHECK_TEXEL_NEAR(low, x, 0, 1e-5f, glm::vec4(score_low[x], 5, 10, x == 4 ? 9 : -1));
+  }
+  k.threshold = 0.05f;
+
+  // Another surface key: a 4 x 1 row, surfaces 5, 5, 7, 7, red 0.2, 0.2, 0.3, 0.3 (a step of
+  // 0.1 at the edge, a bend of 0.1 on both sides): 1 and 2 score 0.1. With one colour on both
+  // surfaces the key edge scores nothing: its step is 0.
+  const Texture mk =
+      texels("marks", 4, 1, {{1, 5, 10, -1}, {1, 5, 10, -1}, {1, 7, 10, -1}, {1, 7, 10, -1}});
+  const Texture ck = texels(
+      "colour", 4, 1,
+      {{0.2f, 0.5f, 0.5f, 1}, {0.2f, 0.5f, 0.5f, 1}, {0.3f, 0.5f, 0.5f, 1}, {0.3f, 0.5f, 0.5f, 1}});
+  const Texture outk = ktest::run(k, {&mk, &ck}, 4, 1, glm::vec4(9.0f));
+  const float keyk[4] = {5, 5, 7, 7}, scorek[4] = {0, 0.1f, 0.1f, 0};
+  for (int x = 0; x < 4; ++x) {
+    CAPTURE(x);
+    CHECK_TEXEL_NEAR(outk, x, 0, 1e-5f, glm::vec4(scorek[x], keyk[x], 10, -1));
+  }
+  const Texture same = texels("colour", 4, 1, std::vector<glm::vec4>(4, {0.2f, 0.5f, 0.5f, 1}));
+  const Texture outs = ktest::run(k, {&mk, &same}, 4, 1, glm::vec4(9.0f));
+  for (int x = 0; x < 4; ++x) CHECK_TEXEL(outs, x, 0, glm::vec4(0, keyk[x], 10, -1));
+
+  // A fold: a 1 x 4 column on one surface, t 10, 10, 14, 14, green 0.5, 0.5, 0.58, 0.66 (an
+  // even ramp from row 1 on: row 2's bend is 0). Rows 1 and 2 fold (depth bends of 4 and -4),
+  // so their largest step counts, 0.08; row 3 bends by 0.58 + 0.66 - 1.32 (the edge clamps):
+  // 0.08; row 0 scores 0. At one depth (no fold) row 2 scores nothing: its bend is 0.
+  const std::vector<glm::vec4> cfold{
+      {0.1f, 0.5f, 0.1f, 1}, {0.1f, 0.5f, 0.1f, 1}, {0.1f, 0.58f, 0.1f, 1}, {0.1f, 0.66f, 0.1f, 1}};
+  const Texture cf = texels("colour", 1, 4, cfold);
+  const Texture mf =
+      texels("marks", 1, 4, {{1, 5, 10, -1}, {1, 5, 10, -1}, {1, 5, 14, -1}, {1, 5, 14, -1}});
+  const Texture mflat = texels("marks", 1, 4, std::vector<glm::vec4>(4, {1, 5, 10, -1}));
+  const Texture outf = ktest::run(k, {&mf, &cf}, 1, 4, glm::vec4(9.0f));
+  const Texture outflat = ktest::run(k, {&mflat, &cf}, 1, 4, glm::vec4(9.0f));
+  const float scoref[4] = {0, 0.08f, 0.08f, 0.08f}, scoreflat[4] = {0, 0.08f, 0, 0.08f};
+  const float tf[4] = {10, 10, 14, 14};
+  for (int y = 0; y < 4; ++y) {
+    CAPTURE(y);
+    CHECK_TEXEL_NEAR(outf, 0, y, 1e-5f, glm::vec4(scoref[y], 5, tf[y], -1));
+    CHECK_TEXEL_NEAR(outflat, 0, y, 1e-5f, glm::vec4(scoreflat[y], 5, 10, -1));
+  }
+}
+
+TEST_CASE("scored hits counts the pixels that hit whose score exceeds the value, and no others") {
+  // Scores 0, 0.3, 0.2, 0.5 (a miss), 0.7, 0.2; keys 5, 5, 5, -1, 6, 5.
+  const Texture m = texels("marks", 6, 1,
+                           {{0, 5, 10, -1},
+                            {0.3f, 5, 10, -1},
+                            {0.2f, 5, 10, -1},
+                            {0.5f, -1, 0, -1},
+                            {0.7f, 6, 10, -1},
+                            {0.2f, 5, 10, -1}});
+  kernels::ScoredHits k;
+  for (const auto& [above, expect] : std::vector<std::pair<float, uint64_t>>{
+           {-1.0f, 5}, {0.0f, 4}, {0.2f, 2}, {0.3f, 1}, {0.7f, 0}}) {
+    CAPTURE(above);
+    k.above = above;
+    uint64_t count = 99;
+    const Texture out = ktest::run(k, {&m}, 6, 1, glm::vec4(9.0f), &count);
+    CHECK(count == expect);
+    // The counted pixels write the dummy value, the rest keep the target's.
+    for (int x = 0; x < 6; ++x) {
+      const glm::vec4 t = ktest::at(m, x, 0);
+      CAPTURE(x);
+      const bool counted = t.x > above && t.y >= 0;
+      CHECK_TEXEL(out, x, 0, counted ? glm::vec4(1, 0, 0, 0) : glm::vec4(9.0f));
+    }
+  }
+}
+
+TEST_CASE("cut scores marks the pixels scoring above the threshold and keeps the rest") {
+  const Texture m = texels(
+      "marks", 4, 1, {{0, 5, 10, -1}, {0.3f, 5, 11, 2}, {0.2f, -1, 0, -1}, {0.25f, 6, 12, 3}});
+  kernels::CutScores k;
+  k.above = 0.2f;
+  const Texture out = ktest::run(k, {&m}, 4, 1, glm::vec4(9.0f));
+  CHECK_TEXEL(out, 0, 0, glm::vec4(0, 5, 10, -1));
+  CHECK_TEXEL(out, 1, 0, glm::vec4(1, 5, 11, 2));
+  CHECK_TEXEL(out, 2, 0, glm::vec4(0, -1, 0, -1));
+  CHECK_TEXEL(out, 3, 0, glm::vec4(1, 6, 12, 3));
 }

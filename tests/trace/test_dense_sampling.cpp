@@ -31,6 +31,7 @@ host::RenderOptions options(int mode, bool compact, int width = 24) {
   if (mode == 0) {
     opt.spp = 16;
     opt.adaptive = true;
+    opt.aa_criterion = host::RenderOptions::AaCriterion::image;
   } else {
     opt.undersample = 2;
   }

@@ -155,6 +155,7 @@ host::RenderOptions adaptive_options(int spp, float threshold) {
   opt.width = 8;
   opt.height = 6;
   opt.adaptive = true;
+  opt.aa_criterion = host::RenderOptions::AaCriterion::image;
   opt.aa_threshold = threshold;
   return opt;
 }
@@ -300,9 +301,11 @@ TEST_CASE(
       host::make_accel(host::AccelKind::grid, scene, params),
       host::make_accel(host::AccelKind::bvh, scene, params),
       host::make_accel(host::AccelKind::kdtree, scene, params)};
-  for (const int mode : {0, 1, 2}) {
-    // 0: adaptive up to 16 samples, 1: undersampling, K = 2, 2: adaptive by the pixels' cones
-    // (--aa-criterion object: the hit distances and the mirror's reflected keys).
+  for (const int mode : {0, 1, 2, 3}) {
+    // 0: adaptive up to 16 samples (--aa-criterion image), 1: undersampling, K = 2, 2: adaptive
+    // by the pixels' cones (--aa-criterion object: the hit distances and the mirror's reflected
+    // keys), 3: by their scores within the budget (--aa-criterion budget: the search, the kept
+    // level).
     CAPTURE(mode);
     host::RenderOptions opt;
     opt.width = opt.height = 16;
@@ -311,7 +314,10 @@ TEST_CASE(
     if (mode != 1) {
       opt.spp = 16;
       opt.adaptive = true;
-      if (mode == 2) opt.aa_criterion = host::RenderOptions::AaCriterion::object;
+      opt.aa_criterion = mode == 0   ? host::RenderOptions::AaCriterion::image
+                         : mode == 2 ? host::RenderOptions::AaCriterion::object
+                                     : host::RenderOptions::AaCriterion::budget;
+      if (mode == 3) opt.aa_threshold.reset();  // the budget's floor
     } else {
       opt.undersample = 2;
     }
@@ -328,7 +334,7 @@ TEST_CASE(
       // Some pixels were refined (or traced between the lattice), not all.
       const auto most = *std::max_element(g.rays_per_pixel.begin(), g.rays_per_pixel.end());
       const auto least = *std::min_element(g.rays_per_pixel.begin(), g.rays_per_pixel.end());
-      CHECK(most == (mode != 1 ? 21u : 1u));
+      CHECK(most == (mode == 1 ? 1u : mode == 3 ? 17u : 21u));
       CHECK(least == (mode != 1 ? 1u : 0u));
       float worst = 0;
       for (size_t i = 0; i < g.rgb.size(); ++i)

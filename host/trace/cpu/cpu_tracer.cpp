@@ -3,8 +3,10 @@
 #include "host/trace/cpu/cpu_tracer.h"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <stdexcept>
@@ -25,17 +27,38 @@ namespace {
 
 using namespace cpu_core;
 
+// --aa-criterion budget's score of pixel i (kernels/cone_budget.h, puntuarConos), in double: the
+// largest colour step to a 4-neighbour with another surface key or reflected key (to any
+// neighbour where the hit distances fold), or the colour's second difference.
+double budget_score(const std::vector<glm::dvec3>& estimate, const std::vector<int>& key,
+                    const std::vector<int>& reflected, bool folds, size_t i,
+                    const std::array<size_t, 4>& n) {
+  auto largest = [](glm::dvec3 v) { return std::max({v.x, v.y, v.z}); };
+  double score = 0;
+  for (int a = 0; a < 2; ++a)  // left + right, up + down
+    score = std::max(score, largest(glm::abs(estimate[n[size_t(2 * a)]] +
+                                             estimate[n[size_t(2 * a + 1)]] - 2.0 * estimate[i])));
+  for (const size_t j : n)
+    if (folds || key[j] != key[i] || reflected[j] != reflected[i])
+      score = std::max(score, largest(glm::abs(estimate[j] - estimate[i])));
+  return score;
+}
+
 // --aa adaptive as the stream tracer runs it (host/trace/stream/stream_tracer.cpp,
 // render_adaptive): the centre ray, then levels of n x n samples where marcarPixeles' rule marks
 // the pixel (a neighbour's surface key differs, or the colour's second difference exceeds the
-// threshold), each level's samples replacing the pixel's earlier ones.
+// threshold), each level's samples replacing the pixel's earlier ones. With --aa-criterion
+// budget each level refines the highest scores above the threshold within its share of the
+// pixels that hit (the threshold found exactly, by sorting: the search's answer), and its kept
+// levels add their new samples to the earlier ones.
 void adaptive(const Tracer& tracer, const RenderOptions& opt, unsigned workers,
               std::vector<Counters>& counters, RenderResult& res) {
   const int W = opt.width, H = opt.height;
   // --aa-criterion object (kernels/cones.h, marcarConos): also where the centre rays' hit
   // distances (the depth AOV, 0 for a miss) on both sides of a hit bend by more than cone_depth
   // widths of the pixel's cone at its hit. As the kernel, in float.
-  const bool cones = opt.aa_criterion == RenderOptions::AaCriterion::object;
+  const bool cones = opt.aa_criterion != RenderOptions::AaCriterion::image;
+  const bool budget = opt.aa_criterion == RenderOptions::AaCriterion::budget;
   const bool mirrors = cones && !tracer.ray_streams();  // the reflected surface keys
   const float width_per_t = tracer.pixel_spread() * opt.cone_depth;
   auto cone_folds = [width_per_t](const std::vector<float>& t, const std::vector<int>& k,
@@ -53,9 +76,14 @@ void adaptive(const Tracer& tracer, const RenderOptions& opt, unsigned workers,
           tracer.centre(x, y, res, key[i], counters[worker], mirrors ? &reflected[i] : nullptr);
     }
   });
-  for (const int side : adaptive_levels(opt.spp)) {
+  const auto kept =
+      budget ? kept_level_samples(opt.spp, opt.sample_seed) : std::vector<std::vector<glm::vec2>>{};
+  const uint64_t hits =
+      uint64_t(std::count_if(key.begin(), key.end(), [](int k) { return k >= 0; }));
+  std::vector<double> score(n, 0.0);
+  const std::vector<int> levels = adaptive_levels(opt.spp);
+  for (size_t l = 0; l < levels.size(); ++l) {
     // The 4-neighbours, clamped at the image's edge as the texture units clamp.
-    size_t count = 0;
     for (int y = 0; y < H; ++y)
       for (int x = 0; x < W; ++x) {
         const size_t i = size_t(y) * size_t(W) + size_t(x);
@@ -63,29 +91,57 @@ void adaptive(const Tracer& tracer, const RenderOptions& opt, unsigned workers,
           return size_t(std::clamp(y + dy, 0, H - 1)) * size_t(W) +
                  size_t(std::clamp(x + dx, 0, W - 1));
         };
-        bool edge = false;
-        for (const glm::ivec2 d : {glm::ivec2(-1, 0), {1, 0}, {0, -1}, {0, 1}})
-          edge = edge || key[at(d.x, d.y)] != key[i] || reflected[at(d.x, d.y)] != reflected[i];
+        const std::array<size_t, 4> nb{at(-1, 0), at(1, 0), at(0, -1), at(0, 1)};
+        const bool folds = cones && (cone_folds(res.depth, key, i, nb[0], nb[1]) ||
+                                     cone_folds(res.depth, key, i, nb[2], nb[3]));
+        if (budget) {
+          const double sc = budget_score(estimate, key, reflected, folds, i, nb);
+          score[i] = candidate[i] && sc > double(opt.threshold()) ? sc : 0.0;
+          continue;
+        }
+        bool edge = folds;
+        for (const size_t j : nb) edge = edge || key[j] != key[i] || reflected[j] != reflected[i];
         // The colour's second difference along x and along y.
-        for (const glm::ivec2 d : {glm::ivec2(1, 0), {0, 1}}) {
-          const glm::dvec3 bend =
-              glm::abs(estimate[at(-d.x, -d.y)] + estimate[at(d.x, d.y)] - 2.0 * estimate[i]);
-          edge = edge || std::max({bend.x, bend.y, bend.z}) > double(opt.aa_threshold);
-          if (cones) edge = edge || cone_folds(res.depth, key, i, at(-d.x, -d.y), at(d.x, d.y));
+        for (int a = 0; a < 2; ++a) {
+          const glm::dvec3 bend = glm::abs(estimate[nb[size_t(2 * a)]] +
+                                           estimate[nb[size_t(2 * a + 1)]] - 2.0 * estimate[i]);
+          edge = edge || std::max({bend.x, bend.y, bend.z}) > double(opt.threshold());
         }
         marked[i] = candidate[i] && edge;
-        count += marked[i];
       }
-    if (count == 0) break;
-    const int m = side * side;
+    if (budget) {
+      // The least threshold with at most the budget's hits scoring above it: the first hit's
+      // score left out when the scored hits are ranked, highest first.
+      const std::vector<float>& shares = opt.aa_budget;
+      const auto allowed =
+          uint64_t(std::floor(double(shares[std::min(l, shares.size() - 1)]) * double(hits)));
+      std::vector<double> ranked;
+      for (size_t i = 0; i < n; ++i)
+        if (key[i] >= 0 && score[i] > 0) ranked.push_back(score[i]);
+      double t = 0;
+      if (ranked.size() > allowed) {
+        std::nth_element(ranked.begin(), ranked.begin() + std::ptrdiff_t(allowed), ranked.end(),
+                         std::greater<>());
+        t = ranked[allowed];
+      }
+      for (size_t i = 0; i < n; ++i) marked[i] = score[i] > t;
+      res.budget_levels.push_back({float(std::max(t, double(opt.threshold()))), allowed, 0});
+    }
+    if (std::find(marked.begin(), marked.end(), 1) == marked.end()) break;
+    const int m = levels[l] * levels[l];
+    const bool keeps = l > 0 && l < kept.size();
+    std::vector<glm::vec2> offsets;
+    if (l < kept.size()) {
+      offsets = kept[l];
+    } else {
+      for (int k = 0; k < m; ++k) offsets.push_back(sample_offset(m, k, opt.sample_seed));
+    }
     for_each_row(H, workers, [&](unsigned worker, int y) {
       for (int x = 0; x < W; ++x) {
         const size_t i = size_t(y) * size_t(W) + size_t(x);
         if (!marked[i]) continue;
-        glm::dvec3 sum(0.0);
-        for (int k = 0; k < m; ++k)
-          sum +=
-              tracer.sample(x, y, sample_offset(m, k, opt.sample_seed), nullptr, counters[worker]);
+        glm::dvec3 sum = keeps ? estimate[i] * double(samples[i]) : glm::dvec3(0.0);
+        for (const glm::vec2 o : offsets) sum += tracer.sample(x, y, o, nullptr, counters[worker]);
         estimate[i] = sum / double(m);
         samples[i] = m;
       }
@@ -96,7 +152,7 @@ void adaptive(const Tracer& tracer, const RenderOptions& opt, unsigned workers,
   int most = 1;
   for (size_t i = 0; i < n; ++i) {
     for (int c = 0; c < 3; ++c) res.rgb[i * 3 + size_t(c)] = float(estimate[i][c]);
-    res.rays_per_pixel[i] = adaptive_rays(opt.spp, samples[i]);
+    res.rays_per_pixel[i] = adaptive_rays(opt.spp, samples[i], kept.size());
     most = std::max(most, samples[i]);
   }
   res.samples = most;
@@ -126,7 +182,7 @@ void undersample(const Tracer& tracer, const RenderOptions& opt, unsigned worker
     for (int x = 0; x < W; ++x) {
       if (on_lattice(x, y, K, W, H)) continue;
       const GapTest t = undersample_gap_test(colour, key, x, y, K, W, H);
-      if (t.keys_differ || t.spread > double(opt.aa_threshold)) trace(worker, x, y);
+      if (t.keys_differ || t.spread > double(opt.threshold())) trace(worker, x, y);
     }
   });
   res.rays_per_pixel.assign(n, 0);
@@ -137,7 +193,7 @@ void undersample(const Tracer& tracer, const RenderOptions& opt, unsigned worker
       if (traced[i]) {
         res.rays_per_pixel[i] = 1;
       } else {
-        c = undersample_fill(colour, x, y, K, W, H, double(opt.aa_threshold));
+        c = undersample_fill(colour, x, y, K, W, H, double(opt.threshold()));
         const glm::ivec4 q = lattice_cell(x, y, K, W, H);
         const int nx = x - q.x <= q.y - x ? q.x : q.y, ny = y - q.z <= q.w - y ? q.z : q.w;
         const size_t j = size_t(ny) * size_t(W) + size_t(nx);

@@ -4,6 +4,7 @@
 // resolve (resolve_samples: resolverMuestras, or rellenarHuecos), which leaves the pixels'
 // colours in the current result texture.
 #include <algorithm>
+#include <cmath>
 #include <vector>
 
 #include "host/trace/sampling.h"
@@ -39,16 +40,16 @@ void StreamTracer::accumulate_gated(const Texture* marks, bool restart) {
 }
 
 void StreamTracer::dense_level(const Camera& cam, RenderResult& res, int& iteration_number,
-                               uint64_t marked, int n) {
+                               uint64_t marked, const std::vector<glm::vec2>& offsets,
+                               bool restart) {
   State& s = *s_;
   MarkStreams& d = *s.dense;
-  // The level's n samples of every marked pixel, as few frames as the stream's W x H slots
+  // The level's samples of every marked pixel, as few frames as the stream's W x H slots
   // allow: each frame traces a run of whole samples (sample-major), then adds each sample's
   // colours into the marked pixels' sums in the gated frames' order (acumularDensos).
   d.pack(*s.runner, s.marks.current(), marked);
-  std::vector<glm::vec2> offsets(static_cast<size_t>(n));
-  for (int k = 0; k < n; ++k) offsets[size_t(k)] = sample_offset(n, k, opt_.sample_seed);
   d.set_samples(offsets);
+  const int n = int(offsets.size());
   const int per = d.samples_per_frame();
   for (int k0 = 0; k0 < n; k0 += per) {
     const int k1 = std::min(n, k0 + per);
@@ -56,10 +57,34 @@ void StreamTracer::dense_level(const Camera& cam, RenderResult& res, int& iterat
     frame(cam, s.sample_generate, res, false, iteration_number, &s.marks.current());
     for (int k = k0; k < k1; ++k) {
       d.accumulate(*s.runner, s.sum.current(), s.marks.current(), s.result.current(), k - k0,
-                   k == 0, s.sum.next());
+                   restart && k == 0, s.sum.next());
       s.sum.swap();
     }
   }
+}
+
+void StreamTracer::budget_marks(size_t level, uint64_t& hits, RenderResult& res) {
+  State& s = *s_;
+  PassRunner& r = *s.runner;
+  r.pass(s.score_cones, {&s.marks.current(), &s.result.current()}, s.marks.next());
+  s.marks.swap();
+  auto above = [&](float t) {
+    s.scored_hits.kernel.above = t;
+    return r.count(s.scored_hits, s.marks.current(), nullptr, nullptr);
+  };
+  // Every pixel that hits (the scores are 0 or above the floor, so all exceed -1).
+  uint64_t steps = 0;
+  if (level == 0) hits = above(-1.0f), steps = 1;
+  const std::vector<float>& shares = opt_.aa_budget;
+  const double share = double(shares[std::min(level, shares.size() - 1)]);
+  const auto budget = uint64_t(std::floor(share * double(hits)));
+  const BudgetSearch found = budget_threshold(opt_.threshold(), budget, above);
+  const float t = found.threshold;
+  steps += found.counts;
+  s.cut_scores.kernel.above = t;
+  r.pass(s.cut_scores, {&s.marks.current()}, s.marks.next());
+  s.marks.swap();
+  res.budget_levels.push_back({t, budget, steps});
 }
 
 void StreamTracer::resolve_samples(const vgpu::Program& resolve) {
@@ -99,29 +124,45 @@ void StreamTracer::render_adaptive(const Camera& cam, RenderResult& res, int& it
   s.accumulate.kernel.gated = false;
   accumulate_samples(nullptr);
   const std::vector<int> levels = adaptive_levels(opt_.spp);
+  // The budget's levels keep the samples before them where they fall one to a stratum.
+  const auto kept = budget() ? kept_level_samples(opt_.spp, opt_.sample_seed)
+                             : std::vector<std::vector<glm::vec2>>{};
+  uint64_t hits = 0;
   for (size_t l = 0; l < levels.size(); ++l) {
     // marcarPixeles on the current estimate, then pixelesMarcados: how many get more samples.
-    // (marcarConos instead with --aa-criterion object: kernels/cones.h.)
-    r.pass(cones() ? static_cast<const vgpu::Program&>(s.mark_cones) : s.mark,
-           {&s.marks.current(), &s.result.current()}, s.marks.next());
-    s.marks.swap();
+    // (marcarConos instead with --aa-criterion object: kernels/cones.h; the budget's scores,
+    // search and cut with --aa-criterion budget: kernels/cone_budget.h.)
+    if (budget()) {
+      budget_marks(l, hits, res);
+    } else {
+      r.pass(cones() ? static_cast<const vgpu::Program&>(s.mark_cones) : s.mark,
+             {&s.marks.current(), &s.result.current()}, s.marks.next());
+      s.marks.swap();
+    }
     const uint64_t marked = r.count(s.marked, s.marks.current(), nullptr, nullptr);
     if (marked == 0) break;
-    // The level's n x n samples, only in marked pixels, replacing their earlier ones.
+    // The level's n x n samples, only in marked pixels, replacing their earlier ones; a kept
+    // level's new samples, added to them.
     const int n = levels[l] * levels[l];
+    const bool keeps = l > 0 && l < kept.size();
+    std::vector<glm::vec2> offsets;
+    if (l < kept.size()) {
+      offsets = kept[l];
+    } else {
+      for (int k = 0; k < n; ++k) offsets.push_back(sample_offset(n, k, opt_.sample_seed));
+    }
     if (s.dense) {
-      dense_level(cam, res, iteration_number, marked, n);
+      dense_level(cam, res, iteration_number, marked, offsets, !keeps);
       resolve_samples(s.resolve);
       continue;
     }
     s.sample_generate.kernel.gated = true;
     s.accumulate.kernel.gated = true;
-    for (int k = 0; k < n; ++k) {
-      const glm::vec2 j = sample_offset(n, k, opt_.sample_seed);
-      s.sample_generate.kernel.jitter_x = j.x;
-      s.sample_generate.kernel.jitter_y = j.y;
+    for (size_t k = 0; k < offsets.size(); ++k) {
+      s.sample_generate.kernel.jitter_x = offsets[k].x;
+      s.sample_generate.kernel.jitter_y = offsets[k].y;
       frame(cam, s.sample_generate, res, false, iteration_number, &s.marks.current());
-      s.accumulate.kernel.restart = k == 0;
+      s.accumulate.kernel.restart = k == 0 && !keeps;
       accumulate_samples(&s.marks.current());
     }
     // The new estimate: the next level's marks read it, and after the last level it is the
@@ -140,7 +181,8 @@ void StreamTracer::render_adaptive(const Camera& cam, RenderResult& res, int& it
     for (int x = 0; x < W; ++x) {
       const int samples = int(sum.texel(x, y)[3]);
       most = std::max(most, samples);
-      res.rays_per_pixel[size_t(y) * size_t(W) + size_t(x)] = adaptive_rays(opt_.spp, samples);
+      res.rays_per_pixel[size_t(y) * size_t(W) + size_t(x)] =
+          adaptive_rays(opt_.spp, samples, kept.size());
     }
   res.samples = most;
 }

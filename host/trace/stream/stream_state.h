@@ -11,6 +11,7 @@
 #include "host/trace/stream/ray_streams.h"
 #include "host/trace/stream/stream_tracer.h"
 #include "host/trace/walks/accel_walk.h"
+#include "kernels/cone_budget.h"
 #include "kernels/cones.h"
 
 namespace host {
@@ -49,6 +50,10 @@ struct StreamTracer::State {
   vgpu::KernelProgram<kernels::KeepCones> keep_cones;
   vgpu::KernelProgram<kernels::KeepReflected> keep_reflected;
   vgpu::KernelProgram<kernels::MarkCones> mark_cones;
+  // ... and their budget (--aa-criterion budget): scores, the search's counts, the cut.
+  vgpu::KernelProgram<kernels::ScoreCones> score_cones;
+  vgpu::KernelProgram<kernels::ScoredHits> scored_hits;
+  vgpu::KernelProgram<kernels::CutScores> cut_scores;
   PingPong<vgpu::Texture> marks;
   vgpu::Texture materials;
   // Adaptive undersampling (--aa undersample:K): the lattice, the gaps, the fill.

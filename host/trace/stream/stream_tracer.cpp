@@ -134,15 +134,17 @@ StreamTracer::StreamTracer(const Scene& scene, const Accel& accel, const RenderO
   if (marking) {
     for (int i = 0; i < 2; ++i)
       s.marks[i] = gpu.make_texture(std::string("marks ") + (i ? "B" : "A"), W, H, 4, Format::fp32);
-    s.mark.kernel.threshold = opt_.aa_threshold;
-    s.mark_cones.kernel.threshold = opt_.aa_threshold;
+    s.mark.kernel.threshold = opt_.threshold();
+    s.mark_cones.kernel.threshold = opt_.threshold();
     s.mark_cones.kernel.depth_cones = opt_.cone_depth;
+    s.score_cones.kernel.threshold = opt_.threshold();
+    s.score_cones.kernel.depth_cones = opt_.cone_depth;
     const LatticeUniforms lattice{float(std::max(opt_.undersample, 1)), float(W), float(H)};
     s.mark_lattice.kernel.lattice = lattice;
     s.mark_gaps.kernel.lattice = lattice;
-    s.mark_gaps.kernel.threshold = opt_.aa_threshold;
+    s.mark_gaps.kernel.threshold = opt_.threshold();
     s.fill.kernel.lattice = lattice;
-    s.fill.kernel.threshold = opt_.aa_threshold;
+    s.fill.kernel.threshold = opt_.threshold();
   }
   s.grid_mask = Stencil(W, H, 1);
   s.isect_mask = Stencil(W, H, 1);
@@ -322,6 +324,7 @@ RenderResult StreamTracer::render(const Camera& cam) {
   s.shader.kernel.texture.up = g.up;
   s.shader.kernel.texture.spread = 2.0f * g.tan_half_fov / float(H);
   s.mark_cones.kernel.spread = s.shader.kernel.texture.spread;  // the cones' width per distance
+  s.score_cones.kernel.spread = s.shader.kernel.texture.spread;
   if (opt_.trace_pixel && opt_.trace_out)
     *opt_.trace_out << "pixel " << opt_.trace_pixel->x << "," << opt_.trace_pixel->y << ":\n";
   int iteration_number = 0;

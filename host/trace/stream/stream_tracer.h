@@ -83,9 +83,13 @@ class StreamTracer {
   // frame traced those marks' pixels as a dense stream, whose hits are gathered back first.
   void primary_hits(RenderResult& res, bool aovs, bool keep_hits,
                     const vgpu::Texture* dense_marks = nullptr);
-  // Whether adaptive supersampling decides by the pixels' cones (--aa-criterion object).
+  // Whether adaptive supersampling decides by the pixels' cones (--aa-criterion object, or
+  // budget: their scores).
   bool cones() const {
-    return opt_.adaptive && opt_.aa_criterion == RenderOptions::AaCriterion::object;
+    return opt_.adaptive && opt_.aa_criterion != RenderOptions::AaCriterion::image;
+  }
+  bool budget() const {
+    return opt_.adaptive && opt_.aa_criterion == RenderOptions::AaCriterion::budget;
   }
   // Reflection origin (inicioReflejo): from the rays and their hits, the hit points and the
   // surface record into `surface`, which the shader reads and the next rays start from.
@@ -119,8 +123,15 @@ class StreamTracer {
   void accumulate_gated(const vgpu::Texture* marks, bool restart);
   // One adaptive level with dense streams: the `marked` pixels' n samples each, packed into
   // as few frames as W x H slots allow, their colours added into the sums.
+  // `offsets`: the level's samples; `restart`: the first replaces the pixels' earlier sums (a
+  // kept level adds to them).
   void dense_level(const Camera& cam, RenderResult& res, int& iteration_number, uint64_t marked,
-                   int n);
+                   const std::vector<glm::vec2>& offsets, bool restart);
+  // --aa-criterion budget, one level (kernels/cone_budget.h): puntuarConos scores the
+  // candidates, pixelesPuntuados counts the pixels that hit above a value (the image's hits at
+  // the first level, into `hits`), the binary search finds the least threshold whose count fits
+  // the level's share of them, cortarPuntajes marks the scores above it.
+  void budget_marks(size_t level, uint64_t& hits, RenderResult& res);
   // The sampling resolve, the last stage of a frame with several samples per pixel: `resolve`
   // (resolverMuestras, the box filter, or rellenarHuecos, the undersampling fill) turns the
   // sum of the sample frames into the pixels' colours, in the next result texture, which
