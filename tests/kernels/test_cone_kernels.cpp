@@ -118,17 +118,17 @@ TEST_CASE(
     "score cones scores a candidate by the largest colour step behind an edge its cone sees, or "
     "its colour's bend, and keeps scores above the threshold only") {
   // A 7 x 1 row at t 10 on surface 5 (spread 0.01, 2 cone widths: a fold needs a depth bend
-  // over 0.2), threshold 0.05. Red steps 0 -> 0.3 between pixels 1 and 2; pixel 4 sees
-  // reflected surface 9 and is 0.02 bluer than its neighbours; pixel 6 is no candidate.
-  //  0: flat (bend 0), score 0;  1: red bend 0 + 0.3 - 0 = 0.3;  2: 0 + 0.3 - 0.6: 0.3;
-  //  3: the step to 4 (another reflected key) 0.02, the blue bend 0.6 + 0.62 - 1.2 = 0.02: 0.02;
-  //  4: steps of 0.02 to both sides, the bend 0.6 + 0.6 - 1.24: 0.04;  5: as 3, 0.02;
-  //  6: no candidate: 0, whatever it scores.
+  // over 0.2). Red steps 0 -> 0.3 between pixels 1 and 2; blue ramps evenly, 0.6 + 0.02 x (no
+  // bend but at the clamped ends); pixels 4 to 6 see reflected surface 9; pixel 6 is no
+  // candidate. Scores:
+  //  0: the blue bend at the clamped edge, 0.6 + 0.62 - 1.2 = 0.02;  1, 2: the red bend 0.3;
+  //  3, 4: the blue step across the reflected edge between them, 0.02 (their bends are 0);
+  //  5: 0 (its neighbours see 9 too);  6: no candidate: 0, whatever it scores.
   // At threshold 0.05 only 1 and 2 keep theirs; at 0.01 all do.
   std::vector<glm::vec4> marks, colour;
   for (int x = 0; x < 7; ++x) {
-    marks.push_back({x == 6 ? 0 : 1, 5, 10, x == 4 ? 9 : -1});
-    colour.push_back({x >= 2 ? 0.3f : 0.0f, 0.5f, x == 4 ? 0.62f : 0.6f, 1});
+    marks.push_back({x == 6 ? 0 : 1, 5, 10, x >= 4 ? 9 : -1});
+    colour.push_back({x >= 2 ? 0.3f : 0.0f, 0.5f, 0.6f + 0.02f * float(x), 1});
   }
   const Texture m = texels("marks", 7, 1, marks), c = texels("colour", 7, 1, colour);
   kernels::ScoreCones k;
@@ -139,34 +139,35 @@ TEST_CASE(
   const float score[7] = {0, 0.3f, 0.3f, 0, 0, 0, 0};
   for (int x = 0; x < 7; ++x) {
     CAPTURE(x);
-    CHECK_TEXEL_NEAR(out, x, 0, 1e-5f, glm::vec4(score[x], 5, 10, x == 4 ? 9 : -1));
+    CHECK_TEXEL_NEAR(out, x, 0, 1e-5f, glm::vec4(score[x], 5, 10, x >= 4 ? 9 : -1));
   }
   k.threshold = 0.01f;
   const Texture low = ktest::run(k, {&m, &c}, 7, 1, glm::vec4(9.0f));
-  const float score_low[7] = {0, 0.3f, 0.3f, 0.02f, 0.04f, 0.02f, 0};
+  const float score_low[7] = {0.02f, 0.3f, 0.3f, 0.02f, 0.02f, 0, 0};
   for (int x = 0; x < 7; ++x) {
     CAPTURE(x);
-    CHECK_TEXEL_NEAR(low, x, 0, 1e-5f, glm::vec4(score_low[x], 5, 10, x == 4 ? 9 : -1));
+    CHECK_TEXEL_NEAR(low, x, 0, 1e-5f, glm::vec4(score_low[x], 5, 10, x >= 4 ? 9 : -1));
   }
   k.threshold = 0.05f;
 
-  // Another surface key: a 4 x 1 row, surfaces 5, 5, 7, 7, red 0.2, 0.2, 0.3, 0.3 (a step of
-  // 0.1 at the edge, a bend of 0.1 on both sides): 1 and 2 score 0.1. With one colour on both
-  // surfaces the key edge scores nothing: its step is 0.
-  const Texture mk =
-      texels("marks", 4, 1, {{1, 5, 10, -1}, {1, 5, 10, -1}, {1, 7, 10, -1}, {1, 7, 10, -1}});
-  const Texture ck = texels(
-      "colour", 4, 1,
-      {{0.2f, 0.5f, 0.5f, 1}, {0.2f, 0.5f, 0.5f, 1}, {0.3f, 0.5f, 0.5f, 1}, {0.3f, 0.5f, 0.5f, 1}});
-  const Texture outk = ktest::run(k, {&mk, &ck}, 4, 1, glm::vec4(9.0f));
-  const float keyk[4] = {5, 5, 7, 7}, scorek[4] = {0, 0.1f, 0.1f, 0};
-  for (int x = 0; x < 4; ++x) {
-    CAPTURE(x);
-    CHECK_TEXEL_NEAR(outk, x, 0, 1e-5f, glm::vec4(scorek[x], keyk[x], 10, -1));
+  // Another surface key: a 6 x 1 row, surfaces 5, 5, 5, 7, 7, 7, red ramping evenly 0.2 to 0.7
+  // (bends of 0.1 only at the clamped ends): 2 and 3 score the step across their edge, 0.1.
+  // With one colour everywhere the key edge scores nothing: its step is 0.
+  std::vector<glm::vec4> mkv, ckv;
+  for (int x = 0; x < 6; ++x) {
+    mkv.push_back({1, x < 3 ? 5.0f : 7.0f, 10, -1});
+    ckv.push_back({0.2f + 0.1f * float(x), 0.5f, 0.5f, 1});
   }
-  const Texture same = texels("colour", 4, 1, std::vector<glm::vec4>(4, {0.2f, 0.5f, 0.5f, 1}));
-  const Texture outs = ktest::run(k, {&mk, &same}, 4, 1, glm::vec4(9.0f));
-  for (int x = 0; x < 4; ++x) CHECK_TEXEL(outs, x, 0, glm::vec4(0, keyk[x], 10, -1));
+  const Texture mk = texels("marks", 6, 1, mkv), ck = texels("colour", 6, 1, ckv);
+  const Texture outk = ktest::run(k, {&mk, &ck}, 6, 1, glm::vec4(9.0f));
+  const float scorek[6] = {0.1f, 0, 0.1f, 0.1f, 0, 0.1f};
+  for (int x = 0; x < 6; ++x) {
+    CAPTURE(x);
+    CHECK_TEXEL_NEAR(outk, x, 0, 1e-5f, glm::vec4(scorek[x], x < 3 ? 5 : 7, 10, -1));
+  }
+  const Texture same = texels("colour", 6, 1, std::vector<glm::vec4>(6, {0.2f, 0.5f, 0.5f, 1}));
+  const Texture outs = ktest::run(k, {&mk, &same}, 6, 1, glm::vec4(9.0f));
+  for (int x = 0; x < 6; ++x) CHECK_TEXEL(outs, x, 0, glm::vec4(0, x < 3 ? 5 : 7, 10, -1));
 
   // A fold: a 1 x 4 column on one surface, t 10, 10, 14, 14, green 0.5, 0.5, 0.58, 0.66 (an
   // even ramp from row 1 on: row 2's bend is 0). Rows 1 and 2 fold (depth bends of 4 and -4),
