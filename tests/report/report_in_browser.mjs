@@ -112,6 +112,32 @@ try {
     if (t.grey) check(t.hits === 0, `grey tile ${t.tx},${t.ty} has no hit (${t.hits})`);
     else check(t.start <= t.nearest, `tile ${t.tx},${t.ty}: rays start at ${t.start}, before the nearest hit ${t.nearest}`);
   }
+
+  // An adaptive frame (the budget criterion, the default): the search's section, one table row
+  // per level of the JSON, one point per counting pass (the first level's first count, every
+  // pixel that hits, is the budget's base, not a step), and the pixels marked within budget.
+  const ahtml = path.join(work, "budget.html"), astats = path.join(work, "budget.json");
+  execFileSync(vgpu, ["render", "bunny-refl", "--size", "32x32", "--quiet", "--stats", "none", "--threads", "2",
+    "--bounces", "1", "--aa", "adaptive", "--spp", "16", "--report", ahtml, "--stats-json", astats]);
+  await page.goto("file://" + path.resolve(ahtml));
+  await page.waitForFunction(() => document.body.dataset.ready === "1" || document.body.dataset.error, null, { timeout: 60000 });
+  check(errors.length === 0 && !(await page.evaluate(() => document.body.dataset.error)), `no script errors in the adaptive frame's report (${errors.join("; ")})`);
+  check(await page.isVisible("#budget"), "the budget's section is shown for an adaptive frame");
+  const levels = JSON.parse(fs.readFileSync(astats, "utf8")).sampling.budget_levels;
+  const drawn = await page.evaluate(() => {
+    const rows = [...document.querySelectorAll("#budget-levels tbody tr")].map(tr => [...tr.cells].map(td => td.textContent));
+    const chart = Chart.getChart("budget-chart");
+    return { rows, points: chart.data.datasets.filter((d, i) => i % 2 === 0).map(d => d.data.length) };
+  });
+  check(drawn.rows.length === levels.length && levels.length === 2, `${drawn.rows.length} table rows, ${levels.length} levels`);
+  levels.forEach((l, i) => {
+    const row = drawn.rows[i] || [];
+    check(+row[1].replace(/,/g, "") === l.budget_pixels, `level ${i + 1}: budget ${row[1]} (${l.budget_pixels})`);
+    check(Math.abs(+row[2] - l.threshold) <= 1e-5 * l.threshold, `level ${i + 1}: threshold ${row[2]} (${l.threshold})`);
+    check(drawn.points[i] === l.counting_passes - (i === 0 ? 1 : 0), `level ${i + 1}: ${drawn.points[i]} points, ${l.counting_passes} counting passes`);
+    const marked = +row[4].replace(/,/g, "");
+    check(marked > 0 && marked <= l.budget_pixels, `level ${i + 1}: ${marked} pixels that hit marked, budget ${l.budget_pixels}`);
+  });
 } finally {
   await browser.close();
 }
