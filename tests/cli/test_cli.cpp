@@ -702,14 +702,21 @@ TEST_CASE("beams auto renders the same image, and its JSON and table say what it
   CHECK(au["primary_ms"]["on"].get<double>() < au["primary_ms"]["off"].get<double>());
   CHECK(au["why"].get<std::string>().rfind("on: ", 0) == 0);
   // Where beams cannot run, off without a word on stderr, and the JSON says why.
-  const nlohmann::json bvh = render_json("--bounces 0 --beams auto --accel bvh", dir, o);
+  const nlohmann::json kd = render_json("--bounces 0 --beams auto --accel kdtree", dir, o);
   REQUIRE(o.status == 0);
   CHECK(o.err.empty());
-  CHECK(bvh["beams"]["on"] == false);
-  CHECK_FALSE(bvh["beams"].contains("tiles"));
-  CHECK(bvh["beams"]["auto"]["probed"] == false);
-  CHECK(bvh["beams"]["auto"]["why"].get<std::string>().find("uniform grid only") !=
+  CHECK(kd["beams"]["on"] == false);
+  CHECK_FALSE(kd["beams"].contains("tiles"));
+  CHECK(kd["beams"]["auto"]["probed"] == false);
+  CHECK(kd["beams"]["auto"]["why"].get<std::string>().find("the uniform grid and the BVH only") !=
         std::string::npos);
+  // Through the BVH it probes, and keeps what the probes predict.
+  const nlohmann::json bvh = render_json("--bounces 0 --beams auto --accel bvh", dir, o);
+  REQUIRE(o.status == 0);
+  const nlohmann::json& ba = bvh["beams"]["auto"];
+  CHECK(ba["probed"] == true);
+  CHECK(bvh["beams"]["on"] ==
+        (ba["primary_ms"]["on"].get<double>() < 0.98 * ba["primary_ms"]["off"].get<double>()));
   // The statistics table's summary names the choice.
   const Outcome table = run("render bunny-low --size 32x32 -q --bounces 0 --beams auto --out " +
                             (dir / "image.png").string());
