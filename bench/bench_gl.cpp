@@ -264,17 +264,23 @@ nlohmann::ordered_json measure_latencies(gl::GlDevice& d, int runs, int warmup_m
 // A sampling mode of --sampling: spp:N (N rays per pixel, the accumulation frames),
 // adaptive:N (adaptive supersampling up to N) or undersample:K (the lattice of every K-th
 // pixel, then the gaps); a ":gated" suffix runs the gated frames over the whole target
-// (--compact off) instead of the dense streams. Returns false for anything else, or N not a
+// (--compact off) instead of the dense streams; adaptive's ":image" or ":object" suffix its
+// criterion instead of the default, the budget. Returns false for anything else, or N not a
 // square from 1 to 256.
 bool parse_sampling(const std::string& text, host::RenderOptions& opt) {
   std::smatch m;
-  if (!std::regex_match(text, m, std::regex(R"((spp|adaptive|undersample):(\d{1,4})(:gated)?)")))
+  if (!std::regex_match(
+          text, m, std::regex(R"((spp|adaptive|undersample):(\d{1,4})(:gated)?(:image|:object)?)")))
     return false;
   const int n = std::stoi(m[2]);
   opt.spp = 1;
   opt.adaptive = false;
   opt.undersample = 0;
   opt.compact = !m[3].matched;
+  opt.aa_criterion = m[4] == ":image"    ? host::RenderOptions::AaCriterion::image
+                     : m[4] == ":object" ? host::RenderOptions::AaCriterion::object
+                                         : host::RenderOptions::AaCriterion::budget;
+  if (m[4].matched && m[1] != "adaptive") return false;
   if (m[1] == "undersample") {
     opt.undersample = n;
     return n >= 1 && n <= 64;
@@ -419,7 +425,8 @@ void add_options(CLI::App& app, Args& a) {
       ->capture_default_str();
   app.add_option("--sampling", a.sampling,
                  "Sampling modes per frame: spp:N (N a square, 1 to 256), adaptive:N (--aa "
-                 "adaptive up to N), undersample:K (--aa undersample:K, K 1 to 64); "
+                 "adaptive up to N, the budget criterion; adaptive:N:image, adaptive:N:object "
+                 "the other criteria), undersample:K (--aa undersample:K, K 1 to 64); "
                  "adaptive:N:gated, undersample:K:gated with --compact off")
       ->check(CLI::Validator(
           [](std::string& t) -> std::string {

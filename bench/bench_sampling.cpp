@@ -34,34 +34,43 @@ struct Mode {
   // Dense streams (RenderOptions::compact); false: the gated frames over the whole target, as
   // before issue 35 (the same image, the old cost).
   bool compact = true;
-  bool budget = false;  // --aa-criterion budget (kernels/cone_budget.h), its default shares
+  bool budget = false;                      // --aa-criterion budget (kernels/cone_budget.h)
+  std::vector<float> shares{0.30f, 0.28f};  // its --aa-budget, per level
 };
 
 // The modes docs/sampling.md charts; the first is the one-ray image the others are compared with.
 std::vector<Mode> modes() {
-  std::vector<Mode> m = {{"spp 1", 1},
-                         {"spp 4", 4},
-                         {"spp 16", 16},
-                         {"spp 64", 64},
-                         {"adaptive 16, T 0.05", 16, true, 0.05f},
-                         {"adaptive 16, T 0.1", 16, true, 0.1f},
-                         {"adaptive 16, T 0.2", 16, true, 0.2f},
-                         {"adaptive 64, T 0.1", 64, true, 0.1f},
-                         // --aa-criterion object (docs/sampling.md's cones section; the
-                         // page's other tables leave them out).
-                         {"object 16, T 0.05", 16, true, 0.05f, 0, true},
-                         {"object 16, T 0.1", 16, true, 0.1f, 0, true},
-                         {"object 16, T 0.2", 16, true, 0.2f, 0, true},
-                         {"object 16, T 0.3", 16, true, 0.3f, 0, true},
-                         {"object 16, T 0.1, cones 1", 16, true, 0.1f, 0, true, 1.0f},
-                         {"object 16, T 0.1, cones 4", 16, true, 0.1f, 0, true, 4.0f},
-                         // --aa-criterion budget, its defaults (T 0.05, 30% then 28% of
-                         // the pixels that hit; the 4x4 level keeps the 2x2 samples).
-                         {"budget 16", 16, true, 0.05f, 0, false, 2.0f, true, true},
-                         {"undersample 2", 1, false, 0.1f, 2},
-                         {"undersample 2, T 0.05", 1, false, 0.05f, 2},
-                         {"undersample 2, T 0.02", 1, false, 0.02f, 2},
-                         {"undersample 4", 1, false, 0.1f, 4}};
+  std::vector<Mode> m = {
+      {"spp 1", 1},
+      {"spp 4", 4},
+      {"spp 16", 16},
+      {"spp 64", 64},
+      {"adaptive 16, T 0.05", 16, true, 0.05f},
+      {"adaptive 16, T 0.1", 16, true, 0.1f},
+      {"adaptive 16, T 0.2", 16, true, 0.2f},
+      {"adaptive 64, T 0.1", 64, true, 0.1f},
+      // --aa-criterion object (docs/sampling.md's cones section; the
+      // page's other tables leave them out).
+      {"object 16, T 0.05", 16, true, 0.05f, 0, true},
+      {"object 16, T 0.1", 16, true, 0.1f, 0, true},
+      {"object 16, T 0.2", 16, true, 0.2f, 0, true},
+      {"object 16, T 0.3", 16, true, 0.3f, 0, true},
+      {"object 16, T 0.1, cones 1", 16, true, 0.1f, 0, true, 1.0f},
+      {"object 16, T 0.1, cones 4", 16, true, 0.1f, 0, true, 4.0f},
+      // --aa-criterion budget, its defaults (T 0.05, 30% then 28% of
+      // the pixels that hit; the 4x4 level keeps the 2x2 samples).
+      {"budget 16", 16, true, 0.05f, 0, false, 2.0f, true, true},
+      // ... and other shares (docs/sampling.md's cones section charts them).
+      {"budget 10%/9%", 16, true, 0.05f, 0, false, 2.0f, true, true, {0.10f, 0.09f}},
+      {"budget 15%/13%", 16, true, 0.05f, 0, false, 2.0f, true, true, {0.15f, 0.13f}},
+      {"budget 18%/16%", 16, true, 0.05f, 0, false, 2.0f, true, true, {0.18f, 0.16f}},
+      {"budget 20%/18%", 16, true, 0.05f, 0, false, 2.0f, true, true, {0.20f, 0.18f}},
+      {"budget 25%/23%", 16, true, 0.05f, 0, false, 2.0f, true, true, {0.25f, 0.23f}},
+      {"budget 35%/33%", 16, true, 0.05f, 0, false, 2.0f, true, true, {0.35f, 0.33f}},
+      {"undersample 2", 1, false, 0.1f, 2},
+      {"undersample 2, T 0.05", 1, false, 0.05f, 2},
+      {"undersample 2, T 0.02", 1, false, 0.02f, 2},
+      {"undersample 4", 1, false, 0.1f, 4}};
   // Each adaptive and undersampling mode again as gated frames over the whole target (the
   // object and budget criteria's modes only dense: their section compares rays, not time).
   const size_t n = m.size();
@@ -225,8 +234,11 @@ int main(int argc, char** argv) {
       opt.adaptive = m.adaptive;
       opt.aa_threshold = m.threshold;
       opt.undersample = m.undersample;
-      if (m.object) opt.aa_criterion = host::RenderOptions::AaCriterion::object;
-      if (m.budget) opt.aa_criterion = host::RenderOptions::AaCriterion::budget;
+      // The "adaptive" rows are the image criterion's (no longer the default).
+      opt.aa_criterion = m.object   ? host::RenderOptions::AaCriterion::object
+                         : m.budget ? host::RenderOptions::AaCriterion::budget
+                                    : host::RenderOptions::AaCriterion::image;
+      opt.aa_budget = m.shares;
       opt.cone_depth = m.cone_depth;
       opt.compact = m.compact;
       host::StreamTracer tracer(scene, grid, opt);

@@ -19,8 +19,9 @@ h200="${H200:-.h200}"
 # The CLI's defaults (2 bounces, Phong, shadows), the paper's grid and multipass kernels.
 common="--runs $runs --sizes $size --threads 16 --readback-wait poll --grid auto --no-fixed"
 common="$common --shadows --bounces 2 --variants multipass --warmup-ms 2000"
-modes="spp:1 spp:16 adaptive:16 adaptive:16:gated undersample:2 undersample:2:gated"
+# MODES and PREFIX: other modes into other files (scripts/h200/budget_sampling.sh).
+modes="${MODES:-spp:1 spp:16 adaptive:16 adaptive:16:gated undersample:2 undersample:2:gated}"
 for scene in classic bunny; do
   "$h200/bench_gl" $common --sampling $modes --scenes "scenes/$scene.gltf" \
-    --json "$out/compact_h200_$scene.json"
+    --json "$out/${PREFIX:-compact_h200}_$scene.json"
 done

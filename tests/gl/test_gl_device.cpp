@@ -282,8 +282,8 @@ TEST_CASE(
     "and marks its pixels at both levels") {
   // bunny-refl, spp 16: the 2 x 2 level, then the 4 x 4 level's 12 new samples added to them.
   const auto budget = host::RenderOptions::AaCriterion::budget;
-  const Frame v = render("bunny-refl", "vgpu", 24, true, false, "auto", 16, true, 0, budget),
-              g = render("bunny-refl", "gl", 24, true, false, "auto", 16, true, 0, budget);
+  const Frame v = render("bunny-refl", "vgpu", 16, true, false, "auto", 16, true, 0, budget),
+              g = render("bunny-refl", "gl", 16, true, false, "auto", 16, true, 0, budget);
   const auto& pv = v.result.stats.passes;
   const auto& pg = g.result.stats.passes;
   REQUIRE(pv.size() == pg.size());

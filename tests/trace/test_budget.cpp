@@ -105,7 +105,7 @@ TEST_CASE(
     "the budget criterion refines at most its share of the pixels that hit, and the stream "
     "tracer marks the CPU tracer's pixels") {
   const Frame f("bunny-refl");
-  const host::RenderOptions opt = budget_options(32);
+  const host::RenderOptions opt = budget_options(24);
   host::StreamTracer tracer(f.scene, f.grid, opt);
   const host::RenderResult s = tracer.render(f.camera);
   const host::RenderResult c = host::render_cpu(f.scene, f.grid, f.camera, opt);
