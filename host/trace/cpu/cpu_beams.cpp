@@ -5,10 +5,28 @@
 #include <cmath>
 #include <limits>
 
+#include "host/trace/walks/bvh_beams.h"
 #include "host/trace/walks/grid_beams.h"
 #include "vgpu/fragment.h"
 
 namespace host {
+
+namespace {
+
+// The primary rays' generator, as the stream tracer fills it (its generadorRayos uniforms).
+kernels::GenerateRays beam_camera(const Camera& camera, const RenderOptions& options) {
+  kernels::GenerateRays c;
+  c.forward = camera.forward;
+  c.right = glm::normalize(glm::cross(camera.forward, camera.up));
+  c.up = glm::cross(c.right, camera.forward);
+  c.tan_half_fov = std::tan(0.5f * camera.yfov);
+  c.aspect = float(options.width) / float(options.height);
+  c.width = float(options.width);
+  c.height = float(options.height);
+  return c;
+}
+
+}  // namespace
 
 CpuBeams::CpuBeams(const Grid& grid, const Camera& camera, const RenderOptions& options)
     : distances_(beam_distance_texels(grid)),
@@ -25,16 +43,7 @@ CpuBeams::CpuBeams(const Grid& grid, const Camera& camera, const RenderOptions& 
   g.res = glm::vec3(grid.res);
   kernels::BeamUniforms& u = march_.beams;
   set_beam_grid(u, g, options.beam_tile);
-  // The primary rays' generator, as the stream tracer fills it (its generadorRayos uniforms).
-  const int W = options.width, H = options.height;
-  kernels::GenerateRays& c = u.camera;
-  c.forward = camera.forward;
-  c.right = glm::normalize(glm::cross(camera.forward, camera.up));
-  c.up = glm::cross(c.right, camera.forward);
-  c.tan_half_fov = std::tan(0.5f * camera.yfov);
-  c.aspect = float(W) / float(H);
-  c.width = float(W);
-  c.height = float(H);
+  u.camera = beam_camera(camera, options);
   u.eye = camera.position;
   u.far = beam_far(u, u.eye);
 }
@@ -92,6 +101,95 @@ CpuBeamStart CpuBeams::start(int x, int y, glm::vec2 j) const {
 }
 
 CpuBeamCounts CpuBeams::counts() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return counts_;
+}
+
+CpuBvhBeams::CpuBvhBeams(const Bvh& bvh, const Camera& camera, const RenderOptions& options)
+    : depth_(bvh_levels(bvh)),
+      tiles_x_((options.width + options.beam_tile - 1) / options.beam_tile),
+      tiles_y_((options.height + options.beam_tile - 1) / options.beam_tile),
+      tile_(options.beam_tile) {
+  // The node texels in one row, as the BVH walk lays them out (x, y, z the box, w the escape;
+  // hi's w the leaf's list, -1 for an inner node).
+  const size_t n = bvh.nodes.size();
+  lo_.assign(4 * n, 0.0f);
+  hi_.assign(4 * n, 0.0f);
+  for (size_t i = 0; i < n; ++i) {
+    const BvhNode& node = bvh.nodes[i];
+    for (int a = 0; a < 3; ++a)
+      lo_[4 * i + size_t(a)] = node.lo[a], hi_[4 * i + size_t(a)] = node.hi[a];
+    lo_[4 * i + 3] = float(node.escape);
+    hi_[4 * i + 3] = node.count > 0 ? float(node.leaf) : kernels::kNone;
+  }
+  kernels::BvhBeamUniforms& u = descend_.u;
+  u.bvh.node_width = float(std::max<size_t>(n, 1));
+  u.bvh.nodes = float(n);
+  u.beams.tile = float(options.beam_tile);
+  u.beams.camera = beam_camera(camera, options);
+  u.beams.eye = camera.position;
+  u.beams.margin = bvh_beam_margin(bvh);
+}
+
+const CpuBvhBeams::Map& CpuBvhBeams::map(glm::vec2 j) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::unique_ptr<Map>& slot = maps_[{j.x, j.y}];
+  if (slot) return *slot;
+  slot = std::make_unique<Map>();
+  Map& m = *slot;
+  kernels::BvhBeamDescend descend = descend_;
+  descend.u.beams.offset_x = j.x - 0.5f;
+  descend.u.beams.offset_y = j.y - 0.5f;
+  const size_t tiles = size_t(tiles_x_) * size_t(tiles_y_);
+  m.beams.assign(tiles * 4, 0.0f);  // every beam at the root, descending
+  // The kernel's code one fragment (lane) at a time: a tile's fragment reads only its own beam
+  // texel, so descending one tile to its end is what the passes do to it.
+  using L = vgpu::SimdLanes<1>;
+  using F = L::F;
+  const int nw = int(descend.u.bvh.node_width);
+  vgpu::BoundTexture units[3];
+  units[kernels::BvhBeamDescend::kBeams] = {m.beams.data(), tiles_x_, tiles_y_, 4};
+  units[kernels::BvhBeamDescend::kNodesLo] = {lo_.data(), nw, 1, 4};
+  units[kernels::BvhBeamDescend::kNodesHi] = {hi_.data(), nw, 1, 4};
+  uint64_t idle = 0;
+  vgpu::FetchTally tally;
+  vgpu::Fragments<L> f(units, false, &idle, &tally);
+  uint64_t most = 0;
+  for (int ty = 0; ty < tiles_y_; ++ty)
+    for (int tx = 0; tx < tiles_x_; ++tx) {
+      float* b = &m.beams[(size_t(ty) * size_t(tiles_x_) + size_t(tx)) * 4];
+      uint64_t runs = 0;
+      // As the stream tracer's passes: one level a pass while the beam descends (y 0).
+      while (b[1] <= 0.0f && runs < uint64_t(depth_)) {
+        f.reset(F(float(tx) + 0.5f), F(float(ty) + 0.5f), L::M(true), 1);
+        descend(f);
+        const kernels::Vec4<F>& out = f.output(0);
+        b[0] = out.x[0];
+        b[1] = out.y[0];
+        b[2] = out.z[0];
+        b[3] = out.w[0];
+        ++runs;
+      }
+      most = std::max(most, runs);
+      counts_.steps += runs;
+      counts_.tiles_missed += b[2] > 0.0f;
+    }
+  counts_.tiles += tiles;
+  counts_.passes += most;
+  return m;
+}
+
+CpuBeamStart CpuBvhBeams::start(int x, int y, glm::vec2 j) const {
+  const Map& m = map(j);
+  const size_t t = size_t(y / tile_) * size_t(tiles_x_) + size_t(x / tile_);
+  CpuBeamStart s;
+  s.missed = m.beams[t * 4 + 2] > 0.0f;
+  s.node = int32_t(m.beams[t * 4]);
+  s.end = int32_t(m.beams[t * 4 + 1]);
+  return s;
+}
+
+CpuBeamCounts CpuBvhBeams::counts() const {
   std::lock_guard<std::mutex> lock(mutex_);
   return counts_;
 }

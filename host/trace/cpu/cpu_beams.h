@@ -12,18 +12,22 @@
 #include <utility>
 #include <vector>
 
+#include "host/accel/bvh.h"
 #include "host/accel/grid.h"
 #include "host/scene/camera.h"
 #include "host/trace/render_options.h"
 #include "kernels/beams.h"
+#include "kernels/bvh_beams.h"
 
 namespace host {
 
 // Where a primary ray may start: the ray parameter t before which all of its tile's rays cross
-// empty space (0: from the grid's face), or `missed`: the whole tile misses the grid.
+// empty space (0: from the grid's face), or `missed`: the whole tile misses the grid. Through the
+// BVH: the node its walk starts at and the index its walk ends at (its escape), or missed.
 struct CpuBeamStart {
   float t = 0.0f;
   bool missed = false;
+  int32_t node = 0, end = -1;
 };
 
 // What the beams cost, summed over every beam map a frame marched (one per sample position).
@@ -51,6 +55,30 @@ class CpuBeams {
   kernels::BeamMarch march_;
   std::vector<float> distances_;  // beam_distance_texels
   int tiles_x_ = 0, tiles_y_ = 0, tile_ = 8, dist_w_ = 0, dist_h_ = 0;
+  mutable std::mutex mutex_;
+  mutable std::map<std::pair<float, float>, std::unique_ptr<Map>> maps_;
+  mutable CpuBeamCounts counts_;
+};
+
+// Beams through the BVH in the CPU tracer (--engine cpu --accel bvh --beams on): each tile's
+// descent (kernels::BvhBeamDescend, its own code on the host at one lane, as CpuBeams marches),
+// so that its rays walk only the subtree of its node, [node, escape), in depth-first order as the
+// full walk would: every node outside it is missed by every ray of the tile.
+class CpuBvhBeams {
+ public:
+  CpuBvhBeams(const Bvh& bvh, const Camera& camera, const RenderOptions& options);
+  CpuBeamStart start(int x, int y, glm::vec2 j) const;
+  CpuBeamCounts counts() const;
+
+ private:
+  struct Map {
+    std::vector<float> beams;  // per tile, the beam texel (node, end, missed, depth)
+  };
+  const Map& map(glm::vec2 j) const;
+
+  kernels::BvhBeamDescend descend_;
+  std::vector<float> lo_, hi_;  // the node texels, as the stream tracer's BVH walk writes them
+  int depth_ = 1, tiles_x_ = 0, tiles_y_ = 0, tile_ = 8;
   mutable std::mutex mutex_;
   mutable std::map<std::pair<float, float>, std::unique_ptr<Map>> maps_;
   mutable CpuBeamCounts counts_;

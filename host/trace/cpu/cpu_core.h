@@ -8,6 +8,7 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <vector>
 
@@ -132,16 +133,27 @@ class Tracer {
     for (const SceneTexture& t : scene.textures) chains_.push_back(build_mip_chain(t));
     for (const Material& m : scene.materials) has_glass_ = has_glass_ || m.transmission > 0.0f;
     spread_ = 2.0 * primary_.t / double(opt.height);
-    // Beams over tiles: for the uniform grid's walk only (the options refuse the others).
+    // Beams over tiles: for the uniform grid's walk and the BVH's (the options refuse the
+    // others).
     if (opt.beams && grid_ && !bvh_ && !kd_ && !grid2_)
       beams_ = std::make_unique<CpuBeams>(*grid_, camera, opt);
+    if (opt.beams && bvh_) bvh_beams_ = std::make_unique<CpuBvhBeams>(*bvh_, camera, opt);
   }
 
-  const CpuBeams* beams() const { return beams_.get(); }
+  // What the frame's beams cost (nothing where beams are off).
+  std::optional<CpuBeamCounts> beam_counts() const {
+    if (beams_) return beams_->counts();
+    if (bvh_beams_) return bvh_beams_->counts();
+    return std::nullopt;
+  }
   // Where the primary ray of pixel (x, y) through point j of it starts (null: beams are off).
   const CpuBeamStart* beam_start(int x, int y, glm::vec2 j, CpuBeamStart& s) const {
-    if (!beams_) return nullptr;
-    s = beams_->start(x, y, j);
+    if (beams_)
+      s = beams_->start(x, y, j);
+    else if (bvh_beams_)
+      s = bvh_beams_->start(x, y, j);
+    else
+      return nullptr;
     return &s;
   }
 
@@ -182,7 +194,7 @@ class Tracer {
   Hit trace(const glm::dvec3& o, const glm::dvec3& d, double tmax, bool any_hit, Counters& c,
             const CpuBeamStart* beam = nullptr) const {
     ++c.rays;
-    if (bvh_) return trace_bvh(o, d, tmax, any_hit, c);
+    if (bvh_) return trace_bvh(o, d, tmax, any_hit, c, beam);
     if (kd_) return trace_kd(o, d, tmax, any_hit, c);
     if (grid2_) return trace_grid2(o, d, tmax, any_hit, c);
     Hit best;
@@ -429,15 +441,18 @@ class Tracer {
   std::vector<CpuRay>* log_ = nullptr;
 
   // The stackless BVH walk (kernels/bvh.h) in double: every node in depth-first order whose
-  // padded box the ray meets before the nearest hit so far, its escape otherwise.
-  Hit trace_bvh(const glm::dvec3& o, const glm::dvec3& d, double tmax, bool any_hit,
-                Counters& c) const {
+  // padded box the ray meets before the nearest hit so far, its escape otherwise. `beam` (a
+  // primary ray's, beams through the BVH): only its tile's node's subtree, or nothing where the
+  // whole tile misses.
+  Hit trace_bvh(const glm::dvec3& o, const glm::dvec3& d, double tmax, bool any_hit, Counters& c,
+                const CpuBeamStart* beam) const {
     Hit best;
     if (!(tmax >= 0.0)) return best;
     ++c.entered;
+    if (beam && beam->missed) return best;  // its tile's beam missed the root's box
     const std::vector<BvhNode>& nodes = bvh_->nodes;
-    const int32_t count = int32_t(nodes.size());
-    for (int32_t i = 0; i >= 0 && i < count;) {
+    const int32_t count = beam ? std::min(beam->end, int32_t(nodes.size())) : int32_t(nodes.size());
+    for (int32_t i = beam ? beam->node : 0; i >= 0 && i < count;) {
       ++c.nodes_visited;
       const BvhNode& n = nodes[size_t(i)];
       double tn = 0.0, tf = std::min(best.t, tmax);
@@ -627,10 +642,11 @@ class Tracer {
   // kernels::Shader's and rayosReflejados' constants, so both tracers read them from one place.
   glm::dvec3 ambient_, background_;
   double specular_ = 0, min_weight_ = 0;
-  std::vector<MipChain> chains_;     // per Scene::textures entry
-  bool has_glass_ = false;           // some material has transmission > 0
-  double spread_ = 0;                // angle between neighbouring pixels' rays (base_texel)
-  std::unique_ptr<CpuBeams> beams_;  // beams over tiles (RenderOptions::beams), or null
+  std::vector<MipChain> chains_;            // per Scene::textures entry
+  bool has_glass_ = false;                  // some material has transmission > 0
+  double spread_ = 0;                       // angle between neighbouring pixels' rays (base_texel)
+  std::unique_ptr<CpuBeams> beams_;         // beams over tiles (RenderOptions::beams), or null
+  std::unique_ptr<CpuBvhBeams> bvh_beams_;  // ... through the BVH
 
  public:
   // The stream tracer's float of it (marcarConos' uniform: 2 tan(fov / 2) / height).

@@ -262,8 +262,8 @@ RenderResult render_cpu(const Scene& scene, const Accel& accel, const Camera& ca
   }
   for (auto* kind : {&total.reflected, &total.refracted, &total.total_internal})
     kind->resize(size_t(std::max(res.iterations, 1)), 0);  // one entry per iteration run
-  if (const CpuBeams* beams = tracer.beams()) {
-    const CpuBeamCounts b = beams->counts();
+  if (const std::optional<CpuBeamCounts> counts = tracer.beam_counts()) {
+    const CpuBeamCounts& b = *counts;
     res.beam_tiles = total.beam_tiles = b.tiles;
     res.beam_tiles_missed = total.beam_tiles_missed = b.tiles_missed;
     res.beam_passes = total.beam_passes = b.passes;

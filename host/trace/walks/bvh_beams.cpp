@@ -11,26 +11,35 @@ namespace host {
 
 using vgpu::Texture;
 
-void BvhBeams::set_bvh(const Bvh& bvh, const kernels::BvhUniforms& u) {
-  descend_.kernel.u.bvh = u;
-  entry_.kernel.tile = float(opt_.beam_tile);
-  descend_.kernel.u.beams.tile = float(opt_.beam_tile);
-  // The levels of the tree: a node's children lie one level below it (the right child is where
-  // the left child's subtree ends). Parents come before their children in the layout.
+int bvh_levels(const Bvh& bvh) {
+  // A node's children lie one level below it (the right child is where the left child's
+  // subtree ends). Parents come before their children in the layout.
   std::vector<int> level(bvh.nodes.size(), 1);
-  depth_ = 1;
+  int depth = 1;
   for (size_t i = 0; i < bvh.nodes.size(); ++i) {
-    depth_ = std::max(depth_, level[i]);
+    depth = std::max(depth, level[i]);
     const int32_t escape = bvh.nodes[i].escape;
     if (bvh.nodes[i].count > 0 || i + 1 >= bvh.nodes.size() || size_t(escape) == i + 1) continue;
     level[i + 1] = level[i] + 1;
     const int32_t right = bvh.nodes[i + 1].escape;
     if (right > 0 && size_t(right) < bvh.nodes.size()) level[size_t(right)] = level[i] + 1;
   }
-  // The frustum test's margin: far above the rounding of the pixels' rays and of the plane
-  // test over the scene's extent, far below any gap worth skipping.
+  return depth;
+}
+
+float bvh_beam_margin(const Bvh& bvh) {
+  // Far above the rounding of the pixels' rays and of the plane test over the scene's extent,
+  // far below any gap worth skipping.
   const glm::vec3 extent = bvh.nodes.empty() ? glm::vec3(1.0f) : bvh.nodes[0].hi - bvh.nodes[0].lo;
-  descend_.kernel.u.beams.margin = 1e-4f * std::max(1.0f, glm::length(extent));
+  return 1e-4f * std::max(1.0f, glm::length(extent));
+}
+
+void BvhBeams::set_bvh(const Bvh& bvh, const kernels::BvhUniforms& u) {
+  descend_.kernel.u.bvh = u;
+  entry_.kernel.tile = float(opt_.beam_tile);
+  descend_.kernel.u.beams.tile = float(opt_.beam_tile);
+  depth_ = bvh_levels(bvh);
+  descend_.kernel.u.beams.margin = bvh_beam_margin(bvh);
 }
 
 int BvhBeams::tiles_x() const {

@@ -16,6 +16,12 @@
 
 namespace host {
 
+// The levels of the hierarchy (the most descent passes a beam needs: a node's children lie one
+// level below it) and the frustum test's margin (from the size of the root's box): the stream
+// tracer's descent and the CPU tracer's (host/trace/cpu/cpu_beams.h) take both from here.
+int bvh_levels(const Bvh& bvh);
+float bvh_beam_margin(const Bvh& bvh);
+
 class BvhBeams {
  public:
   explicit BvhBeams(const RenderOptions& options) : opt_(options) {}
