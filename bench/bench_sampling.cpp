@@ -84,6 +84,23 @@ std::vector<Mode> modes() {
   return m;
 }
 
+// The render options of mode m over the bench's `base`.
+host::RenderOptions mode_options(const Mode& m, const host::RenderOptions& base) {
+  host::RenderOptions opt = base;
+  opt.spp = m.spp;
+  opt.adaptive = m.adaptive;
+  opt.aa_threshold = m.threshold;
+  opt.undersample = m.undersample;
+  // The "adaptive" rows are the image criterion's (no longer the default).
+  opt.aa_criterion = m.object   ? host::RenderOptions::AaCriterion::object
+                     : m.budget ? host::RenderOptions::AaCriterion::budget
+                                : host::RenderOptions::AaCriterion::image;
+  opt.aa_budget = m.shares;
+  opt.cone_depth = m.cone_depth;
+  opt.compact = m.compact;
+  return opt;
+}
+
 // An image as the PNG writer stores it: each channel clamped to [0, 1] and rounded to 8 bits,
 // read back in [0, 1] (the error is the one a viewer of the files would see).
 std::vector<double> as_8bit(const std::vector<float>& rgb) {
@@ -229,18 +246,7 @@ int main(int argc, char** argv) {
                           });
       if (!wanted) continue;
       std::fprintf(stderr, "bench_sampling: %s: %s\n", name.c_str(), m.label.c_str());
-      host::RenderOptions opt = base;
-      opt.spp = m.spp;
-      opt.adaptive = m.adaptive;
-      opt.aa_threshold = m.threshold;
-      opt.undersample = m.undersample;
-      // The "adaptive" rows are the image criterion's (no longer the default).
-      opt.aa_criterion = m.object   ? host::RenderOptions::AaCriterion::object
-                         : m.budget ? host::RenderOptions::AaCriterion::budget
-                                    : host::RenderOptions::AaCriterion::image;
-      opt.aa_budget = m.shares;
-      opt.cone_depth = m.cone_depth;
-      opt.compact = m.compact;
+      const host::RenderOptions opt = mode_options(m, base);
       host::StreamTracer tracer(scene, grid, opt);
       host::RenderResult r;
       std::vector<double> ms;
