@@ -6,6 +6,7 @@
 #include <doctest/doctest.h>
 
 #include <string>
+#include <vector>
 
 #include "host/accel/accel.h"
 #include "host/accel/grid.h"
@@ -21,14 +22,6 @@ struct Frame {
   std::string device;
 };
 
-Frame render(const host::Scene& scene, const host::Grid& grid, host::RenderOptions opt,
-             const std::string& device, bool beams) {
-  opt.device = device;
-  opt.beams = beams;
-  host::StreamTracer tracer(scene, grid, opt);
-  return {tracer.render(host::scene_camera(scene)), tracer.device().description()};
-}
-
 Frame render(const host::Scene& scene, const host::Accel& accel, host::RenderOptions opt,
              const std::string& device, bool beams) {
   opt.device = device;
@@ -43,18 +36,18 @@ uint64_t passes_of(const host::RenderResult& r, const std::string& program) {
   return n;
 }
 
-}  // namespace
+struct Setup {
+  const char* scene;
+  int width, height, tile, bounces;
+};
 
-TEST_CASE(
-    "beams over tiles on the GL device give the emulator's beam queries, hit ids, depths "
-    "and image, and the image of beams off") {
-  struct Setup {
-    const char* scene;
-    int width, height, tile, bounces;
-  };
-  // 36x28 in 8x8 tiles: the last column and row of tiles are cut short; classic with one
-  // bounce and its shadows, the bunny's primary rays alone.
-  for (const Setup s : {Setup{"classic", 36, 28, 8, 1}, Setup{"bunny-low", 32, 32, 4, 0}}) {
+// The emulator's frame with beams and the GL frames with and without them, through `kind`: the
+// same passes in the same order, each query counting the same fragments (the beams still
+// marching or descending after each beam pass, the tiles missed, the rays walking after each
+// step); `beam_pass` runs once per beam pass, `entry` once; the same hit ids, depths and image.
+void check_beams_on_gl(host::AccelKind kind, const std::vector<Setup>& setups,
+                       const std::string& beam_pass, const std::string& entry) {
+  for (const Setup& s : setups) {
     const std::string name = s.scene;
     CAPTURE(name);
     const host::Scene scene = host::load_scene(host::resolve_scene(s.scene));
@@ -66,22 +59,20 @@ TEST_CASE(
     opt.shadows = s.bounces > 0;
     opt.beam_tile = s.tile;
     opt.keep_pass_records = true;
-    const host::Grid grid =
-        host::build_grid(scene, host::grid_spec_for({}, scene, vgpu::profile(opt.profile)));
-    const Frame vgpu_on = render(scene, grid, opt, "vgpu", true);
-    const Frame gl_on = render(scene, grid, opt, "gl", true);
-    const Frame gl_off = render(scene, grid, opt, "gl", false);
+    const auto accel = host::make_accel(
+        kind, scene, host::AccelParams{host::grid_spec_for({}, scene, vgpu::profile(opt.profile))});
+    const Frame vgpu_on = render(scene, *accel, opt, "vgpu", true);
+    const Frame gl_on = render(scene, *accel, opt, "gl", true);
+    const Frame gl_off = render(scene, *accel, opt, "gl", false);
     const host::RenderResult &a = vgpu_on.result, &b = gl_on.result;
-    // The same passes in the same order, each query counting the same fragments: the beams
-    // still marching after each march pass, the tiles missed, the rays walking after each step.
     REQUIRE(a.stats.passes.size() == b.stats.passes.size());
     for (size_t i = 0; i < a.stats.passes.size(); ++i) {
       CAPTURE(i);
       REQUIRE(a.stats.passes[i].program == b.stats.passes[i].program);
       CHECK(a.stats.passes[i].query_result == b.stats.passes[i].query_result);
     }
-    CHECK(passes_of(b, "beam march") == b.beam_passes);
-    CHECK(passes_of(b, "beam entry") == 1);
+    CHECK(passes_of(b, beam_pass) == b.beam_passes);
+    CHECK(passes_of(b, entry) == 1);
     CHECK(b.beam_passes == a.beam_passes);
     CHECK(b.beam_passes > 1);
     CHECK(b.beam_tiles == a.beam_tiles);
@@ -97,52 +88,22 @@ TEST_CASE(
   }
 }
 
+}  // namespace
+
+TEST_CASE(
+    "beams over tiles on the GL device give the emulator's beam queries, hit ids, depths "
+    "and image, and the image of beams off") {
+  // 36x28 in 8x8 tiles: the last column and row of tiles are cut short; classic with one
+  // bounce and its shadows, the bunny's primary rays alone.
+  check_beams_on_gl(host::AccelKind::grid, {{"classic", 36, 28, 8, 1}, {"bunny-low", 32, 32, 4, 0}},
+                    "beam march", "beam entry");
+}
+
 TEST_CASE(
     "beams through the BVH on the GL device give the emulator's descent queries, hit ids, "
     "depths and image, and the image of beams off") {
   // bunny-low's primary rays at 32x24 in 8x8 tiles, and classic with one bounce and its shadows
   // at 24x24 in 6x6 tiles (the step ends each primary ray's walk at its tile's node).
-  struct Setup {
-    const char* scene;
-    int width, height, tile, bounces;
-  };
-  for (const Setup s : {Setup{"bunny-low", 32, 24, 8, 0}, Setup{"classic", 24, 24, 6, 1}}) {
-    const std::string name = s.scene;
-    CAPTURE(name);
-    const host::Scene scene = host::load_scene(host::resolve_scene(s.scene));
-    host::RenderOptions opt;
-    opt.width = s.width;
-    opt.height = s.height;
-    opt.threads = 2;
-    opt.bounces = s.bounces;
-    opt.shadows = s.bounces > 0;
-    opt.beam_tile = s.tile;
-    opt.keep_pass_records = true;
-    const auto bvh = host::make_accel(
-        host::AccelKind::bvh, scene,
-        host::AccelParams{host::grid_spec_for({}, scene, vgpu::profile(opt.profile))});
-    const Frame vgpu_on = render(scene, *bvh, opt, "vgpu", true);
-    const Frame gl_on = render(scene, *bvh, opt, "gl", true);
-    const Frame gl_off = render(scene, *bvh, opt, "gl", false);
-    const host::RenderResult &a = vgpu_on.result, &b = gl_on.result;
-    REQUIRE(a.stats.passes.size() == b.stats.passes.size());
-    for (size_t i = 0; i < a.stats.passes.size(); ++i) {
-      CAPTURE(i);
-      REQUIRE(a.stats.passes[i].program == b.stats.passes[i].program);
-      CHECK(a.stats.passes[i].query_result == b.stats.passes[i].query_result);
-    }
-    // One descent pass per tree level the beams went down, each followed by its count.
-    CHECK(passes_of(b, "bvh beam descend") == b.beam_passes);
-    CHECK(passes_of(b, "bvh beams descending") >= 1);
-    CHECK(passes_of(b, "bvh beam enter") == 1);
-    CHECK(b.beam_passes > 1);
-    CHECK(b.beam_passes == a.beam_passes);
-    CHECK(b.beam_tiles == a.beam_tiles);
-    CHECK(b.beam_tiles_missed == a.beam_tiles_missed);
-    CHECK(gl_off.result.beam_passes == 0);
-    gltest::check_same_frame(gl_on.device, "intersections", a.hit_id, b.hit_id, a.depth, b.depth,
-                             a.rgb, b.rgb);
-    gltest::check_same_frame(gl_on.device, "intersections", gl_off.result.hit_id, b.hit_id,
-                             gl_off.result.depth, b.depth, gl_off.result.rgb, b.rgb);
-  }
+  check_beams_on_gl(host::AccelKind::bvh, {{"bunny-low", 32, 24, 8, 0}, {"classic", 24, 24, 6, 1}},
+                    "bvh beam descend", "bvh beam enter");
 }

@@ -117,7 +117,7 @@ try {
   // per level of the JSON, one point per counting pass (the first level's first count, every
   // pixel that hits, is the budget's base, not a step), and the pixels marked within budget.
   const ahtml = path.join(work, "budget.html"), astats = path.join(work, "budget.json");
-  execFileSync(vgpu, ["render", "bunny-refl", "--size", "32x32", "--quiet", "--stats", "none", "--threads", "2",
+  execFileSync(vgpu, ["render", "bunny-refl", "--size", "24x24", "--quiet", "--stats", "none", "--threads", "2",
     "--bounces", "1", "--aa", "adaptive", "--spp", "16", "--report", ahtml, "--stats-json", astats]);
   await page.goto("file://" + path.resolve(ahtml));
   await page.waitForFunction(() => document.body.dataset.ready === "1" || document.body.dataset.error, null, { timeout: 60000 });

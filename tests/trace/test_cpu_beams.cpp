@@ -22,102 +22,65 @@
 using test_support::same_bits;
 
 TEST_CASE(
-    "the CPU tracer's beams give the per-pixel rays' hit ids, depths and images, and the "
-    "emulator's beam counts") {
+    "the CPU tracer's beams, through the grid and through the BVH, give the per-pixel rays' hit "
+    "ids, depths and images, fewer steps, and the emulator's beam counts") {
   struct Setup {
     const char* scene;
     int width, height, tile, bounces, spp;
   };
-  // 36x28 in 8x8 tiles: the last tiles are cut short; classic with a bounce and shadows; the
-  // bunny's primary rays in 4x4 tiles; and four jittered samples a pixel (a beam map each).
-  for (const Setup s : {Setup{"classic", 36, 28, 8, 1, 1}, Setup{"bunny-low", 32, 32, 4, 0, 1},
-                        Setup{"bunny-low", 16, 16, 4, 0, 4}}) {
-    const std::string name = s.scene;
-    CAPTURE(name);
-    CAPTURE(s.spp);
-    const host::Scene scene = host::load_scene(host::resolve_scene(s.scene));
-    const host::Camera camera = host::scene_camera(scene);
-    host::RenderOptions opt;
-    opt.width = s.width;
-    opt.height = s.height;
-    opt.threads = 2;
-    opt.bounces = s.bounces;
-    opt.shadows = s.bounces > 0;
-    opt.spp = s.spp;
-    opt.beam_tile = s.tile;
-    const host::Grid grid =
-        host::build_grid(scene, host::grid_spec_for({}, scene, vgpu::profile(opt.profile)));
-    host::CpuStats off_stats, on_stats;
-    const host::RenderResult off = host::render_cpu(scene, grid, camera, opt, &off_stats);
-    opt.beams = true;
-    const host::RenderResult on = host::render_cpu(scene, grid, camera, opt, &on_stats);
-    CHECK(same_bits(off.hit_id, on.hit_id));
-    CHECK(same_bits(off.depth, on.depth));
-    CHECK(same_bits(off.rgb, on.rgb));
-    CHECK(on.rays_traced == off.rays_traced);
-    // The rays start later: fewer voxels stepped through.
-    CHECK(on_stats.voxel_steps < off_stats.voxel_steps);
-    CHECK(off_stats.beam_tiles == 0);
-    // The emulator marches the same beams (the same kernel, the same floats).
-    host::StreamTracer tracer(scene, grid, opt);
-    const host::RenderResult gpu = tracer.render(camera);
-    const uint64_t tiles = uint64_t((s.width + s.tile - 1) / s.tile) *
-                           uint64_t((s.height + s.tile - 1) / s.tile) * uint64_t(s.spp);
-    CHECK(on_stats.beam_tiles == tiles);
-    CHECK(gpu.beam_tiles == tiles);
-    CHECK(on_stats.beam_tiles_missed == gpu.beam_tiles_missed);
-    CHECK(on_stats.beam_passes == gpu.beam_passes);
-    CHECK(on.beam_passes == gpu.beam_passes);
-    CHECK(on_stats.beam_tiles_missed > 0);
-    CHECK(on_stats.beam_steps > on_stats.beam_tiles);
-  }
-}
-
-TEST_CASE(
-    "the CPU tracer's beams through the BVH give the per-pixel rays' hit ids, depths and images, "
-    "fewer node visits, and the emulator's descent counts") {
-  struct Setup {
-    const char* scene;
-    int width, height, tile, bounces, spp;
-  };
-  // classic with a bounce and shadows (only primary rays start at their tile's node), the
-  // bunny's primary rays in 4x4 tiles, and four jittered samples a pixel (a descent each).
-  for (const Setup s : {Setup{"classic", 36, 28, 8, 1, 1}, Setup{"bunny-low", 32, 32, 4, 0, 1},
-                        Setup{"bunny-low", 16, 16, 4, 0, 4}}) {
-    const std::string name = s.scene;
-    CAPTURE(name);
-    CAPTURE(s.spp);
-    const host::Scene scene = host::load_scene(host::resolve_scene(s.scene));
-    const host::Camera camera = host::scene_camera(scene);
-    host::RenderOptions opt;
-    opt.width = s.width;
-    opt.height = s.height;
-    opt.threads = 2;
-    opt.bounces = s.bounces;
-    opt.shadows = s.bounces > 0;
-    opt.spp = s.spp;
-    opt.beam_tile = s.tile;
-    const auto bvh = host::make_accel(
-        host::AccelKind::bvh, scene,
-        host::AccelParams{host::grid_spec_for({}, scene, vgpu::profile(opt.profile))});
-    host::CpuStats off_stats, on_stats;
-    const host::RenderResult off = host::render_cpu(scene, *bvh, camera, opt, &off_stats);
-    opt.beams = true;
-    const host::RenderResult on = host::render_cpu(scene, *bvh, camera, opt, &on_stats);
-    CHECK(same_bits(off.hit_id, on.hit_id));
-    CHECK(same_bits(off.depth, on.depth));
-    CHECK(same_bits(off.rgb, on.rgb));
-    CHECK(on.rays_traced == off.rays_traced);
-    CHECK(on_stats.nodes_visited < off_stats.nodes_visited);
-    CHECK(on_stats.triangle_tests == off_stats.triangle_tests);
-    host::StreamTracer tracer(scene, *bvh, opt);
-    const host::RenderResult gpu = tracer.render(camera);
-    CHECK(on_stats.beam_tiles == gpu.beam_tiles);
-    CHECK(on_stats.beam_tiles_missed == gpu.beam_tiles_missed);
-    CHECK(on_stats.beam_passes == gpu.beam_passes);
-    CHECK(on_stats.beam_passes > 1);
-    CHECK(on_stats.beam_tiles_missed > 0);
-  }
+  // 36x28 in 8x8 tiles: the last tiles are cut short; classic with a bounce and shadows (only
+  // primary rays start where their beam stopped); the bunny's primary rays in 4x4 tiles; and
+  // four jittered samples a pixel (a beam map each).
+  for (const host::AccelKind kind : {host::AccelKind::grid, host::AccelKind::bvh})
+    for (const Setup s : {Setup{"classic", 36, 28, 8, 1, 1}, Setup{"bunny-low", 32, 32, 4, 0, 1},
+                          Setup{"bunny-low", 16, 16, 4, 0, 4}}) {
+      const std::string name = s.scene;
+      CAPTURE(name);
+      CAPTURE(s.spp);
+      CAPTURE(int(kind));
+      const host::Scene scene = host::load_scene(host::resolve_scene(s.scene));
+      const host::Camera camera = host::scene_camera(scene);
+      host::RenderOptions opt;
+      opt.width = s.width;
+      opt.height = s.height;
+      opt.threads = 2;
+      opt.bounces = s.bounces;
+      opt.shadows = s.bounces > 0;
+      opt.spp = s.spp;
+      opt.beam_tile = s.tile;
+      const auto accel = host::make_accel(
+          kind, scene,
+          host::AccelParams{host::grid_spec_for({}, scene, vgpu::profile(opt.profile))});
+      host::CpuStats off_stats, on_stats;
+      const host::RenderResult off = host::render_cpu(scene, *accel, camera, opt, &off_stats);
+      opt.beams = true;
+      const host::RenderResult on = host::render_cpu(scene, *accel, camera, opt, &on_stats);
+      CHECK(same_bits(off.hit_id, on.hit_id));
+      CHECK(same_bits(off.depth, on.depth));
+      CHECK(same_bits(off.rgb, on.rgb));
+      CHECK(on.rays_traced == off.rays_traced);
+      CHECK(on_stats.triangle_tests == off_stats.triangle_tests);
+      // The rays start later (the grid: fewer voxels stepped through) or lower in the tree (the
+      // BVH: fewer nodes visited).
+      if (kind == host::AccelKind::grid)
+        CHECK(on_stats.voxel_steps < off_stats.voxel_steps);
+      else
+        CHECK(on_stats.nodes_visited < off_stats.nodes_visited);
+      CHECK(off_stats.beam_tiles == 0);
+      // The emulator runs the same beams (the same kernel, the same floats).
+      host::StreamTracer tracer(scene, *accel, opt);
+      const host::RenderResult gpu = tracer.render(camera);
+      const uint64_t tiles = uint64_t((s.width + s.tile - 1) / s.tile) *
+                             uint64_t((s.height + s.tile - 1) / s.tile) * uint64_t(s.spp);
+      CHECK(on_stats.beam_tiles == tiles);
+      CHECK(gpu.beam_tiles == tiles);
+      CHECK(on_stats.beam_tiles_missed == gpu.beam_tiles_missed);
+      CHECK(on_stats.beam_passes == gpu.beam_passes);
+      CHECK(on.beam_passes == gpu.beam_passes);
+      CHECK(on_stats.beam_passes > 1);
+      CHECK(on_stats.beam_tiles_missed > 0);
+      CHECK(on_stats.beam_steps > on_stats.beam_tiles);
+    }
 }
 
 namespace {

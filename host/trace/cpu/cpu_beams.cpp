@@ -26,6 +26,42 @@ kernels::GenerateRays beam_camera(const Camera& camera, const RenderOptions& opt
   return c;
 }
 
+// Runs a beam kernel's own code one fragment (lane) at a time over every tile of `beams` (four
+// floats a tile, the beam texture `units` binds): a tile's fragment reads only its own beam texel,
+// so running one tile to its end is what the passes do to it. A tile runs while `going(texel)`,
+// at most `limit` times; the steps, the passes a GPU would run (the most one tile ran) and the
+// tiles missed (z > 0) go into `counts`.
+template <class K, class Going>
+void run_tiles(const K& kernel, const vgpu::BoundTexture* units, std::vector<float>& beams,
+               int tiles_x, int tiles_y, uint64_t limit, Going going, CpuBeamCounts& counts) {
+  using L = vgpu::SimdLanes<1>;
+  using F = L::F;
+  uint64_t idle = 0;
+  vgpu::FetchTally tally;
+  vgpu::Fragments<L> f(units, false, &idle, &tally);
+  uint64_t most = 0;
+  for (int ty = 0; ty < tiles_y; ++ty)
+    for (int tx = 0; tx < tiles_x; ++tx) {
+      float* b = &beams[(size_t(ty) * size_t(tiles_x) + size_t(tx)) * 4];
+      uint64_t runs = 0;
+      while (going(b) && runs < limit) {
+        f.reset(F(float(tx) + 0.5f), F(float(ty) + 0.5f), L::M(true), 1);
+        kernel(f);
+        const kernels::Vec4<F>& out = f.output(0);
+        b[0] = out.x[0];
+        b[1] = out.y[0];
+        b[2] = out.z[0];
+        b[3] = out.w[0];
+        ++runs;
+      }
+      most = std::max(most, runs);
+      counts.steps += runs;
+      counts.tiles_missed += b[2] > 0.0f;
+    }
+  counts.tiles += uint64_t(tiles_x) * uint64_t(tiles_y);
+  counts.passes += most;
+}
+
 }  // namespace
 
 CpuBeams::CpuBeams(const Grid& grid, const Camera& camera, const RenderOptions& options)
@@ -58,39 +94,14 @@ const CpuBeams::Map& CpuBeams::map(glm::vec2 j) const {
   kernels::BeamMarch march = march_;
   march.beams.offset_x = j.x - 0.5f;
   march.beams.offset_y = j.y - 0.5f;
-  const size_t tiles = size_t(tiles_x_) * size_t(tiles_y_);
-  m.beams.assign(tiles * 4, 0.0f);  // every beam at the eye, marching
-  // The kernel's code itself, one fragment (lane) at a time: each tile's fragment reads only its
-  // own beam texel, so marching one tile to its end is what the passes do to it.
-  using L = vgpu::SimdLanes<1>;
-  using F = L::F;
+  m.beams.assign(size_t(tiles_x_) * size_t(tiles_y_) * 4, 0.0f);  // every beam at the eye
   vgpu::BoundTexture units[2];
   units[kernels::BeamMarch::kBeams] = {m.beams.data(), tiles_x_, tiles_y_, 4};
   units[kernels::BeamMarch::kDistances] = {distances_.data(), dist_w_, dist_h_, 1};
-  uint64_t idle = 0;
-  vgpu::FetchTally tally;
-  vgpu::Fragments<L> f(units, false, &idle, &tally);
-  uint64_t most = 0;
-  for (int ty = 0; ty < tiles_y_; ++ty)
-    for (int tx = 0; tx < tiles_x_; ++tx) {
-      float* b = &m.beams[(size_t(ty) * size_t(tiles_x_) + size_t(tx)) * 4];
-      uint64_t runs = 0;
-      while (b[0] >= 0.0f && runs < uint64_t(GridBeams::kMaxPasses)) {
-        f.reset(F(float(tx) + 0.5f), F(float(ty) + 0.5f), L::M(true), 1);
-        march(f);
-        const kernels::Vec4<F>& out = f.output(0);
-        b[0] = out.x[0];
-        b[1] = out.y[0];
-        b[2] = out.z[0];
-        b[3] = out.w[0];
-        ++runs;
-      }
-      most = std::max(most, runs);
-      counts_.steps += runs;
-      counts_.tiles_missed += b[2] > 0.0f;
-    }
-  counts_.tiles += tiles;
-  counts_.passes += most;
+  // A beam marches while x >= 0.
+  run_tiles(
+      march, units, m.beams, tiles_x_, tiles_y_, uint64_t(GridBeams::kMaxPasses),
+      [](const float* b) { return b[0] >= 0.0f; }, counts_);
   return m;
 }
 
@@ -140,42 +151,16 @@ const CpuBvhBeams::Map& CpuBvhBeams::map(glm::vec2 j) const {
   kernels::BvhBeamDescend descend = descend_;
   descend.u.beams.offset_x = j.x - 0.5f;
   descend.u.beams.offset_y = j.y - 0.5f;
-  const size_t tiles = size_t(tiles_x_) * size_t(tiles_y_);
-  m.beams.assign(tiles * 4, 0.0f);  // every beam at the root, descending
-  // The kernel's code one fragment (lane) at a time: a tile's fragment reads only its own beam
-  // texel, so descending one tile to its end is what the passes do to it.
-  using L = vgpu::SimdLanes<1>;
-  using F = L::F;
+  m.beams.assign(size_t(tiles_x_) * size_t(tiles_y_) * 4, 0.0f);  // every beam at the root
   const int nw = int(descend.u.bvh.node_width);
   vgpu::BoundTexture units[3];
   units[kernels::BvhBeamDescend::kBeams] = {m.beams.data(), tiles_x_, tiles_y_, 4};
   units[kernels::BvhBeamDescend::kNodesLo] = {lo_.data(), nw, 1, 4};
   units[kernels::BvhBeamDescend::kNodesHi] = {hi_.data(), nw, 1, 4};
-  uint64_t idle = 0;
-  vgpu::FetchTally tally;
-  vgpu::Fragments<L> f(units, false, &idle, &tally);
-  uint64_t most = 0;
-  for (int ty = 0; ty < tiles_y_; ++ty)
-    for (int tx = 0; tx < tiles_x_; ++tx) {
-      float* b = &m.beams[(size_t(ty) * size_t(tiles_x_) + size_t(tx)) * 4];
-      uint64_t runs = 0;
-      // As the stream tracer's passes: one level a pass while the beam descends (y 0).
-      while (b[1] <= 0.0f && runs < uint64_t(depth_)) {
-        f.reset(F(float(tx) + 0.5f), F(float(ty) + 0.5f), L::M(true), 1);
-        descend(f);
-        const kernels::Vec4<F>& out = f.output(0);
-        b[0] = out.x[0];
-        b[1] = out.y[0];
-        b[2] = out.z[0];
-        b[3] = out.w[0];
-        ++runs;
-      }
-      most = std::max(most, runs);
-      counts_.steps += runs;
-      counts_.tiles_missed += b[2] > 0.0f;
-    }
-  counts_.tiles += tiles;
-  counts_.passes += most;
+  // As the stream tracer's passes: one level a pass while the beam descends (y 0).
+  run_tiles(
+      descend, units, m.beams, tiles_x_, tiles_y_, uint64_t(depth_),
+      [](const float* b) { return b[1] <= 0.0f; }, counts_);
   return m;
 }
 
