@@ -87,6 +87,20 @@ uint32_t adaptive_rays(int spp, int samples) {
   return rays;
 }
 
+std::vector<glm::vec2> adaptive_level_offsets(int spp, size_t level,
+                                              const std::vector<std::vector<glm::vec2>>& kept,
+                                              uint64_t seed) {
+  if (level < kept.size()) return kept[level];
+  const int side = adaptive_levels(spp)[level], m = side * side;
+  std::vector<glm::vec2> offsets;
+  for (int k = 0; k < m; ++k) offsets.push_back(sample_offset(m, k, seed));
+  return offsets;
+}
+
+uint64_t budget_pixels(const std::vector<float>& shares, size_t level, uint64_t hits) {
+  return uint64_t(std::floor(double(shares[std::min(level, shares.size() - 1)]) * double(hits)));
+}
+
 uint32_t adaptive_rays(int spp, int samples, size_t kept) {
   uint32_t rays = 1;
   int before = 0;  // the samples the pixel held before the level

@@ -36,6 +36,17 @@ std::vector<int> adaptive_levels(int spp);
 // double, as spp 9's 2 then 3); spp 16: 4 offsets, then 12.
 std::vector<std::vector<glm::vec2>> kept_level_samples(int spp, uint64_t seed);
 
+// The sample offsets adaptive level `level` (of adaptive_levels(spp)) traces: `kept`'s (the
+// kept_level_samples list, empty when levels do not keep) where it has the level, else the
+// level's own n x n.
+std::vector<glm::vec2> adaptive_level_offsets(int spp, size_t level,
+                                              const std::vector<std::vector<glm::vec2>>& kept,
+                                              uint64_t seed);
+
+// The budget criterion's pixels that hit level `level` may refine: its share (the last one for
+// deeper levels) of `hits`, rounded down.
+uint64_t budget_pixels(const std::vector<float>& shares, size_t level, uint64_t hits);
+
 // The primary rays a pixel took under adaptive supersampling when its final sample count is
 // `samples` (1: the centre ray alone; n*n: every level up to side n, after the centre ray).
 uint32_t adaptive_rays(int spp, int samples);

@@ -112,9 +112,7 @@ void adaptive(const Tracer& tracer, const RenderOptions& opt, unsigned workers,
     if (budget) {
       // The least threshold with at most the budget's hits scoring above it: the first hit's
       // score left out when the scored hits are ranked, highest first.
-      const std::vector<float>& shares = opt.aa_budget;
-      const auto allowed =
-          uint64_t(std::floor(double(shares[std::min(l, shares.size() - 1)]) * double(hits)));
+      const uint64_t allowed = budget_pixels(opt.aa_budget, l, hits);
       std::vector<double> ranked;
       for (size_t i = 0; i < n; ++i)
         if (key[i] >= 0 && score[i] > 0) ranked.push_back(score[i]);
@@ -130,12 +128,8 @@ void adaptive(const Tracer& tracer, const RenderOptions& opt, unsigned workers,
     if (std::find(marked.begin(), marked.end(), 1) == marked.end()) break;
     const int m = levels[l] * levels[l];
     const bool keeps = l > 0 && l < kept.size();
-    std::vector<glm::vec2> offsets;
-    if (l < kept.size()) {
-      offsets = kept[l];
-    } else {
-      for (int k = 0; k < m; ++k) offsets.push_back(sample_offset(m, k, opt.sample_seed));
-    }
+    const std::vector<glm::vec2> offsets =
+        adaptive_level_offsets(opt.spp, l, kept, opt.sample_seed);
     for_each_row(H, workers, [&](unsigned worker, int y) {
       for (int x = 0; x < W; ++x) {
         const size_t i = size_t(y) * size_t(W) + size_t(x);

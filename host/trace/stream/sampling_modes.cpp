@@ -75,9 +75,7 @@ void StreamTracer::budget_marks(size_t level, uint64_t& hits, RenderResult& res)
   // Every pixel that hits (the scores are 0 or above the floor, so all exceed -1).
   uint64_t steps = 0;
   if (level == 0) hits = above(-1.0f), steps = 1;
-  const std::vector<float>& shares = opt_.aa_budget;
-  const double share = double(shares[std::min(level, shares.size() - 1)]);
-  const auto budget = uint64_t(std::floor(share * double(hits)));
+  const uint64_t budget = budget_pixels(opt_.aa_budget, level, hits);
   const BudgetSearch found = budget_threshold(opt_.threshold(), budget, above);
   const float t = found.threshold;
   steps += found.counts;
@@ -143,14 +141,9 @@ void StreamTracer::render_adaptive(const Camera& cam, RenderResult& res, int& it
     if (marked == 0) break;
     // The level's n x n samples, only in marked pixels, replacing their earlier ones; a kept
     // level's new samples, added to them.
-    const int n = levels[l] * levels[l];
     const bool keeps = l > 0 && l < kept.size();
-    std::vector<glm::vec2> offsets;
-    if (l < kept.size()) {
-      offsets = kept[l];
-    } else {
-      for (int k = 0; k < n; ++k) offsets.push_back(sample_offset(n, k, opt_.sample_seed));
-    }
+    const std::vector<glm::vec2> offsets =
+        adaptive_level_offsets(opt_.spp, l, kept, opt_.sample_seed);
     if (s.dense) {
       dense_level(cam, res, iteration_number, marked, offsets, !keeps);
       resolve_samples(s.resolve);
