@@ -441,7 +441,7 @@ void add_options(CLI::App& app, Args& a) {
       ->capture_default_str();
   app.add_option("--beams", a.beams,
                  "Per frame: off, on (beams over tiles, 8x8 pixels, before the primary rays' "
-                 "walk: docs/groups.md; the uniform grid only)")
+                 "walk: docs/groups.md; the uniform grid, the BVH and the kd-tree)")
       ->check(CLI::IsMember({"off", "on"}))
       ->capture_default_str();
   app.add_flag("--shadows", a.shadows, "Shadow rays in the frames (off: Table 1's setting)");
@@ -690,8 +690,10 @@ int main(int argc, char** argv) {
   }
   const bool beams_on = std::count(a.beams.begin(), a.beams.end(), "on") > 0;
   if (beams_on && std::any_of(a.accels.begin(), a.accels.end(),
-                              [](const std::string& s) { return s != "grid"; })) {
-    std::fprintf(stderr, "bench_gl: --beams on walks the uniform grid only (--accel grid)\n");
+                              [](const std::string& s) { return s == "grid2"; })) {
+    std::fprintf(stderr,
+                 "bench_gl: --beams on walks the uniform grid, the BVH and the kd-tree only "
+                 "(--accel grid, bvh or kdtree)\n");
     return 2;
   }
   if (a.latency && a.wait_mode == "none") {

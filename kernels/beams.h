@@ -168,8 +168,7 @@ struct BeamEntry {
     const Vec4<F> ray = f.fetch_own(kRays);
     const Vec3<F> o = splat<F>(u.eye), d = ray.xyz();
     const Vec4<F> entry = grid_entry<L>(o, d, ray.w, g);
-    const Vec4<F> b =
-        f.fetch(kBeams, floor(f.x / F(u.tile)) + F(0.5f), floor(f.y / F(u.tile)) + F(0.5f));
+    const Vec4<F> b = fetch_tile(f, kBeams, u.tile);
     const F ts = b.y;
     // The voxel holding the ray's point at ts, and how deep inside it the point lies.
     const Vec3<F> p = o + d * ts;

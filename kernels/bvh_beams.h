@@ -123,8 +123,7 @@ struct BvhBeamEnter {
   void operator()(Fragments<L>& f) const {
     using F = typename L::F;
     const Vec4<F> ray = f.fetch_own(kRays);
-    const Vec4<F> b =
-        f.fetch(kBeams, floor(f.x / F(tile)) + F(0.5f), floor(f.y / F(tile)) + F(0.5f));
+    const Vec4<F> b = fetch_tile(f, kBeams, tile);
     const Vec4<F> start{b.x, F(kNone), b.y, F(0.0f)};
     const Vec4<F> none{F(kNone), F(kNone), F(0.0f), F(0.0f)};
     f.out(0) = select((ray.w >= F(0.0f)) && (b.z <= F(0.0f)), start, none);

@@ -45,6 +45,14 @@ inline Vec4<typename L::F> fetch_id(const Fragments<L>& f, int unit, const typen
   return f.fetch(unit, u, v);
 }
 
+// The texel of the fragment's tile in a texture of one texel per `tile` x `tile` pixels (beams
+// over tiles, kernels/beams.h).
+template <class L>
+inline Vec4<typename L::F> fetch_tile(const Fragments<L>& f, int unit, float tile) {
+  using F = typename L::F;
+  return f.fetch(unit, floor(f.x / F(tile)) + F(0.5f), floor(f.y / F(tile)) + F(0.5f));
+}
+
 // Amanatides & Woo, recomputed from the voxel index each pass (no per-ray DDA increments to
 // store): for each axis the parameter t at which the ray leaves voxel `vox` through that
 // axis' next boundary; an axis the ray runs parallel to never ends the voxel.

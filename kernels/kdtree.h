@@ -45,13 +45,15 @@ inline F along(const Vec3<F>& v, const F& a) {
 }
 
 // One step of kd-restart for the lanes where `walking` (others keep trav): the node trav.x,
-// fetched as (split, axis, right child, leaf list start).
+// fetched as (split, axis, right child, leaf list start). A restart goes to the root, or to
+// `*root` (beams over tiles: the node the ray's tile's beam descended to, whose region holds the
+// ray's whole segment, so every restart from the root would pass through it unchanged).
 template <class L>
 inline Vec4<typename L::F> kd_step(const Fragments<L>& f, int unit_nodes,
                                    const Vec4<typename L::F>& trav, const Vec4<typename L::F>& best,
                                    const Vec3<typename L::F>& o, const Vec3<typename L::F>& d,
                                    const typename L::F& ray_w, const typename L::M& walking,
-                                   const KdUniforms& kd) {
+                                   const KdUniforms& kd, const typename L::F* root = nullptr) {
   using F = typename L::F;
   const Vec4<F> node = fetch_id(f, unit_nodes, trav.x, kd.node_width);
   const auto leaf = node.y > F(2.5f);
@@ -64,7 +66,7 @@ inline Vec4<typename L::F> kd_step(const Fragments<L>& f, int unit_nodes,
   ray_box_segment(o, d, kd.lo, kd.hi, ray_w, tn, tend);
   const auto over = (best.w >= F(0.0f)) || (trav.w >= tend);
   const Vec4<F> done{F(kNone), F(kNone), F(0.0f), F(0.0f)};
-  const Vec4<F> restart{F(0.0f), F(kNone), trav.w, tend};
+  const Vec4<F> restart{root ? *root : F(0.0f), F(kNone), trav.w, tend};
   // An inner node: the child the segment starts in, cutting the segment at the plane when it
   // reaches the other child; the far child alone when the plane lies before tmin. A ray whose
   // origin lies on the plane (ts = 0, or -0) runs into the child its direction points to
@@ -82,20 +84,36 @@ inline Vec4<typename L::F> kd_step(const Fragments<L>& f, int unit_nodes,
   return select(walking, select(leaf, at_leaf, inner), trav);
 }
 
+// Beams over tiles through the kd-tree (--beams on, primary rays; host/trace/walks/kd_walk.cpp):
+// the kernels below read the beam texture (one texel per tile, kernels::BvhBeamDescend's: x the
+// node the tile's beam descended to, z 1 where the whole tile misses) where beam_tile > 0, the
+// tile's side in pixels. Without beams (0) they never fetch it.
+
+// inicioKd: the segment [tmin, tmax] inside the scene box and the root; with beams, the tile's
+// node instead of the root (the segment is the same: the walk from the root would reach that
+// node with it unchanged), and nothing for a tile that misses.
 struct KdEnter {
   static constexpr const char* name = "kd enter";
   static constexpr const char* paper_name = "inicioKd (extension)";
   static constexpr int outputs = 1;  // -> traversal
-  enum Unit { kOrigins, kRays };
-  static constexpr std::array<const char*, 2> units{"origins", "rays"};
+  enum Unit { kOrigins, kRays, kBeams };
+  static constexpr std::array<const char*, 3> units{"origins", "rays", "kd_beams"};
 
   KdUniforms kd;
+  float beam_tile = 0;
 
   template <class L>
   void operator()(Fragments<L>& f) const {
     using F = typename L::F;
     const Vec4<F> ray = f.fetch_own(kRays);
-    f.out(0) = kd_entry(f.fetch_own(kOrigins).xyz(), ray.xyz(), ray.w, kd);
+    Vec4<F> t = kd_entry(f.fetch_own(kOrigins).xyz(), ray.xyz(), ray.w, kd);
+    if (beam_tile > 0.0f) {
+      const Vec4<F> b = fetch_tile(f, kBeams, beam_tile);
+      const auto starts = (t.x >= F(0.0f)) && (b.z <= F(0.0f));
+      t = select(starts, Vec4<F>{b.x, t.y, t.z, t.w},
+                 Vec4<F>{F(kNone), F(kNone), F(0.0f), F(0.0f)});
+    }
+    f.out(0) = t;
   }
 };
 
@@ -103,12 +121,13 @@ struct KdStep {
   static constexpr const char* name = "kd step";
   static constexpr const char* paper_name = "recorridoKd (extension)";
   static constexpr int outputs = 1;  // -> traversal
-  enum Unit { kOrigins, kRays, kTraversal, kIntersection, kNodes };
-  static constexpr std::array<const char*, 5> units{"origins", "rays", "traversal", "intersection",
-                                                    "kd_nodes"};
+  enum Unit { kOrigins, kRays, kTraversal, kIntersection, kNodes, kBeams };
+  static constexpr std::array<const char*, 6> units{"origins",      "rays",     "traversal",
+                                                    "intersection", "kd_nodes", "kd_beams"};
   static constexpr std::array<int, 1> passthrough{kTraversal};
 
   KdUniforms kd;
+  float beam_tile = 0;  // > 0: restarts go to the tile's node
 
   template <class L>
   void operator()(Fragments<L>& f) const {
@@ -120,7 +139,12 @@ struct KdStep {
       const Vec4<F> ray = f.fetch_own(kRays);
       const Vec4<F> best = f.fetch_own(kIntersection);
       const Vec3<F> o = f.fetch_own(kOrigins).xyz();
-      next = kd_step(f, kNodes, trav, best, o, ray.xyz(), ray.w, walking, kd);
+      if (beam_tile > 0.0f) {
+        const F root = fetch_tile(f, kBeams, beam_tile).x;
+        next = kd_step(f, kNodes, trav, best, o, ray.xyz(), ray.w, walking, kd, &root);
+      } else {
+        next = kd_step(f, kNodes, trav, best, o, ray.xyz(), ray.w, walking, kd);
+      }
     }
     f.out(0) = next;
   }
@@ -187,12 +211,14 @@ struct KdStepLoad {
   static constexpr const char* name = "kd step + load leaf";
   static constexpr const char* paper_name = "recorridoKd+cargarHojaKd (extension)";
   static constexpr int outputs = 2;  // -> traversal, voxel state
-  enum Unit { kOrigins, kRays, kTraversal, kIntersection, kVoxelState, kNodes, kLists };
-  static constexpr std::array<const char*, 7> units{
-      "origins", "rays", "traversal", "intersection", "voxel_state", "kd_nodes", "kd_lists"};
+  enum Unit { kOrigins, kRays, kTraversal, kIntersection, kVoxelState, kNodes, kLists, kBeams };
+  static constexpr std::array<const char*, 8> units{"origins",      "rays",        "traversal",
+                                                    "intersection", "voxel_state", "kd_nodes",
+                                                    "kd_lists",     "kd_beams"};
   static constexpr std::array<int, 2> passthrough{kTraversal, kVoxelState};
 
   KdUniforms kd;
+  float beam_tile = 0;  // > 0: restarts go to the tile's node
 
   template <class L>
   void operator()(Fragments<L>& f) const {
@@ -205,7 +231,12 @@ struct KdStepLoad {
       const Vec4<F> ray = f.fetch_own(kRays);
       const Vec4<F> best = f.fetch_own(kIntersection);
       const Vec3<F> o = f.fetch_own(kOrigins).xyz();
-      next = kd_step(f, kNodes, trav, best, o, ray.xyz(), ray.w, walking, kd);
+      if (beam_tile > 0.0f) {
+        const F root = fetch_tile(f, kBeams, beam_tile).x;
+        next = kd_step(f, kNodes, trav, best, o, ray.xyz(), ray.w, walking, kd, &root);
+      } else {
+        next = kd_step(f, kNodes, trav, best, o, ray.xyz(), ray.w, walking, kd);
+      }
       const auto load = walking && (next.y >= F(0.0f)) && (vs.w < F(0.0f));
       nvs = load_list(f, kLists, next.y, vs, load, kd);
     }
@@ -252,7 +283,8 @@ struct KdIntersectNext {
 // remembered (voxel state y), and a restart begins there instead of at the root, since every
 // later segment lies inside it too. Each iteration tests the leaf's next triangle if one is
 // left, else takes one kd-restart step (loading the leaf it reaches). Voxel state z = 1 marks a
-// descent that has cut the segment since the last restart.
+// descent that has cut the segment since the last restart. With beams over tiles, the
+// remembered node starts at the tile's node instead of the root (y 0, as the state is cleared).
 struct KdLooping {
   static constexpr const char* name = "kd looping traversal";
   static constexpr const char* paper_name = "recorridoKdIterativo (extension)";
@@ -267,16 +299,18 @@ struct KdLooping {
     kV1,
     kV2,
     kNodes,
-    kLists
+    kLists,
+    kBeams
   };
-  static constexpr std::array<const char*, 10> units{
-      "origins",   "rays",      "traversal", "voxel_state", "intersection",
-      "vertices0", "vertices1", "vertices2", "kd_nodes",    "kd_lists"};
+  static constexpr std::array<const char*, 11> units{
+      "origins",   "rays",      "traversal", "voxel_state", "intersection", "vertices0",
+      "vertices1", "vertices2", "kd_nodes",  "kd_lists",    "kd_beams"};
   static constexpr std::array<int, 3> passthrough{kTraversal, kVoxelState, kIntersection};
 
   KdUniforms kd;
   SceneUniforms scene;
   int steps = 32;
+  float beam_tile = 0;  // > 0: push-down starts at the tile's node
 
   template <class L>
   void operator()(Fragments<L>& f) const {
@@ -287,6 +321,7 @@ struct KdLooping {
     Vec4<F> best = f.fetch_own(kIntersection);
     const Vec3<F> o = f.fetch_own(kOrigins).xyz();
     const Vec4<F> ray = f.fetch_own(kRays);
+    if (beam_tile > 0.0f) vs.y = select(vs.y == F(0.0f), fetch_tile(f, kBeams, beam_tile).x, vs.y);
     f.loop(steps, trav.x >= F(0.0f), [&](const M& act) {
       const M testing = act && (vs.w >= F(0.0f));
       best = nearest_hit_in_segment(f, kV0, o, ray, trav, vs, best, testing, scene, kd.t_slack);

@@ -173,10 +173,10 @@ RenderPlan parse_render(const RenderArgs& a, bool lanes_given) {
                        " needs --engine stream (the cpu engine is a double-precision reference "
                        "without passes, lanes or masks)");
   }
-  if (opt.beams && a.accel != "grid" && a.accel != "bvh")
+  if (opt.beams && a.accel != "grid" && a.accel != "bvh" && a.accel != "kdtree")
     throw UsageError(
-        "--beams on: beams are walked through the uniform grid and the BVH only (--accel grid "
-        "or bvh)");
+        "--beams on: beams are walked through the uniform grid, the BVH and the kd-tree only "
+        "(--accel grid, bvh or kdtree; with --accel auto, --beams auto)");
   if (opt.beams && (a.precision != "fp32" || !a.formats.empty()))
     throw UsageError(
         "--beams on needs fp32 ray state (no --precision or --formats): the beam "

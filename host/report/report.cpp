@@ -403,8 +403,9 @@ void write_report(const std::string& path, const FrameRecorder& rec, const Rende
   // Beams over tiles (--beams on, or auto when it chose beams): where each tile's rays started.
   if (const BeamMap& b = res.beam_map; !b.start.empty())
     d["beam_map"] = {{"tiles_x", b.tiles_x},   {"tiles_y", b.tiles_y},
-                     {"tile", b.tile},         {"start", pack(b.start)},
-                     {"steps", pack(b.steps)}, {"missed", pack(b.missed)}};
+                     {"tile", b.tile},         {"tree", b.tree},
+                     {"start", pack(b.start)}, {"steps", pack(b.steps)},
+                     {"missed", pack(b.missed)}};
   auto wave = json::array();
   for (const auto& w : rec.wavefront()) wave.push_back(pack(w));
   d["wavefront"] = std::move(wave);

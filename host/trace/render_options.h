@@ -97,8 +97,9 @@ struct RenderOptions {
   // grid, passes of one fragment per beam_tile x beam_tile tile march each tile's beam through
   // empty space, and every pixel's ray starts where its tile's beam stopped. The same hits,
   // depths and images as without (only where each walk begins changes). Through the BVH, each
-  // tile's beam descends to the first node it cannot narrow down and its rays start there. The
-  // uniform grid and the BVH, fp32 ray state (refusal() says so); every engine.
+  // tile's beam descends to the first node it cannot narrow down and its rays start there;
+  // through the kd-tree likewise (the nodes' boxes), and its rays restart there too. The
+  // uniform grid, the BVH and the kd-tree, fp32 ray state (refusal() says so); every engine.
   bool beams = false;
   int beam_tile = 8;
   // Supersampling (host/trace/sampling.h): rays per pixel, a square from 1 to 256, on a
@@ -200,14 +201,18 @@ struct CompactStats {
 };
 
 // Where each tile's rays started in a frame's first primary trace with beams (the report's tile
-// map, docs/groups.md): the beam texture's texels once the march is over, tile (x, y) at
-// y * tiles_x + x, row 0 at the top of the image as the image's rows. Empty with beams off, or
-// when no pass observer follows the frame (only the report and the pass-by-pass views read it).
+// map, docs/groups.md): the beam texture's texels once the march or the descent is over, tile
+// (x, y) at y * tiles_x + x, row 0 at the top of the image as the image's rows. Empty with beams
+// off, or when no pass observer follows the frame (only the report and the pass-by-pass views
+// read it).
 struct BeamMap {
   int tiles_x = 0, tiles_y = 0, tile = 0;  // tiles across, down, and pixels per tile side
-  std::vector<float> start;                // the ray parameter t where the tile's rays start
-  std::vector<float> steps;                // the march's steps (empty boxes crossed)
-  std::vector<uint8_t> missed;             // 1 where the whole tile missed the grid
+  bool tree = false;  // through the BVH or the kd-tree (a descent), else the grid (a march)
+  // The grid: the ray parameter t where the tile's rays start; a tree: the node they start at.
+  std::vector<float> start;
+  // The grid: the march's steps (empty boxes crossed); a tree: the node's depth (the root 0).
+  std::vector<float> steps;
+  std::vector<uint8_t> missed;  // 1 where the whole tile missed the structure
 };
 
 struct RenderResult {

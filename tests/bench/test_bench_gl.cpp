@@ -196,7 +196,7 @@ TEST_CASE("bench_gl --latency times one fragment's dependent fetches and multipl
 
 TEST_CASE("bench_gl runs GL and emulator frames with beams off and on, counting the same beams") {
   const fs::path js = json_path();
-  const Outcome refused = bench("--readback-wait none --sizes 8 --beams on --accel bvh");
+  const Outcome refused = bench("--readback-wait none --sizes 8 --beams on --accel grid2");
   CHECK(refused.status == 2);
   CHECK(refused.err.find("--beams on") != std::string::npos);
   const Outcome o = bench(

@@ -637,7 +637,9 @@ TEST_CASE(
 }
 
 TEST_CASE("beams are refused where they cannot apply, one line and exit 2") {
-  check_refused("--beams on --accel kdtree", "--beams on", "the uniform grid and the BVH only");
+  check_refused("--beams on --accel grid2", "--beams on",
+                "the uniform grid, the BVH and the kd-tree only");
+  check_refused("--beams on --accel auto", "--beams on", "with --accel auto, --beams auto");
   check_refused("--beams on --precision fp16", "--beams on", "needs fp32 ray state");
   check_refused("--beam-tile 4", "--beam-tile", "needs --beams on");
   check_refused("--beams maybe", "--beams", "maybe not in {off,on,auto}");
@@ -702,14 +704,14 @@ TEST_CASE("beams auto renders the same image, and its JSON and table say what it
   CHECK(au["primary_ms"]["on"].get<double>() < au["primary_ms"]["off"].get<double>());
   CHECK(au["why"].get<std::string>().rfind("on: ", 0) == 0);
   // Where beams cannot run, off without a word on stderr, and the JSON says why.
-  const nlohmann::json kd = render_json("--bounces 0 --beams auto --accel kdtree", dir, o);
+  const nlohmann::json g2 = render_json("--bounces 0 --beams auto --accel grid2", dir, o);
   REQUIRE(o.status == 0);
   CHECK(o.err.empty());
-  CHECK(kd["beams"]["on"] == false);
-  CHECK_FALSE(kd["beams"].contains("tiles"));
-  CHECK(kd["beams"]["auto"]["probed"] == false);
-  CHECK(kd["beams"]["auto"]["why"].get<std::string>().find("the uniform grid and the BVH only") !=
-        std::string::npos);
+  CHECK(g2["beams"]["on"] == false);
+  CHECK_FALSE(g2["beams"].contains("tiles"));
+  CHECK(g2["beams"]["auto"]["probed"] == false);
+  CHECK(g2["beams"]["auto"]["why"].get<std::string>().find(
+            "the uniform grid, the BVH and the kd-tree only") != std::string::npos);
   // Through the BVH it probes, and keeps what the probes predict.
   const nlohmann::json bvh = render_json("--bounces 0 --beams auto --accel bvh", dir, o);
   REQUIRE(o.status == 0);

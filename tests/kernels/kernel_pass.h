@@ -140,8 +140,9 @@ inline const vgpu::Profile& gf6600() {
   return vgpu::profile("gf6600");
 }
 
-// One pass of a fused kernel k (K::outputs targets) through a gf6600 vgpu, over fresh w x h
-// targets of 4 channels, target i cleared to fills[i]. Compared on the GL device like run().
+// One pass of a kernel k of several outputs (K::outputs targets: 2 or 3) through a gf6600 vgpu,
+// over fresh w x h targets of 4 channels, target i cleared to fills[i]. Compared on the GL device
+// like run().
 template <class K>
 std::array<Texture, K::outputs> run_targets(const K& k, const std::vector<const Texture*>& units,
                                             int w, int h,
@@ -155,14 +156,23 @@ std::array<Texture, K::outputs> run_targets(const K& k, const std::vector<const 
     const float f[4] = {v.x, v.y, v.z, v.w};
     outs[size_t(i)].fill(f);
   }
-  const std::vector<Texture> before = before_pass({&outs[0], &outs[1]});
+  static_assert(K::outputs == 2 || K::outputs == 3, "run_targets binds two or three targets");
+  auto targets = [&](auto&& use) {
+    if constexpr (K::outputs == 2)
+      return use({&outs[0], &outs[1]});
+    else
+      return use({&outs[0], &outs[1], &outs[2]});
+  };
+  const std::vector<Texture> before =
+      targets([](std::initializer_list<const Texture*> t) { return before_pass(t); });
   gpu.use_program(program);
   gpu.unbind_textures();
   for (size_t i = 0; i < units.size(); ++i) gpu.bind_texture(int(i), *units[i]);
-  static_assert(K::outputs == 2, "run_targets binds two targets");
-  gpu.set_targets({&outs[0], &outs[1]});
+  targets([&](std::initializer_list<Texture*> t) { gpu.set_targets(t); });
   gpu.draw();
-  check_on_gl(program, units, before, {&outs[0], &outs[1]}, nullptr);
+  targets([&](std::initializer_list<const Texture*> t) {
+    check_on_gl(program, units, before, t, nullptr);
+  });
   return outs;
 }
 

@@ -587,3 +587,76 @@ TEST_CASE(
   }
   check(seq, isect);
 }
+
+TEST_CASE(
+    "with beams, kd enter starts a ray at its tile's node, kd step restarts it there, push-down "
+    "starts there, and a tile that misses ends its rays") {
+  const Tree t;
+  // Tiles of 2 pixels: pixels 0 and 1 in tile 0, whose beam stopped at node 2; pixels 2 and 3
+  // in tile 1, whose beam stopped at node 4 and missed (z 1). The beam texel's y (the end of a
+  // BVH walk) and w (the depth) are not read.
+  const Texture beams = texels("kd beams", 2, 1, {{2, 7, 0, 1}, {4, 5, 1, 2}});
+  const float tile = 2;
+  {
+    const Rays r({{3, 0.5f, 1}, {-1, 5, 1}, {1, 1, 1}, {1, 1, 1}},
+                 {{0, 1, 0, 100},      // inside: [0, 3.5], at tile 0's node 2
+                  {1, 0, 0, 100},      // passing above the box: done
+                  {1, 0, 0, 100},      // inside, but its tile missed: done
+                  {1, 0, 0, kNone}});  // a dead ray: done
+    kernels::KdEnter k;
+    k.kd = kd_uniforms();
+    k.beam_tile = tile;
+    const Texture out = ktest::run(k, {&r.origins, &r.rays, &beams}, r.n, 1, glm::vec4(7));
+    CHECK_TEXEL(out, 0, 0, glm::vec4(2, kNone, 0, 3.5f));
+    CHECK_TEXEL(out, 1, 0, kDone);
+    CHECK_TEXEL(out, 2, 0, kDone);
+    CHECK_TEXEL(out, 3, 0, kDone);
+  }
+  // kd step: a restart goes to the tile's node instead of the root; the other steps are kd
+  // step's own.
+  const Rays r({{3, 0.5f, 1}, {3, 0.5f, 1}, {3, 2.5f, 1}, {3, 2.5f, 1}},
+               {{0, 1, 0, 100}, {0, 1, 0, 100}, {0, 1, 0, 1}, {0, 1, 0, 100}});
+  const Texture trav = texels("traversal", r.n, 1,
+                              {{3, 0, 0, 1.5f},      // 0: empty leaf 3 tested: restart at 2
+                               {2, kNone, 0, 3.5f},  // 1: node 2, cut at y = 2 (t 1.5): 3
+                               {4, 3, 0, 0.5f},      // 2: leaf 4 tested, tmax 1: restart at 4
+                               {4, 3, 0, 1}});       // 3: leaf 4 tested with a hit: done
+  const Texture isect =
+      texels("intersection", r.n, 1, {kNoHit, kNoHit, kNoHit, {0.5f, 0.25f, 0.125f, 1}});
+  kernels::KdStep k;
+  k.kd = kd_uniforms();
+  k.beam_tile = tile;
+  const Texture out = ktest::run(k, {&r.origins, &r.rays, &trav, &isect, &t.nodes, &beams}, r.n, 1);
+  CHECK_TEXEL(out, 0, 0, glm::vec4(2, kNone, 1.5f, 3.5f));
+  CHECK_TEXEL(out, 1, 0, glm::vec4(3, kNone, 0, 1.5f));
+  CHECK_TEXEL(out, 2, 0, glm::vec4(4, kNone, 0.5f, 1));
+  CHECK_TEXEL(out, 3, 0, kDone);
+  // The fused form restarts alike (and loads no leaf: none is reached).
+  const Texture vs = texels("voxel state", r.n, 1, std::vector<glm::vec4>(4, {0, 0, 0, kNone}));
+  kernels::KdStepLoad fused;
+  fused.kd = kd_uniforms();
+  fused.beam_tile = tile;
+  const auto o = ktest::run_targets(
+      fused, {&r.origins, &r.rays, &trav, &isect, &vs, &t.nodes, &t.lists, &beams}, r.n, 1);
+  check_same(o[0], out, r.n);
+  check_same(o[1], vs, r.n);
+  // The looping kernel: the remembered node (voxel state y) starts at the tile's node where it
+  // is still the root (0), and is kept where a pass already moved it. No ray walks here.
+  const Texture done = texels("traversal", r.n, 1, std::vector<glm::vec4>(4, kDone));
+  const Texture vs0 = texels("voxel state", r.n, 1,
+                             {{0, 0, 0, kNone}, {0, 6, 1, kNone}, {0, 0, 0, kNone}, {1, 3, 0, 2}});
+  kernels::KdLooping loop;
+  loop.kd = kd_uniforms();
+  loop.scene.width = 1;
+  loop.beam_tile = tile;
+  const auto l = ktest::run_targets(
+      loop,
+      {&r.origins, &r.rays, &done, &vs0, &isect, &t.v0, &t.v1, &t.v2, &t.nodes, &t.lists, &beams},
+      r.n, 1);
+  check_same(l[0], done, r.n);
+  CHECK_TEXEL(l[1], 0, 0, glm::vec4(0, 2, 0, kNone));
+  CHECK_TEXEL(l[1], 1, 0, glm::vec4(0, 6, 1, kNone));
+  CHECK_TEXEL(l[1], 2, 0, glm::vec4(0, 4, 0, kNone));
+  CHECK_TEXEL(l[1], 3, 0, glm::vec4(1, 3, 0, 2));
+  check_same(l[2], isect, r.n);
+}

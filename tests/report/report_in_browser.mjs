@@ -113,6 +113,44 @@ try {
     else check(t.start <= t.nearest, `tile ${t.tx},${t.ty}: rays start at ${t.start}, before the nearest hit ${t.nearest}`);
   }
 
+  // Beams through the kd-tree: the map shades each tile by the depth of the node its rays start
+  // at; a grey square's tile missed the tree's box (none of its pixels hits); every other one
+  // names a node of the tree no deeper than the tree, and the deepest tile is drawn yellow.
+  const khtml = path.join(work, "kd-beams.html"), kstats = path.join(work, "kd-beams.json");
+  execFileSync(vgpu, ["render", "bunny-low", "--size", "48x32", "--quiet", "--stats", "none", "--threads", "2",
+    "--bounces", "0", "--shadows", "off", "--accel", "kdtree", "--beams", "on", "--beam-tile", "4", "--report", khtml, "--stats-json", kstats]);
+  await page.goto("file://" + path.resolve(khtml));
+  await page.waitForFunction(() => document.body.dataset.ready === "1" || document.body.dataset.error, null, { timeout: 60000 });
+  check(errors.length === 0 && !(await page.evaluate(() => document.body.dataset.error)), `no script errors in the kd-tree beams frame's report (${errors.join("; ")})`);
+  const kd = await page.evaluate(async () => {
+    const c = document.getElementById("beam-map"), px = +c.dataset.tilePx, ctx = c.getContext("2d");
+    const hit = await unpack(D.hit, Float32Array);
+    const node = await unpack(D.beam_map.start, Float32Array), depth = await unpack(D.beam_map.steps, Float32Array);
+    const out = [];
+    for (let ty = 0; ty < 8; ++ty)
+      for (let tx = 0; tx < 12; ++tx) {
+        const p = ctx.getImageData(tx * px + 1, ty * px + 1, 1, 1).data;
+        let hits = 0;
+        for (let y = ty * 4; y < ty * 4 + 4; ++y)
+          for (let x = tx * 4; x < tx * 4 + 4; ++x) if (hit[y * W + x] >= 0) ++hits;
+        out.push({ tx, ty, rgb: [p[0], p[1], p[2]], grey: p[0] === 200 && p[1] === 200 && p[2] === 200, hits, node: node[ty * 12 + tx], depth: depth[ty * 12 + tx] });
+      }
+    return { tree: D.beam_map.tree, legend: document.getElementById("beam-legend").textContent, out };
+  });
+  const kj = JSON.parse(fs.readFileSync(kstats, "utf8"));
+  check(kd.tree === true, "the kd-tree frame's map is a tree's");
+  check(kd.legend.includes("missed the kd-tree"), `the legend names the kd-tree (${kd.legend})`);
+  const kgreys = kd.out.filter(t => t.grey);
+  check(kgreys.length === kj.beams.tiles_missed && kgreys.length > 0, `${kgreys.length} grey tiles, ${kj.beams.tiles_missed} missed`);
+  const deepest = Math.max(...kd.out.filter(t => !t.grey).map(t => t.depth));
+  for (const t of kd.out) {
+    if (t.grey) { check(t.hits === 0, `grey tile ${t.tx},${t.ty} has no hit (${t.hits})`); continue; }
+    check(t.node >= 0 && t.node < kj.accel.nodes && t.depth <= kj.accel.depth, `tile ${t.tx},${t.ty}: node ${t.node} at depth ${t.depth}`);
+    // viridis ends in yellow (red and green high, blue low).
+    if (t.depth === deepest) check(t.rgb[0] > 200 && t.rgb[1] > 200 && t.rgb[2] < 100, `the deepest tile ${t.tx},${t.ty} is yellow (${t.rgb})`);
+  }
+  check(deepest > 0, `some tile starts below the root (deepest ${deepest})`);
+
   // An adaptive frame (the budget criterion, the default): the search's section, one table row
   // per level of the JSON, one point per counting pass (the first level's first count, every
   // pixel that hits, is the budget's base, not a step), and the pixels marked within budget.

@@ -126,13 +126,7 @@ CpuBvhBeams::CpuBvhBeams(const Bvh& bvh, const Camera& camera, const RenderOptio
   const size_t n = bvh.nodes.size();
   lo_.assign(4 * n, 0.0f);
   hi_.assign(4 * n, 0.0f);
-  for (size_t i = 0; i < n; ++i) {
-    const BvhNode& node = bvh.nodes[i];
-    for (int a = 0; a < 3; ++a)
-      lo_[4 * i + size_t(a)] = node.lo[a], hi_[4 * i + size_t(a)] = node.hi[a];
-    lo_[4 * i + 3] = float(node.escape);
-    hi_[4 * i + 3] = node.count > 0 ? float(node.leaf) : kernels::kNone;
-  }
+  bvh_node_texels(bvh, lo_, hi_);
   kernels::BvhBeamUniforms& u = descend_.u;
   u.bvh.node_width = float(std::max<size_t>(n, 1));
   u.bvh.nodes = float(n);

@@ -17,6 +17,7 @@
 #include "host/trace/cpu/optics.h"
 #include "host/trace/sampling.h"
 #include "host/trace/textures.h"
+#include "host/trace/walks/bvh_beams.h"
 #include "kernels/kernels.h"
 
 namespace host::cpu_core {
@@ -133,11 +134,13 @@ class Tracer {
     for (const SceneTexture& t : scene.textures) chains_.push_back(build_mip_chain(t));
     for (const Material& m : scene.materials) has_glass_ = has_glass_ || m.transmission > 0.0f;
     spread_ = 2.0 * primary_.t / double(opt.height);
-    // Beams over tiles: for the uniform grid's walk and the BVH's (the options refuse the
-    // others).
+    // Beams over tiles: for the uniform grid's walk, the BVH's and the kd-tree's (through its
+    // nodes' boxes; the options refuse the two-level grid).
     if (opt.beams && grid_ && !bvh_ && !kd_ && !grid2_)
       beams_ = std::make_unique<CpuBeams>(*grid_, camera, opt);
     if (opt.beams && bvh_) bvh_beams_ = std::make_unique<CpuBvhBeams>(*bvh_, camera, opt);
+    if (opt.beams && kd_)
+      bvh_beams_ = std::make_unique<CpuBvhBeams>(kd_beam_nodes(*kd_), camera, opt);
   }
 
   // What the frame's beams cost (nothing where beams are off).
@@ -195,7 +198,7 @@ class Tracer {
             const CpuBeamStart* beam = nullptr) const {
     ++c.rays;
     if (bvh_) return trace_bvh(o, d, tmax, any_hit, c, beam);
-    if (kd_) return trace_kd(o, d, tmax, any_hit, c);
+    if (kd_) return trace_kd(o, d, tmax, any_hit, c, beam);
     if (grid2_) return trace_grid2(o, d, tmax, any_hit, c);
     Hit best;
     // Slab test against the grid box.
@@ -490,8 +493,10 @@ class Tracer {
 
   // kd-restart (kernels/kdtree.h) in double: descend to the first leaf the segment reaches, test
   // its triangles with the in-leaf rule (the segment widened by the slack), restart past it.
-  Hit trace_kd(const glm::dvec3& o, const glm::dvec3& d, double tmax, bool any_hit,
-               Counters& c) const {
+  // `beam` (a primary ray's, beams through the kd-tree): start and restart at its tile's node,
+  // or nothing where the whole tile misses.
+  Hit trace_kd(const glm::dvec3& o, const glm::dvec3& d, double tmax, bool any_hit, Counters& c,
+               const CpuBeamStart* beam) const {
     Hit best;
     if (!(tmax >= 0.0)) return best;
     double tn = 0.0, tend = tmax;
@@ -505,10 +510,11 @@ class Tracer {
       tn = std::max(tn, t0);
       tend = std::min(tend, t1);
     }
-    if (!(tn <= tend)) return best;
+    if (!(tn <= tend) || (beam && beam->missed)) return best;
     ++c.entered;
     double tmin = tn, tmx = tend;
-    int32_t i = 0;
+    const int32_t root = beam ? beam->node : 0;
+    int32_t i = root;
     for (;;) {
       ++c.nodes_visited;
       const KdNode& n = kd_->nodes[size_t(i)];
@@ -526,7 +532,7 @@ class Tracer {
         ++c.restarts;
         tmin = tmx;
         tmx = tend;
-        i = 0;
+        i = root;
         continue;
       }
       const int a = n.axis;

@@ -173,12 +173,14 @@ class ListWalk : public AccelWalk {
   // reached: `step` (reading origins, rays, traversal, hits, `nodes`, `more_nodes`) and `load`
   // (traversal, list state, `lists`), or under --mrt on both in one pass, `step_load` (as
   // `step`, with the list state before the nodes and `lists` after). `more_nodes` may be
-  // nullptr (a structure with one node texture).
+  // nullptr (a structure with one node texture). `tail` (the kd-tree's beams), where given, is
+  // read last by both forms (after the nodes by `step`, after `lists` by `step_load`).
   template <class X, class Key>
   void step_and_load(X& x, Cursor& c, const Key& key, int step, const StepSites& site,
                      const vgpu::Program& step_p, const vgpu::Program& load,
                      const vgpu::Program& step_load, const vgpu::Texture& nodes,
-                     const vgpu::Texture* more_nodes, const vgpu::Texture& lists);
+                     const vgpu::Texture* more_nodes, const vgpu::Texture& lists,
+                     const vgpu::Texture* tail = nullptr);
 
   // The looping variant (RenderOptions::looping): `looping`, reading (origins, rays,
   // traversal, list state, hits, vertices, then `statics`), drawn again while rays walk,
@@ -247,7 +249,8 @@ template <class X, class Key>
 void ListWalk::step_and_load(X& x, Cursor& c, const Key& key, int step, const StepSites& site,
                              const vgpu::Program& step_p, const vgpu::Program& load,
                              const vgpu::Program& step_load, const vgpu::Texture& nodes,
-                             const vgpu::Texture* more_nodes, const vgpu::Texture& lists) {
+                             const vgpu::Texture* more_nodes, const vgpu::Texture& lists,
+                             const vgpu::Texture* tail) {
   vgpu::Texture &origins = *c.origins, &rays = *c.rays;
   const vgpu::Texture *trav = &c.trav.current(), *hits = &c.isect.current();
   vgpu::Stencil* grid_mask = sh_.grid_mask;
@@ -257,6 +260,9 @@ void ListWalk::step_and_load(X& x, Cursor& c, const Key& key, int step, const St
     if (more_nodes)
       x.pass(key_s, step_load, {&origins, &rays, trav, hits, vs, &nodes, more_nodes, &lists},
              {&c.trav.next(), &c.vs.next()}, grid_mask);
+    else if (tail)
+      x.pass(key_s, step_load, {&origins, &rays, trav, hits, vs, &nodes, &lists, tail},
+             {&c.trav.next(), &c.vs.next()}, grid_mask);
     else
       x.pass(key_s, step_load, {&origins, &rays, trav, hits, vs, &nodes, &lists},
              {&c.trav.next(), &c.vs.next()}, grid_mask);
@@ -265,9 +271,9 @@ void ListWalk::step_and_load(X& x, Cursor& c, const Key& key, int step, const St
     return;
   }
   const auto key_s = key(step, -1, site.step);
-  if (more_nodes)
-    x.pass(key_s, step_p, {&origins, &rays, trav, hits, &nodes, more_nodes}, {&c.trav.next()},
-           grid_mask);
+  if (more_nodes || tail)
+    x.pass(key_s, step_p, {&origins, &rays, trav, hits, &nodes, more_nodes ? more_nodes : tail},
+           {&c.trav.next()}, grid_mask);
   else
     x.pass(key_s, step_p, {&origins, &rays, trav, hits, &nodes}, {&c.trav.next()}, grid_mask);
   c.trav.swap();

@@ -66,8 +66,47 @@ void BvhBeams::set_camera(const kernels::GenerateRays& camera, float offset_x, f
   u.offset_y = offset_y;
 }
 
-void BvhBeams::enter(PassRunner& r, Texture& rays, glm::vec3 eye, Texture& nodes_lo,
-                     Texture& nodes_hi, Texture& traversal) {
+Bvh kd_beam_nodes(const KdTree& kd) {
+  Bvh b;
+  b.nodes.resize(kd.nodes.size());
+  if (kd.nodes.empty()) return b;
+  b.nodes[0].lo = kd.lo;
+  b.nodes[0].hi = kd.hi;
+  b.nodes[0].escape = -1;
+  // Depth first: a parent comes before its children, so its box and escape are known first.
+  for (size_t i = 0; i < kd.nodes.size(); ++i) {
+    const KdNode& n = kd.nodes[i];
+    BvhNode& p = b.nodes[i];
+    if (n.axis == 3) {
+      p.leaf = n.leaf;
+      p.count = n.count;
+      continue;
+    }
+    BvhNode& left = b.nodes[i + 1];
+    BvhNode& right = b.nodes[size_t(n.right)];
+    left.lo = right.lo = p.lo;
+    left.hi = right.hi = p.hi;
+    left.hi[n.axis] = n.split;
+    right.lo[n.axis] = n.split;
+    left.escape = n.right;
+    right.escape = p.escape;
+  }
+  b.depth = kd.depth;
+  b.leaves = kd.leaves;
+  b.max_leaf = kd.max_leaf;
+  return b;
+}
+
+void bvh_node_texels(const Bvh& bvh, std::vector<float>& lo, std::vector<float>& hi) {
+  for (size_t i = 0; i < bvh.nodes.size(); ++i) {
+    const BvhNode& n = bvh.nodes[i];
+    for (int a = 0; a < 3; ++a) lo[4 * i + size_t(a)] = n.lo[a], hi[4 * i + size_t(a)] = n.hi[a];
+    lo[4 * i + 3] = float(n.escape);
+    hi[4 * i + 3] = n.count > 0 ? float(n.leaf) : kernels::kNone;
+  }
+}
+
+void BvhBeams::descend(PassRunner& r, glm::vec3 eye, Texture& nodes_lo, Texture& nodes_hi) {
   vgpu::Device& gpu = r.device();
   descend_.kernel.u.beams.eye = eye;
   // Every beam starts at the root, descending (y = 0).
@@ -88,6 +127,14 @@ void BvhBeams::enter(PassRunner& r, Texture& rays, glm::vec3 eye, Texture& nodes
   gpu.begin_query();
   r.pass(missed_, {&beams_.current()}, counter_);
   n.beam_tiles_missed += gpu.end_query();
+  // The report's tile map (the emulator's texels, no read-back to count).
+  if (n.beam_map.start.empty() && opt_.observer && dynamic_cast<vgpu::Gpu*>(&gpu))
+    n.beam_map = beam_map(beams_.current(), opt_.beam_tile, true);
+}
+
+void BvhBeams::enter(PassRunner& r, Texture& rays, glm::vec3 eye, Texture& nodes_lo,
+                     Texture& nodes_hi, Texture& traversal) {
+  descend(r, eye, nodes_lo, nodes_hi);
   r.pass(entry_, {&rays, &beams_.current()}, traversal);
 }
 

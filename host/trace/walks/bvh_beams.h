@@ -6,8 +6,10 @@
 #pragma once
 
 #include <cstdint>
+#include <vector>
 
 #include "host/accel/bvh.h"
+#include "host/accel/kdtree.h"
 #include "host/trace/passes.h"
 #include "host/trace/ping_pong.h"
 #include "host/trace/render_options.h"
@@ -22,6 +24,18 @@ namespace host {
 int bvh_levels(const Bvh& bvh);
 float bvh_beam_margin(const Bvh& bvh);
 
+// The kd-tree's nodes as the descent reads them (beams through the kd-tree): node i of the
+// result is the kd-tree's node i, with its box (the root's box cut by the planes above it), its
+// escape (the index past its subtree; -1 where that is the end) and, for a leaf, its list. A
+// kd-tree's children split their parent's box, so a beam that skips one child's box has all of
+// its rays' segments inside the parent's box in the other child.
+Bvh kd_beam_nodes(const KdTree& kd);
+
+// The BVH walk's node texels (kernels/bvh.h): node i's lo texel holds its box's low corner and
+// its escape, its hi texel the high corner and its leaf's list (-1 for an inner node or an empty
+// leaf), written at 4 i onward of `lo` and `hi` (each at least 4 floats per node).
+void bvh_node_texels(const Bvh& bvh, std::vector<float>& lo, std::vector<float>& hi);
+
 class BvhBeams {
  public:
   explicit BvhBeams(const RenderOptions& options) : opt_(options) {}
@@ -32,8 +46,10 @@ class BvhBeams {
   void make_state(vgpu::Device& gpu);
   // The primary rays' camera and the sample's offset from the pixel centre (pixels).
   void set_camera(const kernels::GenerateRays& camera, float offset_x, float offset_y);
-  // The descent passes (at most one per level of the tree), then inicioHazBVH: the primary rays'
-  // traversal state into `traversal`.
+  // The descent passes (at most one per level of the tree) and the count of the tiles that
+  // missed: beams() then holds each tile's node.
+  void descend(PassRunner& r, glm::vec3 eye, vgpu::Texture& nodes_lo, vgpu::Texture& nodes_hi);
+  // descend(), then inicioHazBVH: the primary rays' traversal state into `traversal`.
   void enter(PassRunner& r, vgpu::Texture& rays, glm::vec3 eye, vgpu::Texture& nodes_lo,
              vgpu::Texture& nodes_hi, vgpu::Texture& traversal);
 

@@ -42,12 +42,7 @@ uint64_t BvhWalk::set_bvh(vgpu::Device& gpu, const Bvh& bvh, float scene_width,
   std::vector<float> lo(nodes_lo_.data().begin(), nodes_lo_.data().end());
   std::vector<float> hi(nodes_hi_.data().begin(), nodes_hi_.data().end());
   std::vector<float> entries(lists_.data().begin(), lists_.data().end());
-  for (size_t i = 0; i < bvh.nodes.size(); ++i) {
-    const BvhNode& n = bvh.nodes[i];
-    for (int a = 0; a < 3; ++a) lo[4 * i + size_t(a)] = n.lo[a], hi[4 * i + size_t(a)] = n.hi[a];
-    lo[4 * i + 3] = float(n.escape);
-    hi[4 * i + 3] = n.count > 0 ? float(n.leaf) : kNone;
-  }
+  bvh_node_texels(bvh, lo, hi);
   for (size_t k = 0; k < bvh.lists.size(); ++k) entries[k] = float(bvh.lists[k]);
   const uint64_t bytes =
       replace_texels(gpu, {{&nodes_lo_, &lo}, {&nodes_hi_, &hi}, {&lists_, &entries}}, uploaded);

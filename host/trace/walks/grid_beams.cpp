@@ -111,15 +111,16 @@ void GridBeams::set_camera(const kernels::GenerateRays& camera, float offset_x, 
   }
 }
 
-BeamMap beam_map(const vgpu::Texture& beams, int tile) {
+BeamMap beam_map(const vgpu::Texture& beams, int tile, bool tree) {
   BeamMap m;
   m.tiles_x = beams.width();
   m.tiles_y = beams.height();
   m.tile = tile;
+  m.tree = tree;
   for (int y = 0; y < m.tiles_y; ++y)
     for (int x = 0; x < m.tiles_x; ++x) {
       const float* b = beams.texel(x, y);
-      m.start.push_back(b[1]);
+      m.start.push_back(tree ? b[0] : b[1]);
       m.steps.push_back(b[3]);
       m.missed.push_back(b[2] > 0.0f ? 1 : 0);
     }

@@ -37,7 +37,7 @@ float beam_far(const kernels::BeamUniforms& u, glm::vec3 eye);
 
 // The tile map of a beam texture after the march (kernels/beams.h's layout: y = t, z = missed,
 // w = steps), `tile` pixels per tile side.
-BeamMap beam_map(const vgpu::Texture& beams, int tile);
+BeamMap beam_map(const vgpu::Texture& beams, int tile, bool tree = false);
 
 class GridBeams {
  public:

@@ -19,6 +19,13 @@ KdWalk::KdWalk(vgpu::Device& gpu, const KdTree& kd, const RenderOptions& options
                float t_slack)
     : ListWalk(options, {&tree_, &lists_}) {
   compute_in_groups(enter_, step_, step_load_, load_, intersect_, intersect_next_, looping_);
+  if (options.beams) {
+    beams_ = std::make_unique<BvhBeams>(options);
+    compute_in_groups(beam_enter_, beam_step_, beam_step_load_, load_, intersect_, intersect_next_,
+                      beam_looping_);
+    statics_.push_back(&boxes_lo_);
+    statics_.push_back(&boxes_hi_);
+  }
   set_tree(gpu, kd, scene_width, t_slack, nullptr);
 }
 
@@ -52,7 +59,20 @@ uint64_t KdWalk::set_tree(vgpu::Device& gpu, const KdTree& kd, float scene_width
     t[3] = n.axis == 3 ? float(n.leaf) : kNone;
   }
   for (size_t k = 0; k < kd.lists.size(); ++k) entries[k] = float(kd.lists[k]);
-  const uint64_t bytes = replace_texels(gpu, {{&tree_, &nodes}, {&lists_, &entries}}, uploaded);
+  uint64_t bytes = replace_texels(gpu, {{&tree_, &nodes}, {&lists_, &entries}}, uploaded);
+  Bvh boxes;
+  if (beams_) {
+    // The nodes' boxes for the beams' descent, laid out as the BVH walk lays out its nodes.
+    boxes = kd_beam_nodes(kd);
+    if (fresh || !holds(boxes_lo_, kd.nodes.size())) {
+      boxes_lo_ = entry_texture(gpu, "kd boxes lo", kd.nodes.size(), 4, "kd-tree nodes");
+      boxes_hi_ = entry_texture(gpu, "kd boxes hi", kd.nodes.size(), 4, "kd-tree nodes");
+    }
+    std::vector<float> lo(boxes_lo_.data().begin(), boxes_lo_.data().end());
+    std::vector<float> hi(boxes_hi_.data().begin(), boxes_hi_.data().end());
+    bvh_node_texels(boxes, lo, hi);
+    bytes += replace_texels(gpu, {{&boxes_lo_, &lo}, {&boxes_hi_, &hi}}, uploaded);
+  }
 
   KdUniforms u;
   u.lo = kd.lo;
@@ -73,6 +93,19 @@ uint64_t KdWalk::set_tree(vgpu::Device& gpu, const KdTree& kd, float scene_width
   looping_.kernel.kd = u;
   looping_.kernel.scene = su;
   looping_.kernel.steps = opt_.steps_per_pass;
+  if (beams_) {
+    const float tile = float(opt_.beam_tile);
+    beam_enter_.kernel = enter_.kernel;
+    beam_step_.kernel = step_.kernel;
+    beam_step_load_.kernel = step_load_.kernel;
+    beam_looping_.kernel = looping_.kernel;
+    beam_enter_.kernel.beam_tile = beam_step_.kernel.beam_tile = tile;
+    beam_step_load_.kernel.beam_tile = beam_looping_.kernel.beam_tile = tile;
+    BvhUniforms bu;
+    bu.node_width = float(boxes_lo_.width());
+    bu.nodes = float(nodes_);
+    beams_->set_bvh(boxes, bu);
+  }
   return bytes;
 }
 
@@ -84,18 +117,32 @@ uint64_t KdWalk::rebuild(vgpu::Device& gpu, const Accel& accel, float scene_widt
 
 void KdWalk::make_state(vgpu::Device& gpu, const WalkShared& shared) {
   make_pairs(gpu, shared, "kd traversal", "leaf state");
+  if (beams_) beams_->make_state(gpu);
 }
 
-void KdWalk::trace(PassRunner& r, Texture& origins, Texture& rays, bool, glm::vec3) {
+void KdWalk::trace(PassRunner& r, Texture& origins, Texture& rays, bool primary, glm::vec3 eye) {
   clear(r.device());
   // Every ray starts at the root with its segment inside the scene box (primary rays' origins
-  // hold the eye).
-  r.pass(enter_, {&origins, &rays}, trav_.next());
+  // hold the eye); with beams over tiles, a primary ray starts at its tile's node instead, and
+  // restarts there.
+  const bool beams = primary && beams_;
+  if (beams) {
+    beams_->descend(r, eye, boxes_lo_, boxes_hi_);
+    beam_nodes_ = &beams_->beams();
+    r.pass(beam_enter_, {&origins, &rays, beam_nodes_}, trav_.next());
+  } else {
+    beam_nodes_ = nullptr;
+    r.pass(enter_, {&origins, &rays}, trav_.next());
+  }
   trav_.swap();
   if (opt_.looping) {
     // Per leaf visited: at most depth descents, two steps at the leaf, its triangles.
-    walk_looping(r, looping_, origins, rays, {&tree_, &lists_},
-                 int64_t(depth_ + 2 + max_leaf_) * int64_t(leaves_ + 1), count_entered(r));
+    const int64_t most = int64_t(depth_ + 2 + max_leaf_) * int64_t(leaves_ + 1);
+    if (beams)
+      walk_looping(r, beam_looping_, origins, rays, {&tree_, &lists_, beam_nodes_}, most,
+                   count_entered(r));
+    else
+      walk_looping(r, looping_, origins, rays, {&tree_, &lists_}, most, count_entered(r));
     return;
   }
   Cursor c = cursor(origins, rays);
@@ -119,8 +166,12 @@ void KdWalk::walk(X& x, Cursor& c) {
       x.unfinished(walking);
       break;
     }
-    step_and_load(x, c, key, step, {kStep, kLoad, kStepLoad}, step_, load_, step_load_, tree_,
-                  nullptr, lists_);
+    if (beam_nodes_)
+      step_and_load(x, c, key, step, {kStep, kLoad, kStepLoad}, beam_step_, load_, beam_step_load_,
+                    tree_, nullptr, lists_, beam_nodes_);
+    else
+      step_and_load(x, c, key, step, {kStep, kLoad, kStepLoad}, step_, load_, step_load_, tree_,
+                    nullptr, lists_);
     test_triangles(x, c, key, step, {kTesting, kIntersect, kNext, kIntersectNext, kTestingOn},
                    max_leaf_, intersect_, intersect_next_, lists_, true);
     walking = x.count(key(step, -1, kWalking), walking_, c.trav.current(), &grid_mask, &grid_mask);

@@ -1,10 +1,13 @@
 // The kd-restart walk (an extension; kernels/kdtree.h): the tree's textures, and which pass runs
 // next, steered by which query, in the grid walk's manner (grid_walk.h): one node per pass for
 // every walking ray, then the triangles of the leaves reached, one per pass. The pass sequence
-// is the BVH walk's (bvh_walk.h) with the kd-tree's kernels.
+// is the BVH walk's (bvh_walk.h) with the kd-tree's kernels. With beams over tiles
+// (RenderOptions::beams), each tile's beam descends the tree first (BvhBeams, on the nodes' boxes:
+// kd_beam_nodes), and its primary rays start, and restart, at the node it reached.
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -12,6 +15,7 @@
 #include "host/trace/passes.h"
 #include "host/trace/render_options.h"
 #include "host/trace/walks/accel_walk.h"
+#include "host/trace/walks/bvh_beams.h"
 #include "kernels/kernels.h"
 #include "vgpu/vgpu.h"
 
@@ -48,6 +52,12 @@ class KdWalk : public ListWalk {
                    std::vector<std::string>& uploaded) override;
   void trace(PassRunner& r, vgpu::Texture& origins, vgpu::Texture& rays, bool primary,
              glm::vec3 eye) override;
+  void set_camera(const kernels::GenerateRays& camera, float offset_x, float offset_y) override {
+    if (beams_) beams_->set_camera(camera, offset_x, offset_y);
+  }
+  // Beams over tiles (RenderOptions::beams; null: off).
+  const BvhBeams* beams() const { return beams_.get(); }
+  uint64_t extra_bytes() const override { return beams_ ? beams_->state_bytes() : 0; }
 
   // The multipass walk (host/trace/walks/walk.h); Cursor and write_back are ListWalk's.
   template <class X>
@@ -63,6 +73,15 @@ class KdWalk : public ListWalk {
   vgpu::KernelProgram<kernels::KdStepLoad> step_load_;
   vgpu::KernelProgram<kernels::KdIntersectNext> intersect_next_;
   vgpu::KernelProgram<kernels::KdLooping> looping_;
+  // Beams over tiles: the nodes' boxes (kd_beam_nodes, in the BVH's node layout), the descent,
+  // and the programs of the primary trace that read each tile's node (beam_tile > 0).
+  std::unique_ptr<BvhBeams> beams_;
+  vgpu::Texture boxes_lo_, boxes_hi_;
+  vgpu::KernelProgram<kernels::KdEnter> beam_enter_;
+  vgpu::KernelProgram<kernels::KdStep> beam_step_;
+  vgpu::KernelProgram<kernels::KdStepLoad> beam_step_load_;
+  vgpu::KernelProgram<kernels::KdLooping> beam_looping_;
+  const vgpu::Texture* beam_nodes_ = nullptr;  // during a primary trace with beams: each tile's
 };
 
 }  // namespace host
