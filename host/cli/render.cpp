@@ -317,11 +317,17 @@ void print_table(const RenderArgs& a, const RenderPlan& plan, const host::Scene&
               cpu ? "engine" : "profile", cpu ? "cpu" : opt.profile.c_str(), r.width, r.height,
               r.iterations, a.shading.c_str(), a.shadows.c_str(), a.masks.c_str(), a.mrt.c_str());
   if (!cpu) std::cout << "formats (texture and arithmetic, per group):\n" << describe(opt.formats);
-  if (opt.beams)
-    std::printf("beams %dx%d: %llu tiles, %llu beam passes, %llu tiles missed the scene\n",
+  if (opt.beams) {
+    std::printf("beams %dx%d: %llu tiles, %llu beam passes, %llu tiles missed the scene",
                 opt.beam_tile, opt.beam_tile, static_cast<unsigned long long>(r.beam_tiles),
                 static_cast<unsigned long long>(r.beam_passes),
                 static_cast<unsigned long long>(r.beam_tiles_missed));
+    if (accel.kind() != host::AccelKind::grid && r.beam_tiles > 0)
+      std::printf("; rays start %.2f levels below the root on average, %llu at most",
+                  double(r.beam_depth_sum) / double(r.beam_tiles),
+                  static_cast<unsigned long long>(r.beam_depth_max));
+    std::printf("\n");
+  }
   // --aa-criterion budget: each level's threshold and budget (kernels/cone_budget.h).
   for (size_t l = 0; l < r.budget_levels.size(); ++l) {
     const auto& b = r.budget_levels[l];

@@ -118,6 +118,12 @@ nlohmann::ordered_json frame_stats_json(const FrameStatsInputs& in) {
     // The CPU tracer marches the same beams one tile at a time: the passes are the most steps
     // one tile's beam ran (what the passes would have been), and it also counts every step.
     if (cpu) j["beams"]["steps"] = cpu_stats.beam_steps;
+    // Through the BVH or the kd-tree: the depth of the node each tile's rays started at (0 the
+    // root), the mean over the tiles and the deepest.
+    const AccelKind kind = in.accel.kind();
+    if ((kind == AccelKind::bvh || kind == AccelKind::kdtree) && r.beam_tiles > 0)
+      j["beams"]["entry_depth"] = {{"mean", double(r.beam_depth_sum) / double(r.beam_tiles)},
+                                   {"max", r.beam_depth_max}};
   }
   // --beams auto: what it chose and why; with beams off, {"on": false} and the choice alone.
   if (const BeamsChoice* bc = in.beams_choice) {

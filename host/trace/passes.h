@@ -23,6 +23,10 @@ struct WalkCounts {
   // Beams over tiles (--beams on, host/trace/walks/grid_beams.h): passes of rayosHaz, tiles
   // marched (over the frame's primary traces) and tiles whose whole beam missed the grid.
   uint64_t beam_passes = 0, beam_tiles = 0, beam_tiles_missed = 0;
+  // Through the BVH or the kd-tree: the levels every tile's beam descended, summed over the
+  // tiles, and the most one took (the descent's queries give both: after pass k they count the
+  // tiles k or more levels down).
+  uint64_t beam_depth_sum = 0, beam_depth_max = 0;
   BeamMap beam_map;  // the frame's first primary trace's tiles, when an observer follows it
 };
 

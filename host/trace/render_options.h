@@ -228,6 +228,9 @@ struct RenderResult {
   bool batch_walk = false;       // the grid walks ran in batches (RenderOptions::batch_walk)
   // Beams over tiles (RenderOptions::beams): beam passes, tiles marched, tiles that missed.
   uint64_t beam_passes = 0, beam_tiles = 0, beam_tiles_missed = 0;
+  // Through the BVH or the kd-tree: the depth of the node each tile's rays started at (its
+  // beam's stop, missed tiles included), summed over the tiles, and the deepest.
+  uint64_t beam_depth_sum = 0, beam_depth_max = 0;
   BeamMap beam_map;
   int samples = 1;                  // sample frames rendered (RenderOptions::spp)
   uint64_t first_frame_passes = 0;  // passes of the first sample frame (the rest is sampling's)

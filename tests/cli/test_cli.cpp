@@ -681,6 +681,25 @@ TEST_CASE(
   CHECK(c["steps"].get<uint64_t>() >= c["tiles"].get<uint64_t>());
   CHECK(cpu_on["cpu"]["voxel_steps"].get<uint64_t>() <
         cpu_off["cpu"]["voxel_steps"].get<uint64_t>());
+  CHECK(!b.contains("entry_depth"));  // the grid's beams march; no node to start at
+  // Through the kd-tree: the depth of the nodes the rays start at, the same on both engines,
+  // in the JSON and the table.
+  const nlohmann::json kd =
+      render_json("--bounces 0 --accel kdtree --beams on --beam-tile 4", dir, o);
+  REQUIRE(o.status == 0);
+  const Outcome table =
+      run("render bunny-low --size 32x32 -q --bounces 0 --accel kdtree --beams "
+          "on --beam-tile 4 --out " +
+          (dir / "table.png").string());
+  REQUIRE(table.status == 0);
+  CHECK(table.out.find("levels below the root on average") != std::string::npos);
+  const nlohmann::json kd_cpu =
+      render_json("--bounces 0 --accel kdtree --beams on --beam-tile 4 --engine cpu", dir, o);
+  REQUIRE(o.status == 0);
+  const nlohmann::json& d = kd["beams"]["entry_depth"];
+  CHECK(d["mean"].get<double>() > 0.0);
+  CHECK(d["max"].get<uint64_t>() >= 1);
+  CHECK(kd_cpu["beams"]["entry_depth"] == d);
   fs::remove_all(dir);
 }
 

@@ -171,6 +171,55 @@ TEST_CASE("the tile map holds each tile where the image has it, missed tiles wit
   CHECK(reached > 0);  // some beams moved on from the eye
 }
 
+TEST_CASE(
+    "through the bvh and the kd-tree, the tile map holds each tile's start node and depth, and "
+    "the descent's queries give the depths' sum and deepest") {
+  // 48x32 in 4x4 tiles: 12 across, 8 down.
+  const host::Scene scene = host::load_scene(host::resolve_scene("bunny-low"));
+  for (const host::AccelKind kind : {host::AccelKind::bvh, host::AccelKind::kdtree}) {
+    CAPTURE(int(kind));
+    host::RenderOptions opt = small(48, 32);
+    opt.bounces = 0;
+    opt.shadows = false;
+    opt.beams = true;
+    opt.beam_tile = 4;
+    const auto accel = built(scene, kind, opt);
+    const host::Camera cam = host::scene_camera(scene, float(opt.width) / float(opt.height));
+    host::RenderResult plain;
+    {
+      host::StreamTracer tracer(scene, *accel, opt);
+      plain = tracer.render(cam);
+    }
+    Blind blind;
+    opt.observer = &blind;
+    host::StreamTracer tracer(scene, *accel, opt);
+    const host::RenderResult r = tracer.render(cam);
+    const host::BeamMap& m = r.beam_map;
+    CHECK(m.tree);
+    REQUIRE(m.tiles_x == 12);
+    REQUIRE(m.tiles_y == 8);
+    REQUIRE(m.steps.size() == 96);
+    const int nodes = kind == host::AccelKind::bvh ? int(accel->bvh()->nodes.size())
+                                                   : int(accel->kd()->nodes.size());
+    uint64_t sum = 0, deepest = 0, missed = 0;
+    for (size_t i = 0; i < 96; ++i) {
+      CAPTURE(i);
+      CHECK(m.start[i] >= 0.0f);
+      CHECK(m.start[i] < float(nodes));
+      sum += uint64_t(m.steps[i]);
+      deepest = std::max(deepest, uint64_t(m.steps[i]));
+      missed += m.missed[i];
+    }
+    // The queries' sums are the map's own (with or without an observer), on every tile.
+    CHECK(r.beam_depth_sum == sum);
+    CHECK(r.beam_depth_max == deepest);
+    CHECK(plain.beam_depth_sum == sum);
+    CHECK(plain.beam_depth_max == deepest);
+    CHECK(deepest > 1);
+    CHECK(missed == r.beam_tiles_missed);
+  }
+}
+
 TEST_CASE("the beam textures are counted in the frame's texture bytes") {
   const host::Scene scene = host::load_scene(host::resolve_scene("bunny-low"));
   host::RenderOptions opt = small(40, 24);  // 5x3 tiles of 8x8

@@ -79,6 +79,12 @@ TEST_CASE(
       CHECK(gpu.beam_tiles == tiles);
       CHECK(on_stats.beam_tiles_missed == gpu.beam_tiles_missed);
       CHECK(on_stats.beam_passes == gpu.beam_passes);
+      // Through a tree, the depths the tiles' beams reached, as the descent's queries count them.
+      if (kind != host::AccelKind::grid) {
+        CHECK(on.beam_depth_sum == gpu.beam_depth_sum);
+        CHECK(on.beam_depth_max == gpu.beam_depth_max);
+        CHECK(on.beam_depth_max > 0);
+      }
       CHECK(on.beam_passes == gpu.beam_passes);
       CHECK(on_stats.beam_passes > 1);
       missed[kind] += on_stats.beam_tiles_missed;

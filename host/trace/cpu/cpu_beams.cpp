@@ -56,6 +56,8 @@ void run_tiles(const K& kernel, const vgpu::BoundTexture* units, std::vector<flo
       }
       most = std::max(most, runs);
       counts.steps += runs;
+      counts.depth_sum += uint64_t(b[3]);
+      counts.depth_max = std::max(counts.depth_max, uint64_t(b[3]));
       counts.tiles_missed += b[2] > 0.0f;
     }
   counts.tiles += uint64_t(tiles_x) * uint64_t(tiles_y);

@@ -262,6 +262,8 @@ RenderResult render_cpu(const Scene& scene, const Accel& accel, const Camera& ca
     res.beam_tiles_missed = total.beam_tiles_missed = b.tiles_missed;
     res.beam_passes = total.beam_passes = b.passes;
     total.beam_steps = b.steps;
+    res.beam_depth_sum = b.depth_sum;
+    res.beam_depth_max = b.depth_max;
   }
   if (stats) *stats = total;
   if (res.rays_per_pixel.empty()) res.samples = std::max(options.spp, 1);

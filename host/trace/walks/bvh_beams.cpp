@@ -123,6 +123,9 @@ void BvhBeams::descend(PassRunner& r, glm::vec3 eye, Texture& nodes_lo, Texture&
     gpu.begin_query();
     r.pass(descending_, {&beams_.current()}, counter_);
     descending = gpu.end_query();
+    // The tiles still descending after pass k are those k or more levels down.
+    n.beam_depth_sum += descending;
+    if (descending > 0) n.beam_depth_max = std::max(n.beam_depth_max, uint64_t(pass + 1));
   }
   gpu.begin_query();
   r.pass(missed_, {&beams_.current()}, counter_);
