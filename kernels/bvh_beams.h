@@ -47,6 +47,67 @@ struct BvhBeamUniforms {
   BvhUniforms bvh;
 };
 
+// A tile's beam: its corner pixels' primary rays (as the grid's beam march has them), the axis
+// between them, the eye and the frustum test's margin.
+template <class L>
+struct TileBeam {
+  using F = typename L::F;
+  Vec3<F> d[4], axis, e;
+  F margin;
+  TileBeam(const Fragments<L>& f, const BeamUniforms& bu) {
+    const F x0 = (f.x - F(0.5f)) * F(bu.tile) + F(0.5f + bu.offset_x);
+    const F y0 = (f.y - F(0.5f)) * F(bu.tile) + F(0.5f + bu.offset_y);
+    const F x1 = min(x0 + F(bu.tile - 1.0f), F(bu.camera.width - 0.5f + bu.offset_x));
+    const F y1 = min(y0 + F(bu.tile - 1.0f), F(bu.camera.height - 0.5f + bu.offset_y));
+    d[0] = bu.camera.ray_through<L>(x0, y0).xyz();
+    d[1] = bu.camera.ray_through<L>(x1, y0).xyz();
+    d[2] = bu.camera.ray_through<L>(x1, y1).xyz();
+    d[3] = bu.camera.ray_through<L>(x0, y1).xyz();
+    axis = normalize(d[0] + d[1] + d[2] + d[3]);
+    e = splat<F>(bu.eye);
+    margin = F(bu.margin);
+  }
+};
+
+// One level of a tile's descent: the beam texel b (node, end or 0 while descending, missed,
+// depth) after the node b.x is looked at (rayosHazBVH's work; its looping form repeats it).
+template <class L>
+inline Vec4<typename L::F> bvh_beam_step(const Fragments<L>& f, int unit_lo, int unit_hi,
+                                         const Vec4<typename L::F>& b, const TileBeam<L>& beam,
+                                         const BvhUniforms& bvh) {
+  using F = typename L::F;
+  const F node = b.x;
+  const Vec4<F> lo = fetch_id(f, unit_lo, node, bvh.node_width);
+  const Vec4<F> hi = fetch_id(f, unit_hi, node, bvh.node_width);
+  const F end = select(lo.w < F(0.0f), F(bvh.nodes), lo.w);
+  // A leaf (or an empty one, written as an inner node: its subtree is itself) has no children:
+  // its own texels stand in for them (and are not used).
+  const auto leaf = (hi.w >= F(0.0f)) || (node + F(1.0f) >= end);
+  const F left = select(leaf, node, node + F(1.0f));
+  const Vec4<F> llo = fetch_id(f, unit_lo, left, bvh.node_width);
+  const Vec4<F> lhi = fetch_id(f, unit_hi, left, bvh.node_width);
+  // The right child follows the left child's subtree: the left child's escape.
+  const F right = select(leaf, node, llo.w);
+  const Vec4<F> rlo = fetch_id(f, unit_lo, right, bvh.node_width);
+  const Vec4<F> rhi = fetch_id(f, unit_hi, right, bvh.node_width);
+  const auto& d = beam.d;
+  const auto self_out = beam_skips_box(beam.e, d, beam.axis, lo.xyz(), hi.xyz(), beam.margin);
+  const auto left_out =
+      beam_skips_box(beam.e, d, beam.axis, llo.xyz(), lhi.xyz(), beam.margin) && !leaf;
+  const auto right_out =
+      beam_skips_box(beam.e, d, beam.axis, rlo.xyz(), rhi.xyz(), beam.margin) && !leaf;
+  const auto descending = b.y <= F(0.0f);
+  // The whole tile misses: the node's box (the root's: a child's is tested before the beam
+  // moves there), or both children's.
+  const auto missed = descending && (self_out || (!leaf && left_out && right_out));
+  const auto moves =
+      descending && !missed && !leaf && ((left_out && !right_out) || (right_out && !left_out));
+  const F next = select(left_out, right, left);
+  const auto stops = descending && !moves;
+  return {select(moves, next, node), select(stops, end, b.y), select(missed, F(1.0f), b.z),
+          select(moves, b.w + F(1.0f), b.w)};
+}
+
 // rayosHazBVH: one node of a tile's descent. The beam texture (one texel per tile) holds x = the
 // node the beam is at; y = 0 while it descends, then the end of its rays' walk (the node's
 // escape, the node count for -1); z = 1 where the whole tile misses the tree; w = the depth of
@@ -63,47 +124,36 @@ struct BvhBeamDescend {
 
   template <class L>
   void operator()(Fragments<L>& f) const {
+    const TileBeam<L> beam(f, u.beams);
+    f.out(0) = bvh_beam_step(f, kNodesLo, kNodesHi, f.fetch_own(kBeams), beam, u.bvh);
+  }
+};
+
+// rayosHazBVHIterativo: a tile's whole descent in one pass (--kernels looping): rayosHazBVH's
+// step repeated while the beam descends, at most `levels` times (the tree's levels). The same
+// texel as the passes leave, without a query per level.
+struct BvhBeamDescendLooping {
+  static constexpr const char* name = "bvh beam descent loop";
+  static constexpr const char* paper_name = "rayosHazBVHIterativo (extension)";
+  static constexpr int outputs = 1;  // -> beams
+  enum Unit { kBeams, kNodesLo, kNodesHi };
+  static constexpr std::array<const char*, 3> units{"beams", "nodes_lo", "nodes_hi"};
+  static constexpr std::array<int, 1> passthrough{kBeams};
+
+  BvhBeamUniforms u;
+  int levels = 1;
+
+  template <class L>
+  void operator()(Fragments<L>& f) const {
     using F = typename L::F;
-    const BeamUniforms& bu = u.beams;
-    const Vec4<F> b = f.fetch_own(kBeams);
-    // The tile's corner pixels' sample positions, as the grid's beam march has them.
-    const F x0 = (f.x - F(0.5f)) * F(bu.tile) + F(0.5f + bu.offset_x);
-    const F y0 = (f.y - F(0.5f)) * F(bu.tile) + F(0.5f + bu.offset_y);
-    const F x1 = min(x0 + F(bu.tile - 1.0f), F(bu.camera.width - 0.5f + bu.offset_x));
-    const F y1 = min(y0 + F(bu.tile - 1.0f), F(bu.camera.height - 0.5f + bu.offset_y));
-    const Vec3<F> d[4] = {
-        bu.camera.ray_through<L>(x0, y0).xyz(), bu.camera.ray_through<L>(x1, y0).xyz(),
-        bu.camera.ray_through<L>(x1, y1).xyz(), bu.camera.ray_through<L>(x0, y1).xyz()};
-    const Vec3<F> axis = normalize(d[0] + d[1] + d[2] + d[3]);
-    const Vec3<F> e = splat<F>(bu.eye);
-    const F mg = F(bu.margin);
-    const F node = b.x;
-    const Vec4<F> lo = fetch_id(f, kNodesLo, node, u.bvh.node_width);
-    const Vec4<F> hi = fetch_id(f, kNodesHi, node, u.bvh.node_width);
-    const F end = select(lo.w < F(0.0f), F(u.bvh.nodes), lo.w);
-    // A leaf (or an empty one, written as an inner node: its subtree is itself) has no children:
-    // its own texels stand in for them (and are not used).
-    const auto leaf = (hi.w >= F(0.0f)) || (node + F(1.0f) >= end);
-    const F left = select(leaf, node, node + F(1.0f));
-    const Vec4<F> llo = fetch_id(f, kNodesLo, left, u.bvh.node_width);
-    const Vec4<F> lhi = fetch_id(f, kNodesHi, left, u.bvh.node_width);
-    // The right child follows the left child's subtree: the left child's escape.
-    const F right = select(leaf, node, llo.w);
-    const Vec4<F> rlo = fetch_id(f, kNodesLo, right, u.bvh.node_width);
-    const Vec4<F> rhi = fetch_id(f, kNodesHi, right, u.bvh.node_width);
-    const auto self_out = beam_skips_box(e, d, axis, lo.xyz(), hi.xyz(), mg);
-    const auto left_out = beam_skips_box(e, d, axis, llo.xyz(), lhi.xyz(), mg) && !leaf;
-    const auto right_out = beam_skips_box(e, d, axis, rlo.xyz(), rhi.xyz(), mg) && !leaf;
-    const auto descending = b.y <= F(0.0f);
-    // The whole tile misses: the node's box (the root's: a child's is tested before the beam
-    // moves there), or both children's.
-    const auto missed = descending && (self_out || (!leaf && left_out && right_out));
-    const auto moves =
-        descending && !missed && !leaf && ((left_out && !right_out) || (right_out && !left_out));
-    const F next = select(left_out, right, left);
-    const auto stops = descending && !moves;
-    f.out(0) = Vec4<F>{select(moves, next, node), select(stops, end, b.y),
-                       select(missed, F(1.0f), b.z), select(moves, b.w + F(1.0f), b.w)};
+    using M = typename L::M;
+    const TileBeam<L> beam(f, u.beams);
+    Vec4<F> b = f.fetch_own(kBeams);
+    f.loop(levels, b.y <= F(0.0f), [&](const M& act) {
+      b = select(act, bvh_beam_step(f, kNodesLo, kNodesHi, b, beam, u.bvh), b);
+      return b.y <= F(0.0f);
+    });
+    f.out(0) = b;
   }
 };
 

@@ -6,5 +6,6 @@ template class vgpu::KernelProgram<kernels::BeamMarch>;
 template class vgpu::KernelProgram<kernels::BeamEntry>;
 template class vgpu::KernelProgram<kernels::BeamsMissed>;
 template class vgpu::KernelProgram<kernels::BvhBeamDescend>;
+template class vgpu::KernelProgram<kernels::BvhBeamDescendLooping>;
 template class vgpu::KernelProgram<kernels::BvhBeamEnter>;
 template class vgpu::KernelProgram<kernels::BvhBeamsDescending>;

@@ -54,8 +54,10 @@ using MultipassKernels = KernelList<
     BeamMarch, BeamsMissed, BeamEntry, BvhBeamDescend, BvhBeamsDescending, BvhBeamEnter>;
 
 // The looping variant (--kernels looping): each structure's whole walk in one program with a
-// data-dependent loop (kernels/looping_traversal.h and the structures' headers).
-using LoopingKernels = KernelList<LoopingTraversal, BvhLooping, KdLooping, Grid2Looping>;
+// data-dependent loop (kernels/looping_traversal.h and the structures' headers); with beams
+// through a tree, the whole descent in one program (kernels/bvh_beams.h).
+using LoopingKernels =
+    KernelList<LoopingTraversal, BvhLooping, KdLooping, Grid2Looping, BvhBeamDescendLooping>;
 
 // Which kernels a list holds.
 enum class Programs {

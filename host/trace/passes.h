@@ -27,7 +27,8 @@ struct WalkCounts {
   // tiles, and the most one took (the descent's queries give both: after pass k they count the
   // tiles k or more levels down).
   uint64_t beam_depth_sum = 0, beam_depth_max = 0;
-  BeamMap beam_map;  // the frame's first primary trace's tiles, when an observer follows it
+  bool beam_depths = false;  // the descent counted them (not the looping descent: one pass)
+  BeamMap beam_map;          // the frame's first primary trace's tiles, when an observer follows it
 };
 
 // The state a batch walk hands back to the textures and masks: each ping-pong pair of state

@@ -26,7 +26,8 @@ inline gl::GlDevice& device() {
   return d;
 }
 
-// A second context whose profile has multiple render targets, for the fused programs.
+// A second context whose profile has multiple render targets and loops, for the fused and the
+// looping programs.
 inline gl::GlDevice& mrt_device() {
   static gl::GlDevice d(vgpu::profile("gf6600"));
   return d;
@@ -87,7 +88,7 @@ inline void check_same_targets(const vgpu::Program& p,
                                const std::vector<const vgpu::Texture*>& before,
                                const std::vector<const vgpu::Texture*>& vgpu_outs,
                                const uint64_t* vgpu_query) {
-  gl::GlDevice& d = p.outputs() > 1 ? mrt_device() : device();
+  gl::GlDevice& d = p.outputs() > 1 || p.analyze().loop.loops > 0 ? mrt_device() : device();
   std::vector<vgpu::Texture> outs;  // copies: new textures, created on the device from these texels
   outs.reserve(before.size());
   for (const vgpu::Texture* t : before) outs.push_back(*t);

@@ -112,7 +112,10 @@ Texture run(vgpu::Device& gpu, const K& k, const std::vector<const Texture*>& un
             glm::vec4 fill = glm::vec4(0.0f), uint64_t* query = nullptr,
             vgpu::PassRecord* record = nullptr) {
   vgpu::KernelProgram<K> program(k);
-  Texture out = gpu.make_texture(std::string(K::name) + " out", w, h, 4);
+  // Built in place, not by operator+ (GCC 12 warns, wrongly, of a bounds overflow there).
+  std::string name(K::name);
+  name.append(" out");
+  Texture out = gpu.make_texture(name, w, h, 4);
   const float f[4] = {fill.x, fill.y, fill.z, fill.w};
   out.fill(f);
   const std::vector<Texture> before = before_pass({&out});  // the GL pass starts from these

@@ -96,6 +96,34 @@ TEST_CASE("bvh beam descent skips the children a beam misses and stops where it 
   for (int t = 0; t < 4; ++t) CHECK_TEXEL(three, t, 0, ktest::at(two, t, 0));
 }
 
+TEST_CASE(
+    "the looping bvh beam descent ends in one pass where the passes end, and stops at its level "
+    "budget") {
+  const Tree tree;
+  const kernels::BvhBeamDescend one_level = descend(kEye);
+  kernels::BvhBeamDescendLooping k;
+  k.u = one_level.u;
+  k.levels = 3;
+  vgpu::Gpu gpu(ktest::gf6600(), 1, 1);  // a profile with loops
+  const Texture start = texels("beams", 4, 1, std::vector<glm::vec4>(4, glm::vec4(0.0f)));
+  vgpu::PassRecord rec;
+  const Texture out =
+      ktest::run(gpu, k, {&start, &tree.lo, &tree.hi}, 4, 1, glm::vec4(7, 8, 9, 10), nullptr, &rec);
+  // The second pass's texels above: tile 0 stopped at L (depth 1), tiles 1 and 2 missed at the
+  // root, tile 3 stopped at the leaf B (depth 1).
+  CHECK_TEXEL(out, 0, 0, glm::vec4(1, 4, 0, 1));
+  CHECK_TEXEL(out, 1, 0, glm::vec4(0, 5, 1, 0));
+  CHECK_TEXEL(out, 2, 0, glm::vec4(0, 5, 1, 0));
+  CHECK_TEXEL(out, 3, 0, glm::vec4(4, 5, 0, 1));
+  // Iterations: tiles 0 and 3 move, then stop (2 each); tiles 1 and 2 stop at once (1 each).
+  CHECK(rec.counters.loop_iterations == 2 + 1 + 1 + 2);
+  // With one level of budget the loop leaves tiles 0 and 3 where the first pass leaves them.
+  k.levels = 1;
+  const Texture cut = ktest::run(gpu, k, {&start, &tree.lo, &tree.hi}, 4, 1, glm::vec4(7));
+  CHECK_TEXEL(cut, 0, 0, glm::vec4(1, 0, 0, 1));
+  CHECK_TEXEL(cut, 3, 0, glm::vec4(4, 0, 0, 1));
+}
+
 TEST_CASE("bvh beam descent misses the whole tree behind the eye") {
   const Tree tree;
   // The eye past the boxes (z = 5), looking on down +z: the root lies behind every beam.

@@ -361,6 +361,7 @@ RenderResult StreamTracer::render(const Camera& cam) {
   res.beam_tiles_missed = r.counts.beam_tiles_missed;
   res.beam_depth_sum = r.counts.beam_depth_sum;
   res.beam_depth_max = r.counts.beam_depth_max;
+  res.beam_depths = r.counts.beam_depths;
   res.beam_map = std::move(r.counts.beam_map);
   if (s.streams) res.streams = s.streams->stats;
   if (s.dense) res.compact = s.dense->stats;

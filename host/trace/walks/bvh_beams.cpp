@@ -40,6 +40,7 @@ void BvhBeams::set_bvh(const Bvh& bvh, const kernels::BvhUniforms& u) {
   descend_.kernel.u.beams.tile = float(opt_.beam_tile);
   depth_ = bvh_levels(bvh);
   descend_.kernel.u.beams.margin = bvh_beam_margin(bvh);
+  descend_looping_.kernel.levels = depth_;
 }
 
 int BvhBeams::tiles_x() const {
@@ -114,7 +115,15 @@ void BvhBeams::descend(PassRunner& r, glm::vec3 eye, Texture& nodes_lo, Texture&
   gpu.clear(beams_.current(), {0, 0, 0, 0});
   WalkCounts& n = r.counts;
   n.beam_tiles += uint64_t(tiles_x()) * uint64_t(tiles_y());
-  uint64_t descending = 1;
+  if (opt_.looping) {
+    // The whole descent in one pass: no query per level, so no depths counted.
+    descend_looping_.kernel.u = descend_.kernel.u;
+    r.pass(descend_looping_, {&beams_.current(), &nodes_lo, &nodes_hi}, beams_.next());
+    beams_.swap();
+    ++n.beam_passes;
+  }
+  uint64_t descending = opt_.looping ? 0 : 1;
+  if (!opt_.looping) n.beam_depths = true;
   // A beam moves down one level per pass and stops at a leaf at the latest.
   for (int pass = 0; pass < depth_ && descending > 0; ++pass) {
     r.pass(descend_, {&beams_.current(), &nodes_lo, &nodes_hi}, beams_.next());

@@ -46,8 +46,9 @@ class BvhBeams {
   void make_state(vgpu::Device& gpu);
   // The primary rays' camera and the sample's offset from the pixel centre (pixels).
   void set_camera(const kernels::GenerateRays& camera, float offset_x, float offset_y);
-  // The descent passes (at most one per level of the tree) and the count of the tiles that
-  // missed: beams() then holds each tile's node.
+  // The descent passes (at most one per level of the tree; with --kernels looping one pass of
+  // rayosHazBVHIterativo) and the count of the tiles that missed: beams() then holds each
+  // tile's node.
   void descend(PassRunner& r, glm::vec3 eye, vgpu::Texture& nodes_lo, vgpu::Texture& nodes_hi);
   // descend(), then inicioHazBVH: the primary rays' traversal state into `traversal`.
   void enter(PassRunner& r, vgpu::Texture& rays, glm::vec3 eye, vgpu::Texture& nodes_lo,
@@ -65,6 +66,7 @@ class BvhBeams {
   PingPong<vgpu::Texture> beams_;
   vgpu::Texture counter_;
   vgpu::KernelProgram<kernels::BvhBeamDescend> descend_;
+  vgpu::KernelProgram<kernels::BvhBeamDescendLooping> descend_looping_;  // --kernels looping
   vgpu::KernelProgram<kernels::BvhBeamEnter> entry_;
   vgpu::KernelProgram<kernels::BvhBeamsDescending> descending_;
   vgpu::KernelProgram<kernels::BeamsMissed> missed_;
