@@ -10,7 +10,8 @@
 #   mkdir -p .gl && (cd .gl && apt-get download libegl1 libglvnd0 libopengl0 libgl1 libglx0)
 # copy the repository with .h200 and .gl to the GPU host and run there, from its root:
 #   OUT=DIR scripts/h200/beams.sh       (SIZE=32 RUNS=1 WARMUP=0: the end-to-end check on llvmpipe)
-# (ACCEL=kdtree or bvh: through that structure instead, into beams_h200_ACCEL_SCENE.json)
+# (ACCEL=kdtree or bvh: through that structure instead, into beams_h200_ACCEL_SCENE.json;
+#  VARIANT=looping: the looping kernels, into beams_h200_[ACCEL_]looping_SCENE.json)
 # then copy DIR's files to results/beams/ (beams_h200_SCENE.json and clocks.csv).
 set -u
 out="${OUT:?set OUT to a folder}"
@@ -22,9 +23,11 @@ mkdir -p "$out"
 . scripts/h200/env.sh
 common="--runs $runs --sizes $size --threads 16 --readback-wait poll --grid auto --no-fixed"
 accel="${ACCEL:-grid}"
+variant="${VARIANT:-multipass}"
 tag=""
 [ "$accel" = grid ] || tag="${accel}_"
-common="$common --accel $accel --variants multipass --bounces 0 --warmup-ms ${WARMUP:-2000}"
+[ "$variant" = multipass ] || tag="${tag}${variant}_"
+common="$common --accel $accel --variants $variant --bounces 0 --warmup-ms ${WARMUP:-2000}"
 status=0
 for scene in ${SCENES:-bunny classic hop}; do
   "$h200/bench_gl" $common --beams off on --scenes "scenes/$scene.gltf" \
