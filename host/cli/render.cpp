@@ -322,7 +322,7 @@ void print_table(const RenderArgs& a, const RenderPlan& plan, const host::Scene&
                 opt.beam_tile, opt.beam_tile, static_cast<unsigned long long>(r.beam_tiles),
                 static_cast<unsigned long long>(r.beam_passes),
                 static_cast<unsigned long long>(r.beam_tiles_missed));
-    if (accel.kind() != host::AccelKind::grid && r.beam_depths && r.beam_tiles > 0)
+    if (r.beam_depths && r.beam_tiles > 0)
       std::printf("; rays start %.2f levels below the root on average, %llu at most",
                   double(r.beam_depth_sum) / double(r.beam_tiles),
                   static_cast<unsigned long long>(r.beam_depth_max));

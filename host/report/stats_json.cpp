@@ -120,8 +120,7 @@ nlohmann::ordered_json frame_stats_json(const FrameStatsInputs& in) {
     if (cpu) j["beams"]["steps"] = cpu_stats.beam_steps;
     // Through the BVH or the kd-tree: the depth of the node each tile's rays started at (0 the
     // root), the mean over the tiles and the deepest.
-    const AccelKind kind = in.accel.kind();
-    if ((kind == AccelKind::bvh || kind == AccelKind::kdtree) && r.beam_depths && r.beam_tiles > 0)
+    if (r.beam_depths && r.beam_tiles > 0)
       j["beams"]["entry_depth"] = {{"mean", double(r.beam_depth_sum) / double(r.beam_tiles)},
                                    {"max", r.beam_depth_max}};
   }

@@ -231,7 +231,7 @@ struct RenderResult {
   // Through the BVH or the kd-tree: the depth of the node each tile's rays started at (its
   // beam's stop, missed tiles included), summed over the tiles, and the deepest.
   uint64_t beam_depth_sum = 0, beam_depth_max = 0;
-  bool beam_depths = false;  // counted (a multipass descent, or the CPU tracer's)
+  bool beam_depths = false;  // counted: a tree's multipass descent, or the CPU tracer's
   BeamMap beam_map;
   int samples = 1;                  // sample frames rendered (RenderOptions::spp)
   uint64_t first_frame_passes = 0;  // passes of the first sample frame (the rest is sampling's)

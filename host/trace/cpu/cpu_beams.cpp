@@ -56,8 +56,10 @@ void run_tiles(const K& kernel, const vgpu::BoundTexture* units, std::vector<flo
       }
       most = std::max(most, runs);
       counts.steps += runs;
-      counts.depth_sum += uint64_t(b[3]);
-      counts.depth_max = std::max(counts.depth_max, uint64_t(b[3]));
+      if (counts.depths) {
+        counts.depth_sum += uint64_t(b[3]);
+        counts.depth_max = std::max(counts.depth_max, uint64_t(b[3]));
+      }
       counts.tiles_missed += b[2] > 0.0f;
     }
   counts.tiles += uint64_t(tiles_x) * uint64_t(tiles_y);
@@ -136,6 +138,7 @@ CpuBvhBeams::CpuBvhBeams(const Bvh& bvh, const Camera& camera, const RenderOptio
   u.beams.camera = beam_camera(camera, options);
   u.beams.eye = camera.position;
   u.beams.margin = bvh_beam_margin(bvh);
+  counts_.depths = true;  // a descent's texel w is its node's depth
 }
 
 const CpuBvhBeams::Map& CpuBvhBeams::map(glm::vec2 j) const {

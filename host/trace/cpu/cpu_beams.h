@@ -35,9 +35,10 @@ struct CpuBeamCounts {
   uint64_t tiles = 0, tiles_missed = 0;
   uint64_t passes = 0;  // per map, the most steps one tile ran: the passes a GPU would run
   uint64_t steps = 0;   // march steps over every tile (kernel runs)
-  // The beam texels' w after the march or descent (the grid: march steps; a tree: the depth of
-  // the tile's node), summed over the tiles, and the largest.
+  // Through a tree (CpuBvhBeams): the depth of each tile's node (its beam texel's w), summed
+  // over the tiles, and the largest; `depths` says they were counted.
   uint64_t depth_sum = 0, depth_max = 0;
+  bool depths = false;
 };
 
 class CpuBeams {

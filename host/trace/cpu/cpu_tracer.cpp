@@ -264,7 +264,7 @@ RenderResult render_cpu(const Scene& scene, const Accel& accel, const Camera& ca
     total.beam_steps = b.steps;
     res.beam_depth_sum = b.depth_sum;
     res.beam_depth_max = b.depth_max;
-    res.beam_depths = true;
+    res.beam_depths = b.depths;
   }
   if (stats) *stats = total;
   if (res.rays_per_pixel.empty()) res.samples = std::max(options.spp, 1);
