@@ -50,9 +50,14 @@ struct SubGrid {
   using F = typename L::F;
   Vec4<F> rec;
   Vec3<F> lo, size;
-  SubGrid(const Fragments<L>& f, int unit_cells, const Vec3<F>& cc, const Grid2Uniforms& u) {
-    const F id = (cc.z * F(u.res.y) + cc.y) * F(u.res.x) + cc.x;
-    rec = fetch_id(f, unit_cells, id, u.cell_width);
+  SubGrid(const Fragments<L>& f, int unit_cells, const Vec3<F>& cc, const Grid2Uniforms& u)
+      : SubGrid(
+            cc,
+            fetch_id(f, unit_cells, (cc.z * F(u.res.y) + cc.y) * F(u.res.x) + cc.x, u.cell_width),
+            u) {}
+  // The sub-grid of coarse cell `cc` whose record is `record` (no fetch: the beam entry's
+  // empty cells, whose sub-grid is one cell).
+  SubGrid(const Vec3<F>& cc, const Vec4<F>& record, const Grid2Uniforms& u) : rec(record) {
     lo = {F(u.lo.x) + cc.x * F(u.cell.x), F(u.lo.y) + cc.y * F(u.cell.y),
           F(u.lo.z) + cc.z * F(u.cell.z)};
     size = {F(u.cell.x) / rec.x, F(u.cell.y) / rec.y, F(u.cell.z) / rec.z};

@@ -16,6 +16,7 @@
 #include "kernels/gather_children.h"
 #include "kernels/generate_rays.h"
 #include "kernels/grid2.h"
+#include "kernels/grid2_beams.h"
 #include "kernels/init_traversal.h"
 #include "kernels/intersections.h"
 #include "kernels/kdtree.h"
@@ -107,3 +108,4 @@ extern template class vgpu::KernelProgram<kernels::BeamsMissed>;
 extern template class vgpu::KernelProgram<kernels::BvhBeamDescend>;
 extern template class vgpu::KernelProgram<kernels::BvhBeamEnter>;
 extern template class vgpu::KernelProgram<kernels::BvhBeamsDescending>;
+extern template class vgpu::KernelProgram<kernels::Grid2BeamEntry>;

@@ -50,8 +50,10 @@ using MultipassKernels = KernelList<
     // Sampling that saves time (issue 35): the marked pixels as a dense stream, and back.
     CompactMarks, GenerateDenseRays, AccumulateDense, GatherMarked,
     // Beams over tiles (issue 35, kernels/beams.h): --beams on, one fragment per tile; through
-    // the BVH (kernels/bvh_beams.h), the descent to each tile's entry node.
-    BeamMarch, BeamsMissed, BeamEntry, BvhBeamDescend, BvhBeamsDescending, BvhBeamEnter>;
+    // the BVH (kernels/bvh_beams.h), the descent to each tile's entry node; through the
+    // two-level grid (kernels/grid2_beams.h), the entry at the walk's sub-cell.
+    BeamMarch, BeamsMissed, BeamEntry, BvhBeamDescend, BvhBeamsDescending, BvhBeamEnter,
+    Grid2BeamEntry>;
 
 // The looping variant (--kernels looping): each structure's whole walk in one program with a
 // data-dependent loop (kernels/looping_traversal.h and the structures' headers); with beams

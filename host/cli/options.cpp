@@ -245,12 +245,14 @@ void add_render_options(CLI::App& render, RenderArgs& a) {
       ->check(CLI::IsMember(on_off))
       ->capture_default_str();
   render
-      .add_option("--beams", a.beams,
-                  "Beams over tiles (issue 35, docs/groups.md): passes of one fragment per tile "
-                  "march each tile's beam through empty space, and the primary rays start where "
-                  "it stopped; the same image. --accel grid, bvh or kdtree, fp32; every engine "
-                  "(stream, gl, cpu). auto: on where two probes of the primary trace priced by the cost model "
-                  "say beams pay, else off")
+      .add_option(
+          "--beams", a.beams,
+          "Beams over tiles (issue 35, docs/groups.md): passes of one fragment per tile "
+          "march each tile's beam through empty space, and the primary rays start where "
+          "it stopped; the same image. Every structure (not --accel auto), fp32; every engine "
+          "(stream, gl, cpu). auto: on where two probes of the primary trace priced by the cost "
+          "model "
+          "say beams pay, else off")
       ->check(CLI::IsMember({"off", "on", "auto"}))
       ->capture_default_str();
   render.add_option("--beam-tile", a.beam_tile, "With --beams on or auto: pixels per tile side")

@@ -173,10 +173,11 @@ RenderPlan parse_render(const RenderArgs& a, bool lanes_given) {
                        " needs --engine stream (the cpu engine is a double-precision reference "
                        "without passes, lanes or masks)");
   }
-  if (opt.beams && a.accel != "grid" && a.accel != "bvh" && a.accel != "kdtree")
+  if (opt.beams && a.accel == "auto")
     throw UsageError(
-        "--beams on: beams are walked through the uniform grid, the BVH and the kd-tree only "
-        "(--accel grid, bvh or kdtree; with --accel auto, --beams auto)");
+        "--beams on: beams go through the structure the frame walks, and --accel auto has not "
+        "chosen it yet: name one (--accel grid, grid2, bvh or kdtree), or with --accel auto, "
+        "--beams auto");
   if (opt.beams && (a.precision != "fp32" || !a.formats.empty()))
     throw UsageError(
         "--beams on needs fp32 ray state (no --precision or --formats): the beam "

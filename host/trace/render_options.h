@@ -98,8 +98,9 @@ struct RenderOptions {
   // empty space, and every pixel's ray starts where its tile's beam stopped. The same hits,
   // depths and images as without (only where each walk begins changes). Through the BVH, each
   // tile's beam descends to the first node it cannot narrow down and its rays start there;
-  // through the kd-tree likewise (the nodes' boxes), and its rays restart there too. The
-  // uniform grid, the BVH and the kd-tree, fp32 ray state (refusal() says so); every engine.
+  // through the kd-tree likewise (the nodes' boxes), and its rays restart there too; through the
+  // two-level grid, the beams march over its coarse grid. Every structure, fp32 ray state
+  // (refusal() says so); every engine.
   bool beams = false;
   int beam_tile = 8;
   // Supersampling (host/trace/sampling.h): rays per pixel, a square from 1 to 256, on a

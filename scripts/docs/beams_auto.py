@@ -33,7 +33,7 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--vgpu-rt", default=os.path.join(ROOT, "build/host/vgpu-rt"))
     ap.add_argument("--size", type=int, default=256)
-    ap.add_argument("--accel", default="grid", choices=("grid", "bvh", "kdtree"))
+    ap.add_argument("--accel", default="grid", choices=("grid", "grid2", "bvh", "kdtree"))
     ap.add_argument("--json", help="rows out (default results/beams/beams_auto.json, "
                     "beams_auto_ACCEL.json for another structure)")
     ap.add_argument("--scenes", nargs="*", help="scene files (default: bundled and uneven)")

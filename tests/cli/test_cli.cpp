@@ -637,8 +637,6 @@ TEST_CASE(
 }
 
 TEST_CASE("beams are refused where they cannot apply, one line and exit 2") {
-  check_refused("--beams on --accel grid2", "--beams on",
-                "the uniform grid, the BVH and the kd-tree only");
   check_refused("--beams on --accel auto", "--beams on", "with --accel auto, --beams auto");
   check_refused("--beams on --precision fp16", "--beams on", "needs fp32 ray state");
   check_refused("--beam-tile 4", "--beam-tile", "needs --beams on");
@@ -723,21 +721,25 @@ TEST_CASE("beams auto renders the same image, and its JSON and table say what it
   CHECK(au["primary_ms"]["on"].get<double>() < au["primary_ms"]["off"].get<double>());
   CHECK(au["why"].get<std::string>().rfind("on: ", 0) == 0);
   // Where beams cannot run, off without a word on stderr, and the JSON says why.
-  const nlohmann::json g2 = render_json("--bounces 0 --beams auto --accel grid2", dir, o);
+  const nlohmann::json cpu = render_json("--bounces 0 --beams auto --engine cpu", dir, o);
   REQUIRE(o.status == 0);
   CHECK(o.err.empty());
-  CHECK(g2["beams"]["on"] == false);
-  CHECK_FALSE(g2["beams"].contains("tiles"));
-  CHECK(g2["beams"]["auto"]["probed"] == false);
-  CHECK(g2["beams"]["auto"]["why"].get<std::string>().find(
-            "the uniform grid, the BVH and the kd-tree only") != std::string::npos);
-  // Through the BVH it probes, and keeps what the probes predict.
-  const nlohmann::json bvh = render_json("--bounces 0 --beams auto --accel bvh", dir, o);
-  REQUIRE(o.status == 0);
-  const nlohmann::json& ba = bvh["beams"]["auto"];
-  CHECK(ba["probed"] == true);
-  CHECK(bvh["beams"]["on"] ==
-        (ba["primary_ms"]["on"].get<double>() < 0.98 * ba["primary_ms"]["off"].get<double>()));
+  CHECK(cpu["beams"]["on"] == false);
+  CHECK_FALSE(cpu["beams"].contains("tiles"));
+  CHECK(cpu["beams"]["auto"]["probed"] == false);
+  CHECK(cpu["beams"]["auto"]["why"].get<std::string>().find("the cpu engine runs none") !=
+        std::string::npos);
+  // Through the BVH and the two-level grid it probes, and keeps what the probes predict.
+  for (const char* accel : {"bvh", "grid2"}) {
+    CAPTURE(accel);
+    const nlohmann::json j =
+        render_json(std::string("--bounces 0 --beams auto --accel ") + accel, dir, o);
+    REQUIRE(o.status == 0);
+    const nlohmann::json& ba = j["beams"]["auto"];
+    CHECK(ba["probed"] == true);
+    CHECK(j["beams"]["on"] ==
+          (ba["primary_ms"]["on"].get<double>() < 0.98 * ba["primary_ms"]["off"].get<double>()));
+  }
   // The statistics table's summary names the choice.
   const Outcome table = run("render bunny-low --size 32x32 -q --bounces 0 --beams auto --out " +
                             (dir / "image.png").string());
@@ -747,10 +749,10 @@ TEST_CASE("beams auto renders the same image, and its JSON and table say what it
   fs::remove_all(dir);
 }
 
-TEST_CASE("the kernels command lists the three beam kernels and prints each one's GLSL") {
+TEST_CASE("the kernels command lists the grids' beam kernels and prints each one's GLSL") {
   const Outcome list = run("kernels");
   REQUIRE(list.status == 0);
-  for (const char* name : {"beam-march", "beams-missed", "beam-entry"}) {
+  for (const char* name : {"beam-march", "beams-missed", "beam-entry", "grid2-beam-entry"}) {
     CAPTURE(name);
     CHECK(list.out.find(std::string("\n") + name + " ") != std::string::npos);
     const Outcome glsl = run(std::string("kernels ") + name + " --glsl");
@@ -758,4 +760,5 @@ TEST_CASE("the kernels command lists the three beam kernels and prints each one'
     CHECK(glsl.out.find("void main()") != std::string::npos);
   }
   CHECK(list.out.find("rayosHaz (extension)") != std::string::npos);
+  CHECK(list.out.find("inicioHazGrilla2 (extension)") != std::string::npos);
 }

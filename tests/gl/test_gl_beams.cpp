@@ -2,8 +2,8 @@
 // the emulator's passes (the beam march with its queries, the count of missed tiles, the beam
 // entry), gets the same query counts, and gives the same hit ids, depths and image as the
 // emulator's frame with beams on and as the GL frame with beams off (on llvmpipe bit for bit,
-// tests/gl/gl_compare.h); through the grid, the BVH and the kd-tree
-// (host/trace/walks/bvh_beams.h).
+// tests/gl/gl_compare.h); through the grid, the two-level grid (kernels/grid2_beams.h), the BVH
+// and the kd-tree (host/trace/walks/bvh_beams.h).
 #include <doctest/doctest.h>
 
 #include <string>
@@ -123,4 +123,14 @@ TEST_CASE(
   check_beams_on_gl(host::AccelKind::kdtree,
                     {{"bunny-low", 36, 28, 6, 0}, {"classic", 24, 24, 6, 1}}, "bvh beam descend",
                     "kd enter");
+}
+
+TEST_CASE(
+    "beams over the two-level grid on the GL device give the emulator's march queries, hit ids, "
+    "depths and image, and the image of beams off") {
+  // The beams march over the coarse grid; the sphere's primary rays at 36x28 in 8x8 tiles, and
+  // the teapot with one bounce and its shadows at 32x24 in 6x6 tiles (only primary rays start
+  // past empty coarse cells).
+  check_beams_on_gl(host::AccelKind::grid2, {{"sphere", 36, 28, 8, 0}, {"teapot", 32, 24, 6, 1}},
+                    "beam march", "grid2 beam entry");
 }

@@ -23,20 +23,26 @@
 using test_support::same_bits;
 
 TEST_CASE(
-    "the CPU tracer's beams, through the grid, the BVH and the kd-tree, give the per-pixel rays' "
-    "hit ids, depths and images, fewer steps, and the emulator's beam counts") {
+    "the CPU tracer's beams, through the grid, the two-level grid, the BVH and the kd-tree, give "
+    "the per-pixel rays' hit ids, depths and images, fewer steps, and the emulator's beam "
+    "counts") {
   struct Setup {
     const char* scene;
     int width, height, tile, bounces, spp;
   };
   // 36x28 in 8x8 tiles: the last tiles are cut short; classic with a bounce and shadows (only
   // primary rays start where their beam stopped); the bunny's primary rays in 4x4 tiles; and
-  // four jittered samples a pixel (a beam map each).
+  // four jittered samples a pixel (a beam map each). Over the two-level grid's coarse grid, the
+  // sphere and the teapot in their place (classic's and the bunny's coarse cells next to the eye
+  // hold triangles: their rays start where they enter).
   std::map<host::AccelKind, uint64_t> missed;
-  for (const host::AccelKind kind :
-       {host::AccelKind::grid, host::AccelKind::bvh, host::AccelKind::kdtree})
-    for (const Setup s : {Setup{"classic", 36, 28, 8, 1, 1}, Setup{"bunny-low", 32, 32, 4, 0, 1},
-                          Setup{"bunny-low", 16, 16, 4, 0, 4}}) {
+  const std::vector<Setup> scenes{
+      {"classic", 36, 28, 8, 1, 1}, {"bunny-low", 32, 32, 4, 0, 1}, {"bunny-low", 16, 16, 4, 0, 4}};
+  const std::vector<Setup> coarse{
+      {"sphere", 36, 28, 8, 1, 1}, {"teapot", 32, 32, 4, 0, 1}, {"sphere", 16, 16, 4, 0, 4}};
+  for (const host::AccelKind kind : {host::AccelKind::grid, host::AccelKind::grid2,
+                                     host::AccelKind::bvh, host::AccelKind::kdtree})
+    for (const Setup& s : kind == host::AccelKind::grid2 ? coarse : scenes) {
       const std::string name = s.scene;
       CAPTURE(name);
       CAPTURE(s.spp);
@@ -63,9 +69,10 @@ TEST_CASE(
       CHECK(same_bits(off.rgb, on.rgb));
       CHECK(on.rays_traced == off.rays_traced);
       CHECK(on_stats.triangle_tests == off_stats.triangle_tests);
-      // The rays start later (the grid: fewer voxels stepped through) or lower in the tree (the
-      // BVH and the kd-tree: fewer nodes visited).
-      if (kind == host::AccelKind::grid)
+      // The rays start later (the grids: fewer voxels or sub-cells stepped through) or lower in
+      // the tree (the BVH and the kd-tree: fewer nodes visited).
+      const bool grid = kind == host::AccelKind::grid || kind == host::AccelKind::grid2;
+      if (grid)
         CHECK(on_stats.voxel_steps < off_stats.voxel_steps);
       else
         CHECK(on_stats.nodes_visited < off_stats.nodes_visited);
@@ -80,7 +87,7 @@ TEST_CASE(
       CHECK(on_stats.beam_tiles_missed == gpu.beam_tiles_missed);
       CHECK(on_stats.beam_passes == gpu.beam_passes);
       // Through a tree, the depths the tiles' beams reached, as the descent's queries count them.
-      if (kind != host::AccelKind::grid) {
+      if (!grid) {
         CHECK(on.beam_depth_sum == gpu.beam_depth_sum);
         CHECK(on.beam_depth_max == gpu.beam_depth_max);
         CHECK(on.beam_depth_max > 0);

@@ -134,10 +134,11 @@ class Tracer {
     for (const SceneTexture& t : scene.textures) chains_.push_back(build_mip_chain(t));
     for (const Material& m : scene.materials) has_glass_ = has_glass_ || m.transmission > 0.0f;
     spread_ = 2.0 * primary_.t / double(opt.height);
-    // Beams over tiles: for the uniform grid's walk, the BVH's and the kd-tree's (through its
-    // nodes' boxes; the options refuse the two-level grid).
+    // Beams over tiles: for the uniform grid's walk, the two-level grid's (marched over its
+    // coarse grid), the BVH's and the kd-tree's (through its nodes' boxes).
     if (opt.beams && grid_ && !bvh_ && !kd_ && !grid2_)
       beams_ = std::make_unique<CpuBeams>(*grid_, camera, opt);
+    if (opt.beams && grid2_) beams_ = std::make_unique<CpuBeams>(grid2_->coarse, camera, opt);
     if (opt.beams && bvh_) bvh_beams_ = std::make_unique<CpuBvhBeams>(*bvh_, camera, opt);
     if (opt.beams && kd_)
       bvh_beams_ = std::make_unique<CpuBvhBeams>(kd_beam_nodes(*kd_), camera, opt);
@@ -199,7 +200,7 @@ class Tracer {
     ++c.rays;
     if (bvh_) return trace_bvh(o, d, tmax, any_hit, c, beam);
     if (kd_) return trace_kd(o, d, tmax, any_hit, c, beam);
-    if (grid2_) return trace_grid2(o, d, tmax, any_hit, c);
+    if (grid2_) return trace_grid2(o, d, tmax, any_hit, c, beam);
     Hit best;
     // Slab test against the grid box.
     double tnear = 0.0, tfar = tmax;
@@ -562,11 +563,54 @@ class Tracer {
     return i;
   }
 
+  // Moves the two-level walk on from its entry (coarse cell cc, sub-cell s, entered at t_enter)
+  // to the state it reaches in the coarse cell holding o + d ts, bit for bit, as the beam entry
+  // does in float (kernels/grid2_beams.h says why it is the walk's own): every coarse cell before
+  // it is empty, a one-cell sub-grid whose far face along an axis depends on its coordinate
+  // there alone, so the walk crosses each axis's faces in order of t. Returns false (the state
+  // untouched) where the checks fail or nothing would be skipped.
+  bool grid2_skip(const glm::dvec3& o, const glm::dvec3& d, double ts, glm::ivec3& cc, size_t& ci,
+                  glm::ivec3& s, double& t_enter) const {
+    if (!(ts > t_enter)) return false;
+    const Grid& g = grid2_->coarse;
+    // The far face along `a` of an empty coarse cell at coordinate k there, as the walk computes
+    // it (Grid2::sub_boundary of its one sub-cell: its box minimum, plus its size going up).
+    auto face = [&](int a, int k) {
+      const double lo = double(float(g.boundary(a, k)));
+      return (lo + (d[a] > 0.0 ? double(g.cell[a]) : 0.0) - o[a]) / d[a];
+    };
+    glm::ivec3 v(0);
+    glm::dvec3 into(-kInf);
+    double te = -kInf, next = kInf;
+    for (int a = 0; a < 3; ++a) {
+      const double f = std::floor((o[a] + d[a] * ts - double(g.lo[a])) / double(g.cell[a]));
+      if (!(f >= 0.0 && f < double(g.res[a]))) return false;
+      v[a] = int(f);
+      if (d[a] == 0.0) {
+        if (v[a] != cc[a]) return false;
+        continue;
+      }
+      const int dir = d[a] > 0.0 ? 1 : -1;
+      if ((v[a] - cc[a]) * dir < 0) return false;
+      if (v[a] != cc[a]) te = std::max(te, into[a] = face(a, v[a] - dir));
+      next = std::min(next, face(a, v[a]));
+    }
+    if (!(te > t_enter) || !(te < next) || !(te <= ts)) return false;
+    cc = v;
+    ci = g.index(cc);
+    for (int a = 0; a < 3; ++a)
+      s[a] = into[a] == te ? (d[a] > 0.0 ? 0 : grid2_->sub_res[ci][a] - 1)
+                           : grid2_sub_of(ci, a, o[a] + d[a] * te);
+    t_enter = te;
+    return true;
+  }
+
   // The walk of kernels/grid2.h: each sub-cell's triangles with the in-cell rule (its segment
   // widened by the slack), then the next sub-cell; leaving the sub-grid steps the coarse grid
-  // and enters the next cell's sub-grid on the face crossed.
-  Hit trace_grid2(const glm::dvec3& o, const glm::dvec3& d, double tmax, bool any_hit,
-                  Counters& c) const {
+  // and enters the next cell's sub-grid on the face crossed. `beam` (a primary ray's, beams over
+  // the coarse grid): the whole tile misses, or the walk may start further on.
+  Hit trace_grid2(const glm::dvec3& o, const glm::dvec3& d, double tmax, bool any_hit, Counters& c,
+                  const CpuBeamStart* beam) const {
     Hit best;
     const Grid& g = grid2_->coarse;
     double tnear = 0.0, tfar = tmax;
@@ -583,11 +627,13 @@ class Tracer {
     }
     if (!(tnear <= tfar) || !(tmax >= 0.0)) return best;
     ++c.entered;
+    if (beam && beam->missed) return best;  // its tile's beam left the grid box behind
     glm::ivec3 cc = g.voxel_of(o + d * tnear);
     size_t ci = g.index(cc);
     glm::ivec3 s;
     for (int a = 0; a < 3; ++a) s[a] = grid2_sub_of(ci, a, o[a] + d[a] * tnear);
     double t_enter = tnear;
+    if (beam) grid2_skip(o, d, double(beam->t), cc, ci, s, t_enter);
     for (;;) {
       ++c.voxel_steps;
       const glm::ivec3 r = grid2_->sub_res[ci];

@@ -148,11 +148,6 @@ BeamsChoice choose_beams(const Scene& scene, const Accel& accel, const RenderOpt
   // priced alike; the CPU tracer has no passes for the cost model to price.
   if (engine == "cpu")
     refused = "the cost model prices passes, and the cpu engine runs none";
-  else if (accel.kind() == AccelKind::grid2)
-    refused =
-        "beams run through the uniform grid, the BVH and the kd-tree only, and this frame "
-        "walks " +
-        std::string(accel.name());
   else
     refused = with.refusal(profile);
   if (!refused.empty()) {

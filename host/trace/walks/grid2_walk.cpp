@@ -19,7 +19,12 @@ Grid2Walk::Grid2Walk(vgpu::Device& gpu, const Grid2& g2, const RenderOptions& op
                      float scene_width, float t_slack)
     : ListWalk(options, {&cells_, &subs_, &lists_}) {
   compute_in_groups(enter_, step_, step_load_, load_, intersect_, intersect_next_, looping_);
+  if (opt_.beams) {
+    beams_ = std::make_unique<GridBeams>(opt_);
+    compute_in({{&beam_enter_, Group::traversal}});
+  }
   set_grid(gpu, g2, scene_width, t_slack, nullptr);
+  if (beams_) statics_.push_back(&beams_->distances());
 }
 
 uint64_t Grid2Walk::set_grid(vgpu::Device& gpu, const Grid2& g2, float scene_width, float t_slack,
@@ -85,7 +90,14 @@ uint64_t Grid2Walk::set_grid(vgpu::Device& gpu, const Grid2& g2, float scene_wid
   looping_.kernel.grid2 = u;
   looping_.kernel.scene = su;
   looping_.kernel.steps = opt_.steps_per_pass;
-  return bytes;
+  if (!beams_) return bytes;
+  // The beams march over the coarse grid (its beam distances, kernels/beams.h).
+  beam_enter_.kernel.grid2 = u;
+  GridUniforms coarse;
+  coarse.lo = u.lo;
+  coarse.cell = u.cell;
+  coarse.res = u.res;
+  return bytes + beams_->set_grid(gpu, g2.coarse, coarse, uploaded);
 }
 
 uint64_t Grid2Walk::rebuild(vgpu::Device& gpu, const Accel& accel, float scene_width,
@@ -96,13 +108,21 @@ uint64_t Grid2Walk::rebuild(vgpu::Device& gpu, const Accel& accel, float scene_w
 
 void Grid2Walk::make_state(vgpu::Device& gpu, const WalkShared& shared) {
   make_pairs(gpu, shared, "grid2 traversal", "cell state");
+  if (beams_) beams_->make_state(gpu);
 }
 
-void Grid2Walk::trace(PassRunner& r, Texture& origins, Texture& rays, bool, glm::vec3) {
+void Grid2Walk::trace(PassRunner& r, Texture& origins, Texture& rays, bool primary, glm::vec3 eye) {
   clear(r.device());
   // Every ray starts in the sub-cell where it enters the box (primary rays' origins hold the
-  // eye), that sub-cell's list start in hand.
-  r.pass(enter_, {&origins, &rays, &cells_, &subs_}, trav_.next());
+  // eye), that sub-cell's list start in hand; with beams, a primary ray in the sub-cell its walk
+  // reaches where its tile's beam stopped.
+  if (primary && beams_) {
+    Texture& beams = beams_->march(r, eye);
+    beam_enter_.kernel.beams = beams_->uniforms();
+    r.pass(beam_enter_, {&origins, &rays, &beams, &cells_, &subs_}, trav_.next());
+  } else {
+    r.pass(enter_, {&origins, &rays, &cells_, &subs_}, trav_.next());
+  }
   trav_.swap();
   if (opt_.looping) {
     const uint64_t walking = count_entered(r);

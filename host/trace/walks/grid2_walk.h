@@ -2,10 +2,12 @@
 // textures, and which pass runs next, steered by which query, in the grid walk's manner
 // (grid_walk.h): one sub-cell per pass for every walking ray, then the triangles of the sub-cells
 // reached, one per pass. The pass sequence is the kd-tree walk's (kd_walk.h) with these kernels,
-// the entry sub-cell loaded once before the loop.
+// the entry sub-cell loaded once before the loop. With beams over tiles, the primary rays enter
+// where their tile's beam stopped on the coarse grid (kernels/grid2_beams.h).
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -13,6 +15,7 @@
 #include "host/trace/passes.h"
 #include "host/trace/render_options.h"
 #include "host/trace/walks/accel_walk.h"
+#include "host/trace/walks/grid_beams.h"
 #include "kernels/kernels.h"
 #include "vgpu/vgpu.h"
 
@@ -50,10 +53,17 @@ class Grid2Walk : public ListWalk {
                    std::vector<std::string>& uploaded) override;
   void trace(PassRunner& r, vgpu::Texture& origins, vgpu::Texture& rays, bool primary,
              glm::vec3 eye) override;
+  void set_camera(const kernels::GenerateRays& camera, float offset_x, float offset_y) override {
+    if (beams_) beams_->set_camera(camera, offset_x, offset_y);
+  }
 
   // The multipass walk (host/trace/walks/walk.h); Cursor and write_back are ListWalk's.
   template <class X>
   void walk(X& x, Cursor& c);
+
+ protected:
+  // The beam texture pair and the beam passes' counting target (the beam distances are a static).
+  uint64_t extra_bytes() const override { return beams_ ? beams_->state_bytes() : 0; }
 
  private:
   int max_list_ = 0;
@@ -66,6 +76,10 @@ class Grid2Walk : public ListWalk {
   vgpu::KernelProgram<kernels::Grid2StepLoad> step_load_;
   vgpu::KernelProgram<kernels::Grid2IntersectNext> intersect_next_;
   vgpu::KernelProgram<kernels::Grid2Looping> looping_;
+  // Beams over tiles (RenderOptions::beams; null: off): marched over the coarse grid, then each
+  // primary ray entered at the sub-cell its walk reaches there (kernels/grid2_beams.h).
+  std::unique_ptr<GridBeams> beams_;
+  vgpu::KernelProgram<kernels::Grid2BeamEntry> beam_enter_;
 };
 
 }  // namespace host

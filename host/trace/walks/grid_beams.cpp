@@ -128,12 +128,17 @@ BeamMap beam_map(const vgpu::Texture& beams, int tile, bool tree) {
 }
 
 void GridBeams::enter(PassRunner& r, Texture& rays, glm::vec3 eye, Texture& traversal) {
+  Texture& beams = march(r, eye);
+  entry_.kernel.beams = march_.kernel.beams;
+  r.pass(entry_, {&rays, &beams}, traversal);
+}
+
+Texture& GridBeams::march(PassRunner& r, glm::vec3 eye) {
   vgpu::Device& gpu = r.device();
   kernels::BeamUniforms& u = march_.kernel.beams;
   u.eye = eye;
   // Past the farthest corner of the grid box from the eye, a beam has left the box behind.
   u.far = beam_far(u, eye);
-  entry_.kernel.beams = u;
   // Every beam starts at the eye, marching.
   beams_.make_current(0);
   gpu.clear(beams_.current(), {0, 0, 0, 0});
@@ -155,7 +160,7 @@ void GridBeams::enter(PassRunner& r, Texture& rays, glm::vec3 eye, Texture& trav
   // (no download is issued, so the frame's statistics are those of a frame without a report).
   if (n.beam_map.start.empty() && opt_.observer && dynamic_cast<vgpu::Gpu*>(&gpu))
     n.beam_map = beam_map(beams_.current(), opt_.beam_tile);
-  r.pass(entry_, {&rays, &beams_.current()}, traversal);
+  return beams_.current();
 }
 
 }  // namespace host

@@ -1,4 +1,5 @@
-// Beams over tiles for the uniform grid's primary rays (an extension, issue 35; docs/groups.md):
+// Beams over tiles for the uniform grid's primary rays (an extension, issue 35; docs/groups.md;
+// the two-level grid's march over its coarse grid, kernels/grid2_beams.h):
 // the beam distances (per voxel, how far the nearest voxel holding a triangle is), the beam
 // texture (one texel per tile), and the passes that march the beams (rayosHaz, with an occlusion
 // query per pass) and start each pixel's ray where its tile's beam stopped (inicioHaz). The grid
@@ -57,6 +58,10 @@ class GridBeams {
   void set_camera(const kernels::GenerateRays& camera, float offset_x, float offset_y);
   // The beam passes, then inicioHaz: the primary rays' traversal state into `traversal`.
   void enter(PassRunner& r, vgpu::Texture& rays, glm::vec3 eye, vgpu::Texture& traversal);
+  // The beam passes alone (the two-level grid's walk runs its own entry after them): every
+  // tile's beam marched from `eye`. Returns the beam texture; uniforms() are the march's.
+  vgpu::Texture& march(PassRunner& r, glm::vec3 eye);
+  const kernels::BeamUniforms& uniforms() const { return march_.kernel.beams; }
 
   const vgpu::Texture& distances() const { return distances_; }
   uint64_t state_bytes() const;
