@@ -103,6 +103,7 @@ extern template class vgpu::KernelProgram<kernels::GatherMarked>;
 extern template class vgpu::KernelProgram<kernels::AccumulateDense>;
 extern template class vgpu::KernelProgram<kernels::ShadowGlass>;
 extern template class vgpu::KernelProgram<kernels::BeamMarch>;
+extern template class vgpu::KernelProgram<kernels::BeamMarchLooping>;
 extern template class vgpu::KernelProgram<kernels::BeamEntry>;
 extern template class vgpu::KernelProgram<kernels::BeamsMissed>;
 extern template class vgpu::KernelProgram<kernels::BvhBeamDescend>;

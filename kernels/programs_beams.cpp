@@ -4,6 +4,7 @@
 #include "kernels/kernels.h"
 
 template class vgpu::KernelProgram<kernels::BeamMarch>;
+template class vgpu::KernelProgram<kernels::BeamMarchLooping>;
 template class vgpu::KernelProgram<kernels::BeamEntry>;
 template class vgpu::KernelProgram<kernels::BeamsMissed>;
 template class vgpu::KernelProgram<kernels::BvhBeamDescend>;

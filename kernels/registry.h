@@ -57,9 +57,10 @@ using MultipassKernels = KernelList<
 
 // The looping variant (--kernels looping): each structure's whole walk in one program with a
 // data-dependent loop (kernels/looping_traversal.h and the structures' headers); with beams
-// through a tree, the whole descent in one program (kernels/bvh_beams.h).
-using LoopingKernels =
-    KernelList<LoopingTraversal, BvhLooping, KdLooping, Grid2Looping, BvhBeamDescendLooping>;
+// through a tree, the whole descent in one program (kernels/bvh_beams.h); through a grid, the
+// whole march (kernels/beams.h).
+using LoopingKernels = KernelList<LoopingTraversal, BvhLooping, KdLooping, Grid2Looping,
+                                  BvhBeamDescendLooping, BeamMarchLooping>;
 
 // Which kernels a list holds.
 enum class Programs {

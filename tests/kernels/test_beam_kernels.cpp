@@ -128,6 +128,57 @@ TEST_CASE("beam march moves each beam to where its first corner ray leaves an em
   CHECK(missed == 1);
 }
 
+TEST_CASE(
+    "the looping beam march ends in one pass where the march's passes end, and stops at its step "
+    "budget") {
+  // The distances of the test above, with a deeper empty pocket: the voxels of z 1 to 3 whose x
+  // and y are 1 to 3 are empty, those on the axis (2, 2, z) two steps from any triangle, so tile
+  // 2 marches through three cubes and out of the far face (it misses).
+  std::vector<float> k(16 * 4, 0.0f);
+  for (int z = 1; z < 4; ++z) {
+    for (int x = 1; x < 4; ++x)
+      for (int y = 1; y < 4; ++y) k[size_t(z * 16 + x * 4 + y)] = 1.0f;
+    k[size_t(z * 16 + 2 * 4 + 2)] = 2.0f;
+  }
+  const Texture distances = scalars("beam distances", 16, 4, k);
+  const Texture start =
+      texels("beams", 4, 1, {{0, 0, 0, 0}, {0, 5.5f, 0, 4}, {0, 6.5f, 0, 2}, {0, 20, 0, 7}});
+  kernels::BeamMarch march;
+  march.beams = beam_uniforms();
+  // The passes: step until no beam marches (x -1 everywhere), counting each tile's steps.
+  std::vector<Texture> passes{start};
+  int runs = 0;
+  auto marching = [](const Texture& t) {
+    for (int i = 0; i < 4; ++i)
+      if (ktest::at(t, i, 0).x >= 0) return true;
+    return false;
+  };
+  while (marching(passes.back())) {
+    REQUIRE(++runs < 20);
+    passes.push_back(ktest::run(march, {&passes.back(), &distances}, 4, 1));
+  }
+  REQUIRE(runs >= 3);  // some beam takes two steps or more before it stops
+  kernels::BeamMarchLooping loop;
+  loop.beams = beam_uniforms();
+  loop.steps = 20;
+  vgpu::Gpu gpu(ktest::gf6600(), 1, 1);  // a profile with loops
+  vgpu::PassRecord rec;
+  const Texture out =
+      ktest::run(gpu, loop, {&start, &distances}, 4, 1, glm::vec4(7, 8, 9, 10), nullptr, &rec);
+  uint64_t iterations = 0;
+  for (int i = 0; i < 4; ++i) {
+    CAPTURE(i);
+    CHECK_TEXEL(out, i, 0, ktest::at(passes.back(), i, 0));
+    // A tile iterates once per pass it ran while marching (the last one stops it).
+    for (size_t p = 0; p + 1 < passes.size(); ++p) iterations += ktest::at(passes[p], i, 0).x >= 0;
+  }
+  CHECK(rec.counters.loop_iterations == iterations);
+  // With a budget of one step the loop leaves every tile where the first pass leaves it.
+  loop.steps = 1;
+  const Texture cut = ktest::run(gpu, loop, {&start, &distances}, 4, 1, glm::vec4(7));
+  for (int i = 0; i < 4; ++i) CHECK_TEXEL(cut, i, 0, ktest::at(passes[1], i, 0));
+}
+
 TEST_CASE("beam entry starts a ray at the traversal state the 3D-DDA reaches, or where it enters") {
   const kernels::BeamUniforms u = beam_uniforms();
   const glm::vec3 e = u.eye;

@@ -144,7 +144,15 @@ Texture& GridBeams::march(PassRunner& r, glm::vec3 eye) {
   gpu.clear(beams_.current(), {0, 0, 0, 0});
   WalkCounts& n = r.counts;
   n.beam_tiles += uint64_t(tiles_x()) * uint64_t(tiles_y());
-  uint64_t marching = 1;
+  // With the looping kernels, the whole march in one pass (the same texels, no query per step).
+  if (opt_.looping) {
+    march_looping_.kernel.beams = u;
+    march_looping_.kernel.steps = kMaxPasses;
+    r.pass(march_looping_, {&beams_.current(), &distances_}, beams_.next());
+    beams_.swap();
+    ++n.beam_passes;
+  }
+  uint64_t marching = opt_.looping ? 0 : 1;
   for (int pass = 0; pass < kMaxPasses && marching > 0; ++pass) {
     r.pass(march_, {&beams_.current(), &distances_}, beams_.next());
     beams_.swap();

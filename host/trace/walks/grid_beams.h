@@ -42,7 +42,8 @@ BeamMap beam_map(const vgpu::Texture& beams, int tile, bool tree = false);
 
 class GridBeams {
  public:
-  // Most beam passes a frame runs (a beam still marching then starts where it got to).
+  // Most beam passes a frame runs (a beam still marching then starts where it got to), and the
+  // looping march's most steps.
   static constexpr int kMaxPasses = 48;
 
   explicit GridBeams(const RenderOptions& options) : opt_(options) {}
@@ -74,6 +75,7 @@ class GridBeams {
   PingPong<vgpu::Texture> beams_;
   vgpu::Texture counter_;
   vgpu::KernelProgram<kernels::BeamMarch> march_;
+  vgpu::KernelProgram<kernels::BeamMarchLooping> march_looping_;  // --kernels looping
   vgpu::KernelProgram<kernels::BeamEntry> entry_;
   vgpu::KernelProgram<kernels::RaysInGrid> marching_;
   vgpu::KernelProgram<kernels::BeamsMissed> missed_;
