@@ -40,24 +40,32 @@ struct BeamUniforms {
   float min_step = 0.5f;
 };
 
-// A tile's beam (rayosHaz's view of it): the tile's corner pixels' sample positions (a tile at
-// the image's edge may be cut short), their rays, the rays' reciprocals (shared by every box),
-// the beam's axis and cos(theta) from below, theta the widest angle between the axis and a
-// corner. Computed once per tile (the looping march steps it many times).
+// The sample positions of the corner pixels of the fragment's tile: x0, y0, x1, y1 (a tile at
+// the image's edge may be cut short).
+template <class L>
+inline Vec4<typename L::F> tile_corners(const Fragments<L>& f, const BeamUniforms& u) {
+  using F = typename L::F;
+  const F x0 = (f.x - F(0.5f)) * F(u.tile) + F(0.5f + u.offset_x);
+  const F y0 = (f.y - F(0.5f)) * F(u.tile) + F(0.5f + u.offset_y);
+  return {x0, y0, min(x0 + F(u.tile - 1.0f), F(u.camera.width - 0.5f + u.offset_x)),
+          min(y0 + F(u.tile - 1.0f), F(u.camera.height - 0.5f + u.offset_y))};
+}
+
+// A tile's beam (rayosHaz's view of it): the rays through the tile's corner pixels, their
+// reciprocals (shared by every box), the beam's axis and cos(theta) from below, theta the widest
+// angle between the axis and a corner. Computed once per tile (the looping march steps it many
+// times).
 template <class L>
 struct MarchBeam {
   using F = typename L::F;
   Vec3<F> d[4], inv[4], axis, e;
   F cosw;
   MarchBeam(const Fragments<L>& f, const BeamUniforms& u) {
-    const F x0 = (f.x - F(0.5f)) * F(u.tile) + F(0.5f + u.offset_x);
-    const F y0 = (f.y - F(0.5f)) * F(u.tile) + F(0.5f + u.offset_y);
-    const F x1 = min(x0 + F(u.tile - 1.0f), F(u.camera.width - 0.5f + u.offset_x));
-    const F y1 = min(y0 + F(u.tile - 1.0f), F(u.camera.height - 0.5f + u.offset_y));
-    d[0] = u.camera.ray_through<L>(x0, y0).xyz();
-    d[1] = u.camera.ray_through<L>(x1, y0).xyz();
-    d[2] = u.camera.ray_through<L>(x0, y1).xyz();
-    d[3] = u.camera.ray_through<L>(x1, y1).xyz();
+    const Vec4<F> c = tile_corners(f, u);
+    d[0] = u.camera.ray_through<L>(c.x, c.y).xyz();
+    d[1] = u.camera.ray_through<L>(c.z, c.y).xyz();
+    d[2] = u.camera.ray_through<L>(c.x, c.w).xyz();
+    d[3] = u.camera.ray_through<L>(c.z, c.w).xyz();
     axis = normalize(d[0] + d[1] + d[2] + d[3]);
     e = splat<F>(u.eye);
     for (int i = 0; i < 4; ++i)

@@ -55,14 +55,11 @@ struct TileBeam {
   Vec3<F> d[4], axis, e;
   F margin;
   TileBeam(const Fragments<L>& f, const BeamUniforms& bu) {
-    const F x0 = (f.x - F(0.5f)) * F(bu.tile) + F(0.5f + bu.offset_x);
-    const F y0 = (f.y - F(0.5f)) * F(bu.tile) + F(0.5f + bu.offset_y);
-    const F x1 = min(x0 + F(bu.tile - 1.0f), F(bu.camera.width - 0.5f + bu.offset_x));
-    const F y1 = min(y0 + F(bu.tile - 1.0f), F(bu.camera.height - 0.5f + bu.offset_y));
-    d[0] = bu.camera.ray_through<L>(x0, y0).xyz();
-    d[1] = bu.camera.ray_through<L>(x1, y0).xyz();
-    d[2] = bu.camera.ray_through<L>(x1, y1).xyz();
-    d[3] = bu.camera.ray_through<L>(x0, y1).xyz();
+    const Vec4<F> c = tile_corners(f, bu);
+    d[0] = bu.camera.ray_through<L>(c.x, c.y).xyz();
+    d[1] = bu.camera.ray_through<L>(c.z, c.y).xyz();
+    d[2] = bu.camera.ray_through<L>(c.z, c.w).xyz();
+    d[3] = bu.camera.ray_through<L>(c.x, c.w).xyz();
     axis = normalize(d[0] + d[1] + d[2] + d[3]);
     e = splat<F>(bu.eye);
     margin = F(bu.margin);

@@ -7,7 +7,7 @@ on), what auto chose, the probes' own modeled time (charged: the frame plus the 
 host time. Prints a Markdown table and writes the rows as JSON.
 
 Usage: python3 scripts/docs/beams_auto.py [--vgpu-rt build/host/vgpu-rt] [--size 256]
-                                          [--accel grid|bvh|kdtree]
+                                          [--accel grid|grid2|bvh|kdtree]
                                           [--json results/beams/beams_auto.json]
 """
 import argparse

@@ -10,7 +10,7 @@
 #   mkdir -p .gl && (cd .gl && apt-get download libegl1 libglvnd0 libopengl0 libgl1 libglx0)
 # copy the repository with .h200 and .gl to the GPU host and run there, from its root:
 #   OUT=DIR scripts/h200/beams.sh       (SIZE=32 RUNS=1 WARMUP=0: the end-to-end check on llvmpipe)
-# (ACCEL=kdtree or bvh: through that structure instead, into beams_h200_ACCEL_SCENE.json;
+# (ACCEL=kdtree, bvh or grid2: through that structure instead, into beams_h200_ACCEL_SCENE.json;
 #  VARIANT=looping: the looping kernels, into beams_h200_[ACCEL_]looping_SCENE.json)
 # then copy DIR's files to results/beams/ (beams_h200_SCENE.json and clocks.csv).
 set -u
