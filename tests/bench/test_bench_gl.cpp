@@ -180,9 +180,17 @@ TEST_CASE("bench_gl --latency times one fragment's dependent fetches and multipl
   for (size_t i = 0; i < rows.size(); ++i) {
     const auto& r = rows[i];
     INFO(r.dump());
-    CHECK(r["long_steps"].get<int>() > r["short_steps"].get<int>());
-    CHECK(r["long_us"].get<double>() > r["short_us"].get<double>());
-    CHECK(r["ns_per_iteration"].get<double>() > 0);
+    const int short_steps = r["short_steps"].get<int>(), long_steps = r["long_steps"].get<int>();
+    CHECK(long_steps > short_steps);
+    // The times are measured, not judged here: on a loaded machine (tests run two at a time) a
+    // single short run can take longer than a long one, so only that each was timed and the
+    // per-iteration figure is their difference over the extra steps (docs/structures.md has the
+    // H200's figures).
+    const double short_us = r["short_us"].get<double>(), long_us = r["long_us"].get<double>();
+    CHECK(short_us > 0);
+    CHECK(long_us > 0);
+    CHECK(r["ns_per_iteration"].get<double>() ==
+          doctest::Approx(1e3 * (long_us - short_us) / (long_steps - short_steps)));
     // The model's own count of each probe's iteration (vgpu/span.h), which prices it.
     CHECK(r["chain_fetches"].get<int>() == (i < 3 ? 1 : 0));
     CHECK(r["chain_operations"].get<int>() == (i < 3 ? 6 : 35));
