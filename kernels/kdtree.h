@@ -84,6 +84,22 @@ inline Vec4<typename L::F> kd_step(const Fragments<L>& f, int unit_nodes,
   return select(walking, select(leaf, at_leaf, inner), trav);
 }
 
+// kd_step restarting at the node the beam texture (unit `unit_beams`) gives the fragment's tile
+// where beam_tile > 0, else at the root without a fetch (the program without beams is the one
+// before them): recorridoKd's step and its fused form's.
+template <class L>
+inline Vec4<typename L::F> kd_step_from_tile(const Fragments<L>& f, int unit_nodes, int unit_beams,
+                                             float beam_tile, const Vec4<typename L::F>& trav,
+                                             const Vec4<typename L::F>& best,
+                                             const Vec3<typename L::F>& o,
+                                             const Vec3<typename L::F>& d,
+                                             const typename L::F& ray_w,
+                                             const typename L::M& walking, const KdUniforms& kd) {
+  if (beam_tile <= 0.0f) return kd_step(f, unit_nodes, trav, best, o, d, ray_w, walking, kd);
+  const typename L::F root = fetch_tile(f, unit_beams, beam_tile).x;
+  return kd_step(f, unit_nodes, trav, best, o, d, ray_w, walking, kd, &root);
+}
+
 // Beams over tiles through the kd-tree (--beams on, primary rays; host/trace/walks/kd_walk.cpp):
 // the kernels below read the beam texture (one texel per tile, kernels::BvhBeamDescend's: x the
 // node the tile's beam descended to, z 1 where the whole tile misses) where beam_tile > 0, the
@@ -139,12 +155,8 @@ struct KdStep {
       const Vec4<F> ray = f.fetch_own(kRays);
       const Vec4<F> best = f.fetch_own(kIntersection);
       const Vec3<F> o = f.fetch_own(kOrigins).xyz();
-      if (beam_tile > 0.0f) {
-        const F root = fetch_tile(f, kBeams, beam_tile).x;
-        next = kd_step(f, kNodes, trav, best, o, ray.xyz(), ray.w, walking, kd, &root);
-      } else {
-        next = kd_step(f, kNodes, trav, best, o, ray.xyz(), ray.w, walking, kd);
-      }
+      next = kd_step_from_tile(f, kNodes, kBeams, beam_tile, trav, best, o, ray.xyz(), ray.w,
+                               walking, kd);
     }
     f.out(0) = next;
   }
@@ -231,12 +243,8 @@ struct KdStepLoad {
       const Vec4<F> ray = f.fetch_own(kRays);
       const Vec4<F> best = f.fetch_own(kIntersection);
       const Vec3<F> o = f.fetch_own(kOrigins).xyz();
-      if (beam_tile > 0.0f) {
-        const F root = fetch_tile(f, kBeams, beam_tile).x;
-        next = kd_step(f, kNodes, trav, best, o, ray.xyz(), ray.w, walking, kd, &root);
-      } else {
-        next = kd_step(f, kNodes, trav, best, o, ray.xyz(), ray.w, walking, kd);
-      }
+      next = kd_step_from_tile(f, kNodes, kBeams, beam_tile, trav, best, o, ray.xyz(), ray.w,
+                               walking, kd);
       const auto load = walking && (next.y >= F(0.0f)) && (vs.w < F(0.0f));
       nvs = load_list(f, kLists, next.y, vs, load, kd);
     }
