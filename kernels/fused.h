@@ -75,12 +75,13 @@ struct TraverseUpdate {
     using F = typename L::F;
     const Vec4<F> trav = f.fetch_own(kTraversal);
     const Vec4<F> hit = f.fetch_own(kIntersection);
-    const Vec3<F> o = f.fetch_own(kOrigins).xyz(), d = f.fetch_own(kRays).xyz();
+    const Vec3<F> o = f.fetch_own(kOrigins).xyz();
+    const Vec4<F> ray = f.fetch_own(kRays);
     const Vec4<F> vs = f.fetch_own(kVoxelState);
     const auto walking = trav.x >= F(0.0f);
     Vec4<F> stepped = trav, next = vs;
     if (f.branch(walking)) {
-      stepped = dda_step<L>(trav, hit, o, d, walking, grid);
+      stepped = dda_step<L>(trav, hit, o, ray.xyz(), ray.w, walking, grid);
       const auto load = (stepped.x >= F(0.0f)) && (vs.w < F(0.0f));
       next = first_in_voxel(f, kPointers, kLists, stepped, vs, load, grid);
     }

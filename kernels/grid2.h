@@ -120,15 +120,16 @@ inline Vec4<typename L::F> grid2_entry(const Fragments<L>& f, int unit_cells, in
 }
 
 // One step for the lanes where `walking` (others keep trav): done when a hit was found inside
-// the sub-cell trav.x or the ray leaves the box; else the next sub-cell along the ray. Every
-// axis tied at the exit steps at once, as the grid's DDA; an axis that leaves the sub-grid steps
-// the coarse grid, and the ray enters the next coarse cell's sub-grid on the face it crossed.
+// the sub-cell trav.x, the ray leaves the box or the next sub-cell begins past its tmax; else the
+// next sub-cell along the ray. Every axis tied at the exit steps at once, as the grid's DDA; an
+// axis that leaves the sub-grid steps the coarse grid, and the ray enters the next coarse cell's
+// sub-grid on the face it crossed.
 template <class L>
 inline Vec4<typename L::F> grid2_step(const Fragments<L>& f, int unit_cells, int unit_subs,
                                       const Vec4<typename L::F>& trav,
                                       const Vec4<typename L::F>& best, const Vec3<typename L::F>& o,
-                                      const Vec3<typename L::F>& d, const typename L::M& walking,
-                                      const Grid2Uniforms& u) {
+                                      const Vec3<typename L::F>& d, const typename L::F& tmax,
+                                      const typename L::M& walking, const Grid2Uniforms& u) {
   using F = typename L::F;
   // Climb: the sub-cell's texel names its coarse cell.
   const F c = fetch_id(f, unit_subs, trav.x, u.sub_width).y;
@@ -163,7 +164,9 @@ inline Vec4<typename L::F> grid2_step(const Fragments<L>& f, int unit_cells, int
   const Vec3<F> from_point{select(lx, F(0.0f), pt), select(ly, F(0.0f), pt),
                            select(lz, F(0.0f), pt)};
   const auto found = best.w >= F(0.0f);  // a hit inside this sub-cell ends the walk
-  const auto done = found || outside;
+  // Past tmax (a shadow ray's light): every later sub-cell's hits have t >= t_exit - t_slack.
+  const auto past = t_exit - F(u.t_slack) >= tmax;
+  const auto done = found || outside || past;
   const Vec3<F> zero{F(0.0f), F(0.0f), F(0.0f)};
   const Vec4<F> next = grid2_cell(f, unit_cells, unit_subs, o, d, select(outside, zero, nc), t_exit,
                                   g, from_point, u);
@@ -209,8 +212,9 @@ struct Grid2Step {
     Vec4<F> next = trav;
     if (f.branch(walking)) {
       const Vec4<F> best = f.fetch_own(kIntersection);
-      const Vec3<F> o = f.fetch_own(kOrigins).xyz(), d = f.fetch_own(kRays).xyz();
-      next = grid2_step(f, kCells, kSubCells, trav, best, o, d, walking, grid2);
+      const Vec3<F> o = f.fetch_own(kOrigins).xyz();
+      const Vec4<F> ray = f.fetch_own(kRays);
+      next = grid2_step(f, kCells, kSubCells, trav, best, o, ray.xyz(), ray.w, walking, grid2);
     }
     f.out(0) = next;
   }
@@ -296,8 +300,9 @@ struct Grid2StepLoad {
     Vec4<F> next = trav, nvs = vs;
     if (f.branch(walking)) {
       const Vec4<F> best = f.fetch_own(kIntersection);
-      const Vec3<F> o = f.fetch_own(kOrigins).xyz(), d = f.fetch_own(kRays).xyz();
-      next = grid2_step(f, kCells, kSubCells, trav, best, o, d, walking, grid2);
+      const Vec3<F> o = f.fetch_own(kOrigins).xyz();
+      const Vec4<F> ray = f.fetch_own(kRays);
+      next = grid2_step(f, kCells, kSubCells, trav, best, o, ray.xyz(), ray.w, walking, grid2);
       const auto load = walking && (next.y >= F(0.0f)) && (vs.w < F(0.0f));
       nvs = load_list(f, kLists, next.y, vs, load, grid2);
     }
@@ -384,7 +389,7 @@ struct Grid2Looping {
       const F tri = list_entry(f, kLists, pos, grid2);
       const M stepping = act && !testing;
       const Vec4<F> next =
-          grid2_step(f, kCells, kSubCells, trav, best, o, ray.xyz(), stepping, grid2);
+          grid2_step(f, kCells, kSubCells, trav, best, o, ray.xyz(), ray.w, stepping, grid2);
       const M load = stepping && (next.y >= F(0.0f));
       const F first = list_entry(f, kLists, next.y, grid2);
       vs = select(testing, Vec4<F>{pos, F(0.0f), F(0.0f), tri},

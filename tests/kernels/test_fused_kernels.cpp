@@ -126,6 +126,27 @@ TEST_CASE("traversal + update voxel steps each ray and loads the first triangle 
   check_same(vs, ktest::run(ku, {&stepped, &tv, &pointers, &lists}, 6, 1));
 }
 
+TEST_CASE("traversal + update voxel ends a ray whose next voxel begins past its tmax") {
+  // The grid of the case above, no slack. Both rays go +x from (0.5, 0.5, 0.5) in voxel
+  // (0, 0, 0), leaving it at t = 0.5: with tmax 0.5 the next voxel holds nothing that can count
+  // (done, voxel state kept); with tmax 0.6 the ray steps and loads triangle 1 of voxel (1, 0, 0).
+  const Texture pointers = scalars("voxel pointers", 4, 2, {0, 1, 0, 0, 0, 4, 0, 0});
+  const Texture lists = scalars("triangle lists", 4, 2, kLists);
+  const glm::vec4 o(0.5f, 0.5f, 0.5f, 0), none(kFar, 0, 0, kNone), empty(0, 0, 0, kNone);
+  const Texture to = texels("origins", 2, 1, {o, o});
+  const Texture tr = texels("rays", 2, 1, {{1, 0, 0, 0.5f}, {1, 0, 0, 0.6f}});
+  const Texture tt = texels("traversal", 2, 1, {{0, 0, 0, 0}, {0, 0, 0, 0}});
+  const Texture ti = texels("intersection", 2, 1, {none, none});
+  const Texture tv = texels("voxel state", 2, 1, {empty, empty});
+  kernels::TraverseUpdate k;
+  k.grid = grid_uniforms(glm::vec3(0.0f), glm::vec3(1.0f), {4, 1, 2}, 4);
+  const auto out = ktest::run_targets(k, {&to, &tr, &tt, &ti, &tv, &pointers, &lists}, 2, 1);
+  CHECK_TEXEL(out[0], 0, 0, glm::vec4(kNone, 0, 0, 0));
+  CHECK_TEXEL(out[0], 1, 0, glm::vec4(1, 0, 0, 0.5f));
+  CHECK_TEXEL(out[1], 0, 0, empty);
+  CHECK_TEXEL(out[1], 1, 0, glm::vec4(1, 0, 0, 1));
+}
+
 TEST_CASE("a fused program is refused on a profile with one output, naming it and the limit") {
   vgpu::Gpu gpu(ktest::gf5700(), 1, 1);
   vgpu::KernelProgram<kernels::TraverseUpdate> p;

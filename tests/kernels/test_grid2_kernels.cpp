@@ -248,6 +248,25 @@ TEST_CASE("grid2 step moves within a sub-grid, descends into the next cell, clim
   CHECK_TEXEL(out, 7, 0, kDone);  // sub-cell 4 along +x leaves the box
 }
 
+TEST_CASE("grid2 step ends a ray whose next sub-cell begins past its tmax, less the slack") {
+  // Ray 0 of walk_rays (+x from (-1, 0.5, 1), in sub-cell 0 from t = 1) leaves it at t = 2;
+  // with the slack 0.5 a hit further on has t >= 1.5, so tmax 1.5 or less ends the walk there
+  // (a shadow ray whose light lies before), a larger one steps into sub-cell 1 as before.
+  const Structure s;
+  Rays r({{-1, 0.5f, 1}, {-1, 0.5f, 1}, {-1, 0.5f, 1}, {-1, 0.5f, 1}},
+         {{1, 0, 0, 1.5f}, {1, 0, 0, 1.2f}, {1, 0, 0, 1.6f}, {1, 0, 0, kFar}});
+  const Texture trav = texels("traversal", r.n, 1, std::vector<glm::vec4>(4, kEntries[0]));
+  const Texture isect = texels("intersection", r.n, 1, std::vector<glm::vec4>(4, kNoHit));
+  kernels::Grid2Step k;
+  k.grid2 = g2_uniforms(0.5f);
+  const Texture out =
+      ktest::run(k, {&r.origins, &r.rays, &trav, &isect, &s.cells, &s.subs}, r.n, 1);
+  CHECK_TEXEL(out, 0, 0, kDone);
+  CHECK_TEXEL(out, 1, 0, kDone);
+  CHECK_TEXEL(out, 2, 0, glm::vec4(1, 1, 2, 3));
+  CHECK_TEXEL(out, 3, 0, glm::vec4(1, 1, 2, 3));
+}
+
 TEST_CASE("grid2 load cell loads the first triangle of a sub-cell just entered") {
   const Structure s;
   const Texture trav = texels("traversal", 4, 1, {{1, 1, 2, 3}, {0, 0, 1, 2}, kDone, {4, 3, 0, 1}});

@@ -102,6 +102,36 @@ TEST_CASE("looping traversal walks, tests and finishes each ray in one pass") {
   CHECK(o.rec.loop_idle[3] == 0);
 }
 
+TEST_CASE("looping traversal ends a ray at the first voxel that begins past its tmax") {
+  // The scene above with a third, empty voxel (x in [2, 3]): triangle 0 at x = 1.5 sits in
+  // voxel 1. Every ray from (0.5, 0.5, 0.5), no slack:
+  //   0 +x, tmax 0.75 (a light before the triangle): voxel 0, then voxel 1 where the hit at
+  //     t = 1 does not pass t < tmax; voxel 2 begins at 1.5 >= tmax: done there, 3 iterations,
+  //     entry t 0.5 kept (a walk on to the grid's face would end in voxel 2, at 1.5, after 4)
+  //   1 -x, no bound: out of the grid through x = 0 (1 iteration)
+  //   2 +x, tmax 1.5: the hit counts (1 < 1.5) and ends the walk (3 iterations)
+  Scene s;
+  s.rays = ktest::texels("rays", 3, 1, {{1, 0, 0, 0.75f}, {-1, 0, 0, kFar}, {1, 0, 0, 1.5f}});
+  s.trav = ktest::texels("traversal", 3, 1, std::vector<glm::vec4>(3, {0, 0, 0, 0}));
+  s.isect = ktest::texels("intersection", 3, 1, std::vector<glm::vec4>(3, {kFar, 0, 0, kNone}));
+  s.pointers = ktest::scalars("voxel pointers", 3, 1, {0, 1, 2});
+  LoopingTraversal k = kernel(32);
+  k.grid = ktest::grid_uniforms({0, 0, 0}, {1, 1, 1}, {3, 1, 1}, 3);
+  vgpu::Gpu gpu(vgpu::profile("gf6600"), 1, 1);
+  const vgpu::KernelProgram<LoopingTraversal> p(k);
+  const Outputs o = pass(gpu, p, s.trav, s.vs, s.isect, s);
+  CHECK_TEXEL(o.trav, 0, 0, glm::vec4(kNone, 0, 0, 0.5f));
+  CHECK_TEXEL(o.vs, 0, 0, glm::vec4(0, 0, 0, kNone));
+  CHECK_TEXEL(o.isect, 0, 0, glm::vec4(kFar, 0, 0, kNone));
+  CHECK_TEXEL(o.trav, 1, 0, glm::vec4(kNone, 0, 0, 0));
+  CHECK_TEXEL(o.vs, 1, 0, glm::vec4(0, 0, 0, kNone));
+  CHECK_TEXEL(o.isect, 1, 0, glm::vec4(kFar, 0, 0, kNone));
+  CHECK_TEXEL(o.trav, 2, 0, glm::vec4(kNone, 0, 0, 0.5f));
+  CHECK_TEXEL(o.vs, 2, 0, glm::vec4(0, 0, 0, kNone));
+  CHECK_TEXEL(o.isect, 2, 0, glm::vec4(1, 0.234375f, 0.375f, 0));
+  CHECK(o.rec.counters.loop_iterations == 3 + 1 + 3);
+}
+
 TEST_CASE("looping traversal stopped by its budget resumes where it stopped") {
   const Scene s;
   vgpu::Gpu gpu(vgpu::profile("gf6600"), 1, 1);

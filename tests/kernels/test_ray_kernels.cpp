@@ -1,5 +1,6 @@
 // Kernel tests for the ray set-up and grid-walk kernels: generadorRayos, initTraversal,
-// reinicializarTraversal and one traversal step, each run as one real pass on hand-made texels.
+// reinicializarTraversal and one traversal step (ending at the grid's face or past the ray's
+// tmax), each run as one real pass on hand-made texels.
 #include <doctest/doctest.h>
 
 #include <cmath>
@@ -150,4 +151,39 @@ TEST_CASE("one traversal pass steps each walking ray into the next voxel along i
   CHECK_TEXEL_NEAR(trav, 5, 0, 1e-6, glm::vec4(1, 1, 0, 0.5 * std::sqrt(2.0)));  // both axes step
   CHECK_TEXEL(trav, 6, 0, glm::vec4(1, 2, 0, 0.25f));
   CHECK_TEXEL_NEAR(trav, 7, 0, 1e-6, glm::vec4(0, 0, 1, 0.625));
+}
+
+TEST_CASE("a traversal pass ends a ray whose next voxel begins past its tmax, less the slack") {
+  // The walk's rule for shadow rays (tmax = the light's distance): a hit in a later voxel has
+  // t >= its entry - t_slack, so once the next voxel's entry t_exit has t_exit - t_slack >= tmax
+  // nothing there can pass t < tmax and the ray is done. Every ray goes +x from (0.5, 1.5, 1.25)
+  // in voxel (1, 1, 1), entered at t = 0.5, leaving at x = 2: t_exit = 1.5, less the slack 0.25
+  // = 1.25.
+  kernels::Traversal k;
+  k.grid = grid_uniforms(glm::vec3(0.0f), glm::vec3(1.0f), glm::vec3(4.0f), 1, 0.25f);
+  const glm::vec4 o(0.5f, 1.5f, 1.25f, 0);
+  const Texture origins = texels("origins", 6, 1, std::vector<glm::vec4>(6, o));
+  const Texture rays = texels("rays", 6, 1,
+                              {{1, 0, 0, 1.25f},    // exactly at the bound: done
+                               {1, 0, 0, 1.0f},     // the light inside this voxel: done
+                               {1, 0, 0, 1.3f},     // a hit in the next voxel could still count
+                               {1, 0, 0, kFar},     // a primary ray
+                               {1, 0, 0, 1.3f},     // in the last voxel: leaves the grid
+                               {1, 0, 0, 1.25f}});  // already done: kept
+  const Texture trav_in = texels("traversal", 6, 1,
+                                 {{1, 1, 1, 0.5f},
+                                  {1, 1, 1, 0.5f},
+                                  {1, 1, 1, 0.5f},
+                                  {1, 1, 1, 0.5f},
+                                  {3, 1, 1, 2.5f},
+                                  {kNone, 4, 5, 6}});
+  const Texture isect =
+      texels("intersection", 6, 1, std::vector<glm::vec4>(6, glm::vec4(kFar, 0, 0, kNone)));
+  const Texture trav = ktest::run(k, {&origins, &rays, &trav_in, &isect}, 6, 1);
+  CHECK_TEXEL(trav, 0, 0, glm::vec4(kNone, 0, 0, 0.5f));
+  CHECK_TEXEL(trav, 1, 0, glm::vec4(kNone, 0, 0, 0.5f));
+  CHECK_TEXEL(trav, 2, 0, glm::vec4(2, 1, 1, 1.5f));
+  CHECK_TEXEL(trav, 3, 0, glm::vec4(2, 1, 1, 1.5f));
+  CHECK_TEXEL(trav, 4, 0, glm::vec4(kNone, 0, 0, 2.5f));
+  CHECK_TEXEL(trav, 5, 0, glm::vec4(kNone, 4, 5, 6));
 }

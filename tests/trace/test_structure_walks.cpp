@@ -408,6 +408,40 @@ TEST_CASE(
   }
 }
 
+TEST_CASE(
+    "with the light among the objects, the grid walks end shadow rays at the light as the CPU "
+    "walk does") {
+  // classic with its light moved between the spheres and the camera (inside the grid's box):
+  // a shadow ray that reaches the light unblocked has voxels left behind it. The CPU walk ends
+  // it at the first voxel that begins past the light (t_enter - slack >= tmax); the stream walk
+  // must take the same steps, shadow rays included (a walk that went on to the box's face would
+  // count more). Triangle tests differ by design for shadow rays (the CPU walk stops at the first
+  // hit it meets, the pass tests the whole voxel), so only the steps are compared.
+  for (const host::AccelKind kind : {host::AccelKind::grid, host::AccelKind::grid2}) {
+    CAPTURE(host::accel_name(kind));
+    host::Scene scene = host::load_scene(host::resolve_scene("classic"), host::with_images());
+    REQUIRE(scene.lights.size() == 1);
+    scene.lights[0].position = {-2.0f, 1.2f, 2.5f};
+    const host::Bounds box = scene.bounds();
+    REQUIRE(glm::all(glm::lessThan(box.lo, scene.lights[0].position)));
+    REQUIRE(glm::all(glm::lessThan(scene.lights[0].position, box.hi)));
+    const host::Camera cam = host::scene_camera(scene, 1.0f);
+    const Structures s = test_support::build_structures(kind, std::move(scene), cam);
+    host::RenderOptions opt = options(48, 48);
+    opt.shadows = true;
+    host::CpuStats cs;
+    const host::RenderResult c = host::render_cpu(s.scene, s.accel(), s.camera, opt, &cs);
+    const host::RenderResult k = stream(s.scene, s.accel(), s.camera, opt);
+    REQUIRE(c.hit_id == k.hit_id);
+    CHECK(host::walk_work(k.stats).voxel_steps == cs.voxel_steps);
+    // Against the same frame without shadows, the shadow rays took steps of their own.
+    opt.shadows = false;
+    host::CpuStats primary;
+    host::render_cpu(s.scene, s.accel(), s.camera, opt, &primary);
+    CHECK(cs.voxel_steps > primary.voxel_steps);
+  }
+}
+
 TEST_CASE("the two-level grid puts a small bunny on a huge floor in sub-grids of its own") {
   // scripts/uneven_scenes.py's stadium, small: bunny-low on a two-triangle floor 270 times its
   // width. The uniform grid gives the bunny a handful of voxels; the two-level grid's crowded
