@@ -163,9 +163,8 @@ inline Vec4<typename L::F> grid2_step(const Fragments<L>& f, int unit_cells, int
   const Vec3<F> g{given(lx, st.x, ns.x), given(ly, st.y, ns.y), given(lz, st.z, ns.z)};
   const Vec3<F> from_point{select(lx, F(0.0f), pt), select(ly, F(0.0f), pt),
                            select(lz, F(0.0f), pt)};
-  const auto found = best.w >= F(0.0f);  // a hit inside this sub-cell ends the walk
-  // Past tmax (a shadow ray's light): every later sub-cell's hits have t >= t_exit - t_slack.
-  const auto past = t_exit - F(u.t_slack) >= tmax;
+  const auto found = best.w >= F(0.0f);                  // a hit inside this sub-cell ends the walk
+  const auto past = past_tmax(t_exit, tmax, u.t_slack);  // a shadow ray past its light
   const auto done = found || outside || past;
   const Vec3<F> zero{F(0.0f), F(0.0f), F(0.0f)};
   const Vec4<F> next = grid2_cell(f, unit_cells, unit_subs, o, d, select(outside, zero, nc), t_exit,

@@ -87,6 +87,14 @@ inline auto in_segment(const F& t, const F& tmin, const F& tmax, float t_slack) 
   return (t >= tmin - F(t_slack)) && (t <= tmax + F(t_slack));
 }
 
+// Whether a walk can end before a cell that begins at t_enter: every hit in it or after it has
+// t >= t_enter - t_slack (in_segment's lower bound), so with that at or past tmax none can pass
+// t < tmax. The grids' steps end a shadow ray there (its tmax is the light's distance).
+template <class F>
+inline auto past_tmax(const F& t_enter, const F& tmax, float t_slack) {
+  return t_enter - F(t_slack) >= tmax;
+}
+
 // The nearest of the hit so far (`best`: t, u, v, triangle) and triangle vs.w, for the lanes
 // where `testing`, counting a hit only inside the segment seg.zw (widened by t_slack).
 template <class L>

@@ -18,6 +18,7 @@
 #pragma once
 
 #include "kernels/common.h"
+#include "kernels/lists.h"
 
 namespace kernels {
 
@@ -88,7 +89,7 @@ struct LoopingTraversal {
       const M outside = (nv.x < F(0.0f)) || (nv.y < F(0.0f)) || (nv.z < F(0.0f)) ||
                         (nv.x >= F(grid.res.x)) || (nv.y >= F(grid.res.y)) ||
                         (nv.z >= F(grid.res.z));
-      const M past = t_exit - F(grid.t_slack) >= ray.w;  // beyond tmax, as dda_step
+      const M past = past_tmax(t_exit, ray.w, grid.t_slack);  // past the light, as dda_step
       const M done = (best.w >= F(0.0f)) || outside || past;
       const Vec4<F> stepped{nv.x, nv.y, nv.z, t_exit};
       const Vec4<F> finished{F(kNone), F(0.0f), F(0.0f), trav.w};

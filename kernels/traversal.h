@@ -7,6 +7,7 @@
 #pragma once
 
 #include "kernels/common.h"
+#include "kernels/lists.h"
 
 namespace kernels {
 
@@ -27,9 +28,8 @@ inline Vec4<F> dda_step(const Vec4<F>& trav, const Vec4<F>& hit, const Vec3<F>& 
   const auto outside = (nv.x < F(0.0f)) || (nv.y < F(0.0f)) || (nv.z < F(0.0f)) ||
                        (nv.x >= F(grid.res.x)) || (nv.y >= F(grid.res.y)) ||
                        (nv.z >= F(grid.res.z));
-  const auto found = hit.w >= F(0.0f);  // a hit inside this voxel ends the walk
-  // Every later voxel begins at t_exit or after, so a hit in it has t >= t_exit - t_slack.
-  const auto past = t_exit - F(grid.t_slack) >= tmax;
+  const auto found = hit.w >= F(0.0f);                      // a hit inside this voxel ends the walk
+  const auto past = past_tmax(t_exit, tmax, grid.t_slack);  // a shadow ray past its light
   const auto done = found || outside || past;
   const Vec4<F> stepped{nv.x, nv.y, nv.z, t_exit};
   const Vec4<F> finished{F(kNone), F(0.0f), F(0.0f), trav.w};
