@@ -18,6 +18,9 @@ import subprocess
 import sys
 import tempfile
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "lib"))
+import vgpurt  # noqa: E402
+
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 
@@ -43,11 +46,9 @@ def main():
         args.json = os.path.join(ROOT, f"results/beams/beams_auto{suffix}.json")
     scenes = args.scenes
     if not scenes:
-        tmp = tempfile.mkdtemp(prefix="beams_auto_")
-        subprocess.run([sys.executable, os.path.join(ROOT, "scripts/scenes/uneven_scenes.py"), tmp],
-                       check=True, capture_output=True)
+        uneven = vgpurt.uneven_scenes(tempfile.mkdtemp(prefix="beams_auto_"))
         scenes = sorted(glob.glob(os.path.join(ROOT, "scenes/*.gltf"))) + [
-            os.path.join(tmp, "stadium.gltf"), os.path.join(tmp, "scales.gltf")]
+            uneven["stadium"], uneven["scales"]]
     rows = []
     print("| scene | card | off | on / off | auto | chose | auto / off | probes (modeled) | "
           "(auto + probes) / off | probes (host) |")

@@ -16,21 +16,23 @@ Usage: python3 scripts/docs/beams_bound.py [--vgpu-rt build/host/vgpu-rt] [--siz
 import argparse
 import json
 import os
-import subprocess
 import sys
 import tempfile
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "lib"))
+import vgpurt  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 CARDS = ("gf6600", "h200")
 ACCELS = ("grid", "grid2", "bvh", "kdtree")
 
 
-def render(vgpu, scene, size, profile, accel, kernels, tile):
+def render(vgpu, scene, size, profile, accel, kernels, tile, work):
     beams = ["--beams", "off"] if tile == 0 else ["--beams", "on", "--beam-tile", str(tile)]
-    cmd = [vgpu, "render", scene, "--size", f"{size}x{size}", "--bounces", "0", "--shadows",
-           "off", "--accel", accel, "--kernels", kernels, "--profile", profile, "--threads", "2",
-           "--quiet", "--stats", "json"] + beams
-    d = json.loads(subprocess.run(cmd, check=True, capture_output=True, text=True).stdout)
+    d = vgpurt.render(vgpu, scene, ["--size", f"{size}x{size}", "--bounces", "0", "--shadows",
+                                    "off", "--accel", accel, "--kernels", kernels, "--profile",
+                                    profile, "--threads", "2"] + beams,
+                      stats_json=os.path.join(work, "frame.json"))
     return {"passes": d["totals"]["passes"], "beam_passes": d.get("beams", {}).get("passes", 0),
             "predicted_ms": {c: d["predicted_ms"][c] for c in CARDS}}
 
@@ -49,13 +51,12 @@ def main():
         with open(args.summary) as f:
             summary(json.load(f)["rows"])
         return
+    work = tempfile.mkdtemp(prefix="beams_bound_")
     scenes = args.scenes
     if not scenes:
-        tmp = tempfile.mkdtemp(prefix="beams_bound_")
-        subprocess.run([sys.executable, os.path.join(ROOT, "scripts/scenes/uneven_scenes.py"), tmp],
-                       check=True, capture_output=True)
+        uneven = vgpurt.uneven_scenes(work)
         scenes = [os.path.join(ROOT, "scenes", s + ".gltf") for s in ("classic", "hop", "bunny")]
-        scenes += [os.path.join(tmp, s + ".gltf") for s in ("stadium", "scales")]
+        scenes += [uneven["stadium"], uneven["scales"]]
     rows = []
     print("| scene | structure | kernels | card | off | best tile | best on / off | 8x8 on / off "
           "| 1x1 on / off |")
@@ -71,7 +72,7 @@ def main():
                         print(f"{name} {accel} {kernels} {card} tile {tile}", file=sys.stderr,
                               flush=True)
                         runs[(card, tile)] = render(args.vgpu_rt, scene, args.size, card, accel,
-                                                    kernels, tile)
+                                                    kernels, tile, work)
                 for card in CARDS:
                     src = card if kernels == "looping" else "gf6600"
                     frames = {t: runs[(src, t)] for t in [0] + args.tiles}

@@ -32,7 +32,6 @@ import json
 import os
 import re
 import statistics
-import subprocess
 import sys
 import tempfile
 import textwrap
@@ -115,9 +114,8 @@ def main():
                     "replacing the stored ones")
     a = ap.parse_args()
     tmp = tempfile.mkdtemp(prefix="structures_")
-    subprocess.run([sys.executable, os.path.join(ROOT, "scripts", "scenes", "uneven_scenes.py"), tmp],
-                   check=True, stdout=subprocess.DEVNULL)
-    scenes = [(s, s) for s in BUNDLED] + [(s, os.path.join(tmp, s + ".gltf")) for s in UNEVEN]
+    uneven = vgpurt.uneven_scenes(tmp)
+    scenes = [(s, s) for s in BUNDLED] + [(s, uneven[s]) for s in UNEVEN]
     size = ["--size", f"{a.size}x{a.size}", "--threads", "2"]
     rows = []
     js = os.path.join(tmp, "r.json")

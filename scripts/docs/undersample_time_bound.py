@@ -21,22 +21,22 @@ Usage: python3 scripts/docs/undersample_time_bound.py [--vgpu-rt build/host/vgpu
 import argparse
 import json
 import os
-import subprocess
 import sys
+import tempfile
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "lib"))
 import h200_frames as hf  # noqa: E402
+import vgpurt  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 DOC = os.path.join(ROOT, "docs", "sampling.md")
 BEGIN, END = "<!-- time-bound:begin -->", "<!-- time-bound:end -->"
 
 
-def frame(vgpu, scene, size, card, kernels, extra):
-    cmd = [vgpu, "render", os.path.join(ROOT, "scenes", scene + ".gltf"), "--size",
-           f"{size}x{size}", "--profile", card, "--kernels", kernels, "--threads", "2", "--quiet",
-           "--stats", "json"] + extra
-    d = json.loads(subprocess.run(cmd, check=True, capture_output=True, text=True).stdout)
+def frame(vgpu, scene, size, card, kernels, extra, work):
+    d = vgpurt.render(vgpu, os.path.join(ROOT, "scenes", scene + ".gltf"),
+                      ["--size", f"{size}x{size}", "--profile", card, "--kernels", kernels,
+                       "--threads", "2"] + extra, stats_json=os.path.join(work, "frame.json"))
     b = d["predicted_breakdown"][card]
     fixed = b["per_pass_ms"] + b["program_load_ms"] + b["bus_ms"] + b["readback_ms"]
     t = d["totals"]
@@ -106,14 +106,15 @@ def main():
                     default=os.path.join(ROOT, "results/sampling/undersample_time_bound.json"))
     args = ap.parse_args()
     rows = []
+    work = tempfile.mkdtemp(prefix="undersample_time_bound_")
     for scene in ("classic", "bunny"):
         for kernels in ("multipass", "looping"):
             for card in ("gf6600", "h200"):
                 print(f"{scene} {kernels} {card}", file=sys.stderr, flush=True)
-                full = frame(args.vgpu_rt, scene, args.size, card, kernels, [])
-                quarter = frame(args.vgpu_rt, scene, args.size // 2, card, kernels, [])
+                full = frame(args.vgpu_rt, scene, args.size, card, kernels, [], work)
+                quarter = frame(args.vgpu_rt, scene, args.size // 2, card, kernels, [], work)
                 under = frame(args.vgpu_rt, scene, args.size, card, kernels,
-                              ["--aa", "undersample:2"])
+                              ["--aa", "undersample:2"], work)
                 bound = quarter["ms"] - quarter["fixed_ms"] + under["fixed_ms"]
                 rows.append({"scene": scene, "kernels": kernels, "profile": card, "full": full,
                              "quarter": quarter, "undersample": under, "bound_ms": bound})

@@ -12,6 +12,7 @@ and returns the JSON as a dict. A refused option or a failed render raises Faile
 vgpu-rt's last line on stderr (the one line a refusal prints) and its exit status (2 for a refusal).
 """
 import json
+import os
 import re
 import subprocess
 import sys
@@ -85,3 +86,11 @@ def kernel_names(exe):
     out = run([exe, "kernels"])
     return [line.split()[0] for line in out.splitlines()[1:]
             if line.strip() and not line.startswith("instructions:")]
+
+
+def uneven_scenes(folder):
+    """Writes docs/structures.md's uneven scenes (scripts/scenes/uneven_scenes.py) into folder and
+    returns their paths by name: {"stadium": ..., "scales": ...}."""
+    here = os.path.dirname(os.path.abspath(__file__))
+    run([sys.executable, os.path.join(here, "..", "scenes", "uneven_scenes.py"), folder])
+    return {name: os.path.join(folder, name + ".gltf") for name in ("stadium", "scales")}
