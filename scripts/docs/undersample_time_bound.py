@@ -65,9 +65,10 @@ def section(rows, size):
         "",
         "Undersampling's frame is two walks, one after the other: the lattice's rays (one in "
         "every 2x2 block), then the gaps its colours mark. `scripts/docs/undersample_time_bound.py` "
-        f"prices, at {size}x{size} with the CLI's defaults, what each costs at least: a frame of "
-        "a quarter of the rays (the same view at half the size, as many rays as the lattice "
-        "traces), and a *bound*: that quarter frame's pass work plus the undersampled frame's "
+        f"prices, at {size}x{size} with the CLI's defaults, what each costs: the lattice as a "
+        "frame of a quarter of the rays (the same view at half the size, as many rays as the "
+        "lattice traces, through the centre of each 2x2 block rather than of its first "
+        "pixel), and a *bound*: that quarter frame's pass work plus the undersampled frame's "
         "fixed costs (per-pass setup, program loads, bus, read-backs), as if the gaps' walk "
         "shaded no fragment at all. Both walks, multipass and looping "
         "(`results/sampling/undersample_time_bound.json`):",
@@ -80,7 +81,8 @@ def section(rows, size):
         f"{0.5 - min(q):.2f}x of the one-ray frame for the gaps' whole walk, their marks, the "
         "scan and compaction that pack them, and the fill.",
         f"- The bound is {min(b):.2f}x to {max(b):.2f}x: above 0.5x on both scenes, both walks "
-        "and both cards, before a gap's ray is shaded.",
+        "and both cards, before a gap's ray is shaded. It counts this implementation's passes "
+        "(the scans, compactions and gathers of the dense streams among them).",
         f"- The looping walk does not change this. Its frames have few passes, yet the quarter "
         f"frame still costs {min(lq):.2f}x to {max(lq):.2f}x for a quarter of the rays, and the "
         f"undersampled frame {min(lu):.2f}x to {max(lu):.2f}x. "
@@ -91,10 +93,11 @@ def section(rows, size):
             for r in loop) + " the one-ray frame's lane slots for " + ", ".join(
             f"{r['undersample']['lanes_active'] / r['full']['lanes_active']:.2f}x"
             for r in loop) + " its active lanes.",
-        "- So the target (0.5x) cannot be met while the gaps wait for the lattice's colours "
-        "(the same marks, so the same image as the gated frames). Deciding the gaps from "
-        "something known before the lattice is shaded would change which rays are traced, and "
-        "with them the image.",
+        "- So the target (0.5x) is out of reach while the gaps wait for the lattice's colours "
+        "(the same marks, so the same image as the gated frames): after the lattice, at most "
+        f"{0.5 - min(q):.2f}x of the one-ray frame is left for a whole second walk, each of "
+        "whose passes pays the fixed costs. Deciding the gaps from something known before the "
+        "lattice is shaded would change which rays are traced, and with them the image.",
     ])
 
 
