@@ -1,9 +1,11 @@
 #!/usr/bin/env python3
 """Checks that docs/ and results/ stay apart and that every file there is accounted for.
 
-- docs/ holds the pages a learner reads: Markdown and the images they show, nothing else.
+- docs/ holds the pages (the learners' path in docs/learn/, the studies in docs/studies/, the
+  reference pages): Markdown, notebooks and the images they show, nothing else.
 - Every file in results/<study>/ (the raw measurements) is named, by its file name, in that
-  study's README.md or in a page (docs/*.md, README.md); every image in docs/ is named by a page.
+  study's README.md or in a page (docs/**/*.md, README.md); every image in docs/ is named by a
+  page.
 - Every path a page or a results README names under docs/, results/ or scripts/ exists (a
   `{a,b}` or `*` in the name is expanded).
 Prints each problem and exits 1 if there is any; runs in well under a second (.ci/run runs it).
@@ -46,7 +48,8 @@ def exists(rel):
 
 def main():
     problems = []
-    pages = sorted(glob.glob(os.path.join(ROOT, "docs", "*.md"))) + [os.path.join(ROOT, "README.md")]
+    pages = sorted(glob.glob(os.path.join(ROOT, "docs", "**", "*.md"), recursive=True))
+    pages.append(os.path.join(ROOT, "README.md"))
     readmes = sorted(glob.glob(os.path.join(ROOT, "results", "*", "README.md")))
     page_text = {p: read(p) for p in pages}
     all_pages = "\n".join(page_text.values())

@@ -23,7 +23,7 @@ What it compares:
   OLD lists, text equal.
 Prints one line per check and exits 1 if anything differs. Sizes are small (at most 256x256, most
 64x64): a full run takes a few minutes on 2 cores (--quick seconds). Used for refactoring and for
-emulator speed work (docs/speed.md), where the host may do less but must compute the same.
+emulator speed work (docs/studies/speed.md), where the host may do less but must compute the same.
 """
 import filecmp
 import os

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Writes docs/animation.png and the measured tables of docs/animation.md (issue 23): what a
+"""Writes docs/studies/animation.png and the measured tables of docs/studies/animation.md (issue 23): what a
 moving scene costs per frame, per structure and update mode, on the emulator and modeled.
 
 For each scene (default: the bundled `hop`, 1,436 triangles, and `scatter`, 37,228 triangles,
@@ -18,8 +18,8 @@ per-frame records it charts and tabulates, per frame:
 Usage: /usr/bin/python3 scripts/docs/animation.py [--vgpu-rt build/host/vgpu-rt] [--scenes hop,scatter]
          [--structures grid,bvh,kdtree] [--refit bvh] [--kernels multipass,looping]
          [--frames 0:2:25] [--size 128] [--probe-sizes 256,512] [--probe-time 1] [--threads 0]
-         [--runs build/animation_runs] [--reuse] [--doc docs/animation.md]
-         [--png docs/animation.png]
+         [--runs build/animation_runs] [--reuse] [--doc docs/studies/animation.md]
+         [--png docs/studies/animation.png]
   --kernels      multipass: the paper's kernels on gf5700; looping: the looping kernels on gf6600
   --probe-sizes  one frame at --probe-time s at each size, per structure and kernels
   --reuse   read the runs' JSON already in --runs instead of rendering (a missing one is run)
@@ -133,7 +133,7 @@ def pct(x):
 
 
 def tables(a, runs, probes):
-    """The Markdown tables of docs/animation.md."""
+    """The Markdown tables of docs/studies/animation.md."""
     n = len(next(iter(runs.values()))["time"])
     lines = [f"Measured by `scripts/docs/animation.py --size {a.size} --frames {a.frames} "
              f"--structures {','.join(a.structures)}`: one run per scene, structure, update mode "
@@ -281,8 +281,8 @@ def main():
     ap.add_argument("--threads", type=int, default=0)
     ap.add_argument("--runs", default=os.path.join(ROOT, "build", "animation_runs"))
     ap.add_argument("--reuse", action="store_true")
-    ap.add_argument("--doc", default=os.path.join(ROOT, "docs", "animation.md"))
-    ap.add_argument("--png", default=os.path.join(ROOT, "docs", "animation.png"))
+    ap.add_argument("--doc", default=os.path.join(ROOT, "docs", "studies", "animation.md"))
+    ap.add_argument("--png", default=os.path.join(ROOT, "docs", "studies", "animation.png"))
     a = ap.parse_args()
     a.scenes = a.scenes.split(",")
     a.structures = a.structures.split(",")

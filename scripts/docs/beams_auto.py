@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Measures --beams auto against --beams off (docs/groups.md's table): every bundled scene
+"""Measures --beams auto against --beams off (docs/studies/groups.md's table): every bundled scene
 (scenes/*.gltf) and the uneven scenes of scripts/scenes/uneven_scenes.py, primary rays only
 (--bounces 0 --shadows off, --accel grid unless told), on gf6600 and h200. Per scene and card: the cost
 model's frame time with beams off, on and with --beams auto (auto decides for the card it renders

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""How far beams over tiles can go (docs/groups.md, "How far beams can go"): the cost model's
+"""How far beams over tiles can go (docs/studies/groups.md, "How far beams can go"): the cost model's
 frame time with --beams on at every tile size from 1x1 (each pixel its own beam: the finest
 entry-point search there is) to 32x32, against --beams off, on the scenes the issue's 0.7x target
 names (classic, hop, and stadium and scales from scripts/scenes/uneven_scenes.py) and bunny (where

@@ -1,13 +1,13 @@
 #!/usr/bin/env python3
-"""Measures the texture filters on the bundled `textured` scene and prints docs/materials.md's
+"""Measures the texture filters on the bundled `textured` scene and prints docs/studies/materials.md's
 table (markdown) on stdout; with --glass, measures the bundled `glass` scene instead and writes
-its tables into docs/materials.md between the glass-measured markers.
+its tables into docs/studies/materials.md between the glass-measured markers.
 
 Usage: /usr/bin/python3 scripts/docs/materials.py [--vgpu-rt build/host/vgpu-rt] [--size 256] [--glass]
        /usr/bin/python3 scripts/docs/materials.py --h200 FILE... [--h200-clocks CSV]
        /usr/bin/python3 scripts/docs/materials.py --opaque-copy PATH
 --h200 measures nothing: it reads bench_gl's JSON from an H200 (scripts/h200/streams_sampling.sh)
-and writes docs/materials.md's H200 section between the h200-measured markers.
+and writes docs/studies/materials.md's H200 section between the h200-measured markers.
 Each filter renders once on the stream engine (the emulator, gf5700: every fragment runs every
 pass, as on the paper's card) with --predict: the shader's texture fetches, the frame's, and
 the cost model's predicted ms for gf5700, gf6600 and h200 from those statistics. The baseline
@@ -201,11 +201,11 @@ def h200(paths, clocks):
 
 def write_h200(paths, clocks):
     text = h200(paths, clocks)
-    hf.replace_section(os.path.join(ROOT, "docs", "materials.md"), H200_BEGIN, H200_END, text)
+    hf.replace_section(os.path.join(ROOT, "docs", "studies", "materials.md"), H200_BEGIN, H200_END, text)
 
 
 def write_glass(exe, size):
-    path = os.path.join(ROOT, "docs", "materials.md")
+    path = os.path.join(ROOT, "docs", "studies", "materials.md")
     text = open(path).read()
     a, b = text.index(BEGIN) + len(BEGIN), text.index(END)
     tables = glass(exe, size)  # measured before the file is opened for writing
@@ -218,12 +218,12 @@ def main():
     ap.add_argument("--vgpu-rt", default=os.path.join(ROOT, "build", "host", "vgpu-rt"))
     ap.add_argument("--size", type=int, default=256)
     ap.add_argument("--glass", action="store_true",
-                    help="measure the glass scene and write docs/materials.md's glass tables")
+                    help="measure the glass scene and write docs/studies/materials.md's glass tables")
     ap.add_argument("--opaque-copy", metavar="PATH",
                     help="only write the glass scene's opaque copy to PATH (for bench_gl)")
     ap.add_argument("--h200", nargs="+", metavar="FILE",
                     help="bench_gl JSON measured on an H200 (results/materials/materials_h200_*.json): only "
-                    "write docs/materials.md's H200 section")
+                    "write docs/studies/materials.md's H200 section")
     ap.add_argument("--h200-clocks", metavar="CSV",
                     default=os.path.join(ROOT, "results", "sampling", "streams_sampling_h200_clocks.csv"),
                     help="nvidia-smi's clock log of the same run")

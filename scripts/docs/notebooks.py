@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Runs the notebooks in docs/ (docs/*.ipynb) and checks or rewrites their outputs.
+"""Runs the learners' path's notebooks (docs/learn/*.ipynb) and checks or rewrites their outputs.
 
 Usage: /usr/bin/python3 scripts/docs/notebooks.py [--build build] [--write] [NOTEBOOK...]
 
@@ -56,7 +56,7 @@ def main():
         sys.exit(f"notebooks: {module}/vgpu_rt is missing (build the target _vgpu_rt)")
     os.environ["PYTHONPATH"] = module + os.pathsep + os.environ.get("PYTHONPATH", "")
     os.environ["PYDEVD_DISABLE_FILE_VALIDATION"] = "1"  # the kernel's debugger: no start-up notes
-    paths = a.notebooks or sorted(glob.glob(os.path.join(ROOT, "docs", "*.ipynb")))
+    paths = a.notebooks or sorted(glob.glob(os.path.join(ROOT, "docs", "learn", "*.ipynb")))
     failed = False
     for path in paths:
         name = os.path.relpath(path, ROOT)

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """The paper's passes on real OpenGL drivers, beside the emulator and the cost model.
 
-Writes docs/real_gpu.md and its chart docs/real_gpu.png (matplotlib) from JSON that
+Writes docs/studies/real_gpu.md and its chart docs/studies/real_gpu.png (matplotlib) from JSON that
 bench/bench_gl wrote:
   results/real_gpu/real_gpu_llvmpipe.json     this machine's EGL device (Mesa llvmpipe); measured again
                                   unless --reuse
@@ -29,7 +29,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-DOCS = os.path.join(ROOT, "docs")
+DOCS = os.path.join(ROOT, "docs", "studies")
 RESULTS = os.path.join(ROOT, "results", "real_gpu")  # the measurements (results/real_gpu/README.md)
 
 
@@ -85,7 +85,7 @@ def fixed_table(d):
 
 
 def plot_chart(pred, llvm, remote, earlier):
-    """docs/real_gpu.png: per scene and size, bars for each measured and predicted frame time
+    """docs/studies/real_gpu.png: per scene and size, bars for each measured and predicted frame time
     (log scale); and the fixed cost of a pass against its size."""
     fig, axes = plt.subplots(1, 2, figsize=(14, 6.4), gridspec_kw={"width_ratios": [3, 2]})
     ax = axes[0]
@@ -190,7 +190,7 @@ INTRO = ["# The paper's passes on real OpenGL drivers",
          "",
          "Written by `scripts/docs/real_gpu.py` from `bench/bench_gl` (do not edit by hand). The GL",
          "device (`gl/`) runs the stream tracer's host loop unchanged, with fragment shaders",
-         "generated from the same C++ kernels the emulator runs. Frames use `docs/table1.md`'s",
+         "generated from the same C++ kernels the emulator runs. Frames use `docs/studies/table1.md`'s",
          "settings (3 iterations, phong, no shadow rays, a 15³ grid); every figure is the median",
          "of the runs after one warm-up (which compiles the programs). Predictions are the cost",
          "model's (`host/model/cost_model.cpp`) from the emulator's counts of the same frame, which",
@@ -354,7 +354,7 @@ def main():
             lines += [f.read().rstrip(), ""]
     with open(os.path.join(DOCS, "real_gpu.md"), "w") as f:
         f.write("\n".join(lines))
-    print(f"real_gpu: wrote docs/real_gpu.md and {os.path.relpath(png, ROOT)}", file=sys.stderr)
+    print(f"real_gpu: wrote docs/studies/real_gpu.md and {os.path.relpath(png, ROOT)}", file=sys.stderr)
 
 
 if __name__ == "__main__":

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Writes docs/sampling.md and docs/sampling.png: the sampling modes (--spp, --aa adaptive,
+"""Writes docs/studies/sampling.md and docs/studies/sampling.png: the sampling modes (--spp, --aa adaptive,
 --aa undersample) on the bundled scenes, error against a 256-sample reference beside rays,
 passes and modeled time.
 
@@ -12,7 +12,7 @@ Usage: /usr/bin/python3 scripts/docs/sampling.py [--bench build/bench/bench_samp
 the undersample-bounds markers; bench/bench_undersample_bounds.cpp, a few seconds), which a
 full regeneration writes too.
 --h200 runs nothing: it reads bench_gl's JSON from an H200 (scripts/h200/streams_sampling.sh) and
-rewrites only docs/sampling.md's H200 section (between the h200-measured markers), which a full
+rewrites only docs/studies/sampling.md's H200 section (between the h200-measured markers), which a full
 regeneration keeps as it is. --h200-looping takes the looping rows from a second run with a warm-up
 before timing (scripts/h200/sampling_looping.sh), --h200-looping-control its run without one.
 
@@ -308,13 +308,13 @@ checkerboards lose (hop 0.56%, classic 0.84% at T 0.1: a checker stripe of low c
 like a curve)."""
 
 
-DOC = os.path.join(ROOT, "docs", "sampling.md")
+DOC = os.path.join(ROOT, "docs", "studies", "sampling.md")
 from sampling_h200 import (BUDGET_BEGIN, BUDGET_END, BUDGET_PROSE, COMPACT_BEGIN,  # noqa: E402
                            COMPACT_END, H200_BEGIN, H200_END, h200, h200_budget, h200_compact)
 
 
 def plot_chart(main_rows, scenes, size):
-    """docs/sampling.png: per scene, each mode's RMS error against its modeled gf6600 time,
+    """docs/studies/sampling.png: per scene, each mode's RMS error against its modeled gf6600 time,
     the Pareto front outlined; each gated mode (before the dense streams) hollow, joined to its
     dense twin (the same image)."""
     fig, axes = plt.subplots(1, len(scenes), figsize=(4.2 * len(scenes), 4.2), sharey=False)
@@ -366,7 +366,7 @@ def plot_chart(main_rows, scenes, size):
                  "triangles: --aa undersample; outlined: on the Pareto front; hollow, dotted to "
                  "their dense twins: the gated frames of before)", fontsize=9)
     fig.tight_layout()
-    fig.savefig(os.path.join(ROOT, "docs/sampling.png"), dpi=110)
+    fig.savefig(os.path.join(ROOT, "docs/studies/sampling.png"), dpi=110)
 
 
 def parse_args():
@@ -380,11 +380,11 @@ def parse_args():
     ap.add_argument("--bounds-bench",
                     default=os.path.join(ROOT, "build/bench/bench_undersample_bounds"))
     ap.add_argument("--bounds-only", action="store_true",
-                    help="only rewrite docs/sampling.md's section on how far any choice of "
+                    help="only rewrite docs/studies/sampling.md's section on how far any choice of "
                     "traced gaps can go")
     ap.add_argument("--h200", nargs="+", metavar="FILE",
                     help="bench_gl JSON measured on an H200 (results/sampling/sampling_h200*.json): only "
-                    "rewrite docs/sampling.md's H200 section")
+                    "rewrite docs/studies/sampling.md's H200 section")
     ap.add_argument("--h200-clocks", metavar="CSV",
                     default=os.path.join(ROOT, "results", "sampling", "streams_sampling_h200_clocks.csv"),
                     help="nvidia-smi's clock log of the same run")
@@ -393,7 +393,7 @@ def parse_args():
                     "scripts/h200/budget_sampling.sh's bench_gl JSON files")
     ap.add_argument("--h200-compact", nargs="+", metavar="FILE",
                     help="bench_gl JSON of the dense streams on an H200 "
-                    "(results/sampling/compact_h200_*.json): only rewrite docs/sampling.md's "
+                    "(results/sampling/compact_h200_*.json): only rewrite docs/studies/sampling.md's "
                     "section on them")
     ap.add_argument("--h200-looping", nargs="+", metavar="FILE",
                     help="bench_gl JSON of the looping frames run again with --warmup-ms "
@@ -622,22 +622,22 @@ def main():
         with tempfile.TemporaryDirectory() as work:
             hf.replace_section(DOC, BOUNDS_BEGIN, BOUNDS_END,
                                bounds_section(args.bounds_bench, work, args.changed_size))
-        print("sampling.py: wrote docs/sampling.md's bounds section", file=sys.stderr)
+        print("sampling.py: wrote docs/studies/sampling.md's bounds section", file=sys.stderr)
         return
     if args.h200_budget:
         hf.replace_section(DOC, BUDGET_BEGIN, BUDGET_END,
                            h200_budget(args.h200_budget, BUDGET_PROSE))
-        print("sampling.py: wrote docs/sampling.md's budget H200 section", file=sys.stderr)
+        print("sampling.py: wrote docs/studies/sampling.md's budget H200 section", file=sys.stderr)
         return
     if args.h200_compact:
         hf.replace_section(DOC, COMPACT_BEGIN, COMPACT_END, h200_compact(args.h200_compact))
-        print("sampling.py: wrote docs/sampling.md's dense-stream H200 section", file=sys.stderr)
+        print("sampling.py: wrote docs/studies/sampling.md's dense-stream H200 section", file=sys.stderr)
         return
     if args.h200:
         hf.replace_section(DOC, H200_BEGIN, H200_END,
                            h200(args.h200, args.h200_clocks, args.h200_looping,
                                 args.h200_looping_control, args.h200_looping_clocks))
-        print("sampling.py: wrote docs/sampling.md's H200 section", file=sys.stderr)
+        print("sampling.py: wrote docs/studies/sampling.md's H200 section", file=sys.stderr)
         return
     scenes = args.scenes.split(",")
     others = [s for s in args.other_scenes.split(",") if s]
@@ -676,7 +676,7 @@ def main():
         out += [kept, ""]
     with open(DOC, "w") as f:
         f.write("\n".join(out))
-    print("sampling.py: wrote docs/sampling.md and docs/sampling.png", file=sys.stderr)
+    print("sampling.py: wrote docs/studies/sampling.md and docs/studies/sampling.png", file=sys.stderr)
 
 
 if __name__ == "__main__":

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
-"""Writes docs/sampling.md's section on the object-space criterion of adaptive sampling
-(--aa-criterion object, kernels/cones.h) and its chart, docs/sampling_cones.png.
+"""Writes docs/studies/sampling.md's section on the object-space criterion of adaptive sampling
+(--aa-criterion object, kernels/cones.h) and its chart, docs/studies/sampling_cones.png.
 
 Runs bench_sampling on every bundled scene with the one-ray and uniform images, the image
 criterion (--aa-criterion image, today's default) and the object criterion at several
@@ -24,7 +24,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-DOC = os.path.join(ROOT, "docs", "sampling.md")
+DOC = os.path.join(ROOT, "docs", "studies", "sampling.md")
 BEGIN = "<!-- cones:begin -->"
 END = "<!-- cones:end -->"
 SCENES = ("sphere,bunny,bunny-refl,classic,bunny-low,bunny-mirror,hop,sphere-alone,teapot,"
@@ -175,7 +175,7 @@ def chart(scenes, size):
                  "or --aa-budget; shaded: at most 35% of uniform 16's rays; dotted: 1.5x its RMS)",
                  fontsize=9)
     fig.tight_layout()
-    fig.savefig(os.path.join(ROOT, "docs", "sampling_cones.png"), dpi=110)
+    fig.savefig(os.path.join(ROOT, "docs", "studies", "sampling_cones.png"), dpi=110)
 
 
 def table(scenes, size):
@@ -253,7 +253,7 @@ def main():
     text += ["", "Which thresholds meet the target on every scene, and the second target:", ""]
     text += verdicts(scenes) + ["", VERDICT, "", TRIED]
     hf.replace_section(DOC, BEGIN, END, "\n".join(text))
-    print("sampling_cones.py: wrote docs/sampling.md's cones section and docs/sampling_cones.png",
+    print("sampling_cones.py: wrote docs/studies/sampling.md's cones section and docs/studies/sampling_cones.png",
           file=sys.stderr)
 
 

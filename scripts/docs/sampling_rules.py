@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
-"""Writes docs/sampling.md's section on rules of where adaptive sampling refines (between the
-rules markers) and its chart, docs/sampling_rules.png: candidates for one default setting that
+"""Writes docs/studies/sampling.md's section on rules of where adaptive sampling refines (between the
+rules markers) and its chart, docs/studies/sampling_rules.png: candidates for one default setting that
 meets the adaptive target on every bundled scene, tried offline.
 
 Usage: /usr/bin/python3 scripts/docs/sampling_rules.py [--bench build/bench/bench_mark_rules]
@@ -32,7 +32,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-DOC = os.path.join(ROOT, "docs", "sampling.md")
+DOC = os.path.join(ROOT, "docs", "studies", "sampling.md")
 BEGIN = "<!-- rules:begin -->"
 END = "<!-- rules:end -->"
 RMS_TARGET, RAYS_TARGET = 1.5, 0.35
@@ -373,7 +373,7 @@ def chart(results, names):
     fig.suptitle("Adaptive 16 at 128x128: where each rule leaves the ten bundled scenes "
                  "(shaded: the target; simulated from bench_mark_rules' data)", fontsize=10)
     fig.tight_layout()
-    fig.savefig(os.path.join(ROOT, "docs", "sampling_rules.png"), dpi=100)
+    fig.savefig(os.path.join(ROOT, "docs", "studies", "sampling_rules.png"), dpi=100)
 
 
 def main():
@@ -400,8 +400,8 @@ def main():
             "target missed):", ""] + table(results, names)
     text += [""] + check_against_bench(results, names) + ["", VERDICT]
     hf.replace_section(DOC, BEGIN, END, "\n".join(text))
-    print("sampling_rules.py: wrote docs/sampling.md's rules section and "
-          "docs/sampling_rules.png", file=sys.stderr)
+    print("sampling_rules.py: wrote docs/studies/sampling.md's rules section and "
+          "docs/studies/sampling_rules.png", file=sys.stderr)
 
 
 if __name__ == "__main__":

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Builds bench/stability_report and writes docs/stability.md: what each stability case probes,
+# Builds bench/stability_report and writes docs/studies/stability.md: what each stability case probes,
 # how its expected answer is computed, the tolerance rules, and the case x precision table.
 set -euo pipefail
 root="$(cd "$(dirname "$0")/../.." && pwd)"
@@ -7,7 +7,7 @@ build="${BUILD_DIR:-$root/build-stab}"
 cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DVGPU_BENCH=ON >/dev/null
 cmake --build "$build" --target stability_report >/dev/null
 table="$("$build/bench/stability_report")"
-out="$root/docs/stability.md"
+out="$root/docs/studies/stability.md"
 cat > "$out" <<MD
 # Numerical stability of the stream tracer
 

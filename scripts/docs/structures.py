@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Writes docs/structures.md and docs/structures.png: the uniform grid (the paper's), the
+"""Writes docs/studies/structures.md and docs/studies/structures.png: the uniform grid (the paper's), the
 two-level grid, the BVH, the kd-tree and --accel auto on the bundled scenes and on uneven scenes
 (scripts/scenes/uneven_scenes.py), side by side in one run.
 
@@ -101,7 +101,7 @@ def main():
     ap.add_argument("--h200-sizes", nargs="*", default=[],
                     help="bench_gl JSON files of the same frames at several sizes "
                     "(results/structures/structures_h200_sizes_*.json)")
-    ap.add_argument("--out", default=os.path.join(ROOT, "docs"),
+    ap.add_argument("--out", default=os.path.join(ROOT, "docs", "studies"),
                     help="where structures.md and structures.png go")
     ap.add_argument("--results", default=os.path.join(ROOT, "results", "structures"),
                     help="where structures.json, the raw figures, goes")
@@ -299,7 +299,7 @@ def looping_again(pairs):
          "scripts/h200/structures.sh`, `results/structures/structures_h200_looping_warm.json`): the same frames, "
          f"each configuration's GL frames run for about {warm_s:.1f} s (`bench_gl --warmup-ms`) "
          "before the timed ones, since a GPU left idle while the emulator computes the frame's "
-         "prediction lowers its clock (docs/sampling.md's H200 section measured it: 345 MHz, and "
+         "prediction lowers its clock (docs/studies/sampling.md's H200 section measured it: 345 MHz, and "
          f"frames 3-5x slower). {within} of its {len(pairs)} looping cells are within 35%. "
          "Beside the first runs' (one warm-up frame):", "",
          "| scene | structure | first run wall ms | vs | warmed wall ms | GPU ms | predicted ms "
@@ -500,7 +500,7 @@ def write_doc(a, rows, h200):
     doc = f"""# Acceleration structures: the grid, a two-level grid, a BVH, a kd-tree, and `--accel auto`
 
 Written by `scripts/docs/structures.py` (run it again to refresh every figure here); the chart is
-`docs/structures.png`, the raw figures `results/structures/structures.json`.
+`docs/studies/structures.png`, the raw figures `results/structures/structures.json`.
 
 The paper walks one uniform grid. A grid fits an object that fills its box; it fails where the
 scene is uneven: a small detailed object on a large floor puts the object in a few voxels of a
@@ -548,7 +548,7 @@ depend on the load).
 "primary" is primary rays only (`--bounces 0 --shadows off`, as the issue's table); "full" is the
 default frame (2 bounces, shadows). Steps: voxels stepped (grid) or nodes visited (BVH, kd-tree)
 by the step passes' working fragments; tests: triangle tests. The modeled ms come from the same
-statistics (cost model, `docs/table1.md`); the scenes "stadium" (the bunny on a floor 270 times
+statistics (cost model, `docs/studies/table1.md`); the scenes "stadium" (the bunny on a floor 270 times
 its width) and "scales" (25 bunnies from 5% to 15 times its size, 92k triangles) are written by
 `scripts/scenes/uneven_scenes.py`.
 
@@ -595,7 +595,7 @@ are compared with the model, which has no compilation term.
 ## Which structure wins where, and why
 
 - **Passes against read-backs.** On the 2004 cards a frame costs its passes (651 us each on the
-  FX 5700, 160 us on the 6600, fitted on the paper's Table 1 in `docs/table1.md`) and its query
+  FX 5700, 160 us on the 6600, fitted on the paper's Table 1 in `docs/studies/table1.md`) and its query
   read-backs (1.3 ms and 320 us) far more than its fragment work. The grid's pass count is the longest ray's voxel steps plus its triangle loop
   per voxel; an uneven scene makes one ray cross a hundred empty voxels (stadium) or sit in a
   voxel listing hundreds of triangles (scales). The BVH's and kd-tree's pass counts follow the

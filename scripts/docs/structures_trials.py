@@ -1,4 +1,4 @@
-"""The H200 trials of docs/structures.md's looping frames, for scripts/docs/structures.py: a second
+"""The H200 trials of docs/studies/structures.md's looping frames, for scripts/docs/structures.py: a second
 warmed run beside the first, the traversal kernels' GPU time against their modeled work, the
 texture-layout trial, the kernels as the driver compiled them and the GLSL without `precise`.
 Each function returns the Markdown it adds (empty where its files were not given)."""

@@ -17,7 +17,7 @@ wrong by three criteria (all through `vgpu-rt compare`, i.e. OpenImageIO):
 plus the PSNR of the colour image. A grid the profile refuses (the render fails) is recorded with
 its message and left out of the chart; a run over --timeout seconds likewise.
 
-Writes results/sweep/sweep.csv, docs/speed_vs_accuracy.png and docs/accuracy.md.
+Writes results/sweep/sweep.csv, docs/studies/speed_vs_accuracy.png and docs/studies/accuracy.md.
 Usage: /usr/bin/python3 scripts/docs/sweep.py [--grids auto,8,16,32] [--jobs 2] [--timeout 300]
                                          [--reuse WORKDIR]
        /usr/bin/python3 scripts/docs/sweep.py --plot-only   (chart and report from results/sweep/sweep.csv)
@@ -80,7 +80,7 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--scenes", default=",".join(SCENES))
     ap.add_argument("--grids", default="auto,8,16,32")
-    ap.add_argument("--out-dir", default=os.path.join(ROOT, "docs"),
+    ap.add_argument("--out-dir", default=os.path.join(ROOT, "docs", "studies"),
                     help="where sweep.csv, speed_vs_accuracy.png and accuracy.md go")
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--timeout", type=float, default=300)
@@ -264,14 +264,14 @@ def plot(rows, path, size):
 
 
 def report(rows, path, size):
-    """docs/accuracy.md: wrong pixels per precision mode, by criterion."""
+    """docs/studies/accuracy.md: wrong pixels per precision mode, by criterion."""
     ok = [r for r in rows if r["render_ms"] != "" and r["wrong_hit_px"] != ""]
     grids = sorted({r["grid"] for r in rows}, key=lambda g: (g != "auto", g.zfill(4)))
     pixels = int(ok[0]["pixels"]) if ok else 0
     L = []
     L.append("# Accuracy per precision mode: wrong pixels against the CPU reference\n")
     L.append("Written by `/usr/bin/python3 scripts/docs/sweep.py` (do not edit by hand; the same runs "
-             "as `results/sweep/sweep.csv` and `docs/speed_vs_accuracy.png`).\n")
+             "as `results/sweep/sweep.csv` and `docs/studies/speed_vs_accuracy.png`).\n")
     L.append(f"Every stream render (`--engine stream --precision P`) is compared with the CPU "
              f"tracer (`--engine cpu`, double precision) at the same scene, grid and bounce "
              f"count, {size} ({pixels} pixels), through `vgpu-rt compare` (OpenImageIO). A pixel "
@@ -288,7 +288,7 @@ def report(rows, path, size):
              "*timed out / refused* the ones left out.\n")
     L.append("*auto* is `--precision auto`: per group of textures and kernels, the fewest bits "
              "the part has that keep the scene's integers exact (see the last section). Modeled "
-             "times are the cost model's (docs/table1.md) on each 2004 part, medians over the "
+             "times are the cost model's (docs/studies/table1.md) on each 2004 part, medians over the "
              "runs; fp24 on the FX 5700 and 6600 runs on their fp32 units, fp32 and fp16 on the "
              "R300 on its fp24 units.\n")
     L.append("| precision | runs | timed out / refused | pixels compared | wrong hit | wrong depth "

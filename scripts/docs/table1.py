@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """The paper's Table 1 beside ours: renders the three scenes on every profile with vgpu-rt, reads
 the statistics and the cost model's predictions (host/model/cost_model.h) from --stats-json, and writes
-docs/table1.md and docs/table1_breakdown.png (matplotlib).
+docs/studies/table1.md and docs/studies/table1_breakdown.png (matplotlib).
 
 Usage: /usr/bin/python3 scripts/docs/table1.py [--vgpu-rt build/host/vgpu-rt] [--reuse] [--fit]
   --reuse  keep the JSON of earlier renders (build/table1/*.json) instead of rendering again
@@ -245,12 +245,12 @@ def main():
         cpu = {scene: run(exe, file, "gf5700", a.work, a.reuse, engine="cpu")
                for scene, file in SCENES}
     write_doc(data, masks, cpu, figures, readings, mrt, mrt_masks)
-    breakdown_chart(data, os.path.join(ROOT, "docs/table1_breakdown.png"))
-    print("wrote docs/table1.md and docs/table1_breakdown.png", file=sys.stderr)
+    breakdown_chart(data, os.path.join(ROOT, "docs/studies/table1_breakdown.png"))
+    print("wrote docs/studies/table1.md and docs/studies/table1_breakdown.png", file=sys.stderr)
 
 
 def write_doc(data, masks, cpu, figures, readings, mrt, mrt_masks):
-    """docs/table1.md: the calibration, Table 1 beside the model, the statistics, where the
+    """docs/studies/table1.md: the calibration, Table 1 beside the model, the statistics, where the
     time goes, the what-ifs, the parameters and the reading of the paper's settings."""
     L = intro_section()
     L += table_section(data, cpu)
@@ -259,7 +259,7 @@ def write_doc(data, masks, cpu, figures, readings, mrt, mrt_masks):
     L += what_if_section(data, masks, mrt, mrt_masks)
     L += parameters_section()
     L.append(explain_readings(data, figures, readings))
-    open(os.path.join(ROOT, "docs/table1.md"), "w").write("\n".join(L))
+    open(os.path.join(ROOT, "docs/studies/table1.md"), "w").write("\n".join(L))
 
 
 def intro_section():

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""How cheap undersampling's frame can get (docs/sampling.md, "How cheap undersampling can
+"""How cheap undersampling's frame can get (docs/studies/sampling.md, "How cheap undersampling can
 get"): for classic and bunny at 256x256 with the CLI's defaults (shadows, two bounces), the
 multipass and the looping kernels, on gf6600 and h200, the cost model's time of
 
@@ -12,7 +12,7 @@ multipass and the looping kernels, on gf6600 and h200, the cost model's time of
               undersampling would cost if its gaps' walk shaded no fragment at all.
 
 Each frame is rendered on its own card (a looping frame's batches follow the card's branch
-granularity). Writes docs/sampling.md's section between the time-bound markers (the table
+granularity). Writes docs/studies/sampling.md's section between the time-bound markers (the table
 and what it shows) and the rows as JSON.
 
 Usage: python3 scripts/docs/undersample_time_bound.py [--vgpu-rt build/host/vgpu-rt]
@@ -29,7 +29,7 @@ import h200_frames as hf  # noqa: E402
 import vgpurt  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-DOC = os.path.join(ROOT, "docs", "sampling.md")
+DOC = os.path.join(ROOT, "docs", "studies", "sampling.md")
 BEGIN, END = "<!-- time-bound:begin -->", "<!-- time-bound:end -->"
 
 
@@ -46,7 +46,7 @@ def frame(vgpu, scene, size, card, kernels, extra, work):
 
 
 def section(rows, size):
-    """docs/sampling.md's section: the table and what it shows."""
+    """docs/studies/sampling.md's section: the table and what it shows."""
     table = ["| scene | kernels | card | one-ray frame | quarter / one-ray | undersample / one-ray "
              "| its fixed costs / one-ray | bound / one-ray |",
              "|---|---|---|---:|---:|---:|---:|---:|"]
@@ -127,7 +127,7 @@ def main():
     text = section(rows, args.size)
     hf.replace_section(DOC, BEGIN, END, text)
     print(text)
-    print(f"undersample_time_bound.py: wrote {args.json} and docs/sampling.md's time-bound section",
+    print(f"undersample_time_bound.py: wrote {args.json} and docs/studies/sampling.md's time-bound section",
           file=sys.stderr)
 
 

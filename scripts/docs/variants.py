@@ -5,7 +5,7 @@ every bundled scene at 256x256, on the GeForce 6600 (fp40) and a modern profile 
 
 Renders each cell with vgpu-rt (--stats-json, --aov hit=...), compares every variant's hit ids
 with the multipass run of the same scene and profile (vgpu-rt compare, OpenImageIO, threshold 0),
-and writes docs/variants.md, results/variants/variants.csv and docs/variants.png (matplotlib).
+and writes docs/studies/variants.md, results/variants/variants.csv and docs/studies/variants.png (matplotlib).
 
 Usage: /usr/bin/python3 scripts/docs/variants.py [--vgpu-rt build/host/vgpu-rt] [--size 256]
          [--threads 1] [--reuse] [--scenes NAME ...]
@@ -27,7 +27,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-DOCS = os.path.join(ROOT, "docs")
+DOCS = os.path.join(ROOT, "docs", "studies")
 PROFILES = [("gf6600", "GeForce 6600 (fp40)"), ("rtx4090", "RTX 4090")]
 # name, extra vgpu-rt arguments
 VARIANTS = [
@@ -270,7 +270,7 @@ def main():
             lines += [f.read().rstrip(), ""]
     with open(os.path.join(DOCS, "variants.md"), "w") as f:
         f.write("\n".join(lines))
-    print(f"variants: wrote docs/variants.md, results/variants/variants.csv, docs/variants.png "
+    print(f"variants: wrote docs/studies/variants.md, results/variants/variants.csv, docs/studies/variants.png "
           f"({time.time() - t0:.0f} s)", file=sys.stderr)
 
 

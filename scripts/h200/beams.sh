@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Beams over tiles (issue 35, docs/groups.md) on an H200 through the GL device: bunny, classic
+# Beams over tiles (issue 35, docs/studies/groups.md) on an H200 through the GL device: bunny, classic
 # and hop at 256x256, primary rays alone (--bounces 0, no shadows), the uniform grid (--grid
 # auto, as the CLI builds it), the paper's multipass kernels, beams off and on; each frame warm
 # (frames of the same configuration for WARMUP ms before timing: a GPU left idle lowers its

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The budget criterion of adaptive sampling (--aa-criterion budget, the default; docs/sampling.md)
+# The budget criterion of adaptive sampling (--aa-criterion budget, the default; docs/studies/sampling.md)
 # on an H200 through the GL device: warm frames at 256x256 of uniform 16 samples, adaptive 16 by
 # the budget and by the image criterion (the default before it), all as dense streams, beside
 # the cost model's h200 prediction from the emulator's statistics of the same frame

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Sampling that saves time (issue 35, docs/sampling.md) on an H200 through the GL device: warm
+# Sampling that saves time (issue 35, docs/studies/sampling.md) on an H200 through the GL device: warm
 # frames at 256x256 of the one-ray frame, uniform 16 samples, and adaptive 16 and undersampling
 # (K = 2) as dense streams and as the gated frames of before (":gated", --compact off), beside
 # the cost model's h200 prediction from the emulator's statistics of the same frame

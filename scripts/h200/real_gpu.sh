@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The H200 measurement of docs/real_gpu.md, as one command for a GPU host that has an NVIDIA
+# The H200 measurement of docs/studies/real_gpu.md, as one command for a GPU host that has an NVIDIA
 # driver and none of this project's packages. Prepare on a Debian 12 machine:
 #   cmake --build build --target bench_gl && mkdir -p .bin && cp build/bench/bench_gl .bin/
 #   mkdir -p .gl && (cd .gl && apt-get download libegl1 libglvnd0 libopengl0 libgl1 libglx0)

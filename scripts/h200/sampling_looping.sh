@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The sampling modes' looping frames on an H200 again (docs/sampling.md's H200 section): the
+# The sampling modes' looping frames on an H200 again (docs/studies/sampling.md's H200 section): the
 # undersample:2 looping frames of scripts/h200/streams_sampling.sh ran 3-5x slower per pass after
 # the GPU idled; here every configuration's GL frames run --warmup-ms of frames before timing,
 # beside a control run without (as that script), and the SM clock is logged every 100 ms.

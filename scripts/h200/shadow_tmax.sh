@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Shadow rays that end at the light (docs/groups.md, "Shadow rays end at the light") on an H200
+# Shadow rays that end at the light (docs/studies/groups.md, "Shadow rays end at the light") on an H200
 # through the GL device: classic and hop with the light moved among the objects
 # (scripts/scenes/lamp_scenes.py), 256x256, primary and shadow rays (--bounces 0 --shadows), the
 # uniform and the two-level grid (--grid auto), multipass and looping kernels; each frame warm

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Glass's ray streams and the sampling modes on an H200 through the GL device (docs/materials.md,
-# docs/sampling.md): warm frames at 256x256 beside the cost model's h200 prediction from the
+# Glass's ray streams and the sampling modes on an H200 through the GL device (docs/studies/materials.md,
+# docs/studies/sampling.md): warm frames at 256x256 beside the cost model's h200 prediction from the
 # emulator's statistics of the same frame (bench/bench_gl.cpp). Prepare here, from the root:
 #   cmake --build build --target bench_gl && mkdir -p .h200 && cp build/bench/bench_gl .h200/
 #   /usr/bin/python3 scripts/docs/materials.py --opaque-copy .h200/glass-opaque.gltf

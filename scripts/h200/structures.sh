@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The structures on an H200 through the GL device (docs/structures.md). Prepare here (Debian 12),
+# The structures on an H200 through the GL device (docs/studies/structures.md). Prepare here (Debian 12),
 # from the repository root:
 #   cmake --build build --target bench_gl && mkdir -p .h200 && cp build/bench/bench_gl .h200/
 #   scripts/scenes/uneven_scenes.py .h200
@@ -7,7 +7,7 @@
 # copy the repository with .h200 and .gl to the GPU host and run there, from its root:
 #   OUT=DIR scripts/h200/structures.sh              (ACCELS="grid2" measures only those structures)
 #   OUT=DIR SIZES=1 scripts/h200/structures.sh      (the same frames at 8x8 to 512x512 instead:
-#                                                    what grows with the image, docs/structures.md)
+#                                                    what grows with the image, docs/studies/structures.md)
 #   OUT=DIR PROGRAMS=1 scripts/h200/structures.sh   (the looping traversal kernels' compiled
 #                                   assembly: results/structures/h200_programs/*.nvfp, --h200-programs)
 #   OUT=DIR LOOPING=1 CLOCK_MS=100 scripts/h200/structures.sh   (the looping walks again, each
@@ -74,7 +74,7 @@ fi
 if [ -n "${LOOPING:-}" ]; then
   # The looping walks' primary frames again, each configuration's GL frames warmed up for
   # WARMUP ms (default 2000) before timing: a GPU idle while the emulator runs lowers its clock
-  # (docs/sampling.md's H200 section). results/structures/structures_h200_looping_warm.json and _clocks.csv,
+  # (docs/studies/sampling.md's H200 section). results/structures/structures_h200_looping_warm.json and _clocks.csv,
   # read by scripts/docs/structures.py --h200-looping.
   # RUNS (default 5) timed frames each; the JSON keeps every frame's wall and GPU time.
   .h200/bench_gl --runs "${RUNS:-5}" --sizes 256 --threads 16 --readback-wait poll --grid auto \

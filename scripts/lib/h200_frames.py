@@ -1,6 +1,6 @@
 """Frames measured on an H200 through the GL device (bench_gl JSON from
 scripts/h200/streams_sampling.sh) beside the cost model's h200 prediction from the emulator's
-statistics of the same frame: the tables of docs/materials.md's and docs/sampling.md's H200
+statistics of the same frame: the tables of docs/studies/materials.md's and docs/studies/sampling.md's H200
 sections (scripts/docs/materials.py --h200, scripts/docs/sampling.py --h200), and the marked section they
 replace. Times are ms; "vs" columns are (predicted - measured) / measured.
 """

@@ -1,4 +1,4 @@
-"""The H200 sections of docs/sampling.md (scripts/docs/sampling.py --h200, --h200-compact,
+"""The H200 sections of docs/studies/sampling.md (scripts/docs/sampling.py --h200, --h200-compact,
 --h200-budget): bench_gl's frames measured on the GPU beside the cost model's h200 prediction,
 read from the JSON files in results/sampling/, and what each section's figures say."""
 import json
@@ -30,7 +30,7 @@ H200_PROSE = """**What the differences say about the model's pricing of sampling
   marked-pixel query (+218%) is the occlusion read-back again: its 12 us wait is in the wall
   time, not in the timer query.
 - *Looping frames* (the second run's, warmed up for 2 s): every mode is 7-22% under the wall
-  time (15-30% before the model priced the looping passes' longest lanes, docs/structures.md's
+  time (15-30% before the model priced the looping passes' longest lanes, docs/studies/structures.md's
   latency term); undersample:2 at -7% on both scenes, where the first run gave -61% (classic)
   and -74% (bunny). That run's
   undersample:2 looping frames each came right after the longest stretches without GPU work

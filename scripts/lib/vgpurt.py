@@ -89,7 +89,7 @@ def kernel_names(exe):
 
 
 def uneven_scenes(folder):
-    """Writes docs/structures.md's uneven scenes (scripts/scenes/uneven_scenes.py) into folder and
+    """Writes docs/studies/structures.md's uneven scenes (scripts/scenes/uneven_scenes.py) into folder and
     returns their paths by name: {"stadium": ..., "scales": ...}."""
     here = os.path.dirname(os.path.abspath(__file__))
     run([sys.executable, os.path.join(here, "..", "scenes", "uneven_scenes.py"), folder])

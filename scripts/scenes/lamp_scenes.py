@@ -3,7 +3,7 @@
 
 The bundled scenes keep their light outside the grid's box (above and behind the camera), so a
 shadow ray that reaches its light unblocked has no voxel left behind the light: no walk goes on
-past it. A lamp among the objects is the case where it could; docs/groups.md ("Shadow rays end
+past it. A lamp among the objects is the case where it could; docs/studies/groups.md ("Shadow rays end
 at the light") measures it with these:
 
   classic-lamp.gltf  scenes/classic.gltf, light at (-2, 1.2, 2.5): between the spheres and the

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Writes scatter.gltf, the larger animation of docs/animation.md (issue 23): ten full bunnies
+"""Writes scatter.gltf, the larger animation of docs/studies/animation.md (issue 23): ten full bunnies
 of scenes/bunny.gltf (3,674 triangles each, 36,740 in all; 37,228 with the board and sphere)
 start inside one another on hop's checkerboard and hop apart onto a ring while the mirror sphere
 turns, 2 s. A BVH built at 0 s groups triangles of different bunnies that then move apart: a

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Writes the uneven scenes of docs/structures.md as glTF files, from the bundled bunny.
+"""Writes the uneven scenes of docs/studies/structures.md as glTF files, from the bundled bunny.
 
   stadium.gltf  the bunny of scenes/bunny.gltf, its camera and light, on a two-triangle floor
                 270 times the bunny's width ("teapot in a stadium": a uniform grid spends

@@ -350,7 +350,7 @@ for (const [file, mesh, what, src] of [
 
 // ---------------------------------------------------------------------------------------------
 // 4b. sphere-alone.gltf, bunny-mirror.gltf — the lighter readings of Table 1's "Sphere" and
-// "BunnyRefl" (docs/table1.md): the object alone, and the bunny on a mirror floor only.
+// "BunnyRefl" (docs/studies/table1.md): the object alone, and the bunny on a mirror floor only.
 // ---------------------------------------------------------------------------------------------
 {
   const g = new Gltf('sphere-alone', 'Table 1 "Sphere" (the reading scripts/docs/table1.py uses): the UV sphere of sphere.gltf alone, no floor; same camera and light', SRC_PROC);
@@ -566,7 +566,7 @@ const lines = [
   '`yfov`, `aspectRatio` 1 for the 256x256 frame). Lights: `KHR_lights_punctual` point lights, white,',
   'intensity 1 (the renderer uses colour x intensity, no physical falloff). Glass: a material\'s',
   '`KHR_materials_transmission.transmissionFactor` and `KHR_materials_ior.ior`, both declared in',
-  '`extensionsUsed` (docs/materials.md gives the model).',
+  '`extensionsUsed` (docs/studies/materials.md gives the model).',
   '',
 ];
 for (const s of summary) {
