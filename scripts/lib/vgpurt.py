@@ -1,5 +1,5 @@
 """Runs vgpu-rt from a script and reads what it writes: the one place the scripts build a
-`vgpu-rt render` command line and load its --stats-json (the contract is in README.md, "Contracts").
+`vgpu-rt render` command line and load its --stats-json (the contract: docs/cli.md, "Contracts").
 
 A script in scripts/<kind>/ finds this folder with
     sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "lib"))
