@@ -5,7 +5,7 @@
 // costs of one pass, one query read-back and one program switch, measured on tiny passes.
 // Frames can run glass's ray streams (--ray-streams) and the sampling modes (--sampling), each
 // priced beside its measurement like the paper's frame, and with beams over tiles (--beams on,
-// docs/groups.md).
+// docs/studies/groups.md).
 // Needs no OpenImageIO and no display: it runs on any machine with EGL (llvmpipe, NVIDIA).
 #include <CLI/CLI.hpp>
 #include <algorithm>
@@ -441,7 +441,7 @@ void add_options(CLI::App& app, Args& a) {
       ->capture_default_str();
   app.add_option("--beams", a.beams,
                  "Per frame: off, on (beams over tiles, 8x8 pixels, before the primary rays' "
-                 "walk: docs/groups.md; every structure)")
+                 "walk: docs/studies/groups.md; every structure)")
       ->check(CLI::IsMember({"off", "on"}))
       ->capture_default_str();
   app.add_flag("--shadows", a.shadows, "Shadow rays in the frames (off: Table 1's setting)");
@@ -619,7 +619,7 @@ json frame_json(const FrameKey& key, const host::RenderOptions& opt, const Frame
 // mode and engine, appended to frames.
 void scene_frames(const Args& a, const host::Scene& scene, int size,
                   const std::vector<std::string>& engines, json& frames) {
-  host::RenderOptions opt;  // docs/table1.md's settings
+  host::RenderOptions opt;  // docs/studies/table1.md's settings
   opt.width = opt.height = size;
   opt.bounces = a.bounces;
   opt.shading = kernels::ShadingModel::phong;

@@ -5,8 +5,8 @@
 // with the rays each traced, the 4 x 4 level that would keep the 2 x 2 samples and trace only
 // the 12 others (its kept level), and the 256-sample reference. A rule then picks, per pixel, the
 // last level it reaches: its image is that level's estimate, its rays the sum of its levels'.
-// scripts/docs/sampling_rules.py reads the files and writes docs/sampling.md's section on the
-// rules it tried.
+// scripts/docs/sampling_rules.py reads the files and writes docs/studies/sampling.md's section on
+// the rules it tried.
 //
 // Output in --out, per scene (N its place in --scenes, from 0): N.f32, float32 little-endian, per
 // pixel (row-major, row 0 the top) the 22 values of `kFields`; and index.json: the size, the

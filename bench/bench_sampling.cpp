@@ -1,7 +1,7 @@
 // Benchmark: the sampling modes (--spp, --aa adaptive, --aa undersample) on bundled scenes, in
 // one run: primary rays per pixel (mean, max), passes, the cost model's ms on gf5700 / gf6600 /
 // h200, the emulator's render ms (median of runs), and the error against the CPU tracer's
-// 256-sample image. scripts/docs/sampling.py runs it (--json) to write docs/sampling.md.
+// 256-sample image. scripts/docs/sampling.py runs it (--json) to write docs/studies/sampling.md.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -38,7 +38,8 @@ struct Mode {
   std::vector<float> shares{0.30f, 0.28f};  // its --aa-budget, per level
 };
 
-// The modes docs/sampling.md charts; the first is the one-ray image the others are compared with.
+// The modes docs/studies/sampling.md charts; the first is the one-ray image the others are compared
+// with.
 std::vector<Mode> modes() {
   std::vector<Mode> m = {
       {"spp 1", 1},
@@ -49,7 +50,7 @@ std::vector<Mode> modes() {
       {"adaptive 16, T 0.1", 16, true, 0.1f},
       {"adaptive 16, T 0.2", 16, true, 0.2f},
       {"adaptive 64, T 0.1", 64, true, 0.1f},
-      // --aa-criterion object (docs/sampling.md's cones section; the
+      // --aa-criterion object (docs/studies/sampling.md's cones section; the
       // page's other tables leave them out).
       {"object 16, T 0.05", 16, true, 0.05f, 0, true},
       {"object 16, T 0.1", 16, true, 0.1f, 0, true},
@@ -60,7 +61,7 @@ std::vector<Mode> modes() {
       // --aa-criterion budget, its defaults (T 0.05, 30% then 28% of
       // the pixels that hit; the 4x4 level keeps the 2x2 samples).
       {"budget 16", 16, true, 0.05f, 0, false, 2.0f, true, true},
-      // ... and other shares (docs/sampling.md's cones section charts them).
+      // ... and other shares (docs/studies/sampling.md's cones section charts them).
       {"budget 10%/9%", 16, true, 0.05f, 0, false, 2.0f, true, true, {0.10f, 0.09f}},
       {"budget 15%/13%", 16, true, 0.05f, 0, false, 2.0f, true, true, {0.15f, 0.13f}},
       {"budget 18%/16%", 16, true, 0.05f, 0, false, 2.0f, true, true, {0.18f, 0.16f}},

@@ -6,7 +6,7 @@
 // 2000-triangle fan whose centre crowds one voxel column, and a generated 320k-triangle terrain;
 // 256x256, no shadows. Also the work the stream engine cannot skip: its passes and the fragments
 // that ran (fragment-steps, counted with the finished-ray mask as an early-z test). Figures in
-// docs/speed.md.
+// docs/studies/speed.md.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>

@@ -9,7 +9,7 @@
 //     marks, which catch silhouettes);
 //   - marcarHuecos' own rule at T (keys, or colour spread > T), and its ranking (keys first, then
 //     spread, largest first) cut at exactly a third of the rays.
-// scripts/docs/sampling.py runs it (--json) for docs/sampling.md's section on these bounds.
+// scripts/docs/sampling.py runs it (--json) for docs/studies/sampling.md's section on these bounds.
 // --images DIR also writes, per scene and threshold, the one-ray image, the rule's image and the
 // CPU tracer's undersample:2 image as PFM files (tests/bench compares them itself).
 #include <CLI/CLI.hpp>

@@ -1,7 +1,7 @@
 // Runs every stability case (tests/trace/stability_cases.h) through the stream tracer at fp32,
 // fp24 and fp16 and prints a markdown table: case x precision -> "pass" or
 // "N of M pixels wrong (hit id), K unfinished rays". scripts/docs/stability.sh writes it to
-// docs/stability.md.
+// docs/studies/stability.md.
 #include <cstdio>
 #include <string>
 

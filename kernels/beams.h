@@ -1,5 +1,5 @@
-// Beams over tiles (an extension, issue 35; docs/groups.md): a tile of T x T pixels is a beam
-// bounded by its corner pixels' primary rays. Before the grid walk, passes of one fragment per
+// Beams over tiles (an extension, issue 35; docs/studies/groups.md): a tile of T x T pixels is a
+// beam bounded by its corner pixels' primary rays. Before the grid walk, passes of one fragment per
 // tile march each beam from the eye through empty space (rayosHaz); then every pixel's ray starts
 // where its tile's beam stopped (inicioHaz) instead of where it enters the grid. Only where the
 // walk begins changes: the ray keeps its origin (the eye), so t, the hit and the depth are the

@@ -1,8 +1,8 @@
-// Beams over tiles through the BVH (an extension, issue 35; docs/groups.md): the entry-point
-// search of multi-level ray tracing (Reshetov et al. 2005). A tile's beam (its four corner
-// pixels' primary rays, as kernels/beams.h computes them) descends the hierarchy from the root,
-// one node per pass (rayosHazBVH): at an inner node, a child whose box lies wholly outside the
-// beam's frustum is skipped, and the beam moves on to the other child; it stops at the first
+// Beams over tiles through the BVH (an extension, issue 35; docs/studies/groups.md): the
+// entry-point search of multi-level ray tracing (Reshetov et al. 2005). A tile's beam (its four
+// corner pixels' primary rays, as kernels/beams.h computes them) descends the hierarchy from the
+// root, one node per pass (rayosHazBVH): at an inner node, a child whose box lies wholly outside
+// the beam's frustum is skipped, and the beam moves on to the other child; it stops at the first
 // node where it can skip neither child (or at a leaf). Then every pixel's ray starts at its
 // tile's node N (inicioHazBVH) and walks only N's subtree, the index range [N, escape(N)) of the
 // depth-first layout, in the order the full walk would: every node outside it is missed by every

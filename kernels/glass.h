@@ -1,5 +1,5 @@
-// Whitted's glass at a hit (docs/materials.md, "Glass: the model"): which side the ray meets,
-// the exact unpolarised Fresnel reflectance with total internal reflection, the refracted
+// Whitted's glass at a hit (docs/studies/materials.md, "Glass: the model"): which side the ray
+// meets, the exact unpolarised Fresnel reflectance with total internal reflection, the refracted
 // direction. Lane code shared by dividirRayos (the shares of a ray's weight) and compactarRayos
 // (the spawned rays), so both see the same numbers.
 #pragma once

@@ -1,6 +1,6 @@
-// Beams over tiles through the two-level grid (an extension, issue 35; docs/groups.md): the beams
-// march over the coarse grid as they march over the uniform grid (rayosHaz, kernels/beams.h, on
-// the coarse grid's beam distances), and each pixel's ray starts at the sub-cell its walk
+// Beams over tiles through the two-level grid (an extension, issue 35; docs/studies/groups.md): the
+// beams march over the coarse grid as they march over the uniform grid (rayosHaz, kernels/beams.h,
+// on the coarse grid's beam distances), and each pixel's ray starts at the sub-cell its walk
 // (kernels/grid2.h) would reach where its tile's beam stopped (inicioHazGrilla2).
 //
 // Why the start is the walk's own state, bit for bit: every coarse cell the ray crosses before

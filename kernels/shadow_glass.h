@@ -1,5 +1,5 @@
 // sombraVidrio (an extension: glass, issue 25): a shadow ray that stopped on glass goes on
-// (docs/materials.md: no caustics, refraction does not bend it). Each glass surface crossed
+// (docs/studies/materials.md: no caustics, refraction does not bend it). Each glass surface crossed
 // multiplies the light by its transmission t; an opaque one blocks it (t = 0); on the 8th glass
 // surface (`last`) the light counts as blocked. One output per pass (fp30): `part` 0 writes the
 // continued origin (just past the glass, along the ray) with the light's transmittance so far in

@@ -1,6 +1,6 @@
 // dividirRayos (an extension: glass, issue 25): per ray of a stream level, the weights of the
-// two rays its hit spawns (docs/materials.md, "Glass: the model"): reflected w((1-t)a + tF),
-// refracted w t(1-F); a ray lives if its weight is at least 1/512 (rayosReflejados' cut). The
+// two rays its hit spawns (docs/studies/materials.md, "Glass: the model"): reflected w((1-t)a +
+// tF), refracted w t(1-F); a ray lives if its weight is at least 1/512 (rayosReflejados' cut). The
 // surface's own shading keeps w(1-t)(1-a) (the shader, through the colour texture's alpha).
 // Output: x = reflected weight, y = refracted weight (0: not spawned), z = rays spawned (0-2),
 // w = 1 where the reflected ray is a total internal reflection.

@@ -23,7 +23,8 @@ const std::vector<Profile>& profiles() {
     fx.precision = Format::fp32;  // fp30 "float" is IEEE single; "half" is fp16
     fx.bus_mbps = 2112;           // AGP 8x: 264 MB/s x 8 (GPU Gems 2, ch. 30)
     // Fixed costs: no public figure; one unit u fitted on Table 1 Bunny3 on this card (5075 ms,
-    // scripts/docs/table1.py --fit), split pass : load : read-back = u : u : 2u (docs/table1.md).
+    // scripts/docs/table1.py --fit), split pass : load : read-back = u : u : 2u
+    // (docs/studies/table1.md).
     fx.program_load_us = 651;  // fitted (Table 1 Bunny3), driver cost of a program switch
     fx.readback_us = 1301;     // fitted (Table 1 Bunny3); GPU Gems 2 ch. 6: a stall
     fx.pass_us = 651;          // fitted (Table 1 Bunny3)
@@ -127,8 +128,8 @@ const std::vector<Profile>& profiles() {
     m.loop_overhead_clocks = 1;       // model parameter (assumed: a compare and a branch)
     t.push_back(m);
 
-    // The H200 the GL device is measured on (docs/real_gpu.md): a 2026 GPU running the paper's
-    // multipass loop through OpenGL 3.3 (EGL, NVIDIA 580 driver).
+    // The H200 the GL device is measured on (docs/studies/real_gpu.md): a 2026 GPU running the
+    // paper's multipass loop through OpenGL 3.3 (EGL, NVIDIA 580 driver).
     m = Profile{};
     m.name = "h200";
     m.display = "NVIDIA H200 SXM (GH100), through OpenGL 3.3";
@@ -137,7 +138,7 @@ const std::vector<Profile>& profiles() {
     // pixel shaders (NVIDIA H100 Tensor Core GPU Architecture whitepaper, 2022). Fragment
     // programs run on those: 4 SMs x 128 FP32 cores.
     // nvidia-smi showed the boost clock through the measured frames, ~1 GHz when the GPU sat
-    // idle between passes (docs/real_gpu.md).
+    // idle between passes (docs/studies/real_gpu.md).
     m.pipelines = 512;  // 4 graphics-capable SMs x 128 FP32 cores (H100 architecture whitepaper)
     m.core_mhz = 1980;  // boost clock, SXM (NVIDIA H100 SXM5 specifications; H200 same GH100)
     m.mem_gbps = 4800;  // HBM3e, 4.8 TB/s (NVIDIA H200 datasheet)
@@ -149,8 +150,8 @@ const std::vector<Profile>& profiles() {
     m.precision = Format::fp32;
     m.bus_mbps = 64000;  // PCI Express 5.0 x16, one direction (H200 datasheet)
     // Fixed costs measured by bench_gl on this H200 (NVIDIA 580 driver, EGL, 1x1 passes, medians
-    // of two runs, docs/real_gpu.md): a pass 10.0 and 10.8 us, a polled query read-back 9 to
-    // 14 us more, a program switch under 1 us. The blocking GL_QUERY_RESULT wait costs up to
+    // of two runs, docs/studies/real_gpu.md): a pass 10.0 and 10.8 us, a polled query read-back 9
+    // to 14 us more, a program switch under 1 us. The blocking GL_QUERY_RESULT wait costs up to
     // 140 us more after a long pass (the driver sleeps); the model prices the polled wait.
     m.pass_us = 10.4;                // measured (bench_gl)
     m.readback_us = 12;              // measured (bench_gl, polled)

@@ -1,6 +1,6 @@
 // Hardware profiles as data: what a fragment program may do on each modeled GPU, and the
 // figures the cost model needs. Every figure carries its source; figures with no public source
-// are marked "model parameter" (fitted or assumed, see docs/table1.md).
+// are marked "model parameter" (fitted or assumed, see docs/studies/table1.md).
 #pragma once
 
 #include <string>

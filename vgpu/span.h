@@ -24,7 +24,7 @@ struct LoopChain {
 
 // The loop of `r` (its first recorded copy); zeros without a loop. fetch_units: how many
 // operation units a fetch's latency lasts in the schedule (the split depends on it only where
-// two paths come close; the H200's measured ratio is about 100, docs/structures.md).
+// two paths come close; the H200's measured ratio is about 100, docs/studies/structures.md).
 LoopChain loop_chain(const Recording& r, int fetch_units = 100);
 
 }  // namespace vgpu

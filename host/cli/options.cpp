@@ -215,7 +215,7 @@ void add_render_options(CLI::App& render, RenderArgs& a) {
           "(a SAH bounding volume hierarchy walked stackless) | kdtree (a SAH kd-tree "
           "walked by kd-restart) | auto (builds each, renders a probe at a quarter of the "
           "size with each and keeps the one the cost model predicts cheapest on "
-          "--profile). grid2, bvh and kdtree are extensions; docs/structures.md")
+          "--profile). grid2, bvh and kdtree are extensions; docs/studies/structures.md")
       ->check(CLI::IsMember({"grid", "grid2", "bvh", "kdtree", "auto"}))
       ->capture_default_str();
   render
@@ -247,7 +247,7 @@ void add_render_options(CLI::App& render, RenderArgs& a) {
   render
       .add_option(
           "--beams", a.beams,
-          "Beams over tiles (issue 35, docs/groups.md): passes of one fragment per tile "
+          "Beams over tiles (issue 35, docs/studies/groups.md): passes of one fragment per tile "
           "march each tile's beam through empty space, and the primary rays start where "
           "it stopped; the same image. Every structure (not --accel auto), fp32; every engine "
           "(stream, gl, cpu). auto: on where two probes of the primary trace priced by the cost "
@@ -260,15 +260,15 @@ void add_render_options(CLI::App& render, RenderArgs& a) {
       ->capture_default_str();
   render
       .add_option("--ray-streams", a.ray_streams,
-                  "Ray streams (glass, docs/materials.md): auto, only for a scene with a "
+                  "Ray streams (glass, docs/studies/materials.md): auto, only for a scene with a "
                   "transmissive material; on, the paper's reflections through them too")
       ->check(CLI::IsMember({"auto", "on"}))
       ->capture_default_str();
   render
       .add_option("--compact", a.compact,
-                  "Sampling that saves time (docs/sampling.md): --aa adaptive's and undersample's "
-                  "gated frames trace their marked pixels packed into a dense stream (the same "
-                  "image); off: over the whole target, to compare")
+                  "Sampling that saves time (docs/studies/sampling.md): --aa adaptive's and "
+                  "undersample's gated frames trace their marked pixels packed into a dense "
+                  "stream (the same image); off: over the whole target, to compare")
       ->check(CLI::IsMember(on_off))
       ->capture_default_str();
   render.add_option("--stats", a.stats, "Statistics on stdout")
@@ -387,7 +387,7 @@ void add_sampling_options(CLI::App& render, RenderArgs& a) {
                   "widths) or budget (the object criterion's edges as a score, the colour step "
                   "across them; each level refines the highest scores above --aa-threshold, as "
                   "many pixels that hit as --aa-budget allows, and the 4x4 level keeps the 2x2 "
-                  "samples; docs/sampling.md). Default budget")
+                  "samples; docs/studies/sampling.md). Default budget")
       ->check(CLI::IsMember({"image", "object", "budget"}));
   render
       .add_option("--aa-budget", a.aa_budget,

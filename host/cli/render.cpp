@@ -289,7 +289,7 @@ void print_table(const RenderArgs& a, const RenderPlan& plan, const host::Scene&
         static_cast<unsigned long long>(cpu_stats.rays),
         static_cast<unsigned long long>(cpu_stats.voxel_steps),
         static_cast<unsigned long long>(cpu_stats.triangle_tests));
-    // Glass (docs/materials.md): the rays of each kind, summed over the iterations.
+    // Glass (docs/studies/materials.md): the rays of each kind, summed over the iterations.
     auto sum = [](const std::vector<uint64_t>& v) {
       return static_cast<unsigned long long>(std::accumulate(v.begin(), v.end(), uint64_t(0)));
     };
@@ -535,8 +535,8 @@ int run_render(const RenderArgs& a, bool lanes_given, RenderOutcome* outcome,
   const std::string path = host::resolve_scene(a.scene);
   std::optional<host::AnimatedScene> animated;
   std::vector<size_t> animation;  // the animations played together
-  // Textures fitted to the profile's largest texture (docs/textures.md), whatever the engine,
-  // so that the CPU reference samples what the card would.
+  // Textures fitted to the profile's largest texture (docs/studies/materials.md), whatever the
+  // engine, so that the CPU reference samples what the card would.
   host::LoadOptions load = host::with_images();
   if (a.textures == "fit") {
     load.fit_textures = vgpu::profile(opt.profile).max_texture_size;

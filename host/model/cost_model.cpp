@@ -181,7 +181,7 @@ std::string describe(const CostBreakdown& c, const vgpu::Profile& profile) {
   auto pct = [&](double v) { return c.total_ms > 0 ? 100.0 * v / c.total_ms : 0.0; };
   std::snprintf(
       buf, sizeof buf,
-      "predicted %s: %.1f ms (cost model, docs/table1.md)\n"
+      "predicted %s: %.1f ms (cost model, docs/studies/table1.md)\n"
       "  pass work  arithmetic %.1f ms (%.0f%%), texture %.1f ms (%.0f%%), "
       "memory %.1f ms (%.0f%%)\n"
       "  fixed      per-pass %.1f ms (%.0f%%), program loads %.1f ms (%.0f%%), "

@@ -1,6 +1,7 @@
 // The cost model: predicts how long a frame would take on a modeled GPU from the virtual GPU's
 // statistics (vgpu::FrameStats) and the profile's hardware figures (vgpu::Profile). It explains
-// the paper's Table 1; docs/table1.md lists every parameter with its source or marks it fitted.
+// the paper's Table 1; docs/studies/table1.md lists every parameter with its source or marks it
+// fitted.
 //
 // Per pass:  time = max(arithmetic, texture, memory) + latency + pass_us
 //   arithmetic = ALU instructions / (pipelines x clock x alu_per_clock x precision rate), each
@@ -51,7 +52,7 @@ struct CostParams {
   // what a skipping batch saves. Assumed 0.75 from the kernels' code: intersecciones (most of
   // every frame) keeps 132 of 135 operations but only 6 of 8 fetches (84 of 116 bytes) inside.
   double branch_body_share = 0.75;
-  // Fixed costs, copied from the profile by defaults_for (fitted, see docs/table1.md).
+  // Fixed costs, copied from the profile by defaults_for (fitted, see docs/studies/table1.md).
   double pass_us = 0;          // one render-to-texture pass: driver, target switch, pipeline fill
   double program_load_us = 0;  // driver cost of binding another fragment program
   double readback_us = 0;      // one occlusion-query read-back: pipeline drain + CPU round trip
@@ -110,7 +111,7 @@ UpdateCost predict_update(uint64_t uploaded_bytes, double build_ms, const vgpu::
 // A few lines: the predicted total and its breakdown, for the CLI.
 std::string describe(const CostBreakdown& cost, const vgpu::Profile& profile);
 
-// What-if transforms of a frame's statistics, predicted by the same model (docs/table1.md).
+// What-if transforms of a frame's statistics, predicted by the same model (docs/studies/table1.md).
 // Multiple render targets: two kernels that always run back to back become one pass writing
 // both targets. The merged pass shades each fragment once, does both programs' operations and
 // fetches except the inputs both read (shared_fetches own texels, shared_bytes each fragment),

@@ -15,7 +15,7 @@ vgpu::Texture entry_texture(vgpu::Device& gpu, const std::string& name, size_t c
   // About square: the width is the smallest power of two whose square holds the entries, so a
   // GL driver whose textures stop at 16384 texels (llvmpipe) takes what one long row of 32768
   // (the h200 profile's limit) did not. The H200 ran the same frames in the same GPU time with
-  // either layout (docs/structures.md, "Tried: the structures' textures laid out square").
+  // either layout (docs/studies/structures.md, "Tried: the structures' textures laid out square").
   size_t side = 1;
   while (side * side < std::max<size_t>(count, 1)) side *= 2;
   const int w = int(std::min<size_t>(side, size_t(maxs)));

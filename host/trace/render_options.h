@@ -93,11 +93,11 @@ struct RenderOptions {
   // where it applies: the vgpu at 8 lanes, with host_shortcut or masks, the multipass kernels,
   // no observer and no trace_pixel; elsewhere the walk runs pass by pass.
   bool batch_walk = true;
-  // Beams over tiles (an extension, issue 35; docs/groups.md): before the primary rays walk the
-  // grid, passes of one fragment per beam_tile x beam_tile tile march each tile's beam through
-  // empty space, and every pixel's ray starts where its tile's beam stopped. The same hits,
-  // depths and images as without (only where each walk begins changes). Through the BVH, each
-  // tile's beam descends to the first node it cannot narrow down and its rays start there;
+  // Beams over tiles (an extension, issue 35; docs/studies/groups.md): before the primary rays
+  // walk the grid, passes of one fragment per beam_tile x beam_tile tile march each tile's beam
+  // through empty space, and every pixel's ray starts where its tile's beam stopped. The same
+  // hits, depths and images as without (only where each walk begins changes). Through the BVH,
+  // each tile's beam descends to the first node it cannot narrow down and its rays start there;
   // through the kd-tree likewise (the nodes' boxes), and its rays restart there too; through the
   // two-level grid, the beams march over its coarse grid. Every structure, fp32 ray state
   // (refusal() says so); every engine.
@@ -202,10 +202,10 @@ struct CompactStats {
 };
 
 // Where each tile's rays started in a frame's first primary trace with beams (the report's tile
-// map, docs/groups.md): the beam texture's texels once the march or the descent is over, tile
-// (x, y) at y * tiles_x + x, row 0 at the top of the image as the image's rows. Empty with beams
-// off, or when no pass observer follows the frame (only the report and the pass-by-pass views
-// read it).
+// map, docs/studies/groups.md): the beam texture's texels once the march or the descent is
+// over, tile (x, y) at y * tiles_x + x, row 0 at the top of the image as the image's rows. Empty
+// with beams off, or when no pass observer follows the frame (only the report and the pass-by-pass
+// views read it).
 struct BeamMap {
   int tiles_x = 0, tiles_y = 0, tile = 0;  // tiles across, down, and pixels per tile side
   bool tree = false;  // through the BVH or the kd-tree (a descent), else the grid (a march)

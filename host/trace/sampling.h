@@ -28,12 +28,12 @@ glm::vec2 sample_offset(int spp, int s, uint64_t seed);
 std::vector<int> adaptive_levels(int spp);
 
 // Adaptive levels that keep the samples before them (--aa-criterion budget's levels, and
-// cpu_adaptive_levels' kept levels; docs/sampling.md, "One default for every scene"): per level,
-// the offsets of the samples it adds. The first level adds its own n x n (sample_offset(n * n, k));
-// each later one adds one sample in each of its n x n strata that the samples before leave empty
-// (the stratum's sample_offset), so that the set stays one sample to a stratum. The list stops
-// before the first level whose earlier samples do not fall one to a stratum (a side that does not
-// double, as spp 9's 2 then 3); spp 16: 4 offsets, then 12.
+// cpu_adaptive_levels' kept levels; docs/studies/sampling.md, "One default for every scene"):
+// per level, the offsets of the samples it adds. The first level adds its own n x n
+// (sample_offset(n * n, k)); each later one adds one sample in each of its n x n strata that the
+// samples before leave empty (the stratum's sample_offset), so that the set stays one sample to a
+// stratum. The list stops before the first level whose earlier samples do not fall one to a
+// stratum (a side that does not double, as spp 9's 2 then 3); spp 16: 4 offsets, then 12.
 std::vector<std::vector<glm::vec2>> kept_level_samples(int spp, uint64_t seed);
 
 // The sample offsets adaptive level `level` (of adaptive_levels(spp)) traces: `kept`'s (the

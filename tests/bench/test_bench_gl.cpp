@@ -184,8 +184,8 @@ TEST_CASE("bench_gl --latency times one fragment's dependent fetches and multipl
     CHECK(long_steps > short_steps);
     // The times are measured, not judged here: on a loaded machine (tests run two at a time) a
     // single short run can take longer than a long one, so only that each was timed and the
-    // per-iteration figure is their difference over the extra steps (docs/structures.md has the
-    // H200's figures).
+    // per-iteration figure is their difference over the extra steps (docs/studies/structures.md has
+    // the H200's figures).
     const double short_us = r["short_us"].get<double>(), long_us = r["long_us"].get<double>();
     CHECK(short_us > 0);
     CHECK(long_us > 0);

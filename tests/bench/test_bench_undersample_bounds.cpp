@@ -1,7 +1,7 @@
-// bench_undersample_bounds as docs/sampling.md uses it: its figures hang together (the floor is
-// what the fill changes beyond the budget), the rule's image is the CPU tracer's own (compared
-// here from the images the bench writes, not taken from its own verdict), and a bad scene is
-// refused with exit 2 and no JSON written.
+// bench_undersample_bounds as docs/studies/sampling.md uses it: its figures hang together (the
+// floor is what the fill changes beyond the budget), the rule's image is the CPU tracer's own
+// (compared here from the images the bench writes, not taken from its own verdict), and a bad scene
+// is refused with exit 2 and no JSON written.
 #include <doctest/doctest.h>
 #include <sys/wait.h>
 #include <unistd.h>

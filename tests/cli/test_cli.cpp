@@ -259,7 +259,7 @@ TEST_CASE("a render writes the image, the AOVs and the statistics asked for, and
   // And the two AOVs are not one buffer written twice.
   CHECK(compare(dir / "depth.exr", dir / "hit.exr", 0.5).differing_percent > 50);
 
-  // The statistics: the keys README.md promises, with this run's values.
+  // The statistics: the keys docs/cli.md promises, with this run's values.
   nlohmann::json j;
   REQUIRE_NOTHROW(j = nlohmann::json::parse(slurp(dir / "stats.json")));
   for (const char* key :

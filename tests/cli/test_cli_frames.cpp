@@ -346,8 +346,8 @@ TEST_CASE("the frame table lists each frame's update, its passes and the nodes i
 }
 
 TEST_CASE("the scatter scene's refitted BVH hits what a rebuild hits while its SAH cost grows") {
-  // scripts/scenes/scatter_scene.py writes the larger animation of docs/animation.md: ten full
-  // bunnies that start inside one another and hop apart.
+  // scripts/scenes/scatter_scene.py writes the larger animation of docs/studies/animation.md: ten
+  // full bunnies that start inside one another and hop apart.
   const fs::path dir = fresh_dir("scatter");
   const std::string script = std::string(VGPU_TEST_DATA) + "/../../scripts/scenes/scatter_scene.py";
   REQUIRE(std::system(("python3 " + script + " " + dir.string() + " >/dev/null").c_str()) == 0);

@@ -1,6 +1,6 @@
 // Numerical-stability cases for the stream tracer: small hand-built scenes whose primary hit ids
 // are known in advance. Shared by tests/trace/test_stability.cpp (asserts fp32) and
-// bench/stability_report.cpp (fp32 / fp24 / fp16 table in docs/stability.md).
+// bench/stability_report.cpp (fp32 / fp24 / fp16 table in docs/studies/stability.md).
 //
 // Expected answers are computed here in double, independently of the tracers: per triangle the
 // ray/plane intersection and the three edge functions (signed areas) of the hit point, not
@@ -36,7 +36,7 @@ constexpr int kDontCare = -3;  // too close to an edge or silhouette to demand o
 
 struct Case {
   std::string name;   // doctest-style sentence
-  std::string probe;  // what it probes, one line for docs/stability.md
+  std::string probe;  // what it probes, one line for docs/studies/stability.md
   host::Scene scene;
   host::Camera camera;
   int width = 9, height = 9;

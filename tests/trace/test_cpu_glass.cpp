@@ -1,6 +1,6 @@
-// Known answers for the CPU reference tracer's glass (docs/materials.md, "Glass: the model"): a
-// slab shifts a ray by the analytic amount and returns it parallel, on every structure; a ray
-// tree's weights never sum above its ray's; shadow rays are dimmed by t per glass surface and
+// Known answers for the CPU reference tracer's glass (docs/studies/materials.md, "Glass: the
+// model"): a slab shifts a ray by the analytic amount and returns it parallel, on every structure;
+// a ray tree's weights never sum above its ray's; shadow rays are dimmed by t per glass surface and
 // blocked past kMaxGlassCrossings; rays are counted by kind.
 #include <doctest/doctest.h>
 

@@ -138,9 +138,9 @@ TEST_CASE("a very large triangle behind a small one is hit around it") {
 
 namespace {
 
-// Known outcomes at reduced precision (docs/stability.md): hit ids wrong at fp24 and at fp16,
-// and the mirror's colour failures at fp16. Cases not listed pass at both. No case leaves rays
-// unfinished. A change of the rounding rules (vgpu/format.h) or of a kernel's arithmetic moves
+// Known outcomes at reduced precision (docs/studies/stability.md): hit ids wrong at fp24 and at
+// fp16, and the mirror's colour failures at fp16. Cases not listed pass at both. No case leaves
+// rays unfinished. A change of the rounding rules (vgpu/format.h) or of a kernel's arithmetic moves
 // these counts.
 struct Known {
   const char* name;

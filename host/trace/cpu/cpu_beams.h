@@ -1,6 +1,6 @@
-// Beams over tiles in the CPU tracer (--engine cpu --beams on; docs/groups.md): the same beams as
-// the stream tracer's passes march (kernels/beams.h), marched here one tile at a time by the
-// kernel's own code run on the host at a lane width of one, and a 3D-DDA that starts where its
+// Beams over tiles in the CPU tracer (--engine cpu --beams on; docs/studies/groups.md): the same
+// beams as the stream tracer's passes march (kernels/beams.h), marched here one tile at a time by
+// the kernel's own code run on the host at a lane width of one, and a 3D-DDA that starts where its
 // tile's beam stopped. The CPU tracer walks in double precision, so the start is found its own
 // way (cpu_dda_skip): the state its walk would reach, bit for bit, or no skip at all.
 #pragma once

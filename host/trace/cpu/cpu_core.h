@@ -319,7 +319,8 @@ class Tracer {
   // Whitted's recursion: the colour seen along o + t d (d unit) by the surface `depth` (0-based)
   // of the tree, whose weight in the final colour is w. Opaque: returns (1 - a) C + a L_reflected,
   // so the primary call returns the paper's sum_i w_i (1 - a_i) C_i. Glass (t > 0, the model of
-  // docs/materials.md): (1 - t)(1 - a) C + ((1 - t) a + t F) L_reflected + t (1 - F) L_refracted.
+  // docs/studies/materials.md):
+  //   (1 - t)(1 - a) C + ((1 - t) a + t F) L_reflected + t (1 - F) L_refracted.
   // A ray is spawned only if its weight is at least 1/512 and the path has fewer than 1 + bounces
   // surfaces, as rayosReflejados does; `kind` is what spawned this one (cpu_ray_tree's log).
   // `reflected_out` (if given) gets an opaque surface's reflected ray's hit (tri -1: none);
@@ -389,7 +390,7 @@ class Tracer {
       return colour;
     }
 
-    // Glass (docs/materials.md): entering when d meets the front of the triangle's winding.
+    // Glass (docs/studies/materials.md): entering when d meets the front of the triangle's winding.
     const bool entering = glm::dot(d, geo_normals_[k]) < 0.0;
     const double e = entering ? 1.0 / double(mat.ior) : double(mat.ior);
     const optics::Interface f = optics::meet(d, n, e);

@@ -41,8 +41,8 @@ struct CpuStats {
 enum class CpuRayKind { primary, reflected, refracted, total_internal };
 
 // A shadow ray crosses at most this many glass surfaces: the eighth glass surface it meets
-// blocks it (docs/materials.md, "Shadow rays through glass"; the stream tracer's 8 rounds of
-// sombraVidrio, the last of which blocks).
+// blocks it (docs/studies/materials.md, "Shadow rays through glass"; the stream tracer's 8 rounds
+// of sombraVidrio, the last of which blocks).
 inline constexpr int kMaxGlassCrossings = 7;
 
 // One ray of a pixel's tree as the CPU tracer traces it (cpu_ray_tree).
@@ -77,9 +77,10 @@ struct CpuRay {
 //     side) * 1e-4 * grid diagonal; a refracted ray's origin is on the other side;
 //   - blend: final = sum_i w_i (1 - a_i) C_i, w_{i+1} = w_i a_i; reflection stops when
 //     w < 1/512 or after 1 + bounces iterations;
-//   - glass (Material::transmission t > 0): docs/materials.md's model, the exact Fresnel term F
-//     of host/trace/cpu/optics.h splitting w into (1 - t)(1 - a) for the local shading, (1 - t) a +
-//     t F for the reflected ray and t (1 - F) for the refracted one, the same cut-off and limit.
+//   - glass (Material::transmission t > 0): docs/studies/materials.md's model, the exact
+//     Fresnel term F of host/trace/cpu/optics.h splitting w into (1 - t)(1 - a) for the local
+//     shading, (1 - t) a + t F for the reflected ray and t (1 - F) for the refracted one, the
+//     same cut-off and limit.
 // Multi-threaded over rows (options.threads, 0 = every core); each pixel is computed alone, so
 // the output is bit-identical for any thread count. RenderResult::stats (vgpu::FrameStats) stays
 // empty; rays_traced counts the rays that enter the grid, as the stream tracer's queries do;
@@ -121,9 +122,9 @@ CpuAdaptiveLevels cpu_adaptive_levels(const Scene& scene, const Accel& accel, co
                                       const RenderOptions& options);
 
 // Every ray the CPU tracer traces for one camera ray from `origin` along the unit `dir` (shadow
-// rays aside), depth-first in the order traced: the tree of docs/materials.md's glass model, with
-// each ray's weight. A ray's weight is w times its parent's share; the weights of its hit's local
-// shading and of its children never sum above its own.
+// rays aside), depth-first in the order traced: the tree of docs/studies/materials.md's glass
+// model, with each ray's weight. A ray's weight is w times its parent's share; the weights of its
+// hit's local shading and of its children never sum above its own.
 std::vector<CpuRay> cpu_ray_tree(const Scene& scene, const Accel& accel,
                                  const RenderOptions& options, const glm::dvec3& origin,
                                  const glm::dvec3& dir);

@@ -1,6 +1,7 @@
-// Dielectric optics in double precision, as docs/materials.md ("Glass: the model") fixes them:
-// the exact Fresnel reflectance of unpolarised light, total internal reflection past the critical
-// angle, and the refracted direction. The CPU reference tracer's glass uses them; so do its tests.
+// Dielectric optics in double precision, as docs/studies/materials.md ("Glass: the model") fixes
+// them: the exact Fresnel reflectance of unpolarised light, total internal reflection past the
+// critical angle, and the refracted direction. The CPU reference tracer's glass uses them; so do
+// its tests.
 #pragma once
 
 #include <algorithm>

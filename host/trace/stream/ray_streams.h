@@ -2,7 +2,7 @@
 // level, without recursion or scatter. The passes around the host loop's trace and shade:
 // dividirRayos (the shares), the compaction (sumaPrefijos + contarRayos + compactarRayos), the
 // chunk copies (copiarFilas) and the colour's way back (reunirHijos), and the shadow rays'
-// continuation through glass (sombraVidrio). docs/materials.md, "Glass on the virtual GPU".
+// continuation through glass (sombraVidrio). docs/studies/materials.md, "Glass on the virtual GPU".
 #pragma once
 
 #include <cstdint>
@@ -121,7 +121,7 @@ const vgpu::Texture& RayStreams::shadows_through_glass(PassRunner& r, const vgpu
   // shadow rays) and the hits of their trace.
   const vgpu::Texture* origins = &surface;
   const vgpu::Texture* rays = &shadow_rays;
-  constexpr int kMaxGlass = 8;  // docs/materials.md: past 8 glass surfaces, blocked
+  constexpr int kMaxGlass = 8;  // docs/studies/materials.md: past 8 glass surfaces, blocked
   for (int round = 1;; ++round) {
     kernels::ShadowGlass& k = shadow_glass.kernel;
     k.first = round == 1;

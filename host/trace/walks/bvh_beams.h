@@ -1,5 +1,5 @@
-// Beams over tiles for the BVH's primary rays (an extension, issue 35; docs/groups.md): the beam
-// texture (one texel per tile), the passes that descend each tile's beam from the root to the
+// Beams over tiles for the BVH's primary rays (an extension, issue 35; docs/studies/groups.md): the
+// beam texture (one texel per tile), the passes that descend each tile's beam from the root to the
 // first node it cannot narrow down (rayosHazBVH, with an occlusion query per pass), and the pass
 // that starts each pixel's ray at its tile's node, its walk ending at that node's escape
 // (inicioHazBVH). The BVH walk (bvh_walk.cpp) runs them in place of inicioBVH.

@@ -1,5 +1,5 @@
-// Beams over tiles for the uniform grid's primary rays (an extension, issue 35; docs/groups.md;
-// the two-level grid's march over its coarse grid, kernels/grid2_beams.h):
+// Beams over tiles for the uniform grid's primary rays (an extension, issue 35;
+// docs/studies/groups.md; the two-level grid's march over its coarse grid, kernels/grid2_beams.h):
 // the beam distances (per voxel, how far the nearest voxel holding a triangle is), the beam
 // texture (one texel per tile), and the passes that march the beams (rayosHaz, with an occlusion
 // query per pass) and start each pixel's ray where its tile's beam stopped (inicioHaz). The grid
