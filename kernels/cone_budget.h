@@ -111,7 +111,3 @@ struct CutScores {
 
 }  // namespace kernels
 
-// Compiled once, in kernels/programs_rays.cpp (as kernels/kernels.h declares the others).
-extern template class vgpu::KernelProgram<kernels::ScoreCones>;
-extern template class vgpu::KernelProgram<kernels::ScoredHits>;
-extern template class vgpu::KernelProgram<kernels::CutScores>;

@@ -117,7 +117,3 @@ struct MarkCones {
 
 }  // namespace kernels
 
-// Compiled once, in kernels/programs_rays.cpp (as kernels/kernels.h declares the others).
-extern template class vgpu::KernelProgram<kernels::KeepCones>;
-extern template class vgpu::KernelProgram<kernels::KeepReflected>;
-extern template class vgpu::KernelProgram<kernels::MarkCones>;

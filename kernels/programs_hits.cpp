@@ -1,7 +1,5 @@
-// The compiled programs of the triangle tests: intersecciones, proximoTriangulo, rayosIntersectando
-// (kernels/kernels.h declares them; every lane family of each is compiled here, once).
-#include "kernels/kernels.h"
-
-template class vgpu::KernelProgram<kernels::Intersections>;
-template class vgpu::KernelProgram<kernels::NextTriangle>;
-template class vgpu::KernelProgram<kernels::RaysIntersecting>;
+// The compiled programs of the triangle tests: intersecciones, proximoTriangulo,
+// rayosIntersectando. kernels/kernel_list.h assigns them to this file; every lane family of each is
+// compiled here, once.
+#define VGPU_PROGRAMS_hits(K) template class vgpu::KernelProgram<kernels::K>;
+#include "kernels/compile_programs.h"
