@@ -84,8 +84,12 @@ nlohmann::ordered_json frame_stats_json(const FrameStatsInputs& in) {
   if (opt.looping) j["steps_per_pass"] = opt.steps_per_pass;
   j["threads"] = opt.threads;
   j["lanes"] = opt.lanes;
-  // How the emulator ran the grid walks: in batches or pass by pass (same statistics).
-  if (!cpu && !gl) j["walk"] = r.batch_walk ? "batches" : "passes";
+  // How the emulator ran the grid walks: in batches or pass by pass (same statistics), and why
+  // a walk ran pass by pass (omitted where every walk ran in batches).
+  if (!cpu && !gl) {
+    j["walk"] = r.batch_walk ? "batches" : "passes";
+    if (!r.walk_reason.empty()) j["walk_passes_because"] = r.walk_reason;
+  }
   j["precision"] = in.precision;
   if (!cpu) j["formats"] = to_json(opt.formats);
   j["init_ms"] = in.init_ms;

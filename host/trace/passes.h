@@ -20,6 +20,13 @@ struct WalkCounts {
   uint64_t rays_traced = 0;      // rays entering a trace
   uint64_t rays_unfinished = 0;  // rays stopped by a walk's pass cap (reduced precision)
   bool batch_walk = false;       // a walk of this frame ran in batches (host/trace/walks/walk.h)
+  // Whether the frame's walks may run in batches, decided once, at its first walk, from the
+  // options and the device (walk::frame_batch_refusal); empty: they may.
+  bool batch_decided = false;
+  std::string batch_refusal;
+  // Why a walk of this frame ran pass by pass: the frame's refusal, or the first walk whose
+  // programs or bindings a batch cannot keep in registers (empty: every walk ran in batches).
+  std::string passes_reason;
   // Beams over tiles (--beams on, host/trace/walks/grid_beams.h): passes of rayosHaz, tiles
   // marched (over the frame's primary traces) and tiles whose whole beam missed the grid.
   uint64_t beam_passes = 0, beam_tiles = 0, beam_tiles_missed = 0;

@@ -227,6 +227,8 @@ struct RenderResult {
   uint64_t rays_traced = 0;      // rays entering a trace (primary, reflected, shadow)
   uint64_t rays_unfinished = 0;  // rays stopped by the pass cap (only under reduced precision)
   bool batch_walk = false;       // the grid walks ran in batches (RenderOptions::batch_walk)
+  // Why a walk ran pass by pass (WalkCounts::passes_reason; empty: every walk ran in batches).
+  std::string walk_reason;
   // Beams over tiles (RenderOptions::beams): beam passes, tiles marched, tiles that missed.
   uint64_t beam_passes = 0, beam_tiles = 0, beam_tiles_missed = 0;
   // Through the BVH or the kd-tree: the depth of the node each tile's rays started at (its

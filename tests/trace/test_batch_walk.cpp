@@ -366,3 +366,31 @@ TEST_CASE(
     // the cap of that + 2.
   }
 }
+
+TEST_CASE("a frame walked pass by pass says why, decided once, and a frame in batches says nothing") {
+  Bundled b("classic", "gf6600", 24, 16);
+  const auto reason = [&](host::RenderOptions opt) {
+    host::StreamTracer tracer(b.scene, b.grid, opt);
+    const host::RenderResult r = tracer.render(b.camera);
+    return std::make_pair(r.batch_walk, r.walk_reason);
+  };
+  host::RenderOptions opt = options(24, 16, "gf6600");
+  CHECK(reason(opt) == std::make_pair(true, std::string()));
+  host::RenderOptions off = opt;
+  off.batch_walk = false;
+  CHECK(reason(off) == std::make_pair(false, std::string("--walk passes")));
+  host::RenderOptions four = opt;
+  four.lanes = 4;
+  CHECK(reason(four) == std::make_pair(false, std::string("--lanes 4 (a batch is 8 lanes)")));
+  host::RenderOptions traced = opt;
+  traced.trace_pixel = glm::ivec2(3, 4);
+  CHECK(reason(traced) == std::make_pair(false, std::string("--trace-pixel prints every pass")));
+  host::RenderOptions bare = opt;
+  bare.masks = false;
+  bare.host_shortcut = false;
+  CHECK(reason(bare) == std::make_pair(false, std::string("no mask skips finished rays")));
+  host::RenderOptions looping = opt;
+  looping.looping = true;
+  CHECK(reason(looping) ==
+        std::make_pair(false, std::string("looping traversal loops (--kernels looping)")));
+}

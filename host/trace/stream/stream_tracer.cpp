@@ -356,6 +356,7 @@ RenderResult StreamTracer::render(const Camera& cam) {
   res.rays_traced = r.counts.rays_traced;
   res.rays_unfinished = r.counts.rays_unfinished;
   res.batch_walk = r.counts.batch_walk;
+  res.walk_reason = r.counts.passes_reason;
   res.beam_passes = r.counts.beam_passes;
   res.beam_tiles = r.counts.beam_tiles;
   res.beam_tiles_missed = r.counts.beam_tiles_missed;

@@ -130,6 +130,9 @@ void ListWalk::walk_looping(PassRunner& r, const vgpu::Program& p, Texture& orig
                             std::initializer_list<const Texture*> statics, int64_t max_iterations,
                             uint64_t walking) {
   vgpu::Device& gpu = r.device();
+  // A batch runs a multipass walk's passes; this walk is one program that loops.
+  if (r.counts.passes_reason.empty())
+    r.counts.passes_reason = std::string(p.name()) + " loops (--kernels looping)";
   const int64_t max_passes = (max_iterations + opt_.steps_per_pass - 1) / opt_.steps_per_pass;
   for (int64_t k = 0; walking > 0; ++k) {
     if (k == max_passes) {

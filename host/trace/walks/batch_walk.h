@@ -304,16 +304,39 @@ class CheckWalker {
   std::array<int, kMaxSites> asked_{};
 };
 
+// Why no walk of a frame with these options on this device can run in batches; empty: they may,
+// where each walk's programs and bindings allow (run_in_batches checks those). Decided once per
+// frame, at its first walk, and recorded with the statistics (RenderResult::walk_reason).
+inline std::string frame_batch_refusal(const RenderOptions& opt, const vgpu::Device& device) {
+  const auto* gpu = dynamic_cast<const vgpu::Gpu*>(&device);
+  if (!opt.batch_walk) return "--walk passes";
+  if (!gpu) return "not the emulator";
+  if (gpu->lanes() != vgpu::kBatchWidth)
+    return "--lanes " + std::to_string(gpu->lanes()) + " (a batch is " +
+           std::to_string(vgpu::kBatchWidth) + " lanes)";
+  if (opt.observer) return "a pass observer follows every pass (--report, --stats-csv)";
+  if (opt.trace_pixel) return "--trace-pixel prints every pass";
+  if (!opt.masks && !opt.host_shortcut) return "no mask skips finished rays";
+  return "";
+}
+
 // The walk batch by batch, then the replay of its passes on the device; false where it does not
-// apply (RenderOptions::batch_walk off, not the vgpu at 8 lanes, an observer or a traced pixel,
-// no mask to skip finished rays, or a binding a batch cannot keep in registers).
+// apply, with the reason in r.counts.passes_reason (the frame's: frame_batch_refusal; the walk's:
+// a program with a loop, or a binding a batch cannot keep in registers).
 template <class Walk>
 bool run_in_batches(PassRunner& r, Walk& walk, typename Walk::Cursor& c) {
   const RenderOptions& opt = r.options();
-  auto* gpu = dynamic_cast<vgpu::Gpu*>(&r.device());
-  if (!opt.batch_walk || !gpu || gpu->lanes() != vgpu::kBatchWidth || opt.observer ||
-      opt.trace_pixel || !(opt.masks || opt.host_shortcut))
+  WalkCounts& counts = r.counts;
+  if (!counts.batch_decided) {
+    counts.batch_refusal = frame_batch_refusal(opt, r.device());
+    counts.batch_decided = true;
+  }
+  const auto passes = [&](const std::string& why) {
+    if (counts.passes_reason.empty()) counts.passes_reason = why;
     return false;
+  };
+  if (!counts.batch_refusal.empty()) return passes(counts.batch_refusal);
+  auto* gpu = static_cast<vgpu::Gpu*>(&r.device());
   const auto t0 = std::chrono::steady_clock::now();
   // The walk's passes and bindings: a batch keeps a texture in registers where every program
   // reads it at the fragment's own texel; a texture the walk writes must be read so everywhere.
@@ -334,10 +357,12 @@ bool run_in_batches(PassRunner& r, Walk& walk, typename Walk::Cursor& c) {
       i.program = p.program;
       i.precision = gpu->precision_of(*p.program);
       const vgpu::Program::Analysis a = p.program->analyze();
-      if (a.loop.loops > 0) return false;
+      if (a.loop.loops > 0) return passes(std::string(p.program->name()) + " loops");
       i.branches = a.branches;
       i.idle_discards = p.program->idle_discards();
-      if (!i.idle_discards && !p.program->has_passthrough()) return false;
+      if (!i.idle_discards && !p.program->has_passthrough())
+        return passes(std::string(p.program->name()) +
+                      " keeps idle fragments without a passthrough");
       for (int o = 0; o < p.program->outputs(); ++o)
         i.passthrough[size_t(o)] = i.idle_discards ? -1 : p.program->passthrough(o);
       i.own_only = r.own_only_units(*p.program);
@@ -348,13 +373,19 @@ bool run_in_batches(PassRunner& r, Walk& walk, typename Walk::Cursor& c) {
       const Texture& t = *p.in[u];
       const bool sized = t.width() == opt.width && t.height() == opt.height;
       const bool own = (it->own_only >> u) & 1;
-      if (own && !sized) return false;
-      if (!own && std::find(written.begin(), written.end(), &t) != written.end()) return false;
+      if (own && !sized)
+        return passes(std::string(p.program->name()) + " reads " + p.program->unit_name(int(u)) +
+                      " from a texture of another size than the frame");
+      if (!own && std::find(written.begin(), written.end(), &t) != written.end())
+        return passes(std::string(p.program->name()) + " reads " + p.program->unit_name(int(u)) +
+                      ", which the walk writes, at another texel than its own");
     }
     if (!it->idle_discards)
       for (size_t o = 0; o < p.out.size(); ++o) {
         const size_t u = size_t(it->passthrough[o]);
-        if (u >= p.in.size() || !((it->own_only >> u) & 1)) return false;
+        if (u >= p.in.size() || !((it->own_only >> u) & 1))
+          return passes(std::string(p.program->name()) + " passes through a unit it reads at " +
+                        "another texel than its own");
       }
   }
 
