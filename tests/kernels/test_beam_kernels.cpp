@@ -129,6 +129,67 @@ TEST_CASE("beam march moves each beam to where its first corner ray leaves an em
 }
 
 TEST_CASE(
+    "beam march leaves the empty cube around the beam's voxel through whichever of its six faces "
+    "the beam points at") {
+  // Beam distances: every voxel of the 4x4x4 grid holds a triangle (0) but (2, 2, 2), whose
+  // neighbours one step away are empty (2): the cube [1, 4) on every axis. A 2x2 image of one
+  // 2x2 tile from the eye (2.3, 2.6, 2.45), inside that voxel, looking along each axis both
+  // ways: the beam must move on to where its first corner ray leaves the cube (less the margin)
+  // through the face it looks at, 1.3 to 1.7 cells away (the cube's faces at 1 and 4), scaled
+  // by cos(theta) and 0.9999; every output channel is checked.
+  std::vector<float> k(16 * 4, 0.0f);
+  k[2 * 16 + 2 * 4 + 2] = 2.0f;
+  const Texture distances = scalars("beam distances", 16, 4, k);
+  const Texture start = texels("beams", 1, 1, {{0, 0, 0, 0}});
+  const glm::dvec3 e(2.3, 2.6, 2.45);
+  const double m = 1e-3;
+  for (int axis = 0; axis < 3; ++axis)
+    for (const double sign : {-1.0, 1.0}) {
+      CAPTURE(axis);
+      CAPTURE(sign);
+      glm::dvec3 f(0.0), right(0.0), up(0.0);
+      f[axis] = sign;
+      right[(axis + 1) % 3] = 1.0;
+      up[(axis + 2) % 3] = 1.0;
+      kernels::BeamUniforms u = beam_uniforms();
+      u.camera.forward = glm::vec3(f);
+      u.camera.right = glm::vec3(right);
+      u.camera.up = glm::vec3(up);
+      u.camera.aspect = 1.0f;
+      u.camera.width = 2;
+      u.camera.height = 2;
+      u.eye = glm::vec3(e);
+      kernels::BeamMarch march;
+      march.beams = u;
+      const Texture out = ktest::run(march, {&start, &distances}, 1, 1);
+      // The test's own corner rays (pixel centres 0.5 and 1.5 of the 2x2 image), in double.
+      std::vector<glm::dvec3> corners;
+      for (double py : {0.5, 1.5})
+        for (double px : {0.5, 1.5})
+          corners.push_back(
+              glm::normalize(f + right * ((px - 1.0) * 0.05) + up * ((1.0 - py) * 0.05)));
+      glm::dvec3 mean(0.0);
+      for (const auto& d : corners) mean += d;
+      mean = glm::normalize(mean);
+      double cosw = 1.0, exit = 1e300;
+      for (const auto& d : corners) {
+        cosw = std::min(cosw, glm::dot(mean, d));
+        double tf = 1e300;
+        for (int a = 0; a < 3; ++a) {
+          if (d[a] == 0.0) continue;
+          tf = std::min(tf, std::max((1 + m - e[a]) / d[a], (4 - m - e[a]) / d[a]));
+        }
+        exit = std::min(exit, tf);
+      }
+      // Along the axis the face it looks at comes first: x 1.3 or 1.7 away, y 1.6 or 1.4, z 1.45
+      // or 1.55.
+      const double face = sign < 0 ? e[axis] - 1 - m : 4 - m - e[axis];
+      CHECK(exit == doctest::Approx(face / cosw).epsilon(1e-3));
+      CHECK_TEXEL_NEAR(out, 0, 0, 1e-5, glm::vec4(0, float(exit * cosw * 0.9999), 0, 1));
+    }
+}
+
+TEST_CASE(
     "the looping beam march ends in one pass where the march's passes end, and stops at its step "
     "budget") {
   // The distances of the test above, with a deeper empty pocket: the voxels of z 1 to 3 whose x
