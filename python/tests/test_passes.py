@@ -1,7 +1,10 @@
 """vgpu_rt.passes: a frame pass by pass, stopped and resumed, agrees with the whole frame."""
 
+import base64
 import csv
 import gc
+import gzip
+import json
 import os
 import subprocess
 import tempfile
@@ -13,6 +16,20 @@ import vgpu_rt
 
 CLI = os.environ.get("VGPU_RT_CLI", "")
 OPTIONS = dict(size="16x16", bounces=1)
+
+
+def report_data(path):
+    """The data an HTML report (`vgpu-rt render --report`) carries, as a dict."""
+    with open(path) as f:
+        page = f.read()
+    tag = '<script id="report-data" type="application/json">'
+    start = page.index(tag) + len(tag)
+    return json.loads(page[start:page.index("</script>", start)])
+
+
+def unpack(text, dtype):
+    """One of the report's arrays: gzip, then base64 (host/report/report.cpp's pack)."""
+    return np.frombuffer(gzip.decompress(base64.b64decode(text)), dtype)
 
 
 class PassesTest(unittest.TestCase):
@@ -63,6 +80,53 @@ class PassesTest(unittest.TestCase):
         self.assertEqual(first.target.shape, (16, 16, first.target.shape[2]))
         norms = np.linalg.norm(first.target[:, :, :3], axis=2)
         self.assertTrue(np.allclose(norms, 1.0, atol=1e-5), norms)
+
+    @unittest.skipUnless(CLI, "VGPU_RT_CLI names the vgpu-rt executable")
+    def test_every_pass_s_target_holds_what_the_command_line_s_report_kept_of_it(self):
+        # A 24x20 frame (not square: rows and columns cannot trade places unseen) with masks:
+        # every pass's target is the frame's size with the report's channels, and the report
+        # keeps the state after every pass of the pixels whose x and y are multiples of 8 (nine
+        # of them), for each pass they took part in (its work mask holds them) that writes
+        # state: each must be that texel of the pass's target, bit for bit.
+        w, h = 24, 20
+        seen = list(vgpu_rt.passes("bunny", size=(w, h), bounces=1, masks=True))
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "report.html")
+            subprocess.run([CLI, "render", "bunny", "--size", f"{w}x{h}", "--bounces", "1",
+                            "--masks", "on", "--stats", "none", "--quiet", "--report", path],
+                           check=True)
+            d = report_data(path)
+        cols = {name: unpack(text, np.float64) for name, text in d["passes"].items()}
+        self.assertEqual(len(cols["kernel"]), len(seen))
+        # The work masks: each stored XOR the one before it, a bit per pixel, row by row.
+        chain = unpack(d["masks"], np.uint8).reshape(d["mask_count"], (w * h + 7) // 8)
+        bits = np.unpackbits(np.bitwise_xor.accumulate(chain, axis=0), axis=1, bitorder="little")
+        masks = bits[:, :w * h].reshape(-1, h, w).astype(bool)
+        for i, p in enumerate(seen):
+            self.assertEqual(d["kernel_names"][int(cols["kernel"][i])], p.kernel, i)
+            self.assertEqual(d["target_names"][int(cols["target"][i])], p.target_name, i)
+            self.assertEqual(p.target.shape, (h, w, int(cols["channels"][i])), i)
+            if p.work is not None:  # the stencil the pass ran under is the report's work mask
+                self.assertTrue(np.array_equal(p.work, masks[int(cols["work"][i])]), i)
+        kept = d["history"]["pixels"]
+        self.assertEqual(len(kept), 9)
+        checked = 0
+        for (x, y), packed in zip(kept, d["history"]["states"]):
+            states = unpack(packed, np.float32)
+            at = 0
+            for i, p in enumerate(seen):
+                rows, columns, channels = p.target.shape
+                mask = int(cols["work"][i])
+                if not cols["prints"][i] or x >= columns or y >= rows:
+                    continue
+                if mask >= 0 and not masks[mask, y, x]:
+                    continue
+                self.assertEqual(p.target[y, x].tobytes(), states[at:at + channels].tobytes(),
+                                 f"pass {i} {p.kernel}, pixel {x},{y}")
+                at += channels
+                checked += 1
+            self.assertEqual(at, len(states), f"pixel {x},{y}")
+        self.assertGreater(checked, 9 * 20)  # every kept pixel in dozens of passes
 
     def test_the_frame_after_its_passes_is_the_whole_frame(self):
         f = self.steps.frame
