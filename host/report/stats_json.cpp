@@ -13,9 +13,9 @@
 
 #include "host/model/cost_model.h"
 #include "host/model/formats.h"
+#include "host/trace/mrt.h"
 #include "host/trace/stream/mark_streams.h"
 #include "host/trace/stream/ray_streams.h"
-#include "host/trace/walks/grid_walk.h"
 #include "vgpu/vgpu.h"
 
 namespace host {
@@ -208,7 +208,8 @@ nlohmann::ordered_json frame_stats_json(const FrameStatsInputs& in) {
   }
   j["predicted_ms"] = predicted_ms;
   j["predicted_breakdown"] = predicted_breakdown;
-  auto what_if = nlohmann::ordered_json::array();  // MRT and resident programs (docs/studies/table1.md)
+  auto what_if =
+      nlohmann::ordered_json::array();  // MRT and resident programs (docs/studies/table1.md)
   for (const auto& [name, s] : cpu || gl ? decltype(what_ifs(r.stats)){} : what_ifs(r.stats)) {
     nlohmann::ordered_json w = {{"name", name}, {"totals", vgpu::to_json(s.totals)}};
     for (const vgpu::Profile& p : vgpu::profiles())

@@ -2,7 +2,7 @@
 // command line and by the stream tracer.
 #include "host/trace/render_options.h"
 
-#include "host/trace/walks/grid_walk.h"
+#include "host/trace/mrt.h"
 
 namespace host {
 

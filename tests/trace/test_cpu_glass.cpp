@@ -16,7 +16,7 @@
 #include "host/accel/grid2.h"
 #include "host/accel/kdtree.h"
 #include "host/trace/cpu/cpu_tracer.h"
-#include "host/trace/walks/grid_walk.h"
+#include "host/trace/diagonal.h"
 #include "kernels/kernels.h"
 
 namespace {

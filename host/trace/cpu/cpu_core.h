@@ -15,6 +15,7 @@
 #include "host/trace/cpu/cpu_beams.h"
 #include "host/trace/cpu/cpu_tracer.h"
 #include "host/trace/cpu/optics.h"
+#include "host/trace/diagonal.h"
 #include "host/trace/sampling.h"
 #include "host/trace/textures.h"
 #include "host/trace/walks/bvh_beams.h"

@@ -13,6 +13,7 @@
 #include <stdexcept>
 
 #include "host/common/parallel.h"
+#include "host/trace/diagonal.h"
 #include "host/trace/passes.h"
 #include "host/trace/sampling.h"
 #include "host/trace/stream/atlas_upload.h"
@@ -23,6 +24,7 @@
 #include "host/trace/textures.h"
 #include "host/trace/walks/bvh_walk.h"
 #include "host/trace/walks/grid2_walk.h"
+#include "host/trace/walks/grid_walk.h"
 #include "host/trace/walks/kd_walk.h"
 
 namespace host {

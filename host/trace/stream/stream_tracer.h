@@ -12,9 +12,9 @@
 #include "host/accel/grid.h"
 #include "host/model/formats.h"
 #include "host/scene/scene.h"
+#include "host/trace/grid_spec.h"
 #include "host/trace/ping_pong.h"
 #include "host/trace/render_options.h"
-#include "host/trace/walks/grid_walk.h"
 #include "kernels/kernels.h"
 #include "vgpu/vgpu.h"
 

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 
+#include "host/trace/diagonal.h"
 #include "host/trace/walks/grid_walk.h"  // kSlackOfDiagonal
 #include "host/trace/walks/walk.h"
 

@@ -7,6 +7,7 @@
 #include <array>
 #include <cmath>
 
+#include "host/trace/diagonal.h"
 #include "host/trace/walks/walk.h"
 
 namespace host {
@@ -15,59 +16,6 @@ using namespace kernels;
 using vgpu::Format;
 using vgpu::Stencil;
 using vgpu::Texture;
-
-GridSpec grid_spec_for(const GridSpec& spec, const Scene& scene, const vgpu::Profile& profile) {
-  if (!spec.automatic()) return spec;
-  glm::ivec3 r = auto_resolution(scene.bounds(), scene.triangle_count());
-  const double maxs = profile.max_texture_size;
-  while (double(r.x) * r.y > maxs) {
-    const double f = std::sqrt(maxs / (double(r.x) * r.y));
-    r.x = std::max(1, int(r.x * f));
-    r.y = std::max(1, int(r.y * f));
-  }
-  r.z = std::min(r.z, profile.max_texture_size);
-  return GridSpec{r};
-}
-
-namespace {
-
-// The fused programs, each with its two kernels' groups (their arithmetic must agree).
-struct FusedInfo {
-  const char* name;
-  int outputs;
-  Group first, second;
-};
-const std::array<FusedInfo, 2>& fused_programs() {
-  static const std::array<FusedInfo, 2> f{
-      FusedInfo{IntersectNext::name, IntersectNext::outputs, Group::hits, Group::voxel},
-      FusedInfo{TraverseUpdate::name, TraverseUpdate::outputs, Group::traversal, Group::voxel}};
-  return f;
-}
-
-}  // namespace
-
-std::string mrt_refusal(const vgpu::Profile& profile, const Formats& formats) {
-  for (const FusedInfo& f : fused_programs()) {
-    if (f.outputs > profile.max_outputs)
-      return "--mrt on: program '" + std::string(f.name) + "' writes " + std::to_string(f.outputs) +
-             " outputs; profile " + profile.name + " allows " +
-             std::to_string(profile.max_outputs) + " (no multiple render targets)";
-    if (formats.arithmetic(f.first) != formats.arithmetic(f.second))
-      return "--mrt on: program '" + std::string(f.name) + "' computes in one format, but groups " +
-             std::string(group_name(f.first)) + " (" +
-             std::string(vgpu::format_name(formats.arithmetic(f.first))) + ") and " +
-             std::string(group_name(f.second)) + " (" +
-             std::string(vgpu::format_name(formats.arithmetic(f.second))) +
-             ") differ; give them one arithmetic format (--formats)";
-  }
-  return {};
-}
-
-std::vector<std::string> mrt_programs() {
-  std::vector<std::string> v;
-  for (const FusedInfo& f : fused_programs()) v.push_back(f.name);
-  return v;
-}
 
 GridWalk::GridWalk(vgpu::Device& gpu, const Grid& grid, const RenderOptions& options,
                    float scene_width)

@@ -19,12 +19,6 @@
 
 namespace host {
 
-// Lengths both tracers derive from the grid diagonal, as fractions of it (the stream tracer's
-// uniforms take float(k) * diagonal in float, the CPU tracer k * diagonal in double).
-inline constexpr double kSlackOfDiagonal = 1e-5;   // GridUniforms::t_slack (in-voxel rule)
-inline constexpr double kOffsetOfDiagonal = 1e-4;  // ReflectionOrigin::offset (origin lift)
-inline constexpr double kAttenOfDiagonal = 0.5;    // Shader::atten_dist
-
 class GridWalk : public ListWalk {
  public:
   // The passes of the walk, by where the walk issues them. With the step (-1 before the first)
@@ -99,18 +93,5 @@ class GridWalk : public ListWalk {
   // Beams over tiles (RenderOptions::beams; null: off).
   std::unique_ptr<GridBeams> beams_;
 };
-
-// The grid spec to build for a profile: an automatic resolution is shrunk in x and y until the
-// voxel pointer texture (sizeX*sizeY by sizeZ texels) fits the profile's largest texture; an
-// explicit one is kept (and refused at initialization if it does not fit).
-GridSpec grid_spec_for(const GridSpec& spec, const Scene& scene, const vgpu::Profile& profile);
-
-// Why RenderOptions::mrt cannot run with this profile and these formats (empty: it can): a
-// fused program writes more outputs than the profile allows, or computes in one arithmetic
-// format where its two kernels' groups differ (host/model/formats.h). Names the fused program.
-std::string mrt_refusal(const vgpu::Profile& profile, const Formats& formats);
-
-// The fused programs --mrt on runs (kernels/fused.h), by statistics name.
-std::vector<std::string> mrt_programs();
 
 }  // namespace host
