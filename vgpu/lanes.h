@@ -107,7 +107,9 @@ struct OpCounter {
 };
 struct CFloat;
 struct CMask {
-  bool v;
+  bool v = false;
+  CMask() = default;
+  CMask(bool b) : v(b) {}  // as a SIMD mask broadcasts one bool (M(false), clang included)
   friend CMask operator&&(CMask a, CMask b) {
     ++OpCounter::ops;
     return {a.v && b.v};

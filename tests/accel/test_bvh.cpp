@@ -158,7 +158,10 @@ TEST_CASE(
     "the BVH of every bundled scene keeps the layout's invariants and builds the same twice") {
   const auto scenes = host::list_scenes();
   REQUIRE(scenes.size() >= 8);
-  for (const auto& [name, path] : scenes) {
+  for (const auto& [bound_name, bound_path] : scenes) {
+    // Named copies: clang 14 cannot capture a structured binding (CAPTURE, INFO).
+    const auto& name = bound_name;
+    const auto& path = bound_path;
     CAPTURE(name);
     const Scene s = host::load_scene(path, host::with_images());
     const Bvh a = host::build_bvh(s), b = host::build_bvh(s);

@@ -190,7 +190,10 @@ TEST_CASE(
 TEST_CASE("every bundled scene's kd-tree lists each triangle in every leaf its box meets") {
   const auto scenes = host::list_scenes();
   REQUIRE(scenes.size() >= 8);
-  for (const auto& [name, path] : scenes) {
+  for (const auto& [bound_name, bound_path] : scenes) {
+    // Named copies: clang 14 cannot capture a structured binding (CAPTURE, INFO).
+    const auto& name = bound_name;
+    const auto& path = bound_path;
     CAPTURE(std::string(name));
     const Scene s = host::load_scene(path, host::with_images());
     const host::Grid box = host::build_grid(s, host::GridSpec{glm::ivec3(1)});

@@ -189,7 +189,10 @@ TEST_CASE("a looping render on a profile without loops or past its loop limit na
        "profile r300 (arbfp1) has no dynamic branching or loops"},
       {"--kernels looping --profile gf6600 --steps-per-pass 256",
        "loops up to 256 iterations; profile gf6600 allows 255"}};
-  for (const auto& [args, problem] : cases) {
+  for (const auto& [bound_args, bound_problem] : cases) {
+    // Named copies: clang 14 cannot capture a structured binding (CAPTURE, INFO).
+    const auto& args = bound_args;
+    const auto& problem = bound_problem;
     const Outcome o = run(std::string("render bunny-low -q --stats none --size 16x16 ") + args);
     INFO("vgpu-rt render " << args << " -> " << o.err);
     CHECK(o.status != 0);
@@ -242,7 +245,10 @@ TEST_CASE("a render writes the image, the AOVs and the statistics asked for, and
   const Exr rgb = read_exr_header(dir / "cpu.exr");
   REQUIRE(rgb.ok);
   REQUIRE(rgb.channels.size() == 3);
-  for (const auto& [name, type] : rgb.channels) {
+  for (const auto& [bound_name, bound_type] : rgb.channels) {
+    // Named copies: clang 14 cannot capture a structured binding (CAPTURE, INFO).
+    const auto& name = bound_name;
+    const auto& type = bound_type;
     CAPTURE(name);
     CHECK(type == 2);
   }

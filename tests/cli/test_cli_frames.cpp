@@ -94,7 +94,10 @@ TEST_CASE("an unknown animation, a skinned mesh and morph-target weights are ref
       {std::string(VGPU_TEST_DATA) + "/gltf/morph_weights.gltf --time 0.5",
        "animation 0 channel 0 animates morph-target weights (node 0); morph targets are not "
        "supported"}};
-  for (const auto& [args, problem] : cases) {
+  for (const auto& [bound_args, bound_problem] : cases) {
+    // Named copies: clang 14 cannot capture a structured binding (CAPTURE, INFO).
+    const auto& args = bound_args;
+    const auto& problem = bound_problem;
     const Outcome o = run("render " + args + " -q --stats none --out " + out.string());
     INFO("vgpu-rt render " << args << " -> " << o.err);
     CHECK(o.status == 2);
@@ -296,7 +299,8 @@ TEST_CASE("--report-frame is refused without --frames, without a report, or past
   const fs::path html =
       fs::temp_directory_path() / ("vgpu_cli_rf_" + std::to_string(::getpid()) + ".html");
   const std::string report = " --report " + html.string();
-  for (const auto& [args, option, problem] : std::vector<std::array<std::string, 3>>{
+  for (const auto& [bound_args, bound_option, bound_problem] :
+       std::vector<std::array<std::string, 3>>{
            {"--time 1 --report-frame 1" + report, "--report-frame", "needs --frames"},
            {"--frames 0:1:2 --report-frame 1", "--report-frame", "needs --report or --stats-csv"},
            {"--frames 0:2:3 --report-frame 4" + report, "--report-frame 4",
@@ -305,6 +309,10 @@ TEST_CASE("--report-frame is refused without --frames, without a report, or past
            {"--frames 0:1:2" + report, "--report",
             "follows one frame: render it with --time T, or name one of the frames with "
             "--report-frame K"}}) {
+    // Named copies: clang 14 cannot capture a structured binding (CAPTURE, INFO).
+    const auto& args = bound_args;
+    const auto& option = bound_option;
+    const auto& problem = bound_problem;
     const Outcome o = run("render bunny-low -q --stats none " + args);
     INFO(args << " -> " << o.err);
     CHECK(o.status == 2);

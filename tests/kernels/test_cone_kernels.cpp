@@ -200,8 +200,11 @@ TEST_CASE("scored hits counts the pixels that hit whose score exceeds the value,
                             {0.7f, 6, 10, -1},
                             {0.2f, 5, 10, -1}});
   kernels::ScoredHits k;
-  for (const auto& [above, expect] : std::vector<std::pair<float, uint64_t>>{
+  for (const auto& case_ : std::vector<std::pair<float, uint64_t>>{
            {-1.0f, 5}, {0.0f, 4}, {0.2f, 2}, {0.3f, 1}, {0.7f, 0}}) {
+    // Named copies: CAPTURE's lambda cannot capture a structured binding under clang 14.
+    const float above = case_.first;
+    const uint64_t expect = case_.second;
     CAPTURE(above);
     k.above = above;
     uint64_t count = 99;

@@ -88,16 +88,25 @@ TEST_CASE(
   }
   const auto rows = glossary_rows(std::string(VGPU_TEST_DATA) + "/../../kernels/README.md");
   std::map<std::string, std::string> written;
-  for (const auto& [name, type] : rows) {
+  for (const auto& [bound_name, bound_type] : rows) {
+    // Named copies: clang 14 cannot capture a structured binding (CAPTURE, INFO).
+    const auto& name = bound_name;
+    const auto& type = bound_type;
     CHECK_MESSAGE(written.count(name) == 0, "kernels/README.md has two rows for ", name);
     written[name] = type;
   }
-  for (const auto& [name, type] : registered) {
+  for (const auto& [bound_name, bound_type] : registered) {
+    // Named copies: clang 14 cannot capture a structured binding (CAPTURE, INFO).
+    const auto& name = bound_name;
+    const auto& type = bound_type;
     INFO("registered kernel ", name, " (", type, ")");
     REQUIRE_MESSAGE(written.count(name) == 1, "kernels/README.md has no row for it");
     CHECK(written[name] == type);
   }
-  for (const auto& [name, type] : written) {
+  for (const auto& [bound_name, bound_type] : written) {
+    // Named copies: clang 14 cannot capture a structured binding (CAPTURE, INFO).
+    const auto& name = bound_name;
+    const auto& type = bound_type;
     INFO("kernels/README.md row ", name, " (", type, ")");
     CHECK_MESSAGE(registered.count(name) == 1, "no registered kernel has that name");
   }

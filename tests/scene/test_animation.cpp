@@ -301,9 +301,12 @@ TEST_CASE(
   const glm::dmat3 s_inv(glm::scale(glm::dmat4(1.0), glm::dvec3(0.5, 1, 1)));
   for (size_t i = 0; i < 2; ++i) {
     CAPTURE(i);
-    for (const auto& [p, n] :
+    for (const auto& [bound_p, bound_n] :
          {std::pair{posed.n0[i], rest.n0[i]}, std::pair{posed.n1[i], rest.n1[i]},
           std::pair{posed.n2[i], rest.n2[i]}}) {
+      // Named copies: clang 14 cannot capture a structured binding (CAPTURE, INFO).
+      const auto& p = bound_p;
+      const auto& n = bound_n;
       const glm::vec3 want(glm::normalize(r * (s_inv * glm::dvec3(n))));
       CHECK_MESSAGE(glm::all(glm::epsilonEqual(p, want, 1e-6f)),
                     str(glm::dvec3(p)) << " != " << str(glm::dvec3(want)));

@@ -153,7 +153,9 @@ uint64_t passes_of(const vgpu::FrameStats& s, const std::string& program) {
 TEST_CASE("every bundled scene at 48x40 gives the same frame and statistics walked in batches") {
   const auto scenes = host::list_scenes();
   REQUIRE(scenes.size() >= 8);
-  for (const auto& [name, path] : scenes) {
+  for (const auto& [bound_name, bound_path] : scenes) {
+    // Named copies: clang 14 cannot capture a structured binding (CAPTURE, INFO).
+    const auto& name = bound_name;
     Bundled b(name, "gf5700", 48, 40);
     for (int bounces : {0, 2}) {
       CAPTURE(std::string(name));
@@ -219,8 +221,10 @@ TEST_CASE("fp24 and fp16 ray state give the same frame and statistics walked in 
       {"mixed", mixed}};
   for (const char* name : {"bunny-low", "classic"}) {
     Bundled b(name, "gf5700", 40, 32);
-    for (const auto& [label, f] : formats)
+    for (const auto& entry : formats)
       for (bool masks : {false, true}) {
+        const char* label = entry.first;  // not a binding: CAPTURE's lambda reads it (clang 14)
+        const host::Formats& f = entry.second;
         if (masks && std::string(name) != "bunny-low") continue;
         CAPTURE(std::string(name));
         CAPTURE(std::string(label));
@@ -367,7 +371,8 @@ TEST_CASE(
   }
 }
 
-TEST_CASE("a frame walked pass by pass says why, decided once, and a frame in batches says nothing") {
+TEST_CASE(
+    "a frame walked pass by pass says why, decided once, and a frame in batches says nothing") {
   Bundled b("classic", "gf6600", 24, 16);
   const auto reason = [&](host::RenderOptions opt) {
     host::StreamTracer tracer(b.scene, b.grid, opt);

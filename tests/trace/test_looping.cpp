@@ -116,7 +116,10 @@ TEST_CASE("looping statistics are bit-identical for 1 and 3 threads and 1, 4, 8 
   CHECK(lp->counters.loop_lanes_idle > 0);
   CHECK(lp->counters.loop_lane_slots ==
         lp->counters.loop_iterations + lp->counters.loop_lanes_idle);
-  for (auto [threads, lanes] : {std::pair{3, 8}, std::pair{1, 4}, std::pair{3, 16}}) {
+  for (auto [bound_threads, bound_lanes] : {std::pair{3, 8}, std::pair{1, 4}, std::pair{3, 16}}) {
+    // Named copies: clang 14 cannot capture a structured binding (CAPTURE, INFO).
+    const auto& threads = bound_threads;
+    const auto& lanes = bound_lanes;
     CAPTURE(threads);
     CAPTURE(lanes);
     opt.threads = threads;

@@ -164,9 +164,13 @@ TEST_CASE("every stability case at fp24 and fp16 gives its written-down outcome"
     Known k{c.name.c_str(), 0, 0, 0};
     for (const Known& r : kReduced)
       if (c.name == r.name) k = r;
-    for (auto [f, wrong, colour] :
+    for (auto [bound_f, bound_wrong, bound_colour] :
          {std::tuple{vgpu::Format::fp24, k.fp24_wrong, 0},
           std::tuple{vgpu::Format::fp16, k.fp16_wrong, k.fp16_colour_wrong}}) {
+      // Named copies: clang 14 cannot capture a structured binding (CAPTURE, INFO).
+      const auto& f = bound_f;
+      const auto& wrong = bound_wrong;
+      const auto& colour = bound_colour;
       INFO(c.name << " at " << vgpu::format_name(f));
       const stability::Outcome o = stability::run(c, f);
       REQUIRE_MESSAGE(o.error.empty(), o.error);

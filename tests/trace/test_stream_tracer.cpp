@@ -230,7 +230,10 @@ TEST_CASE("images and statistics are bit-identical for 1 and 3 threads and 1 and
   opt.lanes = 1;
   const RenderResult ref = render(scene, grid, test_camera(), opt);
   CHECK(ref.iterations == 3);
-  for (auto [threads, lanes] : {std::pair{3, 8}, std::pair{1, 8}, std::pair{3, 1}}) {
+  for (auto [bound_threads, bound_lanes] : {std::pair{3, 8}, std::pair{1, 8}, std::pair{3, 1}}) {
+    // Named copies: clang 14 cannot capture a structured binding (CAPTURE, INFO).
+    const auto& threads = bound_threads;
+    const auto& lanes = bound_lanes;
     CAPTURE(threads);
     CAPTURE(lanes);
     opt.threads = threads;

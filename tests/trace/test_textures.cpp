@@ -265,8 +265,13 @@ TEST_CASE(
   // One texel per pixel, pixel centres on texel centres (the camera half a texel off the
   // quad's centre): level 0, where red and green are 0 and 1 or 1 and 0.
   const Frames one = lod_frames(1.0f / 64, -1.0f / 64, 1.0);
-  for (const auto& [name, f2, f1] : {std::tuple{std::string("stream"), &two.stream, &one.stream},
-                                     std::tuple{std::string("cpu"), &two.cpu, &one.cpu}}) {
+  for (const auto& [bound_name, bound_f2, bound_f1] :
+       {std::tuple{std::string("stream"), &two.stream, &one.stream},
+        std::tuple{std::string("cpu"), &two.cpu, &one.cpu}}) {
+    // Named copies: clang 14 cannot capture a structured binding (CAPTURE, INFO).
+    const auto& name = bound_name;
+    const auto& f2 = bound_f2;
+    const auto& f1 = bound_f1;
     CAPTURE(name);
     int quad = 0, level1 = 0, level0 = 0;
     for (int y = 0; y < 33; ++y)
@@ -293,8 +298,11 @@ TEST_CASE(
   // green = 0.5. Level 1 alone would give 1, level 2 alone 0.5, the exact log2 (fraction 0.585)
   // 0.707.
   const Frames f = lod_frames(0.28125f, 0.15625f, 3.0);
-  for (const auto& [name, r] :
+  for (const auto& [bound_name, bound_r] :
        {std::pair{std::string("stream"), &f.stream}, std::pair{std::string("cpu"), &f.cpu}}) {
+    // Named copies: clang 14 cannot capture a structured binding (CAPTURE, INFO).
+    const auto& name = bound_name;
+    const auto& r = bound_r;
     CAPTURE(name);
     REQUIRE(r->hit_id[16 * 33 + 16] >= 0);
     const glm::vec3 p = pixel(*r, 16, 16);
