@@ -16,8 +16,9 @@ What it compares:
   cases cover the paper's grid and its options (shading, masks, MRT, looping kernels, reduced
   precision), the other three structures (--accel grid2, bvh, kdtree, each multipass, looping
   and fused) and auto, the sampling modes (--spp, --aa adaptive, --aa undersample), textures
-  and their filters, glass and ray streams, the CPU engine, and animation (--frames, every
-  frame's image and the per-frame JSON; a refitted BVH; --time).
+  and their filters, glass and ray streams, beams over tiles (every structure, looping, auto),
+  the dense streams on and off, adaptive's three criteria, the CPU engine, and animation
+  (--frames, every frame's image and the per-frame JSON; a refitted BVH; --time).
 - --trace-pixel: the printed history of one pixel, text equal, for each structure.
 - Kernels: `vgpu-rt kernels` (the table) and `vgpu-rt kernels NAME --glsl` for every kernel
   OLD lists, text equal.
@@ -77,6 +78,20 @@ CASES = [
     ("glass", S48 + ["--accel", "kdtree", "--spp", "4"], "all", 0),
     ("glass", S48 + ["--accel", "bvh"] + LOOPING, "all", 0),
     ("bunny-refl", S64 + ["--ray-streams", "on"], "all", 0),
+    # Beams over tiles through every structure, multipass and looping, and auto.
+    ("bunny", S64 + ["--beams", "on"], "all", 0),
+    ("bunny-refl", S64 + ["--beams", "on", "--accel", "grid2", "--beam-tile", "4"], "all", 0),
+    ("classic", S64 + ["--beams", "on", "--accel", "bvh"], "all", 0),
+    ("bunny", S64 + ["--beams", "on", "--accel", "kdtree"] + LOOPING, "all", 0),
+    ("classic", S64 + ["--beams", "on"] + LOOPING, "all", 0),
+    ("classic", S64 + ["--beams", "auto"], "all", 0),
+    # The dense streams (sampling that saves time) off as well as on, and adaptive's criteria.
+    ("bunny-refl", S48 + ["--aa", "adaptive", "--spp", "16", "--compact", "off"], "all", 0),
+    ("classic", S48 + ["--aa", "undersample:2", "--compact", "off"], "all", 0),
+    ("classic", S48 + ["--aa", "adaptive", "--spp", "16", "--aa-criterion", "image"], "all", 0),
+    ("bunny-refl", S48 + ["--aa", "adaptive", "--spp", "16", "--aa-criterion", "object",
+                          "--accel", "bvh"], "all", 0),
+    ("bunny", S48 + ["--aa", "adaptive", "--spp", "16", "--aa-budget", "20"], "all", 0),
     # The CPU reference tracer.
     ("bunny-refl", S64 + ["--engine", "cpu"], "threads", 0),
     ("glass", S48 + ["--engine", "cpu", "--accel", "bvh"], "threads", 0),
@@ -94,7 +109,7 @@ TRACES = [
     ("bunny-refl", S64 + ["--trace-pixel", "30,34", "--accel", "kdtree"] + LOOPING),
     ("classic", S64 + ["--trace-pixel", "20,40", "--spp", "4"] + MRT),
 ]
-DROPPED = ("threads", "lanes", "walk", "scene_path")
+DROPPED = ("threads", "lanes", "walk", "walk_passes_because", "scene_path")
 
 
 def strip(j):

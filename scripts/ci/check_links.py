@@ -25,6 +25,9 @@ import sys
 import unicodedata
 from urllib.parse import unquote
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from check_data_named import expand  # noqa: E402  (a page's `a_{x,y}.json` names)
+
 ROOT = os.path.abspath(sys.argv[1] if len(sys.argv) > 1 else
                        os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", ".."))
 SKIP_DIRS = {".git", "node_modules", "__pycache__"}
@@ -105,15 +108,6 @@ def check_target(base_dir, target, page):
         if unquote(anchor).lower() not in anchors(full):
             return f"no heading #{anchor} in {os.path.relpath(full, ROOT)}"
     return None
-
-
-def expand(pattern):
-    """`a_{x,y}.json` -> a_x.json, a_y.json (one level of braces at a time)."""
-    m = re.search(r"\{([^{}]*)\}", pattern)
-    if not m:
-        return [pattern]
-    return [p for alt in m.group(1).split(",")
-            for p in expand(pattern[:m.start()] + alt + pattern[m.end():])]
 
 
 def check_markdown(rel, text, problems):
