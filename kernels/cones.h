@@ -116,4 +116,3 @@ struct MarkCones {
 };
 
 }  // namespace kernels
-
