@@ -6,9 +6,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 #include <vector>
 
 #include "kernel_pass.h"
+#include "tests/support/reference.h"
 
 using kernels::kFar;
 using kernels::kNone;
@@ -68,12 +70,8 @@ double first_exit(const Tile& t, double at, glm::dvec3 lo, glm::dvec3 hi) {
   const glm::dvec3 e(2.5, 2.5, -5.0);
   double out = 1e300;
   for (const auto& d : t.corners) {
-    double tn = -1e300, tf = 1e300;
-    for (int a = 0; a < 3; ++a) {
-      const double t0 = (lo[a] - e[a]) / d[a], t1 = (hi[a] - e[a]) / d[a];
-      tn = std::max(tn, std::min(t0, t1));
-      tf = std::min(tf, std::max(t0, t1));
-    }
+    const std::pair<double, double> in_out = host::box_interval(e, d, lo, hi);
+    const double tn = in_out.first, tf = in_out.second;
     REQUIRE(tn <= at);
     REQUIRE(tf >= at);
     out = std::min(out, tf);

@@ -84,4 +84,14 @@ std::vector<RefHit> brute_force_image(const Scene& scene,
   return image;
 }
 
+std::pair<double, double> box_interval(glm::dvec3 e, glm::dvec3 d, glm::dvec3 lo, glm::dvec3 hi) {
+  double tn = -1e300, tf = 1e300;
+  for (int a = 0; a < 3; ++a) {
+    const double t0 = (lo[a] - e[a]) / d[a], t1 = (hi[a] - e[a]) / d[a];
+    tn = std::max(tn, std::min(t0, t1));
+    tf = std::min(tf, std::max(t0, t1));
+  }
+  return {tn, tf};
+}
+
 }  // namespace host

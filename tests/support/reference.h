@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <functional>
 #include <glm/glm.hpp>
+#include <utility>
 #include <vector>
 
 #include "host/accel/grid.h"
@@ -23,6 +24,10 @@ namespace host {
 //  - a ray starting inside the grid starts in the voxel holding its origin;
 //  - a miss, a zero direction, or a ray that only grazes the box at one point gives an empty list.
 std::vector<glm::ivec3> voxel_walk_reference(const Grid& grid, glm::dvec3 origin, glm::dvec3 dir);
+
+// Where the line e + t d enters and leaves the box [lo, hi], by the slab test in double: {t_in,
+// t_out} (t_in > t_out where the line misses it).
+std::pair<double, double> box_interval(glm::dvec3 e, glm::dvec3 d, glm::dvec3 lo, glm::dvec3 hi);
 
 struct RefHit {
   int64_t tri = -1;     // internal triangle index, -1 = miss

@@ -27,6 +27,7 @@
 #include "host/trace/stream/stream_tracer.h"
 #include "host/trace/walks/bvh_beams.h"
 #include "host/trace/walks/grid_beams.h"
+#include "tests/support/reference.h"
 
 namespace {
 
@@ -143,12 +144,8 @@ glm::dvec3 primary(const host::Camera& cam, int w, int h, double px, double py) 
 
 // Where the ray from e along d leaves the box [lo, hi], which it must be inside at `at`.
 double leaves_box(glm::dvec3 e, glm::dvec3 d, glm::dvec3 lo, glm::dvec3 hi, double at) {
-  double tn = -1e300, tf = 1e300;
-  for (int a = 0; a < 3; ++a) {
-    const double t0 = (lo[a] - e[a]) / d[a], t1 = (hi[a] - e[a]) / d[a];
-    tn = std::max(tn, std::min(t0, t1));
-    tf = std::min(tf, std::max(t0, t1));
-  }
+  const std::pair<double, double> in_out = host::box_interval(e, d, lo, hi);
+  const double tn = in_out.first, tf = in_out.second;
   REQUIRE(tn <= at);
   REQUIRE(tf >= at);
   return tf;
