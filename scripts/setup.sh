@@ -8,7 +8,7 @@ pkgs=(
   build-essential cmake ninja-build pkg-config
   libglm-dev libopenimageio-dev openimageio-tools libtinygltf-dev libstb-dev nlohmann-json3-dev
   doctest-dev libbenchmark-dev libcli11-dev libmeshoptimizer-dev
-  clang libclang-rt-14-dev clang-format
+  clang libclang-rt-14-dev clang-format  # clang: the fuzzer and the sanitizer build (.ci/run)
   python3-matplotlib
   pybind11-dev python3-dev python3-numpy python3-nbclient python3-nbformat python3-ipykernel
   libegl-dev libopengl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri
