@@ -29,6 +29,7 @@
 
 #include "host/cli/render.h"
 #include "host/model/cost_model.h"
+#include "host/report/counters_json.h"
 #include "host/scene/animation.h"
 #include "host/scene/gltf_loader.h"
 #include "host/scene/scene.h"
@@ -498,7 +499,7 @@ PYBIND11_MODULE(_vgpu_rt, m) {
           "passes", [](const vgpu::FrameStats& s) { return s.totals.passes; },
           "Render-to-texture passes in the frame.")
       .def(
-          "json", [](const vgpu::FrameStats& s) { return s.to_json(); },
+          "json", [](const vgpu::FrameStats& s) { return host::frame_counters_json(s).dump(2); },
           "The per-kernel totals as JSON text.");
 
   m.def("render", &render, py::arg("args"),

@@ -1,13 +1,9 @@
-// Statistics arithmetic and their JSON and table forms.
+// Statistics arithmetic and their table form (the JSON form is the report room's:
+// host/report/counters_json.h).
 #include "vgpu/stats.h"
-
-// GCC 12 reports false positives inside nlohmann_json's templates.
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-#pragma GCC diagnostic ignored "-Wrestrict"
 
 #include <algorithm>
 #include <cstdio>
-#include <nlohmann/json.hpp>
 
 namespace vgpu {
 
@@ -22,14 +18,6 @@ bool Counters::same_counts(const Counters& o) const {
   for (const auto& [name, field] : kCounterFields)
     if (this->*field != o.*field) return false;
   return true;
-}
-
-nlohmann::ordered_json to_json(const Counters& c, bool device_timed) {
-  nlohmann::ordered_json j;
-  for (const auto& [name, field] : kCounterFields) j[name] = c.*field;
-  j["host_ms"] = c.host_ms;
-  j["device_ms"] = device_timed ? nlohmann::ordered_json(c.device_ms) : nlohmann::ordered_json();
-  return j;
 }
 
 FrameStats::ProgramTotals& FrameStats::program(const std::string& name,
@@ -51,36 +39,6 @@ void FrameStats::clear() {
   programs.clear();
   totals = {};
   downloads = download_bytes = 0;
-}
-
-nlohmann::ordered_json FrameStats::json() const {
-  nlohmann::ordered_json j;
-  j["totals"] = vgpu::to_json(totals, device_timed);
-  auto progs = nlohmann::ordered_json::array();
-  for (const ProgramTotals& p : programs) {
-    nlohmann::ordered_json e;
-    e["name"] = p.name;
-    e["paper_name"] = p.paper_name;
-    // The static count has its own key: the counters' "instructions" (executed) follow.
-    e["static_instructions"] = p.instructions;
-    const nlohmann::ordered_json c = vgpu::to_json(p.counters, device_timed);  // items() needs it
-    for (auto& [k, v] : c.items()) e[k] = v;
-    if (p.loop_budget > 0) {  // a looping program: its loop per iteration
-      e["loop_budget"] = p.loop_budget;
-      e["loop_body_instructions"] = p.loop_body_instructions;
-      e["loop_active_per_iteration"] = p.loop_active;
-      e["loop_idle_per_iteration"] = p.loop_idle;
-    }
-    progs.push_back(e);
-  }
-  j["programs"] = progs;
-  j["downloads"] = downloads;
-  j["download_bytes"] = download_bytes;
-  return j;
-}
-
-std::string FrameStats::to_json(int indent) const {
-  return json().dump(indent);
 }
 
 static std::string human(uint64_t v) {

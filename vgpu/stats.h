@@ -3,7 +3,6 @@
 #pragma once
 
 #include <cstdint>
-#include <nlohmann/json_fwd.hpp>
 #include <string>
 #include <utility>
 #include <vector>
@@ -99,10 +98,6 @@ inline constexpr std::pair<const char*, uint64_t Counters::*> kCounterFields[] =
     {"loop_span_fetches", &Counters::loop_span_fetches},
     {"loop_span_operations", &Counters::loop_span_operations}};
 
-// The counters as a JSON object: every field of kCounterFields, then host_ms, then device_ms
-// (null unless the device measured it).
-nlohmann::ordered_json to_json(const Counters& c, bool device_timed = false);
-
 // One pass as recorded: which program, what it drew, what it cost.
 struct PassRecord {
   std::string program;
@@ -139,10 +134,8 @@ struct FrameStats {
   const ProgramTotals* find(const std::string& name) const;
   void clear();
 
-  // {"totals": {...}, "programs": [{"name", "paper_name", "static_instructions", counters...}]}
-  nlohmann::ordered_json json() const;
-  std::string to_json(int indent = 2) const;  // json(), as text
-  std::string to_table() const;               // human-readable, one row per program
+  // As JSON: host/report/counters_json.h.
+  std::string to_table() const;  // human-readable, one row per program
 };
 
 }  // namespace vgpu

@@ -23,6 +23,7 @@
 #include <sstream>
 
 #include "host/image/image_io.h"
+#include "host/report/counters_json.h"
 #include "host/scene/scene.h"
 #include "kernels/registry.h"
 #include "vgpu/glsl.h"
@@ -374,7 +375,7 @@ void write_report(const std::string& path, const FrameRecorder& rec, const Rende
   d["kernel_names"] = kernels;
   d["paper_names"] = papers;
   d["target_names"] = targets;
-  d["tail"] = vgpu::to_json(rec.tail());
+  d["tail"] = counters_json(rec.tail());
   auto traces = json::array();
   for (const FrameRecorder::Trace& t : rec.traces())
     traces.push_back({{"kind", kind_name(t.kind)},
@@ -402,9 +403,8 @@ void write_report(const std::string& path, const FrameRecorder& rec, const Rende
                {"rays", pack(rays)}};
   // Beams over tiles (--beams on, or auto when it chose beams): where each tile's rays started.
   if (const BeamMap& b = res.beam_map; !b.start.empty())
-    d["beam_map"] = {{"tiles_x", b.tiles_x},   {"tiles_y", b.tiles_y},
-                     {"tile", b.tile},         {"tree", b.tree},
-                     {"start", pack(b.start)}, {"steps", pack(b.steps)},
+    d["beam_map"] = {{"tiles_x", b.tiles_x},    {"tiles_y", b.tiles_y},   {"tile", b.tile},
+                     {"tree", b.tree},          {"start", pack(b.start)}, {"steps", pack(b.steps)},
                      {"missed", pack(b.missed)}};
   auto wave = json::array();
   for (const auto& w : rec.wavefront()) wave.push_back(pack(w));

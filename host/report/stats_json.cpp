@@ -13,6 +13,7 @@
 
 #include "host/model/cost_model.h"
 #include "host/model/formats.h"
+#include "host/report/counters_json.h"
 #include "host/trace/mrt.h"
 #include "host/trace/stream/mark_streams.h"
 #include "host/trace/stream/ray_streams.h"
@@ -180,7 +181,7 @@ nlohmann::ordered_json frame_stats_json(const FrameStatsInputs& in) {
     if (opt.undersample > 0) j["sampling"]["k"] = opt.undersample;
   }
   {
-    nlohmann::ordered_json stats = r.stats.json();
+    nlohmann::ordered_json stats = frame_counters_json(r.stats);
     if (gl)  // the emulator's SIMD model: a driver does not show its lanes
       for (const char* key :
            {"lanes_idle", "idle_in_batch32", "idle_in_batch1024", "loop_iterations",
@@ -211,7 +212,7 @@ nlohmann::ordered_json frame_stats_json(const FrameStatsInputs& in) {
   auto what_if =
       nlohmann::ordered_json::array();  // MRT and resident programs (docs/studies/table1.md)
   for (const auto& [name, s] : cpu || gl ? decltype(what_ifs(r.stats)){} : what_ifs(r.stats)) {
-    nlohmann::ordered_json w = {{"name", name}, {"totals", vgpu::to_json(s.totals)}};
+    nlohmann::ordered_json w = {{"name", name}, {"totals", counters_json(s.totals)}};
     for (const vgpu::Profile& p : vgpu::profiles())
       for (const auto& [key, v] : predict(s, p).items()) w["predicted_breakdown"][p.name][key] = v;
     what_if.push_back(w);

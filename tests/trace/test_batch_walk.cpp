@@ -17,6 +17,7 @@
 
 #include "host/accel/grid.h"
 #include "host/image/image_io.h"
+#include "host/report/counters_json.h"
 #include "host/scene/camera.h"
 #include "host/scene/gltf_loader.h"
 #include "host/trace/stream/stream_tracer.h"
@@ -49,7 +50,7 @@ Json pass_records(const vgpu::FrameStats& s) {
     out.push_back({{"program", p.program},
                    {"width", p.width},
                    {"height", p.height},
-                   {"counters", without_times(vgpu::to_json(p.counters))},
+                   {"counters", without_times(host::counters_json(p.counters))},
                    {"query_result", p.query_result},
                    {"loop_active", p.loop_active},
                    {"loop_idle", p.loop_idle}});
@@ -73,7 +74,8 @@ void check_same_frame(const host::RenderResult& passes, const host::RenderResult
   CHECK(passes.iterations == batches.iterations);
   CHECK(passes.rays_traced == batches.rays_traced);
   CHECK(passes.rays_unfinished == batches.rays_unfinished);
-  const Json a = without_times(passes.stats.json()), b = without_times(batches.stats.json());
+  const Json a = without_times(host::frame_counters_json(passes.stats)),
+             b = without_times(host::frame_counters_json(batches.stats));
   CHECK_MESSAGE(a == b, "statistics differ: ", differences(a, b));
   CHECK(passes.stats.totals.same_counts(batches.stats.totals));
   CHECK(passes.stats.keep_pass_records == batches.stats.keep_pass_records);

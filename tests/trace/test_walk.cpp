@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "host/report/counters_json.h"
 #include "host/trace/walks/walk.h"
 #include "kernels/common.h"
 #include "tests/support/stats_json.h"
@@ -114,7 +115,8 @@ Run run_countdown(bool batches, int threads, bool masks) {
   host::PassRunner r(gpu, opt, target);
   CountdownWalk::Cursor c{0};
   host::walk::run_walk(r, w, c);
-  return {w.counter[c.cur], r.counts, test_support::without_times(gpu.stats().json()).dump()};
+  return {w.counter[c.cur], r.counts,
+          test_support::without_times(host::frame_counters_json(gpu.stats())).dump()};
 }
 
 }  // namespace

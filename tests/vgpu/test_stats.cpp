@@ -1,28 +1,19 @@
 // Statistics: exact counts for known passes, program loads, and the JSON and table reports.
 #include <doctest/doctest.h>
 
-#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
 #include "helpers.h"
+#include "tests/support/known_pass.h"
 #include "vgpu/vgpu.h"
 
 using namespace vgpu;
+using test_support::Add3;
+using test_support::Known;
+using test_support::known_pass;
 
 namespace {
-
-// Three fetches, one multiply, one add: 5 instructions.
-struct Add3 {
-  static constexpr const char* name = "add3";
-  static constexpr const char* paper_name = "intersecciones";
-  static constexpr int outputs = 1;
-  template <class L>
-  void operator()(Fragments<L>& f) const {
-    auto a = f.fetch_own(0), b = f.fetch_own(1), c = f.fetch_own(2);
-    f.out(0) = {a.x + b.x * c.x, a.y, b.y, c.y};
-  }
-};
 
 // Two outputs of different shapes: 16 + 4 bytes per surviving fragment into fp32x4 and fp16x2.
 struct Split {
@@ -36,29 +27,6 @@ struct Split {
     f.out(1) = {v.x * v.y, v.z, v.w, v.w};
   }
 };
-
-struct Known {
-  Counters pass;
-  FrameStats stats;
-};
-
-// The known pass: 64x64 fragments, three fp32x4 fetches each, one write into `target_format`.
-Known known_pass(int threads, int lanes, Format target_format = Format::fp32,
-                 Format source_format = Format::fp32) {
-  Gpu gpu(profile("gf5700"), threads, lanes);
-  Texture a = gpu.make_texture("a", 64, 64, 4, source_format),
-          b = gpu.make_texture("b", 64, 64, 4, source_format),
-          c = gpu.make_texture("c", 64, 64, 4, source_format),
-          o = gpu.make_texture("o", 64, 64, 4, target_format);
-  KernelProgram<Add3> p;
-  gpu.use_program(p);
-  gpu.bind_texture(0, a);
-  gpu.bind_texture(1, b);
-  gpu.bind_texture(2, c);
-  gpu.set_targets({&o});
-  const Counters pass = gpu.draw().counters;
-  return {pass, gpu.stats()};
-}
 
 }  // namespace
 
@@ -197,30 +165,6 @@ TEST_CASE("same_counts compares every integer counter and ignores host time") {
   CHECK(a.bytes_read == 14);
   CHECK(a.query_readbacks == 1);
   CHECK(a.host_ms == 3.0);
-}
-
-TEST_CASE("the JSON report parses and carries the frame totals and every program") {
-  const Known k = known_pass(2, 8);
-  const nlohmann::json j = nlohmann::json::parse(k.stats.to_json());
-  const Counters& t = k.stats.totals;
-  CHECK(j.at("totals").at("passes").get<uint64_t>() == 1);
-  CHECK(j.at("totals").at("fragments_shaded").get<uint64_t>() == 4096);
-  CHECK(j.at("totals").at("texture_fetches").get<uint64_t>() == 12288);
-  CHECK(j.at("totals").at("bytes_read").get<uint64_t>() == 196608);
-  CHECK(j.at("totals").at("bytes_written").get<uint64_t>() == t.bytes_written);
-  CHECK(j.at("totals").at("instructions").get<uint64_t>() == 20480);
-  CHECK(j.at("totals").at("program_loads").get<uint64_t>() == 1);
-  CHECK(j.at("totals").at("program_bytes").get<uint64_t>() == 80);
-  CHECK(j.at("totals").at("host_ms").get<double>() == doctest::Approx(t.host_ms));
-  REQUIRE(j.at("programs").size() == 1);
-  const nlohmann::json& p = j.at("programs")[0];
-  CHECK(p.at("name") == "add3");
-  CHECK(p.at("paper_name") == "intersecciones");
-  CHECK(p.at("static_instructions") == 5);
-  CHECK(p.at("instructions").get<uint64_t>() == 20480);  // executed: static count x fragments
-  CHECK(p.at("texture_fetches").get<uint64_t>() == 12288);
-  // Compact form parses to the same document.
-  CHECK(nlohmann::json::parse(k.stats.to_json(-1)) == j);
 }
 
 TEST_CASE("the table report has a row for every program and the total") {
