@@ -9,8 +9,10 @@
 // C++ exceptions become Python ones (translate below); nothing here lets one escape otherwise.
 
 // GCC 12 reports false positives inside nlohmann_json's templates.
+#if defined(__GNUC__) && !defined(__clang__)  // GCC's warnings; clang has neither
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #pragma GCC diagnostic ignored "-Wrestrict"
+#endif
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>

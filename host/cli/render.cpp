@@ -3,8 +3,10 @@
 // The command line (main.cpp) and the Python module (python/) both run a render through it.
 
 // GCC 12 reports false positives inside nlohmann_json's templates.
+#if defined(__GNUC__) && !defined(__clang__)  // GCC's warnings; clang has neither
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #pragma GCC diagnostic ignored "-Wrestrict"
+#endif
 #include "host/cli/render.h"
 
 #include <unistd.h>

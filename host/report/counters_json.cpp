@@ -1,8 +1,10 @@
 // The virtual GPU's counters as JSON (host/report/counters_json.h).
 
 // GCC 12 reports false positives inside nlohmann_json's templates.
+#if defined(__GNUC__) && !defined(__clang__)  // GCC's warnings; clang has neither
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #pragma GCC diagnostic ignored "-Wrestrict"
+#endif
 #include "host/report/counters_json.h"
 
 namespace host {

@@ -4,8 +4,10 @@
 // diff of two --stats-json files.
 
 // GCC 12 reports false positives inside nlohmann_json's templates.
+#if defined(__GNUC__) && !defined(__clang__)  // GCC's warnings; clang has neither
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #pragma GCC diagnostic ignored "-Wrestrict"
+#endif
 #include "host/report/report.h"
 
 #include <zlib.h>

@@ -2,8 +2,10 @@
 // --stats-json has always written.
 
 // GCC 12 reports false positives inside nlohmann_json's templates.
+#if defined(__GNUC__) && !defined(__clang__)  // GCC's warnings; clang has neither
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #pragma GCC diagnostic ignored "-Wrestrict"
+#endif
 #include "host/report/stats_json.h"
 
 #include <algorithm>
