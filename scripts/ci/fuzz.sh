@@ -3,14 +3,19 @@
 # runs it for DURATION seconds (default 60) on a scratch copy of tests/fuzz/corpus, so the
 # committed seeds stay as they are. Crash inputs are written to build-fuzz/artifacts/.
 # Usage: scripts/ci/fuzz.sh [DURATION]
+# With VGPU_FUZZ_BUILD=DIR it uses a build folder configured already with clang and
+# -DVGPU_FUZZ=ON (CI's sanitizer build, .ci/run), instead of configuring build-fuzz.
 set -euo pipefail
 
 duration=${1:-60}
 root=$(cd "$(dirname "$0")/../.." && pwd)
-build=$root/build-fuzz
-
-CC=clang CXX=clang++ cmake -S "$root" -B "$build" -DVGPU_FUZZ=ON -DVGPU_BENCH=OFF \
-  -DBUILD_TESTING=OFF -DCMAKE_BUILD_TYPE=RelWithDebInfo
+if [ -n "${VGPU_FUZZ_BUILD:-}" ]; then
+  build=$(cd "$VGPU_FUZZ_BUILD" && pwd)
+else
+  build=$root/build-fuzz
+  CC=clang CXX=clang++ cmake -S "$root" -B "$build" -DVGPU_FUZZ=ON -DVGPU_BENCH=OFF \
+    -DBUILD_TESTING=OFF -DCMAKE_BUILD_TYPE=RelWithDebInfo
+fi
 cmake --build "$build" -j2 --target fuzz_gltf_loader
 
 corpus=$build/corpus

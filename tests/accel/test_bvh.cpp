@@ -155,7 +155,7 @@ bool same(const Bvh& a, const Bvh& b) {
 }  // namespace
 
 TEST_CASE(
-    "the BVH of every bundled scene keeps the layout's invariants and builds the same twice") {
+    "the BVH of every bundled scene keeps the layout's invariants and builds the same twice" * doctest::test_suite("sweep")) {
   const auto scenes = host::list_scenes();
   REQUIRE(scenes.size() >= 8);
   for (const auto& [bound_name, bound_path] : scenes) {

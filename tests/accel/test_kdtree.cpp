@@ -187,7 +187,7 @@ TEST_CASE(
   }
 }
 
-TEST_CASE("every bundled scene's kd-tree lists each triangle in every leaf its box meets") {
+TEST_CASE("every bundled scene's kd-tree lists each triangle in every leaf its box meets" * doctest::test_suite("sweep")) {
   const auto scenes = host::list_scenes();
   REQUIRE(scenes.size() >= 8);
   for (const auto& [bound_name, bound_path] : scenes) {

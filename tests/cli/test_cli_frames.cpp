@@ -250,7 +250,7 @@ TEST_CASE("a multi-frame render writes numbered files and one statistics record 
   fs::remove_all(dir);
 }
 
-TEST_CASE("a refitted BVH gives the rebuilt BVH's hit ids and depths on every frame of hop") {
+TEST_CASE("a refitted BVH gives the rebuilt BVH's hit ids and depths on every frame of hop" * doctest::test_suite("sweep")) {
   const fs::path dir = fresh_dir("refit");
   const std::string common = "render hop --accel bvh --frames 0:2:5 --size 48x40 -q --stats none";
   render_update_modes(common, dir, {"rebuild", "refit", "auto"});
@@ -353,7 +353,7 @@ TEST_CASE("the frame table lists each frame's update, its passes and the nodes i
   }
 }
 
-TEST_CASE("the scatter scene's refitted BVH hits what a rebuild hits while its SAH cost grows") {
+TEST_CASE("the scatter scene's refitted BVH hits what a rebuild hits while its SAH cost grows" * doctest::test_suite("sweep")) {
   // scripts/scenes/scatter_scene.py writes the larger animation of docs/studies/animation.md: ten
   // full bunnies that start inside one another and hop apart.
   const fs::path dir = fresh_dir("scatter");

@@ -152,7 +152,7 @@ uint64_t passes_of(const vgpu::FrameStats& s, const std::string& program) {
 
 }  // namespace
 
-TEST_CASE("every bundled scene at 48x40 gives the same frame and statistics walked in batches") {
+TEST_CASE("every bundled scene at 48x40 gives the same frame and statistics walked in batches" * doctest::test_suite("sweep")) {
   const auto scenes = host::list_scenes();
   REQUIRE(scenes.size() >= 8);
   for (const auto& [bound_name, bound_path] : scenes) {
@@ -289,7 +289,7 @@ TEST_CASE("batch walks on 1 and 2 threads give the frame and statistics of pass 
   }
 }
 
-TEST_CASE("kept pass records are the same pass for pass walked in batches") {
+TEST_CASE("kept pass records are the same pass for pass walked in batches" * doctest::test_suite("sweep")) {
   for (const char* profile : {"gf5700", "gf6600"})
     for (bool mrt : {false, true}) {
       if (mrt && std::string(profile) == "gf5700") continue;  // one output
@@ -328,7 +328,7 @@ TEST_CASE("every stability case at fp32 and fp16 gives the same frame walked in 
 }
 
 TEST_CASE(
-    "the stability suite's fan crowded to 600 triangles at fp16 gives the same frame in batches") {
+    "the stability suite's fan crowded to 600 triangles at fp16 gives the same frame in batches" * doctest::test_suite("sweep")) {
   // The fan of tests/trace/stability_cases.h with 600 triangles round the centre vertex on the
   // voxel edge x = y = 2: the voxel lists near it hold hundreds of entries, past what fp16
   // addresses exactly, so list positions get stuck and the walk's triangle loop runs to its cap

@@ -114,7 +114,7 @@ void check_same_frame(const RenderResult& a, const RenderResult& b) {
 
 }  // namespace
 
-TEST_CASE("every bundled scene gives the grid's primary hit ids and coverage with the bvh") {
+TEST_CASE("every bundled scene gives the grid's primary hit ids and coverage with the bvh" * doctest::test_suite("sweep")) {
   // Measured: no pixel differs on any bundled scene at 64x64 (the tie check below is there for a
   // ray through an edge two triangles share, which the two walks may resolve in other orders).
   const auto scenes = host::list_scenes();
@@ -279,7 +279,7 @@ TEST_CASE("fp16 traversal texels on a bvh of fewer than 1024 nodes give fp32's h
   CHECK(same_bits(ref.depth, r.depth));
 }
 
-TEST_CASE("automatic formats keep fp32's hit ids with the bvh on every bundled scene") {
+TEST_CASE("automatic formats keep fp32's hit ids with the bvh on every bundled scene" * doctest::test_suite("sweep")) {
   // --precision auto, as the CLI resolves it for --accel bvh (its grid is one voxel): the voxel
   // state holds positions in the BVH's lists, which are longer than one voxel's list.
   for (const auto& [bound_name, bound_path] : host::list_scenes()) {

@@ -51,7 +51,7 @@ struct Loaded {
 
 TEST_CASE(
     "dense streams give the gated frames' images, depths and hit ids bit for bit on every "
-    "structure, pass by pass and in batches, at any thread count") {
+    "structure, pass by pass and in batches, at any thread count" * doctest::test_suite("sweep")) {
   const Loaded s("bunny");
   for (const host::AccelKind kind : host::kAccelKinds) {
     const std::unique_ptr<host::Accel> accel = host::make_accel(kind, s.scene, s.params);

@@ -58,7 +58,7 @@ uint64_t passes_of(const RenderResult& r, const char* kernel) {
 
 }  // namespace
 
-TEST_CASE("looping kernels give the multipass hit ids, depths and colours on the bundled scenes") {
+TEST_CASE("looping kernels give the multipass hit ids, depths and colours on the bundled scenes" * doctest::test_suite("sweep")) {
   const auto scenes = bundled_scenes();
   REQUIRE(scenes.size() >= 8);
   for (const std::string& path : scenes) {

@@ -91,7 +91,7 @@ host::RenderResult render(const host::Scene& scene, const host::Grid& grid, cons
 
 }  // namespace
 
-TEST_CASE("every bundled scene at 64x64 gives identical hit ids, depths and images with mrt on") {
+TEST_CASE("every bundled scene at 64x64 gives identical hit ids, depths and images with mrt on" * doctest::test_suite("sweep")) {
   for (const auto& [bound_name, bound_path] : host::list_scenes()) {
     // Named copies: clang 14 cannot capture a structured binding (CAPTURE, INFO).
     const auto& name = bound_name;

@@ -292,7 +292,7 @@ TEST_CASE(
 
 TEST_CASE(
     "adaptive sampling (by either criterion) and undersampling mark the same pixels on every "
-    "acceleration structure, with reflections and shadows, on both engines") {
+    "acceleration structure, with reflections and shadows, on both engines" * doctest::test_suite("sweep")) {
   // bunny-refl: a mirror floor under the bunny, two bounces, shadow rays (the CLI's defaults).
   const host::Scene scene = host::load_scene(host::resolve_scene("bunny-refl"));
   const host::Camera camera = host::scene_camera(scene);

@@ -95,7 +95,7 @@ TYPE_TO_STRING_AS("bvh", Bvh);
 TYPE_TO_STRING_AS("kdtree", KdTree);
 TYPE_TO_STRING_AS("grid2", Grid2);
 
-TEST_CASE_TEMPLATE("the walk gives the grid walk's hit ids on every bundled scene, ties apart", T,
+TEST_CASE_TEMPLATE("the walk gives the grid walk's hit ids on every bundled scene, ties apart" * doctest::test_suite("sweep"), T,
                    KdTree, Grid2) {
   const auto scenes = host::list_scenes();
   REQUIRE(scenes.size() >= 8);
@@ -153,7 +153,7 @@ TEST_CASE_TEMPLATE("the walk gives the grid walk's hit ids on every stability ca
 }
 
 TEST_CASE_TEMPLATE(
-    "the walk in batches gives the frame of pass by pass at 1 and 2 threads, masks on/off", T,
+    "the walk in batches gives the frame of pass by pass at 1 and 2 threads, masks on/off" * doctest::test_suite("sweep"), T,
     KdTree, Grid2) {
   for (const char* name : {"bunny-refl", "classic"}) {
     const Structures s = test_support::bundled_structures(T::kind, name, 40, 36);
