@@ -407,11 +407,12 @@ void add_options(CLI::App& app, Args& a) {
                  "both, or none (no GL frames: the emulator's counts and predictions only)")
       ->check(CLI::IsMember({"block", "poll", "both", "none"}))
       ->capture_default_str();
-  app.add_option(
-         "--accel", a.accels,
-         "Acceleration structures per frame: grid (the paper's, --grid), grid2 (two-level), "
-         "bvh, kdtree")
-      ->check(CLI::IsMember({"grid", "grid2", "bvh", "kdtree"}))
+  std::vector<std::string> accel_words;  // the table's (host/accel/accel.h: kAccelRows)
+  for (const host::AccelRow& row : host::kAccelRows) accel_words.emplace_back(row.name);
+  app.add_option("--accel", a.accels,
+                 "Acceleration structures per frame: " + host::accel_names() +
+                     " (as vgpu-rt render --accel; the grid's resolution is --grid)")
+      ->check(CLI::IsMember(accel_words))
       ->capture_default_str();
   app.add_option("--bounces", a.bounces,
                  "Reflection iterations after the primary one (0: primary "

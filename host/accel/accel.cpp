@@ -1,11 +1,14 @@
-// The acceleration structures behind one interface (accel.h): the factory, and each structure's
-// summary, statistics and update for a moved scene.
+// The acceleration structures behind one interface (accel.h): the table's look-ups, and each
+// structure's build, summary, statistics and update for a moved scene.
 #include "host/accel/accel.h"
 
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <iterator>
 #include <nlohmann/json.hpp>
+#include <stdexcept>
+#include <string>
 
 #include "host/common/parallel.h"
 
@@ -36,25 +39,51 @@ void Accel::find_box(const Scene& scene) {
   triangles_ = scene.triangle_count();
 }
 
+// --- The table (accel.h: kAccelRows) ---
+
+const AccelRow& accel_row(AccelKind kind) {
+  for (const AccelRow& row : kAccelRows)
+    if (row.kind == kind) return row;
+  throw std::logic_error("no row in kAccelRows for acceleration structure kind " +
+                         std::to_string(int(kind)));
+}
+
+std::string_view accel_name(AccelKind k) {
+  return accel_row(k).name;
+}
+
+AccelKind parse_accel_kind(const std::string& text) {
+  for (const AccelRow& row : kAccelRows)
+    if (text == row.name) return row.kind;
+  throw std::invalid_argument("unknown acceleration structure '" + text +
+                              "' (known: " + accel_names() + ")");
+}
+
+std::string accel_names(std::string_view last) {
+  std::string names;
+  for (size_t i = 0; i < std::size(kAccelRows); ++i) {
+    if (i > 0) names += i + 1 < std::size(kAccelRows) ? ", " : last;
+    names += kAccelRows[i].name;
+  }
+  return names;
+}
+
 std::unique_ptr<Accel> make_accel(AccelKind kind, const Scene& scene, const AccelParams& params) {
-  if (kind == AccelKind::grid)
-    return std::make_unique<GridAccel>(build_grid(scene, params.grid, params.threads),
-                                       params.threads);
-  // The other structures are built in the scene's box, found first (and timed: their build
-  // time includes it).
+  return accel_row(kind).build(scene, params);
+}
+
+namespace {
+
+// The structures other than the uniform grid are built in the scene's box, found first (and
+// timed: their build time includes it).
+Bounds timed_box(const Scene& scene, double& box_ms) {
   const auto t0 = std::chrono::steady_clock::now();
   const Bounds box = scene.box();
-  const double box_ms = ms_since(t0);
-  switch (kind) {
-    case AccelKind::grid2:
-      return std::make_unique<Grid2Accel>(scene, build_grid2(scene, params.threads), params.threads,
-                                          box_ms);
-    case AccelKind::bvh:
-      return std::make_unique<BvhAccel>(scene, build_bvh(scene), box, box_ms);
-    default:
-      return std::make_unique<KdAccel>(scene, build_kdtree(scene, box.lo, box.hi), box_ms);
-  }
+  box_ms = ms_since(t0);
+  return box;
 }
+
+}  // namespace
 
 // --- The uniform grid ---
 
@@ -62,6 +91,11 @@ GridAccel::GridAccel(Grid grid, unsigned threads)
     : Accel(AccelKind::grid, box_of(grid.lo, grid.hi), grid.references(), 0.0),
       grid_(std::move(grid)),
       threads_(threads) {}
+
+std::unique_ptr<Accel> GridAccel::build(const Scene& scene, const AccelParams& params) {
+  return std::make_unique<GridAccel>(build_grid(scene, params.grid, params.threads),
+                                     params.threads);
+}
 
 void GridAccel::stats_json(nlohmann::ordered_json& acc) const {
   acc["voxels"] = {grid_.res.x, grid_.res.y, grid_.res.z};
@@ -81,6 +115,13 @@ Grid2Accel::Grid2Accel(const Scene& scene, Grid2 g2, unsigned threads, double bo
     : Accel(AccelKind::grid2, box_of(g2.coarse.lo, g2.coarse.hi), scene.triangle_count(), box_ms),
       g2_(std::move(g2)),
       threads_(threads) {}
+
+std::unique_ptr<Accel> Grid2Accel::build(const Scene& scene, const AccelParams& params) {
+  double box_ms = 0;
+  timed_box(scene, box_ms);
+  return std::make_unique<Grid2Accel>(scene, build_grid2(scene, params.threads), params.threads,
+                                      box_ms);
+}
 
 std::string Grid2Accel::describe() const {
   char line[256];
@@ -121,6 +162,12 @@ BvhAccel::BvhAccel(const Scene& scene, Bvh bvh, const Bounds& box, double box_ms
       bvh_(std::move(bvh)),
       built_sah_(bvh_.sah_cost) {}
 
+std::unique_ptr<Accel> BvhAccel::build(const Scene& scene, const AccelParams&) {
+  double box_ms = 0;
+  const Bounds box = timed_box(scene, box_ms);
+  return std::make_unique<BvhAccel>(scene, build_bvh(scene), box, box_ms);
+}
+
 std::string BvhAccel::describe() const {
   return with_build_ms(host::describe(bvh_), bvh_.build_ms);
 }
@@ -155,6 +202,12 @@ std::string BvhAccel::update(const Scene& scene, const std::string& how) {
 KdAccel::KdAccel(const Scene& scene, KdTree kd, double box_ms)
     : Accel(AccelKind::kdtree, box_of(kd.lo, kd.hi), scene.triangle_count(), box_ms),
       kd_(std::move(kd)) {}
+
+std::unique_ptr<Accel> KdAccel::build(const Scene& scene, const AccelParams&) {
+  double box_ms = 0;
+  const Bounds box = timed_box(scene, box_ms);
+  return std::make_unique<KdAccel>(scene, build_kdtree(scene, box.lo, box.hi), box_ms);
+}
 
 std::string KdAccel::describe() const {
   return with_build_ms(host::describe(kd_), kd_.build_ms);

@@ -1,6 +1,7 @@
 // The acceleration structure a frame walks (--accel): the paper's uniform grid, or an extension
 // built beside it (a two-level grid, a BVH, a kd-tree), made by one factory, make_accel (as
-// pbrt-v4's CreateAccelerator).
+// pbrt-v4's CreateAccelerator), from one table of structures, kAccelRows (the end of this file:
+// each row's kind, name, one-line description and build).
 //
 // Design: a small abstract base, Accel, with one subclass per structure (GridAccel, Grid2Accel,
 // BvhAccel, KdAccel), each owning its structure. What every user asks of a structure (its name,
@@ -8,16 +9,19 @@
 // scene, its statistics) is a member, answered by the structure itself, so the command line,
 // the statistics and --accel auto hold no switch on the kind. A learner reads one class per
 // structure, top to bottom. The walks need the concrete structure: grid(), grid2(), bvh() and
-// kd() give it (nullptr for the other kinds), and host/trace picks the walk for a structure in
-// one place (StreamTracer's constructor; the CPU tracer's trace()).
+// kd() give it (nullptr for the other kinds), and host/trace's table of walks, keyed by the same
+// kinds (host/trace/structures.h: the stream walk, the CPU walk and the kernels each walk loads),
+// gives the walk of a structure.
 //
 // Every structure is built in the scene's padded box (Scene::box()). A structure other than the
 // grid reports, where the statistics name the grid, the one voxel that box is: resolution 1x1x1,
 // every triangle listed once.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <glm/glm.hpp>
+#include <iterator>
 #include <memory>
 #include <nlohmann/json_fwd.hpp>
 #include <stdexcept>
@@ -32,25 +36,18 @@
 
 namespace host {
 
+// The key of a structure's row in kAccelRows (the end of this file) and in host/trace's table of
+// walks (host/trace/structures.h).
 enum class AccelKind { grid, bvh, kdtree, grid2 };
-inline constexpr AccelKind kAccelKinds[] = {AccelKind::grid, AccelKind::grid2, AccelKind::bvh,
-                                            AccelKind::kdtree};
 
-inline std::string_view accel_name(AccelKind k) {
-  return k == AccelKind::grid    ? "grid"
-         : k == AccelKind::grid2 ? "grid2"
-         : k == AccelKind::bvh   ? "bvh"
-                                 : "kdtree";
-}
-
-// "grid", "grid2", "bvh" or "kdtree"; throws std::invalid_argument naming the text and the
-// known names.
-inline AccelKind parse_accel_kind(const std::string& text) {
-  for (AccelKind k : kAccelKinds)
-    if (text == accel_name(k)) return k;
-  throw std::invalid_argument("unknown acceleration structure '" + text +
-                              "' (known: grid, grid2, bvh, kdtree)");
-}
+// The name --accel spells (kAccelRows), e.g. "grid2".
+std::string_view accel_name(AccelKind k);
+// A row's name back to its kind; throws std::invalid_argument naming the text and the known
+// names.
+AccelKind parse_accel_kind(const std::string& text);
+// Every row's name in the table's order, joined by ", " and the last by `last` (", " gives
+// "grid, grid2, bvh, kdtree"; " or " gives "grid, grid2, bvh or kdtree").
+std::string accel_names(std::string_view last = ", ");
 
 // What the builders take: the uniform grid's resolution (the command line's --grid, already
 // fitted to the profile: grid_spec_for) and the build threads (0: hardware concurrency).
@@ -111,8 +108,8 @@ class Accel {
   double box_ms_;       // time taken by Scene::box()
 };
 
-// Builds the structure of `kind` over the scene (in Scene::box()). Throws what the builder
-// throws (std::invalid_argument, std::length_error).
+// Builds the structure of `kind` over the scene (in Scene::box()): its row's build. Throws what
+// the builder throws (std::invalid_argument, std::length_error).
 std::unique_ptr<Accel> make_accel(AccelKind kind, const Scene& scene, const AccelParams& params);
 
 // The paper's uniform grid (grid.h). Its box is the grid's.
@@ -120,6 +117,8 @@ class GridAccel : public Accel {
  public:
   // A grid built elsewhere (tests put voxel planes at chosen coordinates: build_grid_in_box).
   explicit GridAccel(Grid grid, unsigned threads = 0);
+  // Its row's build: the grid at params.grid's resolution.
+  static std::unique_ptr<Accel> build(const Scene& scene, const AccelParams& params);
   const Grid* grid() const override { return &grid_; }
   glm::ivec3 grid_res() const override { return grid_.res; }
   uint64_t grid_references() const override { return grid_.references(); }
@@ -140,6 +139,8 @@ class GridAccel : public Accel {
 class Grid2Accel : public Accel {
  public:
   Grid2Accel(const Scene& scene, Grid2 g2, unsigned threads = 0, double box_ms = 0.0);
+  // Its row's build, in the scene's box (found first, and timed).
+  static std::unique_ptr<Accel> build(const Scene& scene, const AccelParams& params);
   const Grid2* grid2() const override { return &g2_; }
   std::string describe() const override;
   double build_ms() const override { return g2_.build_ms; }  // its coarse grid finds the box
@@ -156,6 +157,8 @@ class Grid2Accel : public Accel {
 class BvhAccel : public Accel {
  public:
   BvhAccel(const Scene& scene, Bvh bvh, const Bounds& box, double box_ms = 0.0);
+  // Its row's build, in the scene's box (found first, and timed).
+  static std::unique_ptr<Accel> build(const Scene& scene, const AccelParams& params);
   const Bvh* bvh() const override { return &bvh_; }
   std::string describe() const override;
   double build_ms() const override { return box_ms_ + bvh_.build_ms; }
@@ -178,6 +181,8 @@ class BvhAccel : public Accel {
 class KdAccel : public Accel {
  public:
   KdAccel(const Scene& scene, KdTree kd, double box_ms = 0.0);
+  // Its row's build, in the scene's box (found first, and timed).
+  static std::unique_ptr<Accel> build(const Scene& scene, const AccelParams& params);
   const KdTree* kd() const override { return &kd_; }
   std::string describe() const override;
   double build_ms() const override { return box_ms_ + kd_.build_ms; }
@@ -188,5 +193,34 @@ class KdAccel : public Accel {
  private:
   KdTree kd_;
 };
+
+// The structures, one row each: the one table every list of structures comes from. To add a
+// structure: add a row here (and its AccelKind), write its Accel subclass, its walk and its CPU
+// walk, and give it its row in host/trace/structures.cpp (the same kinds in the same order, which
+// a static_assert there checks); nothing else lists structures. The order is the one --accel's
+// help, --accel auto's candidates and the tests' sweeps take; the first row is the paper's
+// structure (the default), the others are extensions.
+struct AccelRow {
+  AccelKind kind;
+  std::string_view name;         // as --accel spells it
+  std::string_view description;  // --accel's help, in parentheses after the name
+  std::unique_ptr<Accel> (*build)(const Scene& scene, const AccelParams& params);
+};
+inline constexpr AccelRow kAccelRows[] = {
+    {AccelKind::grid, "grid", "the paper's uniform grid", &GridAccel::build},
+    {AccelKind::grid2, "grid2",
+     "a two-level grid: crowded cells of a coarse grid hold a grid of their own",
+     &Grid2Accel::build},
+    {AccelKind::bvh, "bvh", "a SAH bounding volume hierarchy walked stackless", &BvhAccel::build},
+    {AccelKind::kdtree, "kdtree", "a SAH kd-tree walked by kd-restart", &KdAccel::build},
+};
+// The kinds, in the table's order.
+inline constexpr auto kAccelKinds = [] {
+  std::array<AccelKind, std::size(kAccelRows)> kinds{};
+  for (size_t i = 0; i < kinds.size(); ++i) kinds[i] = kAccelRows[i].kind;
+  return kinds;
+}();
+// The row of `kind`.
+const AccelRow& accel_row(AccelKind kind);
 
 }  // namespace host

@@ -1,8 +1,12 @@
 // The render subcommand's options and validators (see options.h).
 #include "host/cli/options.h"
 
+#include <iterator>
 #include <regex>
+#include <string>
+#include <vector>
 
+#include "host/accel/accel.h"
 #include "host/accel/grid.h"
 #include "host/cli/frames.h"
 #include "host/image/image_io.h"
@@ -17,6 +21,29 @@ namespace {
 constexpr int kMaxImageSide = 16384;
 // Host threads: 0 (one per core) or 1..kMaxThreads; more than this only queues context switches.
 constexpr int kMaxThreads = 256;
+
+// --accel's help: every structure of the table (host/accel/accel.h: kAccelRows) with its
+// description, then auto; the rows after the first (the paper's) are extensions.
+std::string accel_help() {
+  std::string help = "Acceleration structure the rays walk: ";
+  for (const host::AccelRow& row : host::kAccelRows)
+    help += std::string(row.name) + " (" + std::string(row.description) + ") | ";
+  help +=
+      "auto (builds each, renders a probe at a quarter of the size with each and keeps the one "
+      "the cost model predicts cheapest on --profile). ";
+  const size_t n = std::size(host::kAccelRows);
+  for (size_t i = 1; i < n; ++i)
+    help += (i == 1 ? "" : i + 1 < n ? ", " : " and ") + std::string(host::kAccelRows[i].name);
+  return help + (n > 2 ? " are extensions" : " is an extension") + "; docs/studies/structures.md";
+}
+
+// --accel's words: the table's names, then auto.
+std::vector<std::string> accel_choices() {
+  std::vector<std::string> choices;
+  for (const host::AccelRow& row : host::kAccelRows) choices.emplace_back(row.name);
+  choices.emplace_back("auto");
+  return choices;
+}
 
 }  // namespace
 
@@ -207,16 +234,8 @@ void add_render_options(CLI::App& render, RenderArgs& a) {
   render.add_option("--grid", a.grid, "Grid voxels per axis")
       ->check(kGridCheck)
       ->capture_default_str();
-  render
-      .add_option(
-          "--accel", a.accel,
-          "Acceleration structure the rays walk: grid (the paper's uniform grid) | grid2 "
-          "(a two-level grid: crowded cells of a coarse grid hold a grid of their own) | bvh "
-          "(a SAH bounding volume hierarchy walked stackless) | kdtree (a SAH kd-tree "
-          "walked by kd-restart) | auto (builds each, renders a probe at a quarter of the "
-          "size with each and keeps the one the cost model predicts cheapest on "
-          "--profile). grid2, bvh and kdtree are extensions; docs/studies/structures.md")
-      ->check(CLI::IsMember({"grid", "grid2", "bvh", "kdtree", "auto"}))
+  render.add_option("--accel", a.accel, accel_help())
+      ->check(CLI::IsMember(accel_choices()))
       ->capture_default_str();
   render
       .add_option("--profile", a.profile,

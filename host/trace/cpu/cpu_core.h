@@ -17,6 +17,7 @@
 #include "host/trace/cpu/optics.h"
 #include "host/trace/diagonal.h"
 #include "host/trace/sampling.h"
+#include "host/trace/structures.h"
 #include "host/trace/textures.h"
 #include "host/trace/walks/bvh_beams.h"
 #include "kernels/kernels.h"
@@ -100,14 +101,7 @@ struct PrimaryRays {
 class Tracer {
  public:
   Tracer(const Scene& scene, const Accel& accel, const Camera& camera, const RenderOptions& opt)
-      : scene_(scene),
-        grid_(accel.grid()),
-        bvh_(accel.bvh()),
-        kd_(accel.kd()),
-        grid2_(accel.grid2()),
-        cam_(camera),
-        opt_(opt),
-        primary_(camera, opt.width, opt.height) {
+      : scene_(scene), cam_(camera), opt_(opt), primary_(camera, opt.width, opt.height) {
     tris_.reserve(scene.triangle_count());
     geo_normals_.reserve(scene.triangle_count());
     for (size_t i = 0; i < scene.triangle_count(); ++i) {
@@ -121,11 +115,6 @@ class Tracer {
     slack_ = kSlackOfDiagonal * diag;
     offset_ = kOffsetOfDiagonal * diag;
     atten_dist_ = kAttenOfDiagonal * diag;
-    if (grid_)  // the grid walk's box: its outer voxel planes
-      for (int a = 0; a < 3; ++a) {
-        box_lo_[a] = grid_->boundary(a, 0);
-        box_hi_[a] = grid_->boundary(a, grid_->res[a]);
-      }
     iterations_ = 1 + std::max(0, opt.bounces);
     const kernels::Shader shader;
     ambient_ = glm::dvec3(shader.ambient);
@@ -135,14 +124,34 @@ class Tracer {
     for (const SceneTexture& t : scene.textures) chains_.push_back(build_mip_chain(t));
     for (const Material& m : scene.materials) has_glass_ = has_glass_ || m.transmission > 0.0f;
     spread_ = 2.0 * primary_.t / double(opt.height);
-    // Beams over tiles: for the uniform grid's walk, the two-level grid's (marched over its
-    // coarse grid), the BVH's and the kd-tree's (through its nodes' boxes).
-    if (opt.beams && grid_ && !bvh_ && !kd_ && !grid2_)
-      beams_ = std::make_unique<CpuBeams>(*grid_, camera, opt);
-    if (opt.beams && grid2_) beams_ = std::make_unique<CpuBeams>(grid2_->coarse, camera, opt);
-    if (opt.beams && bvh_) bvh_beams_ = std::make_unique<CpuBvhBeams>(*bvh_, camera, opt);
-    if (opt.beams && kd_)
-      bvh_beams_ = std::make_unique<CpuBvhBeams>(kd_beam_nodes(*kd_), camera, opt);
+    // The structure's CPU walk, its row's (host/trace/structures.h): its structure and beams.
+    const CpuWalk& walk = walk_row(accel.kind()).cpu;
+    (this->*walk.start)(accel, camera, opt);
+    walk_ = walk.trace;
+  }
+
+  // The CPU walks' starts (their rows' CpuWalk::start): each takes its structure from `accel`
+  // and makes its beams over tiles where --beams on: for the uniform grid's walk, the two-level
+  // grid's (marched over its coarse grid), the BVH's and the kd-tree's (through its nodes' boxes).
+  void start_grid(const Accel& accel, const Camera& camera, const RenderOptions& opt) {
+    grid_ = &walked(accel.grid(), accel);
+    for (int a = 0; a < 3; ++a) {  // the grid walk's box: its outer voxel planes
+      box_lo_[a] = grid_->boundary(a, 0);
+      box_hi_[a] = grid_->boundary(a, grid_->res[a]);
+    }
+    if (opt.beams) beams_ = std::make_unique<CpuBeams>(*grid_, camera, opt);
+  }
+  void start_grid2(const Accel& accel, const Camera& camera, const RenderOptions& opt) {
+    grid2_ = &walked(accel.grid2(), accel);
+    if (opt.beams) beams_ = std::make_unique<CpuBeams>(grid2_->coarse, camera, opt);
+  }
+  void start_bvh(const Accel& accel, const Camera& camera, const RenderOptions& opt) {
+    bvh_ = &walked(accel.bvh(), accel);
+    if (opt.beams) bvh_beams_ = std::make_unique<CpuBvhBeams>(*bvh_, camera, opt);
+  }
+  void start_kd(const Accel& accel, const Camera& camera, const RenderOptions& opt) {
+    kd_ = &walked(accel.kd(), accel);
+    if (opt.beams) bvh_beams_ = std::make_unique<CpuBvhBeams>(kd_beam_nodes(*kd_), camera, opt);
   }
 
   // What the frame's beams cost (nothing where beams are off).
@@ -199,9 +208,14 @@ class Tracer {
   Hit trace(const glm::dvec3& o, const glm::dvec3& d, double tmax, bool any_hit, Counters& c,
             const CpuBeamStart* beam = nullptr) const {
     ++c.rays;
-    if (bvh_) return trace_bvh(o, d, tmax, any_hit, c, beam);
-    if (kd_) return trace_kd(o, d, tmax, any_hit, c, beam);
-    if (grid2_) return trace_grid2(o, d, tmax, any_hit, c, beam);
+    return (this->*walk_)(o, d, tmax, any_hit, c, beam);
+  }
+
+  // The uniform grid's walk (Amanatides & Woo, the paper's) in double: every triangle of each
+  // voxel the ray crosses, a hit counting only inside its voxel (with the slack). `beam` (a
+  // primary ray's, beams over tiles): the whole tile misses, or the walk may start further on.
+  Hit trace_grid(const glm::dvec3& o, const glm::dvec3& d, double tmax, bool any_hit, Counters& c,
+                 const CpuBeamStart* beam) const {
     Hit best;
     // Slab test against the grid box.
     double tnear = 0.0, tfar = tmax;
@@ -685,6 +699,9 @@ class Tracer {
   const Bvh* bvh_ = nullptr;
   const KdTree* kd_ = nullptr;
   const Grid2* grid2_ = nullptr;
+  // Its row's CpuWalk::trace: trace_grid, trace_grid2, trace_bvh or trace_kd.
+  Hit (Tracer::*walk_)(const glm::dvec3&, const glm::dvec3&, double, bool, Counters&,
+                       const CpuBeamStart*) const = nullptr;
   const Camera& cam_;
   const RenderOptions& opt_;
   const PrimaryRays primary_;

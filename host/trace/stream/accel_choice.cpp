@@ -7,6 +7,7 @@
 
 #include "host/model/cost_model.h"
 #include "host/trace/stream/stream_tracer.h"
+#include "host/trace/structures.h"
 #include "kernels/kernels.h"
 
 namespace host {
@@ -19,23 +20,18 @@ WalkWork walk_work(const vgpu::FrameStats& stats, uint64_t rays_traced) {
     const vgpu::Counters& c = p->counters;
     return c.fragments_shaded - std::min(c.lanes_idle, c.fragments_shaded);
   };
-  using namespace kernels;
-  w.voxel_steps = useful(Traversal::name) + useful(TraverseUpdate::name) + useful(Grid2Step::name) +
-                  useful(Grid2StepLoad::name);
-  w.nodes_visited = useful(BvhStep::name) + useful(BvhStepLoad::name) + useful(KdStep::name) +
-                    useful(KdStepLoad::name);
-  w.triangle_tests = useful(Intersections::name) + useful(IntersectNext::name) +
-                     useful(BvhIntersections::name) + useful(BvhIntersectNext::name) +
-                     useful(KdIntersections::name) + useful(KdIntersectNext::name) +
-                     useful(Grid2Intersections::name) + useful(Grid2IntersectNext::name);
-  if (stats.find(KdLoadLeaf::name)) {
-    const uint64_t leaves = useful(KdLoadLeaf::name);
+  // Every structure's walk kernels (its row's, host/trace/structures.h): a frame runs one's.
+  for (const WalkRow& row : walk_rows()) {
+    const WalkKernels& k = row.kernels;
+    for (const char* name : k.steps) (k.tree ? w.nodes_visited : w.voxel_steps) += useful(name);
+    for (const char* name : k.tests) w.triangle_tests += useful(name);
+    if (const vgpu::FrameStats::ProgramTotals* p = stats.find(k.looping))
+      w.loop_iterations += p->counters.loop_iterations;
+  }
+  if (stats.find(kernels::KdLoadLeaf::name)) {
+    const uint64_t leaves = useful(kernels::KdLoadLeaf::name);
     w.restarts = leaves >= rays_traced ? int64_t(leaves - rays_traced) : 0;
   }
-  for (const char* name :
-       {LoopingTraversal::name, BvhLooping::name, KdLooping::name, Grid2Looping::name})
-    if (const vgpu::FrameStats::ProgramTotals* p = stats.find(name))
-      w.loop_iterations += p->counters.loop_iterations;
   return w;
 }
 

@@ -21,11 +21,9 @@
 #include "host/trace/stream/mark_streams.h"
 #include "host/trace/stream/ray_streams.h"
 #include "host/trace/stream/stream_state.h"
+#include "host/trace/structures.h"
 #include "host/trace/textures.h"
-#include "host/trace/walks/bvh_walk.h"
-#include "host/trace/walks/grid2_walk.h"
 #include "host/trace/walks/grid_walk.h"
-#include "host/trace/walks/kd_walk.h"
 
 namespace host {
 
@@ -97,17 +95,9 @@ StreamTracer::StreamTracer(const Scene& scene, const Accel& accel, const RenderO
     s.textured = true;
   }
 
-  // The acceleration structure's textures and walk (host/trace/walks/grid_walk.h, bvh_walk.h,
-  // kd_walk.h, grid2_walk.h): the one place a structure's walk is chosen.
+  // The acceleration structure's textures and walk: its row's (host/trace/structures.h).
   const float t_slack = float(kSlackOfDiagonal) * glm::length(box_.hi - box_.lo);
-  if (const Bvh* bvh = accel.bvh())
-    s.walk = std::make_unique<BvhWalk>(gpu, *bvh, opt_, float(s.v[0].width()));
-  else if (const KdTree* kd = accel.kd())
-    s.walk = std::make_unique<KdWalk>(gpu, *kd, opt_, float(s.v[0].width()), t_slack);
-  else if (const Grid2* g2 = accel.grid2())
-    s.walk = std::make_unique<Grid2Walk>(gpu, *g2, opt_, float(s.v[0].width()), t_slack);
-  else
-    s.walk = std::make_unique<GridWalk>(gpu, *accel.grid(), opt_, float(s.v[0].width()));
+  s.walk = walk_row(accel.kind()).stream_walk(gpu, accel, opt_, float(s.v[0].width()), t_slack);
 
   // Video memory gets the static textures at initialization (and again, where they change,
   // between frames of a moving scene: update()).
