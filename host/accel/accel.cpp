@@ -6,7 +6,6 @@
 #include <chrono>
 #include <cstdio>
 #include <iterator>
-#include <nlohmann/json.hpp>
 #include <stdexcept>
 #include <string>
 
@@ -97,10 +96,9 @@ std::unique_ptr<Accel> GridAccel::build(const Scene& scene, const AccelParams& p
                                      params.threads);
 }
 
-void GridAccel::stats_json(nlohmann::ordered_json& acc) const {
-  acc["voxels"] = {grid_.res.x, grid_.res.y, grid_.res.z};
-  acc["references"] = grid_.references();
-  acc["build_ms"] = grid_.build_ms;
+AccelStats GridAccel::stats() const {
+  return GridStats{
+      .voxels = grid_.res, .references = grid_.references(), .build_ms = grid_.build_ms};
 }
 
 std::string GridAccel::update(const Scene& scene, const std::string&) {
@@ -138,15 +136,14 @@ uint64_t Grid2Accel::list_entries() const {
   return std::max<uint64_t>(g2_.lists.size(), g2_.sub_cells());
 }
 
-void Grid2Accel::stats_json(nlohmann::ordered_json& acc) const {
-  const Grid& c = g2_.coarse;
-  acc["coarse"] = {c.res.x, c.res.y, c.res.z};
-  acc["crowded_cells"] = g2_.crowded;
-  acc["sub_cells"] = g2_.sub_cells();
-  acc["list_entries"] = g2_.lists.size();
-  acc["references"] = g2_.references;
-  acc["max_list"] = g2_.max_list;
-  acc["build_ms"] = g2_.build_ms;
+AccelStats Grid2Accel::stats() const {
+  return Grid2Stats{.coarse = g2_.coarse.res,
+                    .crowded_cells = g2_.crowded,
+                    .sub_cells = g2_.sub_cells(),
+                    .list_entries = g2_.lists.size(),
+                    .references = g2_.references,
+                    .max_list = g2_.max_list,
+                    .build_ms = g2_.build_ms};
 }
 
 std::string Grid2Accel::update(const Scene& scene, const std::string&) {
@@ -172,14 +169,14 @@ std::string BvhAccel::describe() const {
   return with_build_ms(host::describe(bvh_), bvh_.build_ms);
 }
 
-void BvhAccel::stats_json(nlohmann::ordered_json& acc) const {
-  acc["nodes"] = bvh_.nodes.size();
-  acc["leaves"] = bvh_.leaves;
-  acc["depth"] = bvh_.depth;
-  acc["max_leaf"] = bvh_.max_leaf;
-  acc["references"] = bvh_.references();
-  acc["sah_cost"] = bvh_.sah_cost;
-  acc["build_ms"] = bvh_.build_ms;
+AccelStats BvhAccel::stats() const {
+  return BvhStats{.nodes = bvh_.nodes.size(),
+                  .leaves = bvh_.leaves,
+                  .depth = bvh_.depth,
+                  .max_leaf = bvh_.max_leaf,
+                  .references = bvh_.references(),
+                  .sah_cost = bvh_.sah_cost,
+                  .build_ms = bvh_.build_ms};
 }
 
 std::string BvhAccel::update(const Scene& scene, const std::string& how) {
@@ -213,15 +210,15 @@ std::string KdAccel::describe() const {
   return with_build_ms(host::describe(kd_), kd_.build_ms);
 }
 
-void KdAccel::stats_json(nlohmann::ordered_json& acc) const {
-  acc["nodes"] = kd_.nodes.size();
-  acc["leaves"] = kd_.leaves;
-  acc["empty_leaves"] = kd_.empty_leaves;
-  acc["depth"] = kd_.depth;
-  acc["max_leaf"] = kd_.max_leaf;
-  acc["references"] = kd_.references();
-  acc["sah_cost"] = kd_.sah_cost;
-  acc["build_ms"] = kd_.build_ms;
+AccelStats KdAccel::stats() const {
+  return KdTreeStats{.nodes = kd_.nodes.size(),
+                     .leaves = kd_.leaves,
+                     .empty_leaves = kd_.empty_leaves,
+                     .depth = kd_.depth,
+                     .max_leaf = kd_.max_leaf,
+                     .references = kd_.references(),
+                     .sah_cost = kd_.sah_cost,
+                     .build_ms = kd_.build_ms};
 }
 
 std::string KdAccel::update(const Scene& scene, const std::string&) {

@@ -23,11 +23,11 @@
 #include <glm/glm.hpp>
 #include <iterator>
 #include <memory>
-#include <nlohmann/json_fwd.hpp>
 #include <stdexcept>
 #include <string>
 #include <string_view>
 
+#include "host/accel/accel_stats.h"
 #include "host/accel/bvh.h"
 #include "host/accel/grid.h"
 #include "host/accel/grid2.h"
@@ -89,8 +89,9 @@ class Accel {
   // Entries of the triangle-list texture, which the formats must address (host/model/formats.h);
   // 0 for the uniform grid, whose lists the formats count themselves.
   virtual uint64_t list_entries() const = 0;
-  // The structure's own fields of the statistics' "accel" object, after "structure".
-  virtual void stats_json(nlohmann::ordered_json& acc) const = 0;
+  // The structure's own statistics (accel_stats.h: the alternative of its kind), which the
+  // report room writes as the statistics' "accel" object, after "structure".
+  virtual AccelStats stats() const = 0;
   // A later frame of a moving scene (the same triangles, moved): the structure follows `scene`
   // as --update `how` says ("rebuild"; for a BVH also "refit" or "auto", see BvhAccel). Returns
   // what was done: "rebuild" or "refit".
@@ -126,7 +127,7 @@ class GridAccel : public Accel {
   std::string describe() const override { return {}; }
   double build_ms() const override { return grid_.build_ms; }
   uint64_t list_entries() const override { return 0; }
-  void stats_json(nlohmann::ordered_json& acc) const override;
+  AccelStats stats() const override;
   // Rebuilt at the first build's resolution (so the voxel pointers keep their texture).
   std::string update(const Scene& scene, const std::string& how) override;
 
@@ -145,7 +146,7 @@ class Grid2Accel : public Accel {
   std::string describe() const override;
   double build_ms() const override { return g2_.build_ms; }  // its coarse grid finds the box
   uint64_t list_entries() const override;
-  void stats_json(nlohmann::ordered_json& acc) const override;
+  AccelStats stats() const override;
   std::string update(const Scene& scene, const std::string& how) override;
 
  private:
@@ -163,7 +164,7 @@ class BvhAccel : public Accel {
   std::string describe() const override;
   double build_ms() const override { return box_ms_ + bvh_.build_ms; }
   uint64_t list_entries() const override { return bvh_.lists.size(); }
-  void stats_json(nlohmann::ordered_json& acc) const override;
+  AccelStats stats() const override;
   // --update refit keeps the topology and moves the boxes (refit_bvh); auto refits until the
   // refitted tree's SAH cost passes kRefitLimit times the last build's, then builds again;
   // rebuild builds again.
@@ -187,7 +188,7 @@ class KdAccel : public Accel {
   std::string describe() const override;
   double build_ms() const override { return box_ms_ + kd_.build_ms; }
   uint64_t list_entries() const override { return kd_.lists.size(); }
-  void stats_json(nlohmann::ordered_json& acc) const override;
+  AccelStats stats() const override;
   std::string update(const Scene& scene, const std::string& how) override;
 
  private:

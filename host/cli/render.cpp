@@ -2,7 +2,7 @@
 // loaded and its structure built, each frame rendered and its files and statistics written.
 // The command line (main.cpp) and the Python module (python/) both run a render through it.
 
-// GCC 12 reports false positives inside nlohmann_json's templates.
+// GCC 12 reports false positives inside the JSON library's templates (host/report/stats_value.h).
 #if defined(__GNUC__) && !defined(__clang__)  // GCC's warnings; clang has neither
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #pragma GCC diagnostic ignored "-Wrestrict"
@@ -19,7 +19,6 @@
 #include <functional>
 #include <iostream>
 #include <memory>
-#include <nlohmann/json.hpp>
 #include <numeric>
 #include <optional>
 
@@ -553,8 +552,8 @@ int run_render(const RenderArgs& a, bool lanes_given, RenderOutcome* outcome,
       plan.times = cli::frame_times({first, last, int(times.size())});
     }
   }
-  const nlohmann::ordered_json animation_json =
-      animated ? host::animation_json(animated->animations(), animation) : nullptr;
+  const host::StatsJson animation_json =
+      animated ? host::animation_json(animated->animations(), animation) : host::StatsJson();
   auto pose_start = std::chrono::steady_clock::now();
   host::Scene scene = animated ? animated->at(animation, times[0]) : host::load_scene(path, load);
   if (!scene.textures_fitted.empty())
@@ -618,9 +617,10 @@ int run_render(const RenderArgs& a, bool lanes_given, RenderOutcome* outcome,
 
   // Frame by frame: the scene posed, the structure rebuilt, the static textures that changed
   // uploaded again (--update rebuild), the frame rendered and its files written.
-  nlohmann::ordered_json j, frames_json = nlohmann::ordered_json::array();
+  host::StatsJson j;
+  std::vector<host::StatsJson> frames_json;
   std::vector<FrameLine> lines;
-  std::optional<std::pair<host::RenderResult, nlohmann::ordered_json>> reported;  // --report-frame
+  std::optional<std::pair<host::RenderResult, host::StatsJson>> reported;  // --report-frame
   std::string action = "initial";
   for (size_t f = 0; f < times.size(); ++f) {
     const int number = int(f) + 1;
@@ -650,13 +650,10 @@ int run_render(const RenderArgs& a, bool lanes_given, RenderOutcome* outcome,
     double predicted = 0;
     if (!cpu && !gl) predicted = host::predict(r.stats, vgpu::profile(opt.profile)).total_ms;
     if (animating) {
-      const nlohmann::ordered_json update =
+      host::add_moving_frame(
+          j, number, times[f], animation_json,
           host::frame_update_json(f == 0 ? std::string("initial") : action, pose_ms, accel.kind(),
-                                  accel.build_ms(), write_ms, up, tracer.has_value());
-      j["frame"] = number;
-      j["time"] = times[f];
-      j["animation"] = animation_json;
-      j["update"] = update;
+                                  accel.build_ms(), write_ms, up, tracer.has_value()));
       if (several) frames_json.push_back(j);
       if (number == a.report_frame) reported.emplace(r, j);
       if (!a.quiet)
@@ -675,15 +672,14 @@ int run_render(const RenderArgs& a, bool lanes_given, RenderOutcome* outcome,
                      cpu ? cpu_stats.voxel_steps : work.voxel_steps});
   }
   if (several)
-    j = {{"scene", scene.name}, {"scene_path", path},          {"animation", animation_json},
-         {"update", a.update},  {"frame_count", times.size()}, {"frames", frames_json}};
+    j = host::frames_stats_json(scene.name, path, animation_json, a.update, std::move(frames_json));
   if (!a.stats_json.empty()) host::write_stats_json(a.stats_json, j);
   if (!a.stats_csv.empty()) host::write_stats_csv(a.stats_csv, *recorder);
   if (!a.report.empty())
     host::write_report(a.report, *recorder, reported ? reported->first : r,
                        reported ? reported->second : j);
   if (a.stats == "json") {
-    std::cout << j.dump(2) << "\n";
+    std::cout << host::stats_text(j);
   } else if (a.stats == "table" && several) {
     print_frames_table(a, plan, scene, accel.kind(), r, lines, init_ms,
                        played_text(animated ? &*animated : nullptr, animation,

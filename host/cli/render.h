@@ -4,11 +4,11 @@
 #pragma once
 
 #include <cstddef>
-#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
 #include "host/cli/options.h"
+#include "host/report/stats_value.h"
 #include "host/trace/render_options.h"
 
 namespace cli {
@@ -17,8 +17,8 @@ namespace cli {
 // image, AOVs and pass statistics) and the statistics object --stats-json writes.
 struct RenderOutcome {
   host::RenderResult result;
-  nlohmann::ordered_json stats;
-  size_t frames = 0;  // frames rendered (--frames: several; stats then holds them all)
+  host::StatsJson stats;  // written by the report room (host/report/stats_json.h)
+  size_t frames = 0;      // frames rendered (--frames: several; stats then holds them all)
 };
 
 // Parses `render`'s arguments (the scene, then options as on the command line, e.g. {"bunny",

@@ -3,7 +3,6 @@
 #include "host/model/formats.h"
 
 #include <algorithm>
-#include <nlohmann/json.hpp>
 #include <stdexcept>
 
 namespace host {
@@ -185,14 +184,6 @@ Formats auto_formats(const Scene& scene, const Grid& grid, const vgpu::Profile& 
   f.why[size_t(Group::queries)] =
       "query kernels test only the sign of a -1 marker: exact in every format" + only;
   return f;
-}
-
-nlohmann::ordered_json to_json(const Formats& f) {
-  nlohmann::ordered_json j = nlohmann::ordered_json::object();
-  for (Group g : kGroups)
-    j[std::string(group_name(g))] = {
-        {"texels", name(f[g])}, {"arithmetic", name(f.arithmetic(g))}, {"why", f.why[size_t(g)]}};
-  return j;
 }
 
 std::string describe(const Formats& f) {

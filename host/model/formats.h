@@ -5,7 +5,6 @@
 #pragma once
 
 #include <array>
-#include <nlohmann/json_fwd.hpp>
 #include <string>
 #include <string_view>
 
@@ -32,7 +31,8 @@ inline constexpr std::array<Group, 6> kGroups = {Group::rays, Group::traversal, 
 std::string_view group_name(Group g);
 
 // Per group: the texels' format and the writing kernels' arithmetic (NV3x code often stored half
-// and computed float). fp32 everywhere by default.
+// and computed float). fp32 everywhere by default. The statistics' "formats" object is written
+// from it by the report room (host/report/stats_parts_json.h).
 struct Formats {
   std::array<vgpu::Format, kGroups.size()> format{};  // texels
   std::array<vgpu::Format, kGroups.size()> arith{};   // arithmetic of the group's kernels
@@ -91,8 +91,6 @@ uint64_t exact_addresses(vgpu::Format f);
 Formats auto_formats(const Scene& scene, const Grid& grid, const vgpu::Profile& profile,
                      uint64_t list_entries = 0);
 
-// {"rays": {"texels": "fp32", "arithmetic": "fp32", "why": "..."}, ...}
-nlohmann::ordered_json to_json(const Formats& f);
 // One line per group: "  voxel      fp32  list positions reach 14373 ...".
 std::string describe(const Formats& f);
 

@@ -16,9 +16,8 @@
 #include "host/model/cost_model.h"
 #include "host/model/formats.h"
 #include "host/report/counters_json.h"
+#include "host/report/stats_parts_json.h"
 #include "host/trace/mrt.h"
-#include "host/trace/stream/mark_streams.h"
-#include "host/trace/stream/ray_streams.h"
 #include "vgpu/vgpu.h"
 
 namespace host {
@@ -47,7 +46,8 @@ nlohmann::ordered_json frame_stats_json(const FrameStatsInputs& in) {
   {
     nlohmann::ordered_json acc;
     acc["structure"] = accel.name();
-    accel.stats_json(acc);  // the structure's own fields
+    const nlohmann::ordered_json own = accel_stats_json(accel.stats());  // the structure's fields
+    for (const auto& [key, v] : own.items()) acc[key] = v;
     if (!cpu) {
       const WalkWork w = walk_work(r.stats, r.rays_traced);
       acc["work"] = {{"voxel_steps", w.voxel_steps},
@@ -94,7 +94,7 @@ nlohmann::ordered_json frame_stats_json(const FrameStatsInputs& in) {
     if (!r.walk_reason.empty()) j["walk_passes_because"] = r.walk_reason;
   }
   j["precision"] = in.precision;
-  if (!cpu) j["formats"] = to_json(opt.formats);
+  if (!cpu) j["formats"] = formats_json(opt.formats);
   j["init_ms"] = in.init_ms;
   j["grid_build_ms"] = accel.grid_build_ms();
   j["render_ms"] = r.render_ms;
@@ -110,8 +110,8 @@ nlohmann::ordered_json frame_stats_json(const FrameStatsInputs& in) {
                 {"total_internal", cpu_stats.total_internal},
                 {"glass_shadow_crossings", cpu_stats.glass_shadow_crossings}};
   j["rays_traced"] = r.rays_traced;
-  if (r.streams.on) j["streams"] = to_json(r.streams);  // glass's ray streams
-  if (r.compact.on) j["compact"] = to_json(r.compact);  // the sampling modes' dense streams
+  if (r.streams.on) j["streams"] = streams_json(r.streams);  // glass's ray streams
+  if (r.compact.on) j["compact"] = compact_json(r.compact);  // the sampling modes' dense streams
   j["rays_unfinished"] = r.rays_unfinished;
   // Beams over tiles (--beams on): the tile size, beam passes (rayosHaz), tiles marched over the
   // frame's primary traces, and tiles whose whole beam missed the grid. Absent with beams off,
@@ -262,10 +262,30 @@ nlohmann::ordered_json frame_update_json(const std::string& mode, double pose_ms
   return update;
 }
 
+void add_moving_frame(StatsJson& j, int frame, double time, const StatsJson& animation,
+                      StatsJson update) {
+  j["frame"] = frame;
+  j["time"] = time;
+  j["animation"] = animation;
+  j["update"] = std::move(update);
+}
+
+StatsJson frames_stats_json(const std::string& scene, const std::string& scene_path,
+                            const StatsJson& animation, const std::string& update,
+                            std::vector<StatsJson> frames) {
+  const size_t count = frames.size();
+  return {{"scene", scene},   {"scene_path", scene_path}, {"animation", animation},
+          {"update", update}, {"frame_count", count},     {"frames", std::move(frames)}};
+}
+
+std::string stats_text(const StatsJson& j) {
+  return j.dump(2) + "\n";
+}
+
 void write_stats_json(const std::string& path, const nlohmann::ordered_json& j) {
   const std::string tmp = path + ".tmp";
   std::ofstream f(tmp);
-  f << j.dump(2) << "\n";
+  f << stats_text(j);
   f.close();
   if (!f || std::rename(tmp.c_str(), path.c_str()) != 0) {
     std::remove(tmp.c_str());

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "host/accel/accel.h"
+#include "host/report/stats_value.h"
 #include "host/scene/animation.h"
 #include "host/scene/scene.h"
 #include "host/trace/cpu/cpu_tracer.h"
@@ -55,8 +56,23 @@ nlohmann::ordered_json frame_update_json(const std::string& mode, double pose_ms
                                          AccelKind structure, double build_ms, double write_ms,
                                          const StreamTracer::Upload& up, bool uploaded);
 
-// Writes `j` (indented by 2, then a newline) to `path` through a temporary file renamed over it;
-// throws InputError naming the path when it cannot.
+// A moving scene's frame (--time, --frames): its statistics object `j` (frame_stats_json) with
+// "frame" (1 to N), "time", "animation" (animation_json) and "update" (frame_update_json) added.
+void add_moving_frame(StatsJson& j, int frame, double time, const StatsJson& animation,
+                      StatsJson update);
+
+// --frames' document: {scene, scene_path, animation, update (the --update mode), frame_count,
+// frames}, `frames` each frame's object (add_moving_frame).
+StatsJson frames_stats_json(const std::string& scene, const std::string& scene_path,
+                            const StatsJson& animation, const std::string& update,
+                            std::vector<StatsJson> frames);
+
+// The document as --stats json prints it and --stats-json writes it: indented by 2, then a
+// newline.
+std::string stats_text(const StatsJson& j);
+
+// Writes stats_text(j) to `path` through a temporary file renamed over it; throws InputError
+// naming the path when it cannot.
 void write_stats_json(const std::string& path, const nlohmann::ordered_json& j);
 
 }  // namespace host

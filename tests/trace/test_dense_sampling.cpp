@@ -105,11 +105,9 @@ TEST_CASE(
   CHECK(dense.stats.totals.passes < gated.stats.totals.passes);
   const vgpu::Profile& p = vgpu::profile("gf6600");
   CHECK(host::predict(dense.stats, p).total_ms < 0.5 * host::predict(gated.stats, p).total_ms);
-  const nlohmann::ordered_json j = host::to_json(c);
-  CHECK(j["frames"] == c.frames);
-  CHECK(j["live_rays"] == c.live_rays);
-  CHECK(j["scan"]["passes"] == c.scan_passes);
-  CHECK(j["gather"]["bytes"] == c.gather_bytes);
+  CHECK(c.scan_bytes > 0);  // the report room writes these (tests/report/test_stats_parts_json.cpp)
+  CHECK(c.compaction_bytes > 0);
+  CHECK(c.gather_bytes > 0);
   CHECK(host::describe(c).find("dense streams: ") == 0);
 }
 

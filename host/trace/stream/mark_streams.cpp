@@ -25,20 +25,6 @@ void add(const vgpu::PassRecord& rec, uint64_t& passes, uint64_t& bytes) {
 
 }  // namespace
 
-nlohmann::ordered_json to_json(const CompactStats& s) {
-  auto job = [](uint64_t passes, uint64_t bytes) {
-    return nlohmann::ordered_json{{"passes", passes}, {"bytes", bytes}};
-  };
-  return {{"packs", s.packs},
-          {"frames", s.frames},
-          {"live_rays", s.live_rays},
-          {"slots", s.slots},
-          {"pixels", s.pixels},
-          {"scan", job(s.scan_passes, s.scan_bytes)},
-          {"compaction", job(s.compaction_passes, s.compaction_bytes)},
-          {"gather", job(s.gather_passes, s.gather_bytes)}};
-}
-
 std::string describe(const CompactStats& s) {
   auto mb = [](uint64_t b) { return double(b) / 1e6; };
   const double share = s.pixels ? 100.0 * double(s.slots) / double(s.pixels) : 0.0;

@@ -9,7 +9,6 @@
 
 #include <cstdint>
 #include <glm/glm.hpp>
-#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -21,8 +20,8 @@
 
 namespace host {
 
-// The statistics as --stats-json writes them ("compact") and as the table's line prints them.
-nlohmann::ordered_json to_json(const CompactStats& s);
+// The statistics (CompactStats, render_options.h) as the table's line prints them; the report
+// room writes them as the statistics' "compact" object (host/report/stats_parts_json.h).
 std::string describe(const CompactStats& s);
 
 class MarkStreams {

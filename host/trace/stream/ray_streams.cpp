@@ -22,26 +22,6 @@ float unshaded_share(const Material& m) {
   return float(1.0 - (1.0 - double(m.transmission)) * (1.0 - double(m.reflect)));
 }
 
-nlohmann::ordered_json to_json(const StreamStats& s) {
-  nlohmann::ordered_json levels = nlohmann::ordered_json::array();
-  for (const StreamLevel& l : s.levels)
-    levels.push_back({{"rays", l.rays},
-                      {"chunks", l.chunks},
-                      {"reflected", l.reflected},
-                      {"refracted", l.refracted},
-                      {"total_internal", l.total_internal}});
-  auto job = [](uint64_t passes, uint64_t bytes) {
-    return nlohmann::ordered_json{{"passes", passes}, {"bytes", bytes}};
-  };
-  return {{"levels", levels},
-          {"split", job(s.split_passes, s.split_bytes)},
-          {"compaction", job(s.compaction_passes, s.compaction_bytes)},
-          {"copies", job(s.copy_passes, s.copy_bytes)},
-          {"gather", job(s.gather_passes, s.gather_bytes)},
-          {"shadow_glass", job(s.shadow_passes, s.shadow_bytes)},
-          {"shadow_rays_continued", s.shadow_continued}};
-}
-
 std::string describe(const StreamStats& s) {
   std::string out = "ray streams: level rays (chunks) -> reflected + refracted (TIR):";
   char line[200];

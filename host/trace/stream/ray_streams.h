@@ -8,7 +8,6 @@
 #include <cstdint>
 #include <deque>
 #include <initializer_list>
-#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -28,8 +27,8 @@ bool scene_has_glass(const Scene& scene);
 // an opaque material.
 float unshaded_share(const Material& m);
 
-// The statistics as --stats-json writes them ("streams") and as the table's lines print them.
-nlohmann::ordered_json to_json(const StreamStats& s);
+// The statistics (StreamStats, render_options.h) as the table's lines print them; the report
+// room writes them as the statistics' "streams" object (host/report/stats_parts_json.h).
 std::string describe(const StreamStats& s);
 
 class RayStreams {

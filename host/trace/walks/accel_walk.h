@@ -8,7 +8,6 @@
 #include <cstdint>
 #include <glm/glm.hpp>
 #include <initializer_list>
-#include <nlohmann/json.hpp>
 #include <string>
 #include <utility>
 #include <vector>
