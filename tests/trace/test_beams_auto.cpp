@@ -51,8 +51,7 @@ TEST_CASE(
     "through the grid, the two-level grid, the BVH and the kd-tree") {
   // At 32x32 on gf6600: the low bunny's primary trace is 0.90x with beams, classic's 1.04x.
   bool chose_on = false, chose_off = false;
-  for (const host::AccelKind kind : {host::AccelKind::grid, host::AccelKind::grid2,
-                                     host::AccelKind::bvh, host::AccelKind::kdtree})
+  for (const host::AccelKind kind : host::kAccelKinds)
     for (const char* name : {"bunny-low", "classic"}) {
       CAPTURE(name);
       CAPTURE(int(kind));

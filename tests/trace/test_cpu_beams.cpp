@@ -40,8 +40,7 @@ TEST_CASE(
       {"classic", 36, 28, 8, 1, 1}, {"bunny-low", 32, 32, 4, 0, 1}, {"bunny-low", 16, 16, 4, 0, 4}};
   const std::vector<Setup> coarse{
       {"sphere", 36, 28, 8, 1, 1}, {"teapot", 32, 32, 4, 0, 1}, {"sphere", 16, 16, 4, 0, 4}};
-  for (const host::AccelKind kind : {host::AccelKind::grid, host::AccelKind::grid2,
-                                     host::AccelKind::bvh, host::AccelKind::kdtree})
+  for (const host::AccelKind kind : host::kAccelKinds)
     for (const Setup& s : kind == host::AccelKind::grid2 ? coarse : scenes) {
       const std::string name = s.scene;
       CAPTURE(name);
