@@ -196,11 +196,12 @@ class KdAccel : public Accel {
 };
 
 // The structures, one row each: the one table every list of structures comes from. To add a
-// structure: add a row here (and its AccelKind), write its Accel subclass, its walk and its CPU
-// walk, and give it its row in host/trace/structures.cpp (the same kinds in the same order, which
-// a static_assert there checks); nothing else lists structures. The order is the one --accel's
-// help, --accel auto's candidates and the tests' sweeps take; the first row is the paper's
-// structure (the default), the others are extensions.
+// structure: add a row here (and its AccelKind), write its Accel subclass (with its statistics,
+// an alternative of accel_stats.h's AccelStats, which the report room writes), its walk and its
+// CPU walk, and give it its row in host/trace/structures.cpp (the same kinds in the same order,
+// which a static_assert there checks); nothing else lists structures. The order is the one
+// --accel's help, --accel auto's candidates and the tests' sweeps take; the first row is the
+// paper's structure (the default), the others are extensions.
 struct AccelRow {
   AccelKind kind;
   std::string_view name;         // as --accel spells it

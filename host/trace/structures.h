@@ -6,7 +6,8 @@
 //   cpu          the CPU tracer's walk in double (host/trace/cpu/cpu_core.h's Tracer);
 //   kernels      the kernels its walk loads that --accel auto's work counts read (walk_work).
 // To add a structure: add a row here and in kAccelRows, write its Accel subclass
-// (host/accel/accel.h), its walk and its CPU walk; nothing else lists structures.
+// (host/accel/accel.h, with its statistics: an alternative of host/accel/accel_stats.h's
+// AccelStats), its walk and its CPU walk; nothing else lists structures.
 #pragma once
 
 #include <array>
