@@ -33,6 +33,7 @@
 #include "host/scene/gltf_loader.h"
 #include "host/trace/sampling.h"
 #include "host/trace/stream/stream_tracer.h"
+#include "host/trace/validate.h"
 
 namespace {
 
@@ -616,19 +617,67 @@ json frame_json(const FrameKey& key, const host::RenderOptions& opt, const Frame
   return f;
 }
 
-// The frames of one scene at one size: every structure, variant, ray-stream setting, sampling
-// mode and engine, appended to frames.
-void scene_frames(const Args& a, const host::Scene& scene, int size,
-                  const std::vector<std::string>& engines, json& frames) {
-  host::RenderOptions opt;  // docs/studies/table1.md's settings
+// One frame's options: docs/studies/table1.md's settings at `size`, with a variant, a ray-stream
+// setting, a sampling mode, beams and an engine.
+host::RenderOptions frame_options(const Args& a, int size, const std::string& variant,
+                                  const std::string& streams, const std::string& mode,
+                                  const std::string& beams, const std::string& engine) {
+  host::RenderOptions opt;
   opt.width = opt.height = size;
   opt.bounces = a.bounces;
   opt.shading = kernels::ShadingModel::phong;
   opt.shadows = a.shadows;
   opt.threads = a.threads;
   opt.gl_device = a.device;
+  // The paper's pipeline at Table 1's profile; its future work (MRT fused passes, the
+  // looping kernels) needs a profile with several outputs and loops: the h200's.
+  opt.mrt = variant == "mrt";
+  opt.looping = variant == "looping";
+  opt.profile = variant == "multipass" ? "gf5700" : "h200";
+  opt.ray_streams = streams == "on";
+  opt.beams = beams == "on";
+  parse_sampling(mode, opt);  // checked when parsed
+  opt.device = engine != "stream" ? "gl" : "vgpu";
+  opt.gl_readback = engine == "gl-poll" ? "poll" : "block";
+  return opt;
+}
+
+// The engines --readback-wait and --no-stream ask for.
+std::vector<std::string> engines_of(const Args& a) {
+  std::vector<std::string> engines;
+  if (a.wait_mode == "block" || a.wait_mode == "both") engines.push_back("gl");
+  if (a.wait_mode == "poll" || a.wait_mode == "both") engines.push_back("gl-poll");
+  if (!a.no_stream) engines.push_back("stream");
+  return engines;
+}
+
+// host::validate over every frame the options ask for, before any device or scene is built:
+// one line per refused option of each refused combination (empty: every frame can run).
+std::vector<std::string> refused_frames(const Args& a) {
+  std::vector<std::string> lines;
+  for (int size : a.sizes)
+    for (const std::string& variant : a.variants)
+      for (const std::string& streams : a.ray_streams)
+        for (const std::string& mode : a.sampling)
+          for (const std::string& beams : a.beams)
+            for (const std::string& engine : engines_of(a)) {
+              const host::RenderOptions opt =
+                  frame_options(a, size, variant, streams, mode, beams, engine);
+              for (const host::Refusal& r : host::validate(opt, vgpu::profile(opt.profile)))
+                lines.push_back(variant + ", ray streams " + streams + ", " + mode + ", beams " +
+                                beams + ", " + engine + ": " + r.why);
+            }
+  std::sort(lines.begin(), lines.end());
+  lines.erase(std::unique(lines.begin(), lines.end()), lines.end());
+  return lines;
+}
+
+// The frames of one scene at one size: every structure, variant, ray-stream setting, sampling
+// mode and engine, appended to frames.
+void scene_frames(const Args& a, const host::Scene& scene, int size,
+                  const std::vector<std::string>& engines, json& frames) {
   const host::AccelParams params{
-      host::grid_spec_for(host::parse_grid_spec(a.grid_text), scene, vgpu::profile(opt.profile))};
+      host::grid_spec_for(host::parse_grid_spec(a.grid_text), scene, vgpu::profile("gf5700"))};
   std::map<std::string, std::unique_ptr<host::Accel>> built;  // each structure named, once
   for (const std::string& name : a.accels)
     if (!built.count(name))
@@ -637,21 +686,12 @@ void scene_frames(const Args& a, const host::Scene& scene, int size,
   for (const std::string& accel_name : a.accels)
     for (const std::string& variant : a.variants) {
       const host::Accel& accel = *built.at(accel_name);
-      // The paper's pipeline at Table 1's profile; its future work (MRT fused passes, the
-      // looping kernels) needs a profile with several outputs and loops: the h200's.
-      opt.mrt = variant == "mrt";
-      opt.looping = variant == "looping";
-      opt.profile = variant == "multipass" ? "gf5700" : "h200";
       for (const std::string& streams : a.ray_streams)
         for (const std::string& mode : a.sampling)
           for (const std::string& beams : a.beams)
             for (const std::string& engine : engines) {
-              opt.ray_streams = streams == "on";
-              opt.beams = beams == "on";
-              parse_sampling(mode, opt);  // checked when parsed
-              const bool gl = engine != "stream";
-              opt.device = gl ? "gl" : "vgpu";
-              opt.gl_readback = engine == "gl-poll" ? "poll" : "block";
+              const host::RenderOptions opt =
+                  frame_options(a, size, variant, streams, mode, beams, engine);
               const std::string dump =
                   a.dump_programs.empty()
                       ? ""
@@ -666,10 +706,7 @@ void scene_frames(const Args& a, const host::Scene& scene, int size,
 
 // Every frame: the scenes by the sizes, on the engines --readback-wait and --no-stream ask for.
 json measure_frames(const Args& a) {
-  std::vector<std::string> engines;
-  if (a.wait_mode == "block" || a.wait_mode == "both") engines.push_back("gl");
-  if (a.wait_mode == "poll" || a.wait_mode == "both") engines.push_back("gl-poll");
-  if (!a.no_stream) engines.push_back("stream");
+  const std::vector<std::string> engines = engines_of(a);
   json frames = json::array();
   for (const std::string& name : a.scenes) {
     const host::Scene scene = host::load_scene(host::resolve_scene(name), host::with_images());
@@ -695,6 +732,12 @@ int main(int argc, char** argv) {
                  "both)\n");
     return 2;
   }
+  // Every frame's options, checked before any device or scene is built (host::validate).
+  if (!a.no_frames)
+    if (const std::vector<std::string> refused = refused_frames(a); !refused.empty()) {
+      for (const std::string& line : refused) std::fprintf(stderr, "bench_gl: %s\n", line.c_str());
+      return 2;
+    }
 
   try {
     json out;

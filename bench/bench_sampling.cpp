@@ -20,6 +20,7 @@
 #include "host/trace/cpu/cpu_tracer.h"
 #include "host/trace/sampling.h"
 #include "host/trace/stream/stream_tracer.h"
+#include "host/trace/validate.h"
 
 namespace {
 
@@ -177,6 +178,22 @@ int usage(const char* why) {
   return 2;
 }
 
+// Every mode's options at `size` on `profile`, checked before any scene is loaded
+// (host::validate); false, with one line per refusal on stderr, where one cannot run.
+bool modes_run(int size, const vgpu::Profile& profile) {
+  bool run = true;
+  for (const Mode& m : modes()) {
+    host::RenderOptions base;
+    base.width = base.height = size;
+    base.profile = profile.name;
+    for (const host::Refusal& r : host::validate(mode_options(m, base), profile)) {
+      std::fprintf(stderr, "bench_sampling: %s: %s\n", m.label.c_str(), r.why.c_str());
+      run = false;
+    }
+  }
+  return run;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -212,6 +229,7 @@ int main(int argc, char** argv) {
   const vgpu::Profile& gf5700 = vgpu::profile("gf5700");
   const vgpu::Profile& gf6600 = vgpu::profile("gf6600");
   const vgpu::Profile& h200 = vgpu::profile("h200");
+  if (!modes_run(size, gf6600)) return 2;
   for (const std::string& name : scenes) {
     host::Scene scene;
     try {

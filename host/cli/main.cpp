@@ -4,6 +4,7 @@
 // scenes; `compare` diffs two images.
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cstdio>
 #include <iostream>
 #include <string>
@@ -94,8 +95,13 @@ int main(int argc, char** argv) {
           c.psnr, c.max_error);
       return 0;
     }
-  } catch (const UsageError& e) {
-    std::fprintf(stderr, "vgpu-rt: %s\n", e.what());
+  } catch (const UsageError& e) {  // one line per refused option (host::validate)
+    const std::string lines = e.what();
+    for (size_t start = 0; start <= lines.size();) {
+      const size_t end = std::min(lines.find('\n', start), lines.size());
+      std::fprintf(stderr, "vgpu-rt: %s\n", lines.substr(start, end - start).c_str());
+      start = end + 1;
+    }
     return 2;
   } catch (const host::UnsupportedFeature& e) {  // a feature a frame at a time cannot honour
     std::fprintf(stderr, "vgpu-rt: %s\n", e.what());

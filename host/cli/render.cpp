@@ -42,6 +42,7 @@
 #include "host/trace/stream/mark_streams.h"
 #include "host/trace/stream/ray_streams.h"
 #include "host/trace/stream/stream_tracer.h"
+#include "host/trace/validate.h"
 #include "vgpu/vgpu.h"
 
 namespace cli {
@@ -89,11 +90,50 @@ struct RenderPlan {
   bool span_frames = false;        // --frames N: times spread over the played animations' keys
   bool animating = false, cpu = false, gl = false;
   std::optional<host::BeamsChoice> beams_choice;  // --beams auto's, made at initialization
+  host::Request request;                          // the options as written, for host::validate
 };
 
-// Parse: the options into a plan, refusing what cannot run before any work (UsageError, exit 2).
-RenderPlan parse_render(const RenderArgs& a, bool lanes_given) {
-  // CLI11 checked each value; what is left are combinations of options.
+// The command line's options that RenderOptions does not hold, for host::validate.
+host::Request request_of(const RenderArgs& a, bool lanes_given, const RenderPlan& plan,
+                         bool observer) {
+  host::Request q;
+  q.engine = a.engine;
+  q.accel = a.accel;
+  q.beams = a.beams;
+  q.precision = a.precision;
+  q.formats = a.formats;
+  q.aa = a.aa;
+  q.aa_criterion = a.aa_criterion;
+  q.size = a.size;
+  q.trace_pixel = a.trace_pixel;
+  q.predict = a.predict;
+  q.lanes_given = lanes_given;
+  q.steps_given = a.steps_given;
+  q.walk_given = a.walk_given;
+  q.time = a.time;
+  q.frames = a.frames;
+  q.animation = a.animation;
+  q.update = a.update;
+  q.update_given = a.update_given;
+  q.frame_count = plan.times.size();
+  q.report_frame = a.report_frame;
+  for (const auto& [option, file] : {std::pair<std::string, std::string>{"--out", a.out},
+                                     {"--aov", plan.aov_depth},
+                                     {"--aov", plan.aov_hit}})
+    if (!file.empty()) q.files.push_back({option, file, cli::has_frame_number(file)});
+  q.report = !a.report.empty();
+  q.stats_csv = !a.stats_csv.empty();
+  q.gl_device = a.gl_device;
+  q.gl_readback = a.gl_readback;
+  q.observer = observer;
+  q.report_max_pixels = host::kReportMaxPixels;
+  return q;
+}
+
+// Parse: the options into a plan, refusing what cannot run before any work (host::validate's
+// refusals, one line each: UsageError, exit 2). `observer`: a caller follows the passes.
+RenderPlan parse_render(const RenderArgs& a, bool lanes_given, bool observer) {
+  // CLI11 checked each value; what is left are combinations of options (host::validate).
   RenderPlan plan;
   host::RenderOptions& opt = plan.opt;
   const glm::ivec2 size = *parse_size(a.size);
@@ -119,9 +159,6 @@ RenderPlan parse_render(const RenderArgs& a, bool lanes_given) {
   opt.undersample = a.aa == "adaptive" || a.aa == "none" ? 0 : *parse_aa(a.aa);
   // --aa-criterion: budget unless given; only adaptive sampling reads it.
   const std::string criterion = a.aa_criterion.value_or("budget");
-  if (a.aa_criterion && criterion != "image" && !opt.adaptive)
-    throw UsageError("--aa-criterion " + criterion +
-                     " decides where adaptive sampling refines: add --aa adaptive");
   opt.aa_criterion = criterion == "object"   ? host::RenderOptions::AaCriterion::object
                      : criterion == "budget" ? host::RenderOptions::AaCriterion::budget
                                              : host::RenderOptions::AaCriterion::image;
@@ -133,11 +170,6 @@ RenderPlan parse_render(const RenderArgs& a, bool lanes_given) {
   opt.profile = vgpu::profile(a.profile).name;
   opt.threads = a.threads;
   opt.lanes = a.lanes;
-  try {
-    plan.formats = host::parse_format_request(a.precision, a.formats);
-  } catch (const std::invalid_argument& e) {
-    throw UsageError(e.what());
-  }
   plan.grid_spec = host::parse_grid_spec(a.grid);
   std::string& aov_depth = plan.aov_depth;
   std::string& aov_hit = plan.aov_hit;
@@ -146,57 +178,13 @@ RenderPlan parse_render(const RenderArgs& a, bool lanes_given) {
     (aov.compare(0, eq, "depth") == 0 ? aov_depth : aov_hit) = aov.substr(eq + 1);
   }
   if (!a.trace_pixel.empty()) {
-    const glm::ivec2 p = *parse_pixel(a.trace_pixel);
-    if (p.x >= opt.width || p.y >= opt.height)
-      throw UsageError("--trace-pixel: " + a.trace_pixel + " is outside the " + a.size + " image");
-    opt.trace_pixel = p;
+    opt.trace_pixel = *parse_pixel(a.trace_pixel);
     opt.trace_out = &std::cout;
   }
-
-  if (a.engine != "stream" && a.engine != "cpu" && a.engine != "gl")
-    throw UsageError("--engine: expected stream, cpu or gl, got '" + a.engine + "'");
-  const bool cpu = plan.cpu = a.engine == "cpu";
-  const bool gl = plan.gl = a.engine == "gl";
-  // Settings the CPU reference does not use are refused rather than recorded as if they ran.
-  if (cpu) {
-    const char* unused = a.predict                ? "--predict"
-                         : !a.trace_pixel.empty() ? "--trace-pixel"
-                         : lanes_given            ? "--lanes"
-                         : opt.masks              ? "--masks on"
-                         : opt.mrt                ? "--mrt on"
-                         : a.precision != "fp32"  ? "--precision"
-                         : !a.formats.empty()     ? "--formats"
-                         : opt.looping            ? "--kernels looping"
-                         : opt.ray_streams        ? "--ray-streams on"
-                                                  : nullptr;
-    if (unused)
-      throw UsageError(std::string(unused) +
-                       " needs --engine stream (the cpu engine is a double-precision reference "
-                       "without passes, lanes or masks)");
-  }
-  if (opt.beams && a.accel == "auto")
-    throw UsageError(
-        "--beams on: beams go through the structure the frame walks, and --accel auto has not "
-        "chosen it yet: name one (--accel grid, grid2, bvh or kdtree), or with --accel auto, "
-        "--beams auto");
-  if (opt.beams && (a.precision != "fp32" || !a.formats.empty()))
-    throw UsageError(
-        "--beams on needs fp32 ray state (no --precision or --formats): the beam "
-        "entry reaches the voxel the walk would only where both round as fp32");
-  if (a.beam_tile != 8 && a.beams == "off")
-    throw UsageError("--beam-tile needs --beams on or auto");
-  if (a.steps_given && !opt.looping) throw UsageError("--steps-per-pass needs --kernels looping");
-  // Animation (issue 23): the frames' times, and what several frames need.
-  const bool animating = plan.animating = !a.time.empty() || !a.frames.empty();
-  if (!a.time.empty() && !a.frames.empty())
-    throw UsageError("--time and --frames: give one (--frames A:A:1 is --time A)");
-  if (!animating && (!a.animation.empty() || a.update_given))
-    throw UsageError(std::string(a.animation.empty() ? "--update" : "--animation") +
-                     " needs --time or --frames");
-  if (a.update != "rebuild" && a.accel != "bvh")
-    throw UsageError("--update " + a.update +
-                     ": only a BVH's boxes can be refitted (--accel bvh); the grid and the "
-                     "kd-tree are rebuilt (--update rebuild)");
+  plan.cpu = a.engine == "cpu";
+  plan.gl = a.engine == "gl";
+  // Animation (issue 23): the frames' times.
+  plan.animating = !a.time.empty() || !a.frames.empty();
   std::vector<double>& times = plan.times;
   times = {0.0};
   if (!a.time.empty()) times = {cli::parse_time(a.time)};
@@ -206,70 +194,19 @@ RenderPlan parse_render(const RenderArgs& a, bool lanes_given) {
     times = cli::frame_times(range);       // --frames N: set once the file is read
     plan.span_frames = !range.bounded;
   }
-  if (times.size() > 1) {
-    for (const auto& [option, file] : {std::pair<std::string, std::string>{"--out", a.out},
-                                       {"--aov", aov_depth},
-                                       {"--aov", aov_hit}})
-      if (!file.empty() && !cli::has_frame_number(file))
-        throw UsageError(option + " " + file + ": " + std::to_string(times.size()) +
-                         " frames need '#' in the file name for the frame number (e.g. "
-                         "frame_####.png)");
-    const char* one_frame = opt.trace_pixel        ? "--trace-pixel"
-                            : a.report_frame       ? nullptr
-                            : !a.report.empty()    ? "--report"
-                            : !a.stats_csv.empty() ? "--stats-csv"
-                                                   : nullptr;
-    if (one_frame)
-      throw UsageError(
-          std::string(one_frame) + " follows one frame: render it with --time T" +
-          (opt.trace_pixel ? "" : ", or name one of the frames with --report-frame K"));
-  }
-  if (a.report_frame) {
-    if (a.frames.empty())
-      throw UsageError("--report-frame needs --frames (with --time the report is that frame's)");
-    if (a.report.empty() && a.stats_csv.empty())
-      throw UsageError("--report-frame needs --report or --stats-csv");
-    if (size_t(a.report_frame) > times.size())
-      throw UsageError("--report-frame " + std::to_string(a.report_frame) + ": --frames " +
-                       a.frames + " gives " + std::to_string(times.size()) + " frame" +
-                       (times.size() > 1 ? "s" : "") + ", numbered from 1");
-  }
-  if (a.walk_given && a.engine != "stream")
-    throw UsageError("--walk needs --engine stream (it says how the emulator runs the walk)");
-  // Reduced precision runs at 1 or 8 lanes (vgpu/gpu.cpp): refuse another width.
-  const bool reduced = a.precision != "fp32" || !a.formats.empty();
-  if (reduced && opt.lanes != 1 && opt.lanes != 8)
-    throw UsageError("--lanes " + std::to_string(opt.lanes) + ": --precision " + a.precision +
-                     " runs at 1 or 8 lanes");
-  // The combinations the tracer cannot run, before any work (with fp32 formats: MRT's formats
-  // are checked again once resolved).
+  // Every combination of options that cannot run, before any work (with fp32 formats: MRT's
+  // formats are checked again once resolved).
   opt.formats = host::Formats::all(vgpu::Format::fp32);
-  if (const std::string why = opt.refusal(vgpu::profile(opt.profile), a.aa); !why.empty())
-    throw UsageError(why);
-  if (a.engine != "stream" && (!a.report.empty() || !a.stats_csv.empty()))
-    throw UsageError(
-        "--report and --stats-csv need --engine stream (the report reads the "
-        "emulator's per-fragment state)");
-  if (gl) {
-    // The GL device runs every fragment in fp32 GLSL; the emulator-only features are refused.
-    if (!host::have_gl_device())
-      throw host::InputError(
-          "--engine gl: this build has no GL device (EGL and OpenGL were not found when it was "
-          "built; scripts/setup.sh installs them)");
-    if (a.predict || !a.trace_pixel.empty() || opt.masks || a.precision != "fp32")
-      throw UsageError(
-          "--engine gl runs the multipass pipeline as a driver does: --predict, --trace-pixel, "
-          "--masks on and --precision fp24/fp16 need --engine stream");
+  plan.request = request_of(a, lanes_given, plan, observer);
+  if (const auto refused = host::validate(opt, vgpu::profile(opt.profile), &plan.request);
+      !refused.empty())
+    throw UsageError(host::refusal_lines(refused));
+  plan.formats = host::parse_format_request(a.precision, a.formats);  // validate parsed it
+  if (plan.gl) {
     opt.device = "gl";
     opt.gl_device = a.gl_device;
     opt.gl_readback = a.gl_readback;
-  } else if (a.gl_device != "auto" || a.gl_readback != "auto") {
-    throw UsageError(std::string(a.gl_device != "auto" ? "--gl-device" : "--gl-readback") +
-                     " needs --engine gl");
   }
-  if (!a.report.empty() && int64_t(opt.width) * opt.height > host::kReportMaxPixels)
-    throw UsageError("--report: at most " + std::to_string(host::kReportMaxPixels) +
-                     " pixels (512x512); got " + a.size);
   if (!a.report.empty()) host::check_output_path(a.report, {".html"});
   if (!a.stats_csv.empty()) host::check_output_path(a.stats_csv, {".csv"});
   return plan;
@@ -513,7 +450,7 @@ std::vector<RenderOptionInfo> render_option_infos() {
 
 int run_render(const RenderArgs& a, bool lanes_given, RenderOutcome* outcome,
                host::PassObserver* observer) {
-  RenderPlan plan = parse_render(a, lanes_given);
+  RenderPlan plan = parse_render(a, lanes_given, observer != nullptr);
   host::RenderOptions& opt = plan.opt;
   const host::FormatRequest& formats = plan.formats;
   const host::GridSpec& grid_spec = plan.grid_spec;
@@ -522,15 +459,7 @@ int run_render(const RenderArgs& a, bool lanes_given, RenderOutcome* outcome,
   std::optional<host::FrameRecorder> recorder;
   std::optional<OneFrame> one_frame;  // --report-frame K: the recorder sees frame K alone
   attach_recorder(a, opt, recorder, one_frame);
-  if (observer) {
-    // A caller's observer (Python's pass by pass) follows one frame, as the report does.
-    if (recorder) throw UsageError("a pass observer and --report or --stats-csv: give one");
-    if (plan.cpu || plan.gl)
-      throw UsageError("following the passes needs --engine stream (the cpu engine has none)");
-    if (times.size() > 1)
-      throw UsageError("following the passes follows one frame: render it with --time T");
-    opt.observer = observer;
-  }
+  if (observer) opt.observer = observer;  // validate refused it beside another or several frames
 
   // The scene: as the file has it, or posed at each frame's time (--time, --frames).
   const std::string path = host::resolve_scene(a.scene);
@@ -574,8 +503,10 @@ int run_render(const RenderArgs& a, bool lanes_given, RenderOutcome* outcome,
     return host::resolve(formats, scene, accel, vgpu::profile(opt.profile));
   };
   opt.formats = formats_for(*built.front());
-  if (const std::string why = opt.refusal(vgpu::profile(opt.profile), a.aa); !why.empty())
-    throw UsageError(why);
+  // Again with the formats resolved (MRT's) and the scene (a glass scene's ray streams).
+  if (const auto refused = host::validate(opt, vgpu::profile(opt.profile), &plan.request, &scene);
+      !refused.empty())
+    throw UsageError(host::refusal_lines(refused));
   const float aspect = float(opt.width) / float(opt.height);
   // A frame's camera: the file's (moving with its node), else the rest scene's framing.
   auto camera_for = [&](const host::Scene& s) {

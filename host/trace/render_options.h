@@ -76,7 +76,7 @@ struct RenderOptions {
   bool masks = false;
   // Multiple render targets (the paper's future work, kernels/fused.h): the host loop runs
   // intersecciones + proximoTriangulo and traversal + actualizarVoxel as one pass each, writing
-  // two targets. Needs a profile with max_outputs >= 2 (the constructor throws naming the fused
+  // two targets. Needs a profile with max_outputs >= 2 (validate refuses it naming the fused
   // program and the limit, see mrt_refusal). Off: the paper's one-output multipass pipeline.
   bool mrt = false;
   // The kernels that walk the grid: false, the paper's multipass pipeline (one pass per voxel
@@ -100,7 +100,7 @@ struct RenderOptions {
   // each tile's beam descends to the first node it cannot narrow down and its rays start there;
   // through the kd-tree likewise (the nodes' boxes), and its rays restart there too; through the
   // two-level grid, the beams march over its coarse grid. Every structure, fp32 ray state
-  // (refusal() says so); every engine.
+  // (validate says so); every engine.
   bool beams = false;
   int beam_tile = 8;
   // Supersampling (host/trace/sampling.h): rays per pixel, a square from 1 to 256, on a
@@ -153,13 +153,8 @@ struct RenderOptions {
   // Called at the start of each ray-tracing iteration (1-based) with the iteration count.
   std::function<void(int iteration, int iterations)> progress;
   PassObserver* observer = nullptr;  // not owned
-
-  // Every combination of options that cannot run, in one place: the first one's reason, in the
-  // command line's words (empty: these options run on `profile`). The command line refuses them
-  // before any work (exit 2), and the stream tracer's constructor throws vgpu::Error with the same
-  // text. Needs `formats` resolved for the MRT check (fp32 everywhere before that). `aa`: the
-  // command line's --aa text, named as the user wrote it (empty: the mode's own name).
-  std::string refusal(const vgpu::Profile& profile, std::string_view aa = {}) const;
+  // The combinations of these options that cannot run are refused in one place,
+  // host::validate (host/trace/validate.h).
 };
 
 // Glass's ray streams (host/trace/stream/ray_streams.h): what one frame's streams held and cost,

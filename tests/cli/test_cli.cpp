@@ -123,6 +123,19 @@ TEST_CASE("GL device settings are refused without the GL engine and checked agai
   check_refused("--engine gl --gl-readback spin", "--gl-readback", "spin not in {auto,block,poll}");
 }
 
+TEST_CASE("two refused options are two lines, one each, exit 2 and no image") {
+  const fs::path out =
+      fs::temp_directory_path() / ("vgpu_cli_two_" + std::to_string(::getpid()) + ".png");
+  const Outcome o = run("render bunny-low -q --stats none --out " + out.string() +
+                        " --steps-per-pass 4 --gl-device 0");
+  CHECK(o.status == 2);
+  CHECK(o.err ==
+        "vgpu-rt: --steps-per-pass needs --kernels looping\n"
+        "vgpu-rt: --gl-device needs --engine gl\n");
+  CHECK(o.out.empty());
+  CHECK_FALSE(fs::exists(out));
+}
+
 TEST_CASE("settings the cpu engine does not use are refused instead of recorded") {
   for (const char* option : {"--lanes 8", "--precision fp16", "--masks on", "--predict",
                              "--trace-pixel 1,1", "--mrt on"}) {

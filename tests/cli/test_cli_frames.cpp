@@ -70,7 +70,15 @@ TEST_CASE("several frames need a '#' frame number in every output file name") {
   CHECK(o.status == 2);
   check_one_line(o, "--out", "2 frames need '#'");
   const std::string hit = (fs::temp_directory_path() / "hit.exr").string();
-  check_refused("--frames 0:1:2 --aov hit=" + hit, "--out", "2 frames need '#'");
+  // Both files without a number: both refused, one line each.
+  const std::string png = (dir / "a.png").string();
+  const Outcome both =
+      run("render bunny-low -q --stats none --out " + png + " --frames 0:1:2 --aov hit=" + hit);
+  CHECK(both.status == 2);
+  const std::string need =
+      ": 2 frames need '#' in the file name for the frame number (e.g. "
+      "frame_####.png)\n";
+  CHECK(both.err == "vgpu-rt: --out " + png + need + "vgpu-rt: --aov " + hit + need);
   const Outcome aov = run("render bunny-low -q --stats none --frames 0:1:2 --aov hit=" + hit);
   CHECK(aov.status == 2);
   check_one_line(aov, "--aov " + hit, "2 frames need '#'");

@@ -8,6 +8,7 @@
 #include "host/model/cost_model.h"
 #include "host/trace/stream/stream_tracer.h"
 #include "host/trace/structures.h"
+#include "host/trace/validate.h"
 #include "kernels/kernels.h"
 
 namespace host {
@@ -144,8 +145,8 @@ BeamsChoice choose_beams(const Scene& scene, const Accel& accel, const RenderOpt
   // priced alike; the CPU tracer has no passes for the cost model to price.
   if (engine == "cpu")
     refused = "the cost model prices passes, and the cpu engine runs none";
-  else
-    refused = with.refusal(profile);
+  else if (const std::vector<Refusal> r = validate(with, profile); !r.empty())
+    refused = r.front().why;
   if (!refused.empty()) {
     c.why = "off: " + refused;
     return c;

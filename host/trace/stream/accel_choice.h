@@ -85,7 +85,7 @@ struct BeamsChoice {
 // `options` as the frame would run with beams off; `engine` the command line's (stream, cpu or
 // gl: the probes run on the frame's device; the GL device counts the emulator's statistics). Beams
 // off without probes wherever `--beams on` would be refused (another structure than the grid, or
-// RenderOptions::refusal with beams: non-fp32 ray state, dense streams) and on the cpu engine,
+// host::validate with beams: non-fp32 ray state, dense streams) and on the cpu engine,
 // whose frame has no passes to price; `why` then says which.
 BeamsChoice choose_beams(const Scene& scene, const Accel& accel, const RenderOptions& options,
                          const Camera& camera, std::string_view engine);

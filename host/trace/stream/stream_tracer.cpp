@@ -23,6 +23,7 @@
 #include "host/trace/stream/stream_state.h"
 #include "host/trace/structures.h"
 #include "host/trace/textures.h"
+#include "host/trace/validate.h"
 #include "host/trace/walks/grid_walk.h"
 
 namespace host {
@@ -51,12 +52,9 @@ StreamTracer::StreamTracer(const Scene& scene, const Accel& accel, const RenderO
   s_ = std::make_unique<State>();
   State& s = *s_;
   vgpu::Device& gpu = *gpu_;
-  if (opt_.masks && !gpu.has_stencil())
-    throw vgpu::Error("--masks on needs stencil masks, which the " + opt_.device +
-                      " device does not have");
-  if (opt_.trace_pixel && !gpu.has_stencil())
-    throw vgpu::Error("--trace-pixel follows the emulator's finished-ray masks, which the " +
-                      opt_.device + " device does not have");
+  // The options this frame cannot run, as the command line refuses them (host/trace/validate.h):
+  // vgpu::Error, or std::invalid_argument for a sample count.
+  throw_refusals(validate(opt_, gpu.profile(), nullptr, &scene));
   // Each program computes in its group's arithmetic format (formats.h: which kernel is where);
   // the walk's programs are set by the walk.
   const Formats& fm = opt_.formats;
@@ -68,23 +66,13 @@ StreamTracer::StreamTracer(const Scene& scene, const Accel& accel, const RenderO
                                                                {&s.shader, Group::colour},
                                                                {&s.reflected, Group::colour}})
     prog->set_precision(fm.arithmetic(g));
-  // Combinations of options that cannot run (RenderOptions::refusal, the command line's words).
-  if (const std::string why = opt_.refusal(gpu.profile()); !why.empty()) throw vgpu::Error(why);
-  if (const std::string why = spp_refusal(opt_.spp); !why.empty())
-    throw std::invalid_argument("spp: " + why);
   const bool sums = opt_.spp > 1 || opt_.undersample > 0;
   const bool marking = (opt_.adaptive && opt_.spp > 1) || opt_.undersample > 0;
 
   // Ray streams: a scene with glass needs them; --ray-streams on runs the paper's reflections
   // through them.
   const bool glass = scene_has_glass(scene);
-  if (glass || opt_.ray_streams) {
-    if (opt_.trace_pixel)
-      throw vgpu::Error(
-          "--trace-pixel follows one pixel's ray, and ray streams (a glass scene or --ray-streams "
-          "on) move a pixel's rays to other texels");
-    s.streams = std::make_unique<RayStreams>(gpu, opt_, glass);
-  }
+  if (glass || opt_.ray_streams) s.streams = std::make_unique<RayStreams>(gpu, opt_, glass);
 
   // Scene textures: triangle i at texel (i mod width, i div width).
   write_scene(nullptr);
