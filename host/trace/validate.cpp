@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <stdexcept>
 
+#include "host/accel/accel.h"
 #include "host/model/formats.h"
 #include "host/trace/mrt.h"
 #include "host/trace/sampling.h"
@@ -85,8 +86,8 @@ void check_command_line(const RenderOptions& opt, const Request& q, Refusals& ou
   if (opt.beams && q.accel == "auto")
     out.add("--beams", "on",
             "--beams on: beams go through the structure the frame walks, and --accel auto has "
-            "not chosen it yet: name one (--accel grid, grid2, bvh or kdtree), or with --accel "
-            "auto, --beams auto");
+            "not chosen it yet: name one (--accel " +
+                accel_names(" or ") + "), or with --accel auto, --beams auto");
   if (opt.beams && reduced_precision(q))
     out.add("--beams", "on",
             "--beams on needs fp32 ray state (no --precision or --formats): the beam "
