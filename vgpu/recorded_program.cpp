@@ -250,6 +250,13 @@ void RecordedProgram::compile() {
     code_.push_back(in);
   }
 
+  for (int k = 0; k <= int(code_.size()); ++k) {
+    if (k == body_begin_) computed_body_begin_ = int(computed_.size());
+    if (k == body_end_) computed_body_end_ = int(computed_.size());
+    if (k == int(code_.size())) break;
+    (code_[size_t(k)].op == Op::constant ? constants_ : computed_).push_back(code_[size_t(k)]);
+  }
+
   if (has_loop_) {
     max_iterations_ = lp.max_iterations;
     entry_ = reg[size_t(lp.entry)];
@@ -283,11 +290,10 @@ void RecordedProgram::compile() {
 // functor's code performs on L's lanes (the same overloads: vgpu's min, max, select, rsqrt), so it
 // rounds, counts and records as the functor's does.
 template <class L>
-void RecordedProgram::step(Fragments<L>& f, typename L::F* fr, typename L::M* mr, int from, int to,
-                           int prefix) const {
+void RecordedProgram::step(Fragments<L>& f, typename L::F* fr, typename L::M* mr, const Instr* code,
+                           int from, int to, int prefix) const {
   using F = typename L::F;
   using M = typename L::M;
-  const Instr* code = code_.data();
   for (int k = from; k < to; ++k) {
     const Instr& in = code[k];
     switch (in.op) {
@@ -408,7 +414,22 @@ void RecordedProgram::execute(Fragments<L>& f) const {
   M* mr = mregs.data();
   int prefix = 0;
   if constexpr (L::recording) prefix = int(Recorder::current->nodes.size());
-  const int end = int(code_.size());
+  // The recording and counting runs go through every node in order (the recording keeps each
+  // constant's place); the computing families set the constants only where the thread's
+  // registers last held another program's (program ids are never reused).
+  constexpr bool hoisted = !L::recording && !L::counting;
+  const std::vector<Instr>& list = hoisted ? computed_ : code_;
+  const Instr* code = list.data();
+  const int end = int(list.size());
+  const int body_begin = hoisted ? computed_body_begin_ : body_begin_;
+  const int body_end = hoisted ? computed_body_end_ : body_end_;
+  if constexpr (hoisted) {
+    thread_local uint32_t loaded = 0;  // the program whose constants the registers hold
+    if (loaded != id()) {
+      for (const Instr& in : constants_) fr[in.dst] = F(in.value);
+      loaded = id();
+    }
+  }
   auto copy = [&](const Copy& c) {
     if (c.mask)
       mr[c.var] = mr[c.from];
@@ -416,21 +437,21 @@ void RecordedProgram::execute(Fragments<L>& f) const {
       fr[c.var] = fr[c.from];
   };
   if (!has_loop_) {
-    step(f, fr, mr, 0, end, prefix);
+    step(f, fr, mr, code, 0, end, prefix);
   } else {
-    step(f, fr, mr, 0, body_begin_, prefix);
+    step(f, fr, mr, code, 0, body_begin, prefix);
     for (const Copy& c : starts_) copy(c);
     // Fragments::loop decides the iterations (and counts them, or records the body twice); the
     // body is one pass over the first recorded iteration, reading the carried values' registers.
     const M still = f.loop(max_iterations_, mr[entry_], [&](const M& active) -> M {
       mr[active_] = active;
-      step(f, fr, mr, body_begin_, body_end_, prefix);
+      step(f, fr, mr, code, body_begin, body_end, prefix);
       const M more = mr[more_];  // read before the carried values move on (it may be one)
       for (const Copy& c : carries_) copy(c);
       return more;
     });
     mr[active_] = still;
-    step(f, fr, mr, body_end_, end, prefix);
+    step(f, fr, mr, code, body_end, end, prefix);
   }
   for (int o = 0; o < outputs_; ++o) {
     const std::array<int32_t, 4>& r = out_regs_[size_t(o)];

@@ -89,8 +89,8 @@ class RecordedProgram final : public Program {
   template <class L>
   void execute(Fragments<L>& f) const;
   template <class L>
-  void step(Fragments<L>& f, typename L::F* fr, typename L::M* mr, int from, int to,
-            int prefix) const;
+  void step(Fragments<L>& f, typename L::F* fr, typename L::M* mr, const Instr* code, int from,
+            int to, int prefix) const;
 
   Recording rec_;
   std::string name_, paper_name_;
@@ -99,6 +99,12 @@ class RecordedProgram final : public Program {
 
   std::vector<Instr> code_;
   int float_regs_ = 0, mask_regs_ = 0;
+  // The same without its constants, for the computing families: a constant's register keeps its
+  // value from one batch to the next while the thread runs this program (a kernel's literals and
+  // uniforms are a large part of its nodes), so they are set once, not per batch.
+  std::vector<Instr> computed_;
+  std::vector<Instr> constants_;
+  int computed_body_begin_ = 0, computed_body_end_ = 0;
   // The loop, if any: code_[body_begin_, body_end_) is one iteration; starts_ set the carried
   // values before it, carries_ after each iteration. The lanes still looping live in mask
   // register active_ (the body's parameter, then f.loop's answer); more_ is the body's answer.
