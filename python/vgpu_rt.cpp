@@ -30,6 +30,7 @@
 #include <vector>
 
 #include "host/cli/render.h"
+#include "host/common/version.h"
 #include "host/model/cost_model.h"
 #include "host/report/counters_json.h"
 #include "host/scene/animation.h"
@@ -533,6 +534,11 @@ PYBIND11_MODULE(_vgpu_rt, m) {
       "For the benchmark (python/bench_render.py): ms of the library call alone, cli::run_render "
       "with these arguments, timed in C++.");
   m.def("scenes", &scenes, "The bundled scenes as (name, path) pairs.");
+  m.def(
+      "version", [] { return std::string(host::version()); }, "vgpu-rt's version (VERSION).");
+  m.def(
+      "scenes_dir", [] { return host::scenes_dir().string(); },
+      "The bundled scenes' folder, empty when none is found.");
   m.def("check_scene", &check_scene, py::arg("scene"),
         "Raises FileNotFoundError when the scene is neither a bundled name nor a file.");
   m.def("predict", &predict, py::arg("stats"), py::arg("profile"),

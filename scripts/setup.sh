@@ -13,6 +13,7 @@ pkgs=(
   pybind11-dev python3-dev python3-numpy python3-nbclient python3-nbformat python3-ipykernel
   libegl-dev libopengl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri
   zlib1g-dev ccache
+  help2man dpkg-dev python3-venv python3-pip python3-wheel python3-setuptools  # installing (README)
   chromium
 )
 missing=()

@@ -10,7 +10,8 @@
 
 namespace vgpu {
 
-Program::Program() {
+Program::Program(const AbiTag& abi) {
+  check_abi(abi);
   static std::atomic<uint32_t> next{1};
   id_ = next++;
 }

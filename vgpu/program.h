@@ -20,6 +20,7 @@
 #include <span>
 #include <string>
 
+#include "vgpu/abi.h"
 #include "vgpu/fragment.h"
 #include "vgpu/precision.h"
 
@@ -70,7 +71,9 @@ class Program {
   Recording record() const;
 
  protected:
-  Program();
+  // `abi`: the tag of the translation unit that constructs the program (vgpu/abi.h); a kernel
+  // compiled with other target flags than the library is refused here, with std::logic_error.
+  explicit Program(const AbiTag& abi = VGPU_ABI_HERE);
 
  private:
   uint32_t id_;

@@ -13,6 +13,7 @@
 #include "host/cli/commands.h"
 #include "host/cli/options.h"
 #include "host/cli/render.h"
+#include "host/common/version.h"
 #include "host/image/image_io.h"
 #include "host/report/report.h"
 #include "host/scene/animation.h"
@@ -33,6 +34,8 @@ int main(int argc, char** argv) {
       "vgpu-rt: a virtual 2004 GPU and the stream ray tracer of Fal, Vasconcelos & "
       "Delrieux (after Purcell et al. 2002)"};
   app.require_subcommand(1);
+  app.set_version_flag("--version", std::string("vgpu-rt ") + host::version(),
+                       "Print the version and exit");
   RenderArgs a;
   auto* render = app.add_subcommand(
       "render", "Render a scene on the virtual GPU and print the pass statistics");
@@ -72,6 +75,8 @@ int main(int argc, char** argv) {
   } catch (const CLI::CallForHelp& e) {
     return app.exit(e);
   } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
     std::fprintf(stderr, "vgpu-rt: %s (see vgpu-rt --help)\n", e.what());

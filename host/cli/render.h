@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "host/cli/options.h"
+#include "host/common/install_paths.h"  // registers an installed prefix (scenes, images)
 #include "host/report/stats_value.h"
 #include "host/trace/render_options.h"
 

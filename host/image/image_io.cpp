@@ -11,6 +11,7 @@
 #include <mutex>
 #include <stdexcept>
 
+#include "host/common/install_paths.h"
 #include "host/image/image_module.h"
 #include "host/scene/scene.h"
 
@@ -55,27 +56,30 @@ struct ImageModule {
   decltype(&vgpu_image_read) read = nullptr;
 };
 
-// The directory of the running executable (/proc/self/exe), or empty.
-fs::path exe_dir() {
-  std::error_code ec;
-  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
-  return ec ? fs::path() : exe.parent_path();
-}
-
-// Loads the module once: next to the executable first (an installed tree), then where the build
-// put it. Throws InputError naming `user` (the image being written or read) when it cannot.
+// Loads the module once, from the first of install_paths.h's candidates that loads (beside the
+// binary, then an installed tree's lib/vgpu-rt/; the build writes it to build/lib/vgpu-rt/).
+// Throws InputError naming `user` (the image being written or read) when it cannot.
 const ImageModule& image_module(const std::string& user) {
   static std::once_flag once;
   static ImageModule m;
   static std::string error;
   std::call_once(once, [] {
     void* h = nullptr;
-    for (const fs::path& p : {exe_dir() / VGPU_IMAGE_MODULE_NAME, fs::path(VGPU_IMAGE_MODULE)}) {
+    std::string tried;
+    for (const fs::path& p : image_module_candidates(VGPU_IMAGE_MODULE_NAME)) {
+      std::error_code ec;
+      if (!fs::exists(p, ec)) {
+        tried += (tried.empty() ? "" : ", ") + p.string();
+        continue;
+      }
       if ((h = ::dlopen(p.c_str(), RTLD_NOW | RTLD_LOCAL))) break;
       const char* e = ::dlerror();
       if (error.empty() && e) error = e;
     }
-    if (!h) return;
+    if (!h) {
+      if (error.empty()) error = std::string(VGPU_IMAGE_MODULE_NAME) + " not found in " + tried;
+      return;
+    }
     m.write = reinterpret_cast<decltype(m.write)>(::dlsym(h, VGPU_IMAGE_WRITE));
     m.compare = reinterpret_cast<decltype(m.compare)>(::dlsym(h, VGPU_IMAGE_COMPARE));
     m.read = reinterpret_cast<decltype(m.read)>(::dlsym(h, VGPU_IMAGE_READ));

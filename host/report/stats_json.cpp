@@ -13,6 +13,7 @@
 #include <cstdio>
 #include <fstream>
 
+#include "host/common/version.h"
 #include "host/model/cost_model.h"
 #include "host/model/formats.h"
 #include "host/report/counters_json.h"
@@ -30,7 +31,7 @@ nlohmann::ordered_json frame_stats_json(const FrameStatsInputs& in) {
   const RenderResult& r = in.result;
   const CpuStats& cpu_stats = in.cpu_stats;
   const bool cpu = in.engine == "cpu", gl = in.engine == "gl";
-  nlohmann::ordered_json j;
+  nlohmann::ordered_json j{{"version", host::version()}};  // an object: {"version": ...}
   j["scene"] = scene.name;
   j["scene_path"] = in.scene_path;
   j["engine"] = in.engine;
@@ -274,8 +275,9 @@ StatsJson frames_stats_json(const std::string& scene, const std::string& scene_p
                             const StatsJson& animation, const std::string& update,
                             std::vector<StatsJson> frames) {
   const size_t count = frames.size();
-  return {{"scene", scene},   {"scene_path", scene_path}, {"animation", animation},
-          {"update", update}, {"frame_count", count},     {"frames", std::move(frames)}};
+  return {{"version", host::version()}, {"scene", scene},   {"scene_path", scene_path},
+          {"animation", animation},     {"update", update}, {"frame_count", count},
+          {"frames", std::move(frames)}};
 }
 
 std::string stats_text(const StatsJson& j) {

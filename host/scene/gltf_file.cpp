@@ -13,6 +13,7 @@
 #include <span>
 #include <string_view>
 
+#include "host/common/install_paths.h"
 #include "host/scene/gltf_internal.h"
 #include "host/scene/gltf_loader.h"
 
@@ -23,10 +24,6 @@
 #define STB_IMAGE_WRITE_IMPLEMENTATION
 #define TINYGLTF_NO_EXTERNAL_IMAGE
 #include <tiny_gltf.h>
-
-#ifndef VGPU_SCENES_DIR
-#define VGPU_SCENES_DIR "scenes"
-#endif
 
 namespace host {
 namespace {
@@ -467,6 +464,15 @@ std::vector<uint64_t> parse_file(const std::string& path, tinygltf::Model& model
 
 namespace {
 
+// Where the bundled scenes were looked for, when none of the folders exists.
+std::string no_scenes_dir() {
+  std::string where;
+  for (const fs::path& d : scenes_dir_candidates())
+    where += (where.empty() ? "" : ", ") + d.string();
+  return "the bundled scenes are not installed (looked in " + where +
+         "; set VGPU_RT_SCENES to their folder)";
+}
+
 bool is_scene_file(const fs::path& p) {
   const std::string ext = p.extension().string();
   return ext == ".gltf" || ext == ".glb";
@@ -477,18 +483,23 @@ bool is_scene_file(const fs::path& p) {
 std::string resolve_scene(const std::string& name_or_path) {
   std::error_code ec;
   if (fs::is_regular_file(name_or_path, ec)) return name_or_path;
+  const fs::path dir = scenes_dir();
   for (const char* ext : {".gltf", ".glb"}) {
-    const fs::path candidate = fs::path(VGPU_SCENES_DIR) / (name_or_path + ext);
+    if (dir.empty()) break;
+    const fs::path candidate = dir / (name_or_path + ext);
     if (fs::is_regular_file(candidate, ec)) return candidate.string();
   }
-  throw InputError(one_line(name_or_path, 1000) +
-                   ": no such file or scene in scenes/ (try `vgpu-rt scenes`)");
+  if (dir.empty()) throw InputError(one_line(name_or_path, 1000) + ": " + no_scenes_dir());
+  throw InputError(one_line(name_or_path, 1000) + ": no such file or scene in " + dir.string() +
+                   " (try `vgpu-rt scenes`)");
 }
 
 std::vector<std::pair<std::string, std::string>> list_scenes() {
   std::vector<std::pair<std::string, std::string>> out;
+  const fs::path dir = scenes_dir();
+  if (dir.empty()) throw InputError(no_scenes_dir());
   std::error_code ec;
-  for (fs::directory_iterator it(VGPU_SCENES_DIR, ec), end; !ec && it != end; it.increment(ec)) {
+  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
     if (it->is_regular_file(ec) && is_scene_file(it->path()))
       out.emplace_back(it->path().stem().string(), it->path().string());
   }

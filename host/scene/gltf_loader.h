@@ -9,6 +9,7 @@
 #include <utility>
 #include <vector>
 
+#include "host/common/install_paths.h"  // the scenes' folder; registers an installed prefix
 #include "host/scene/scene.h"
 
 namespace host {
@@ -96,11 +97,13 @@ struct LoadOptions {
 //   with Scene::default_light = true.
 Scene load_scene(const std::string& path, const LoadOptions& options = {});
 
-// A path to an existing file is returned as is; otherwise NAME is looked up as
-// VGPU_SCENES_DIR/NAME.gltf, then VGPU_SCENES_DIR/NAME.glb. Throws InputError when none exists.
+// A path to an existing file is returned as is; otherwise NAME is looked up as DIR/NAME.gltf,
+// then DIR/NAME.glb, DIR the bundled scenes' folder (host/common/install_paths.h finds it).
+// Throws InputError when none exists.
 std::string resolve_scene(const std::string& name_or_path);
 
-// (name, path) of every scenes/*.gltf and scenes/*.glb, sorted by name then path.
+// (name, path) of every *.gltf and *.glb in the bundled scenes' folder, sorted by name then
+// path. Throws InputError when that folder is not found.
 std::vector<std::pair<std::string, std::string>> list_scenes();
 
 }  // namespace host

@@ -22,7 +22,7 @@ class ErrorTest(unittest.TestCase):
 
     def test_a_missing_scene_is_a_file_not_found_error_naming_it(self):
         with self.assertRaisesRegex(FileNotFoundError,
-                                    "^no_such_scene.gltf: no such file or scene in scenes/"):
+                                    "^no_such_scene.gltf: no such file or scene in .*scenes "):
             vgpu_rt.render("no_such_scene.gltf", size="8x8")
 
     def test_an_unreadable_scene_file_is_a_value_error_naming_it(self):

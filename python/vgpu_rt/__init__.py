@@ -14,9 +14,12 @@ two exceptions: `stats` defaults to "none" (the statistics come back as frame.st
 to True (no progress lines on stderr). Bad values raise ValueError with the command line's
 message; a scene that is neither a bundled name nor a file raises FileNotFoundError.
 
-The extension (_vgpu_rt) is built by the project's CMake into build/python/vgpu_rt/. This
-package finds it there both when imported from the build folder (PYTHONPATH=build/python) and
-from the source tree (the repository root's vgpu_rt link to python/vgpu_rt).
+The extension (_vgpu_rt) is built for one Python interpreter: by `pip install .` for the one
+running pip, by the project's CMake (into build/python/vgpu_rt/, and `cmake --install` from
+there) for Debian's /usr/bin/python3 unless -DPython_EXECUTABLE names another. Imported by
+another Python version, or without NumPy, the import raises one ImportError that names both
+interpreters and the fix. From a source tree (the repository root's vgpu_rt link to
+python/vgpu_rt) the package loads the build folder's extension.
 """
 
 import glob as _glob
@@ -26,27 +29,74 @@ import os as _os
 import sys as _sys
 
 
-def _load_extension():
-    """Imports _vgpu_rt from beside this file, else from the build folder of this source tree."""
+def _load_module(name, path):
+    spec = _importlib_util.spec_from_file_location(__name__ + "." + name, path)
+    module = _importlib_util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    _sys.modules[__name__ + "." + name] = module
+    return module
+
+
+def _extension_folder():
+    """The folder holding the extension _vgpu_rt: this package's own (an installed package, or
+    the build folder's build/python/vgpu_rt), else, imported from a source tree (the repository
+    root's vgpu_rt link to python/vgpu_rt), that tree's build folder ($VGPU_RT_BUILD or build)."""
     here = _os.path.dirname(_os.path.realpath(__file__))
     candidates = [here]
-    build = _os.environ.get("VGPU_RT_BUILD")  # a build folder other than <repo>/build
     root = _os.path.dirname(_os.path.dirname(here))  # python/vgpu_rt -> the repository
-    candidates.append(_os.path.join(build or _os.path.join(root, "build"), "python", "vgpu_rt"))
+    if _os.path.isfile(_os.path.join(root, "CMakeLists.txt")) and _os.path.isfile(
+            _os.path.join(root, "VERSION")):
+        build = _os.environ.get("VGPU_RT_BUILD") or _os.path.join(root, "build")
+        candidates.append(_os.path.join(build, "python", "vgpu_rt"))
     for folder in candidates:
-        found = sorted(_glob.glob(_os.path.join(folder, "_vgpu_rt*.so")))
-        if found:
-            spec = _importlib_util.spec_from_file_location(__name__ + "._vgpu_rt", found[0])
-            module = _importlib_util.module_from_spec(spec)
-            spec.loader.exec_module(module)
-            _sys.modules[__name__ + "._vgpu_rt"] = module
-            return module
+        if _glob.glob(_os.path.join(folder, "_vgpu_rt*.so")):
+            return folder
     raise ImportError(
         "vgpu_rt: the extension _vgpu_rt is not built; build it with `cmake -S . -B build -G Ninja "
-        "&& cmake --build build --target _vgpu_rt` (looked in " + ", ".join(candidates) + ")")
+        "&& cmake --build build --target _vgpu_rt`, or install the package with "
+        "`python3 -m pip install --no-build-isolation .` (looked in " + ", ".join(candidates) + ")")
+
+
+def _running():
+    return "%s (Python %s)" % (_sys.executable or "python", _sys.version.split()[0])
+
+
+def _check_interpreter(info):
+    """One ImportError, naming the running interpreter, the one the extension was built for and
+    the fix, where the extension cannot work here: another Python version, or no NumPy."""
+    built_for = "%s (Python %s)" % (info.python_executable, info.python_full_version)
+    rebuild = ("or build vgpu_rt for this interpreter: `%s -m pip install --no-build-isolation "
+               "<vgpu-rt source folder>`" % (_sys.executable or "python"))
+    if "%d.%d" % _sys.version_info[:2] != info.python_version:
+        raise ImportError(
+            "vgpu_rt %s was built for %s and cannot be loaded by %s: run it with %s, %s"
+            % (info.version, built_for, _running(), info.python_executable, rebuild))
+    try:
+        import numpy  # noqa: F401  (the extension's arrays are NumPy arrays)
+    except ImportError:
+        raise ImportError(
+            "vgpu_rt %s needs NumPy, which %s cannot import (it was built for %s): run it with "
+            "that interpreter, install NumPy for this one (`%s -m pip install numpy`, or a "
+            "virtual environment made with --system-site-packages over Debian's python3-numpy), "
+            "%s" % (info.version, _running(), built_for, _sys.executable or "python", rebuild)
+        ) from None
+
+
+def _load_extension():
+    folder = _extension_folder()
+    info_path = _os.path.join(folder, "_build_info.py")
+    if not _os.path.isfile(info_path):
+        raise ImportError("vgpu_rt: %s is missing (the build writes it beside the extension; "
+                          "rebuild or reinstall vgpu_rt)" % info_path)
+    info = _load_module("_build_info", info_path)
+    _check_interpreter(info)
+    return _load_module("_vgpu_rt", sorted(_glob.glob(_os.path.join(folder, "_vgpu_rt*.so")))[0])
 
 
 _ext = _load_extension()
+
+#: vgpu-rt's version (the repository's VERSION file), as `vgpu-rt --version` prints it.
+__version__ = _ext.version()
 
 FrameStats = _ext.FrameStats
 Device = _ext.Device
@@ -225,6 +275,12 @@ def passes(scene="bunny", **options):
 def scenes():
     """The bundled scenes as a dict: name -> path of its glTF file."""
     return dict(_ext.scenes())
+
+
+def scenes_dir():
+    """The folder the bundled scenes were found in (an installed tree's share/vgpu-rt/scenes,
+    the pip-installed package's scenes/, or $VGPU_RT_SCENES), or "" where none was found."""
+    return _ext.scenes_dir()
 
 
 def profiles():

@@ -8,6 +8,10 @@ import numpy.typing as npt
 
 _Array = npt.NDArray[np.float32]
 
+__version__: str
+
+def scenes_dir() -> str: ...
+
 class FrameStats:
     """A frame's pass statistics as the C++ library keeps them (per kernel and in total)."""
     @property

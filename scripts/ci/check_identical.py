@@ -10,9 +10,9 @@ What it compares:
 - Renders. Each case renders with OLD at 1 thread, then with NEW at 1 and 2 threads, with
   --walk passes (NEW's default walks in batches at 8 lanes) and at every lane width the case
   allows. Image and AOV pixels must be equal (equal EXR files, else vgpu-rt compare at
-  threshold 0 with max 0); the
-  --stats-json must be equal once every wall-clock field (*_ms), the threads/lanes/walk fields
-  and the scene path (each binary resolves a bundled scene in its own tree) are removed. The
+  threshold 0 with max 0); the --stats-json must be equal once every wall-clock field (*_ms),
+  the threads/lanes/walk fields, the scene path (each binary resolves a bundled scene in its own
+  tree) and the version are removed. The
   cases cover the paper's grid and its options (shading, masks, MRT, looping kernels, reduced
   precision), the other three structures (--accel grid2, bvh, kdtree, each multipass, looping
   and fused) and auto, the sampling modes (--spp, --aa adaptive, --aa undersample), textures
@@ -109,7 +109,7 @@ TRACES = [
     ("bunny-refl", S64 + ["--trace-pixel", "30,34", "--accel", "kdtree"] + LOOPING),
     ("classic", S64 + ["--trace-pixel", "20,40", "--spp", "4"] + MRT),
 ]
-DROPPED = ("threads", "lanes", "walk", "walk_passes_because", "scene_path")
+DROPPED = ("threads", "lanes", "walk", "walk_passes_because", "scene_path", "version")
 
 
 def strip(j):

@@ -23,6 +23,7 @@
 #include <utility>
 #include <vector>
 
+#include "host/common/version.h"
 #include "tests/cli/cli_helpers.h"
 
 namespace fs = std::filesystem;
@@ -286,6 +287,7 @@ TEST_CASE("a render writes the image, the AOVs and the statistics asked for, and
         "kernels", "masks", "mrt", "fused_programs", "kernel_variant", "sampling"})
     CHECK_MESSAGE(j.contains(key), key);
   CHECK(j.value("scene", "") == "sphere");
+  CHECK(j.value("version", "") == host::version());
   CHECK(j.value("profile", "") == "gf5700");
   CHECK(j["size"] == nlohmann::json::array({48, 40}));
   REQUIRE(j["grid"].size() == 3);

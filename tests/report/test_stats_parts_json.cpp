@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "host/common/version.h"
 #include "host/report/stats_json.h"
 #include "host/report/stats_parts_json.h"
 
@@ -181,7 +182,9 @@ TEST_CASE("a moving scene's frame adds frame, time, animation and update; --fram
   CHECK(frame["update"]["mode"] == "refit");
   const Json doc =
       host::frames_stats_json("hop", "/scenes/hop.gltf", animation, "auto", {frame, frame, frame});
-  CHECK(keys(doc) == Keys{"scene", "scene_path", "animation", "update", "frame_count", "frames"});
+  CHECK(keys(doc) ==
+        Keys{"version", "scene", "scene_path", "animation", "update", "frame_count", "frames"});
+  CHECK(doc["version"] == host::version());
   CHECK(doc["scene"] == "hop");
   CHECK(doc["scene_path"] == "/scenes/hop.gltf");
   CHECK(doc["animation"] == animation);

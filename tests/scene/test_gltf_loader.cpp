@@ -8,6 +8,7 @@
 #include <sstream>
 #include <string>
 
+#include "host/common/install_paths.h"
 #include "host/scene/camera.h"
 #include "host/scene/gltf_loader.h"
 
@@ -438,8 +439,8 @@ TEST_CASE(
     host::resolve_scene("no-such-scene-anywhere");
     FAIL("expected InputError");
   } catch (const host::InputError& e) {
-    CHECK(std::string(e.what()) ==
-          "no-such-scene-anywhere: no such file or scene in scenes/ (try `vgpu-rt scenes`)");
+    CHECK(std::string(e.what()) == "no-such-scene-anywhere: no such file or scene in " +
+                                       host::scenes_dir().string() + " (try `vgpu-rt scenes`)");
   }
 }
 
