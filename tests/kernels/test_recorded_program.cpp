@@ -224,7 +224,8 @@ TEST_CASE(
     const bool branches = p->analyze().branches > 0;
     bool any_profile = false;
     for (const char* profile_name : {"gf5700", "gf6600"}) {
-      CAPTURE(std::string(profile_name));
+      const std::string profile_shown(profile_name);  // CAPTURE keeps a reference
+      CAPTURE(profile_shown);
       const vgpu::Profile& profile = vgpu::profile(profile_name);
       for (const Family fam : kFamilies) {
         CAPTURE(fam.lanes);
@@ -265,7 +266,9 @@ TEST_CASE(
         }
         for (const auto& [field, member] : vgpu::kCounterFields)
           if (want.rec.counters.*member != got.rec.counters.*member) {
-            CAPTURE(std::string(field));
+            // A copy: clang 14 lambdas (CAPTURE's) cannot capture a structured binding.
+            const std::string field_shown(field);
+            CAPTURE(field_shown);
             CHECK((branches && branch_counters.count(field)));
             std::string d = field;
             d += " (" + std::to_string(want.rec.counters.*member) + " functor, " +
@@ -308,7 +311,8 @@ TEST_CASE(
     "recording a recorded program gives back its recording node for node, and the same GLSL as "
     "the functor") {
   for (const auto& p : kernels::all_programs(kernels::Programs::with_looping)) {
-    CAPTURE(std::string(p->name()));
+    const std::string name(p->name());  // CAPTURE keeps a reference
+    CAPTURE(name);
     const auto rp = vgpu::RecordedProgram::of(*p);
     const vgpu::Recording again = rp->record();
     CHECK(same_recording(rp->recording(), again));
