@@ -48,6 +48,15 @@
 // counting, recording) is compiled once, in the kernels/programs_*.cpp that kernels/kernel_list.h
 // names for it: a file that includes this header and makes a vgpu::KernelProgram<K> links to that
 // copy instead of compiling its own.
+#ifdef VGPU_KERNEL_WIDTHS_1_8  // the sanitizer build (vgpu/program.h, kEveryLaneWidth)
+namespace vgpu {
+#define VGPU_NARROW_PROGRAM(K, file) \
+  template <>                        \
+  inline constexpr bool kEveryLaneWidth<kernels::K> = false;
+VGPU_ALL_KERNELS(VGPU_NARROW_PROGRAM)
+#undef VGPU_NARROW_PROGRAM
+}  // namespace vgpu
+#endif
 #define VGPU_EXTERN_PROGRAM(K, file) extern template class vgpu::KernelProgram<kernels::K>;
 VGPU_ALL_KERNELS(VGPU_EXTERN_PROGRAM)
 #undef VGPU_EXTERN_PROGRAM

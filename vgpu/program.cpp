@@ -3,12 +3,20 @@
 
 #include <algorithm>
 #include <atomic>
+#include <stdexcept>
+#include <string>
 #include <unordered_map>
 #include <vector>
 
 #include "vgpu/span.h"
 
 namespace vgpu {
+
+void refuse_lane_width(const char* program, int lanes) {
+  throw std::logic_error(std::string(program) + ": this build compiled the project's kernels at " +
+                         "1 and 8 lanes only (VGPU_KERNEL_WIDTHS_1_8, the sanitizer build), not " +
+                         std::to_string(lanes));
+}
 
 Program::Program(const AbiTag& abi) {
   check_abi(abi);
