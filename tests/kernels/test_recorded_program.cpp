@@ -29,9 +29,9 @@
 #include <vector>
 
 #include "kernels/registry.h"
+#include "tests/support/lane_widths.h"
 #include "vgpu/recorded_program.h"
 #include "vgpu/vgpu.h"
-#include "tests/support/lane_widths.h"
 
 namespace {
 

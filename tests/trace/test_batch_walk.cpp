@@ -23,6 +23,7 @@
 #include "host/trace/stream/stream_tracer.h"
 #include "stability_cases.h"
 #include "tests/support/bits.h"
+#include "tests/support/lane_widths.h"
 #include "tests/support/stats_json.h"
 
 using test_support::same_bits;
@@ -386,9 +387,11 @@ TEST_CASE(
   host::RenderOptions off = opt;
   off.batch_walk = false;
   CHECK(reason(off) == std::make_pair(false, std::string("--walk passes")));
-  host::RenderOptions four = opt;
-  four.lanes = 4;
-  CHECK(reason(four) == std::make_pair(false, std::string("--lanes 4 (a batch is 8 lanes)")));
+  if (test_support::kernel_width_built(4)) {
+    host::RenderOptions four = opt;
+    four.lanes = 4;
+    CHECK(reason(four) == std::make_pair(false, std::string("--lanes 4 (a batch is 8 lanes)")));
+  }
   host::RenderOptions traced = opt;
   traced.trace_pixel = glm::ivec2(3, 4);
   CHECK(reason(traced) == std::make_pair(false, std::string("--trace-pixel prints every pass")));

@@ -17,6 +17,7 @@
 #include "host/trace/cpu/cpu_tracer.h"
 #include "host/trace/stream/stream_tracer.h"
 #include "host/trace/textures.h"
+#include "tests/support/lane_widths.h"
 
 namespace {
 
@@ -146,13 +147,13 @@ TEST_CASE("a textured frame is bit-identical at 1 and 8 lanes and 1 and 3 thread
   const host::Camera cam = host::scene_camera(scene);
   std::vector<std::vector<float>> images;
   for (auto [lanes, threads] : {std::pair{1, 1}, std::pair{8, 3}, std::pair{4, 2}}) {
+    if (!test_support::kernel_width_built(lanes)) continue;
     opt.lanes = lanes;
     opt.threads = threads;
     host::StreamTracer tracer(scene, grid, opt);
     images.push_back(tracer.render(cam).rgb);
   }
-  CHECK(images[1] == images[0]);
-  CHECK(images[2] == images[0]);
+  for (size_t i = 1; i < images.size(); ++i) CHECK(images[i] == images[0]);
 }
 
 TEST_CASE("textures whose atlas passes the profile's texture size are refused naming the limit") {
