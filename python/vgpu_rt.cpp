@@ -37,6 +37,7 @@
 #include "host/scene/gltf_loader.h"
 #include "host/scene/scene.h"
 #include "kernels/registry.h"
+#include "user_kernels.h"
 #include "vgpu/vgpu.h"
 
 namespace py = pybind11;
@@ -668,4 +669,5 @@ PYBIND11_MODULE(_vgpu_rt, m) {
                                   std::make_shared<vgpu::FrameStats>(r.stats));
           },
           "Once every pass was seen: the frame as render() returns it; else None.");
+  user_kernels::bind(m, &run_pass);  // kernels written in Python (python/user_kernels.h)
 }

@@ -22,17 +22,24 @@ void Device::check_texture(const Texture& t) const {
                 std::to_string(m) + "x" + std::to_string(m));
 }
 
-void check_pass(const Profile& profile, const Program& p, const Program::Analysis& a,
-                const Texture* const* units, const std::vector<Texture*>& targets,
-                const Rect& rect) {
+void check_texture_units(const Profile& profile, const std::string& program, int units) {
+  if (units > profile.texture_units)
+    throw Error("program '" + program + "' reads texture unit " + std::to_string(units - 1) + " (" +
+                std::to_string(units) + " units); profile " + profile.name + " has " +
+                std::to_string(profile.texture_units) +
+                " texture units (GL_MAX_TEXTURE_IMAGE_UNITS)");
+}
+
+void check_program(const Profile& profile, const Program& p, const Program::Analysis& a) {
   const std::string pname = p.name();
   auto fail = [](const std::string& what) { throw Error(what); };
   // Loops first: a looping program cannot run at all on a profile without them.
   const LoopTally& lp = a.loop;
   if (lp.loops > 0) {
     if (profile.branching != Branching::dynamic || profile.max_loop_iterations <= 0)
-      fail("program '" + pname + "' has a data-dependent loop; profile " + profile.name + " (" +
-           profile.cg_profile + ") has no dynamic branching or loops");
+      fail("program '" + pname + "' has a data-dependent loop of up to " +
+           std::to_string(lp.max_iterations) + " iterations; profile " + profile.name + " (" +
+           profile.cg_profile + ") has no dynamic branching or loops (0 iterations)");
     if (lp.loops > 1)
       fail("program '" + pname + "' has " + std::to_string(lp.loops) +
            " loops; the vgpu models one loop per program");
@@ -54,13 +61,25 @@ void check_pass(const Profile& profile, const Program& p, const Program::Analysi
     fail("program '" + pname + "' writes " + std::to_string(p.outputs()) + " outputs; profile " +
          profile.name + " allows " + std::to_string(profile.max_outputs) +
          " (no multiple render targets)");
-  if (int(targets.size()) != p.outputs())
-    fail("program '" + pname + "' writes " + std::to_string(p.outputs()) + " outputs but " +
-         std::to_string(targets.size()) + " render targets are set");
   if (a.instructions > profile.max_instructions)
     fail("program '" + pname + "' has " + std::to_string(a.instructions) +
          " instructions; profile " + profile.name + " allows " +
          std::to_string(profile.max_instructions));
+  int units = 0;
+  for (int u = 0; u < kMaxTextureUnits; ++u)
+    if (a.fetches.per_unit[size_t(u)]) units = u + 1;
+  check_texture_units(profile, pname, units);
+}
+
+void check_pass(const Profile& profile, const Program& p, const Program::Analysis& a,
+                const Texture* const* units, const std::vector<Texture*>& targets,
+                const Rect& rect) {
+  const std::string pname = p.name();
+  auto fail = [](const std::string& what) { throw Error(what); };
+  check_program(profile, p, a);
+  if (int(targets.size()) != p.outputs())
+    fail("program '" + pname + "' writes " + std::to_string(p.outputs()) + " outputs but " +
+         std::to_string(targets.size()) + " render targets are set");
   const Texture& t0 = *targets[0];
   for (const Texture* t : targets) {
     if (t->width() != t0.width() || t->height() != t0.height())

@@ -90,6 +90,14 @@ class Device {
 void check_pass(const Profile& profile, const Program& program, const Program::Analysis& a,
                 const Texture* const* units, const std::vector<Texture*>& targets,
                 const Rect& rect);
+// The rules of those a program breaks whatever it is bound to, each refusal one line naming the
+// rule, the profile and both numbers (check_pass makes them first): a data-dependent loop where the
+// profile has none or past its loop count, more outputs, more instructions, and a texture unit
+// past the profile's texture_units.
+void check_program(const Profile& profile, const Program& program, const Program::Analysis& a);
+// The texture-unit rule alone, for a program of `units` units (units 0 .. units - 1) that may
+// not be made yet (one past kMaxTextureUnits cannot be): the line check_program throws.
+void check_texture_units(const Profile& profile, const std::string& program, int units);
 
 // A pass's static counters (identical on every device): fragments launched and shaded, the
 // instructions, fetches and bytes the program's counting run implies, bytes written by the

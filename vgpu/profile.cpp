@@ -20,6 +20,9 @@ const std::vector<Profile>& profiles() {
     fx.branching = Branching::none;  // NVIDIA Cg docs, fp30: no data-dependent branching/loops
     fx.branch_granularity = 1;
     fx.max_texture_size = 4096;   // NV3x GL_MAX_TEXTURE_SIZE / RECTANGLE size (driver caps)
+    // NVIDIA's developer FAQ: GL_MAX_TEXTURE_UNITS is 4 on GeForce FX and GeForce 6 "since those
+    // GPUs have 16 texture units", reached through ARB_fragment_program's texture image units.
+    fx.texture_units = 16;        // GL_MAX_TEXTURE_IMAGE_UNITS_ARB on NV3x (NVIDIA developer FAQ)
     fx.precision = Format::fp32;  // fp30 "float" is IEEE single; "half" is fp16
     fx.bus_mbps = 2112;           // AGP 8x: 264 MB/s x 8 (GPU Gems 2, ch. 30)
     // Fixed costs: no public figure; one unit u fitted on Table 1 Bunny3 on this card (5075 ms,
@@ -54,6 +57,7 @@ const std::vector<Profile>& profiles() {
     ati.branching = Branching::none;  // ps_2_0: no flow control in fragment programs
     ati.branch_granularity = 1;       // no branching
     ati.max_texture_size = 2048;      // R300 GL_MAX_TEXTURE_SIZE (driver caps)
+    ati.texture_units = 16;        // Direct3D 9 ps_2_0: samplers s0..s15; ARB_fragment_program 16
     ati.precision = Format::fp24;  // en.wikipedia.org "Radeon 9000 series": FP24 shader precision
     ati.has_fp16 = false;          // partial-precision hints run at fp24 on R300
     ati.bus_mbps = 2112;           // AGP 8x, as the FX 5700
@@ -82,6 +86,7 @@ const std::vector<Profile>& profiles() {
     g6.branching = Branching::dynamic;  // NVIDIA Cg docs, fp40
     g6.branch_granularity = 1024;       // ~1000 pixels on NV4x (AnandTech)
     g6.max_texture_size = 4096;         // NV4x driver caps
+    g6.texture_units = 16;              // GL_MAX_TEXTURE_IMAGE_UNITS on NV4x (NVIDIA developer FAQ)
     g6.precision = Format::fp32;        // FP32 and FP16 equal speed on GeForce 6 (CineFX 3.0 brief)
     g6.bus_mbps = 4000;  // PCI Express x16, one direction (PCI-SIG 1.0a: 250 MB/s/lane)
     // Fixed costs: fitted as on the FX 5700, on Table 1 Bunny3 on this card (1079 ms).
@@ -114,6 +119,7 @@ const std::vector<Profile>& profiles() {
     m.branching = Branching::dynamic;
     m.branch_granularity = 32;   // one warp (NVIDIA CUDA programming guide)
     m.max_texture_size = 32768;  // D3D12 feature level 12 max texture dimension
+    m.texture_units = 32;        // GL_MAX_TEXTURE_IMAGE_UNITS on NVIDIA's current GL drivers
     m.precision = Format::fp32;
     m.bus_mbps = 32000;     // PCI Express 4.0 x16, one direction
     m.program_load_us = 2;  // model parameter (assumed; no Table 1 figure to fit)
@@ -147,6 +153,7 @@ const std::vector<Profile>& profiles() {
     m.branching = Branching::dynamic;
     m.branch_granularity = 32;   // one warp (NVIDIA CUDA programming guide)
     m.max_texture_size = 32768;  // GL_MAX_TEXTURE_SIZE on NVIDIA drivers
+    m.texture_units = 32;        // GL_MAX_TEXTURE_IMAGE_UNITS on NVIDIA's current GL drivers
     m.precision = Format::fp32;
     m.bus_mbps = 64000;  // PCI Express 5.0 x16, one direction (H200 datasheet)
     // Fixed costs measured by bench_gl on this H200 (NVIDIA 580 driver, EGL, 1x1 passes, medians

@@ -28,6 +28,10 @@ struct Profile {
   Branching branching = Branching::none;
   int branch_granularity = 1;       // pixels that branch together (dynamic branching only)
   int max_texture_size = 0;         // texels per side
+  // Texture image units a fragment program may read (OpenGL's GL_MAX_TEXTURE_IMAGE_UNITS under
+  // ARB_fragment_program, Direct3D 9's samplers): unit u exists where u < texture_units. The
+  // emulator binds at most kMaxTextureUnits (vgpu/fragment.h) whatever the profile says.
+  int texture_units = 16;
   Format precision = Format::fp32;  // full arithmetic precision of the fragment units
   bool has_fp16 = true;             // a half-precision arithmetic mode (NV3x+ "half"; not R300)
   double bus_mbps = 0;              // host to GPU bus, MB/s, for program uploads
