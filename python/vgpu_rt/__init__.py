@@ -378,7 +378,20 @@ def _refuse_truth(r, what):
            "`with f.branch(mask):`")
 
 
-class Lanes:
+class _Arithmetic:
+    """+ - * / (and their reflected forms) through the subclass's _bin(other, op, swap)."""
+
+    def __add__(self, o): return self._bin(o, "add")
+    def __radd__(self, o): return self._bin(o, "add", True)
+    def __sub__(self, o): return self._bin(o, "sub")
+    def __rsub__(self, o): return self._bin(o, "sub", True)
+    def __mul__(self, o): return self._bin(o, "mul")
+    def __rmul__(self, o): return self._bin(o, "mul", True)
+    def __truediv__(self, o): return self._bin(o, "div")
+    def __rtruediv__(self, o): return self._bin(o, "div", True)
+
+
+class Lanes(_Arithmetic):
     """A float register of a kernel being recorded: one value per fragment. Arithmetic
     (+ - * / and unary -) with Lanes or Python numbers, comparisons giving a Mask, abs() and
     math.floor(); a Python `if` on it raises (use select)."""
@@ -395,14 +408,6 @@ class Lanes:
         a, b = (o, self) if swap else (self, o)
         return Lanes(self._r, self._r.push(op, a.id, b.id))
 
-    def __add__(self, o): return self._bin(o, "add")
-    def __radd__(self, o): return self._bin(o, "add", True)
-    def __sub__(self, o): return self._bin(o, "sub")
-    def __rsub__(self, o): return self._bin(o, "sub", True)
-    def __mul__(self, o): return self._bin(o, "mul")
-    def __rmul__(self, o): return self._bin(o, "mul", True)
-    def __truediv__(self, o): return self._bin(o, "div")
-    def __rtruediv__(self, o): return self._bin(o, "div", True)
     def __neg__(self): return Lanes(self._r, self._r.push("neg", self.id))
     def __pos__(self): return self
     def __abs__(self): return Lanes(self._r, self._r.push("abs", self.id))
@@ -458,7 +463,7 @@ class Mask:
     def __repr__(self): return f"<vgpu_rt.Mask node {self.id}>"
 
 
-class Vec4:
+class Vec4(_Arithmetic):
     """Four Lanes (.x .y .z .w, or [0] to [3]): a texel, an output. Arithmetic is per component;
     a Lanes or a Python number on the other side is broadcast."""
 
@@ -486,14 +491,6 @@ class Vec4:
             other = Vec4.splat(_lanes(r, other))
         return Vec4(*(a._bin(b, op, swap) for a, b in zip(self, other)))
 
-    def __add__(self, o): return self._bin(o, "add")
-    def __radd__(self, o): return self._bin(o, "add", True)
-    def __sub__(self, o): return self._bin(o, "sub")
-    def __rsub__(self, o): return self._bin(o, "sub", True)
-    def __mul__(self, o): return self._bin(o, "mul")
-    def __rmul__(self, o): return self._bin(o, "mul", True)
-    def __truediv__(self, o): return self._bin(o, "div")
-    def __rtruediv__(self, o): return self._bin(o, "div", True)
     def __neg__(self): return Vec4(*(-a for a in self))
     def __abs__(self): return Vec4(*(abs(a) for a in self))
     def __bool__(self): _refuse_truth(self.x._r, "if/and/or/not")
