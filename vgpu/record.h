@@ -10,6 +10,7 @@
 
 #include <array>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "vgpu/lanes.h"
@@ -64,13 +65,23 @@ struct RecLoop {
   int entry = -1;  // mask node: the lanes entering the loop
 };
 
+// A named uniform of a recording: the constant nodes that read it. A functor's uniforms are its
+// data members, anonymous in its recording; a kernel written outside the project's build (from
+// Python, python/vgpu_rt) names each, so that a frame can set them between passes
+// (vgpu::RecordedProgram::set_uniform, host/trace/user_stage.h).
+struct RecUniform {
+  std::string name;
+  std::vector<int> nodes;  // Op::constant nodes holding its value
+};
+
 // One program's operations in the order the functor performed them.
 struct Recording {
   std::vector<RecNode> nodes;
   std::vector<std::array<int, 4>> outputs;  // node of each channel of each output register
   int kill = -1;                            // mask node: the fragment is discarded (-1: never)
   int mask_false = -1, mask_true = -1;
-  std::vector<RecLoop> loops;  // at most one (the vgpu refuses more)
+  std::vector<RecLoop> loops;        // at most one (the vgpu refuses more)
+  std::vector<RecUniform> uniforms;  // named uniforms (none in a functor's recording)
 
   int push(const RecNode& n) {
     nodes.push_back(n);

@@ -2,7 +2,9 @@
 // lane family through Fragments<L> (vgpu/recorded_program.h says why that way).
 #include "vgpu/recorded_program.h"
 
+#include <atomic>
 #include <bit>
+#include <cmath>
 #include <map>
 #include <stdexcept>
 #include <utility>
@@ -77,6 +79,12 @@ int operand(const RecNode& nd, int slot) {
   return slot == 0 ? nd.a : slot == 1 ? nd.b : nd.c;
 }
 
+// A stamp no program's constants had before (vgpu::RecordedProgram::stamp_).
+uint64_t next_stamp() {
+  static std::atomic<uint64_t> next{1};
+  return next.fetch_add(1, std::memory_order_relaxed);
+}
+
 }  // namespace
 
 RecordedProgram::RecordedProgram(Recording rec, std::string name, std::string paper_name,
@@ -85,8 +93,45 @@ RecordedProgram::RecordedProgram(Recording rec, std::string name, std::string pa
       name_(std::move(name)),
       paper_name_(std::move(paper_name)),
       outputs_(outputs),
-      units_(std::move(units)) {
+      units_(std::move(units)),
+      stamp_(next_stamp()) {
   compile();
+}
+
+std::vector<std::string> RecordedProgram::uniform_names() const {
+  std::vector<std::string> names;
+  for (const RecUniform& u : rec_.uniforms) names.push_back(u.name);
+  return names;
+}
+
+bool RecordedProgram::has_uniform(std::string_view name) const {
+  for (const RecUniform& u : rec_.uniforms)
+    if (u.name == name) return true;
+  return false;
+}
+
+float RecordedProgram::uniform(std::string_view name) const {
+  for (size_t i = 0; i < rec_.uniforms.size(); ++i)
+    if (rec_.uniforms[i].name == name) return values_[i];
+  throw std::invalid_argument("program '" + name_ + "' has no uniform '" + std::string(name) + "'");
+}
+
+void RecordedProgram::set_uniform(std::string_view name, float value) {
+  size_t i = 0;
+  while (i < rec_.uniforms.size() && rec_.uniforms[i].name != name) ++i;
+  if (i == rec_.uniforms.size())
+    throw std::invalid_argument("program '" + name_ + "' has no uniform '" + std::string(name) +
+                                "'");
+  if (std::isnan(value))
+    throw std::invalid_argument("program '" + name_ + "': uniform '" + std::string(name) +
+                                "' set to NaN");
+  if (std::bit_cast<uint32_t>(values_[i]) == std::bit_cast<uint32_t>(value)) return;
+  values_[i] = value;
+  for (int node : rec_.uniforms[i].nodes) rec_.nodes[size_t(node)].value = value;
+  for (std::vector<Instr>* list : {&code_, &constants_})
+    for (Instr& in : *list)
+      if (in.op == Op::constant) in.value = rec_.nodes[size_t(in.node)].value;
+  stamp_ = next_stamp();
 }
 
 std::unique_ptr<RecordedProgram> RecordedProgram::of(const Program& p) {
@@ -136,6 +181,24 @@ void RecordedProgram::compile() {
       fail("node " + std::to_string(i) + ": texture unit " + std::to_string(nd.unit));
     if (nd.op == Op::channel && (nd.unit < 0 || nd.unit > 3))
       fail("node " + std::to_string(i) + ": channel " + std::to_string(nd.unit));
+  }
+  // Each named uniform's nodes are constants holding one value.
+  for (size_t u = 0; u < rec_.uniforms.size(); ++u) {
+    const RecUniform& un = rec_.uniforms[u];
+    if (un.name.empty()) fail("uniform " + std::to_string(u) + " has no name");
+    for (size_t v = 0; v < u; ++v)
+      if (rec_.uniforms[v].name == un.name) fail("two uniforms named '" + un.name + "'");
+    if (un.nodes.empty()) {
+      values_.push_back(0.0f);
+      continue;
+    }
+    for (int id : un.nodes)
+      if (id < 0 || id >= n || nodes[size_t(id)].op != Op::constant ||
+          std::bit_cast<uint32_t>(nodes[size_t(id)].value) !=
+              std::bit_cast<uint32_t>(nodes[size_t(un.nodes[0])].value))
+        fail("uniform '" + un.name + "': node " + std::to_string(id) +
+             " is not a constant of its value");
+    values_.push_back(nodes[size_t(un.nodes[0])].value);
   }
 
   // The loop: body [b, m) and its second copy [m, e), each ending with the mask_and of the lanes
@@ -416,7 +479,7 @@ void RecordedProgram::execute(Fragments<L>& f) const {
   if constexpr (L::recording) prefix = int(Recorder::current->nodes.size());
   // The recording and counting runs go through every node in order (the recording keeps each
   // constant's place); the computing families set the constants only where the thread's
-  // registers last held another program's (program ids are never reused).
+  // registers last held another program's or other values (stamps are never reused).
   constexpr bool hoisted = !L::recording && !L::counting;
   const std::vector<Instr>& list = hoisted ? computed_ : code_;
   const Instr* code = list.data();
@@ -424,10 +487,10 @@ void RecordedProgram::execute(Fragments<L>& f) const {
   const int body_begin = hoisted ? computed_body_begin_ : body_begin_;
   const int body_end = hoisted ? computed_body_end_ : body_end_;
   if constexpr (hoisted) {
-    thread_local uint32_t loaded = 0;  // the program whose constants the registers hold
-    if (loaded != id()) {
+    thread_local uint64_t loaded = 0;  // the stamp whose constants the registers hold
+    if (loaded != stamp_) {
       for (const Instr& in : constants_) fr[in.dst] = F(in.value);
-      loaded = id();
+      loaded = stamp_;
     }
   }
   auto copy = [&](const Copy& c) {

@@ -26,6 +26,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "vgpu/program.h"
@@ -64,8 +65,20 @@ class RecordedProgram final : public Program {
   void run(Fragments<RoundedLanes<8, Format::fp16>>& f) const override;
   void run(Fragments<RecordingLanes>& f) const override;
   std::string unit_name(int unit) const override;
-  // The recording never changes: one set of "uniform" bytes (none) for its whole life.
-  std::span<const std::byte> uniform_bytes() const override { return {}; }
+  // The recording's named uniforms (Recording::uniforms), in its order, and their values now.
+  // A recording from a functor has none: its uniforms are constants fixed when it was recorded.
+  std::vector<std::string> uniform_names() const;
+  bool has_uniform(std::string_view name) const;
+  float uniform(std::string_view name) const;
+  // Sets a named uniform for the passes that follow (as the host sets a functor's members
+  // between passes). Throws std::invalid_argument, naming the program, for a name it does not
+  // have or a NaN value. Not while a pass of this program runs.
+  void set_uniform(std::string_view name, float value);
+  // The named uniforms' values: equal bytes, equal recording (the GL device keeps a compiled
+  // shader per bytes, the loop analysis per program and bytes).
+  std::span<const std::byte> uniform_bytes() const override {
+    return std::as_bytes(std::span<const float>(values_));
+  }
 
  private:
   // One instruction of the compiled recording. dst, a, b, c are register indices: float
@@ -114,6 +127,10 @@ class RecordedProgram final : public Program {
   std::vector<Copy> starts_, carries_;
   std::vector<std::array<int32_t, 4>> out_regs_;
   int32_t kill_ = -1;  // mask register of the discard, -1: none
+  // The named uniforms' values, Recording::uniforms' order, and a stamp that no other program or
+  // set of values has had: a thread's registers hold the constants of the stamp they were set for.
+  std::vector<float> values_;
+  uint64_t stamp_ = 0;
 };
 
 }  // namespace vgpu
