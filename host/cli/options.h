@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "host/trace/user_stage.h"
 #include "vgpu/lanes.h"
 
 namespace cli {
@@ -63,6 +64,9 @@ struct RenderArgs {
   std::string update = "rebuild";
   bool update_given = false;
   int report_frame = 0;  // --report-frame K (1-based; 0: not given)
+  // Not an option of the command line: the stages a library caller (the Python module, another
+  // C++ project) replaces with kernels of its own (host/trace/user_stage.h).
+  host::UserKernels user;
 };
 
 struct UsageError : std::runtime_error {

@@ -157,6 +157,7 @@ RenderPlan parse_render(const RenderArgs& a, bool lanes_given, bool observer) {
   opt.spp = a.spp;
   opt.adaptive = a.aa == "adaptive";
   opt.undersample = a.aa == "adaptive" || a.aa == "none" ? 0 : *parse_aa(a.aa);
+  opt.user = a.user;
   // --aa-criterion: budget unless given; only adaptive sampling reads it.
   const std::string criterion = a.aa_criterion.value_or("budget");
   opt.aa_criterion = criterion == "object"   ? host::RenderOptions::AaCriterion::object

@@ -86,6 +86,22 @@ nlohmann::ordered_json frame_stats_json(const FrameStatsInputs& in) {
   j["fused_programs"] = opt.mrt ? mrt_programs() : std::vector<std::string>{};
   j["kernel_variant"] = in.kernels;  // multipass | looping ("kernels" lists the programs)
   if (opt.looping) j["steps_per_pass"] = opt.steps_per_pass;
+  // Stages replaced by kernels of one's own (host/trace/user_stage.h): each under the stage's
+  // name, with the program's name (its passes are under that name in "kernels") and units.
+  if (opt.user.any()) {
+    nlohmann::ordered_json u = nlohmann::ordered_json::object();
+    auto stage = [&](const char* key, const auto& k, const char* replaces) {
+      if (!k) return;
+      const vgpu::Program& p = k->program();
+      u[key] = {{"program", p.name()},
+                {"replaces", replaces},
+                {"instructions", p.analyze().instructions},
+                {"units", k->units()}};
+    };
+    stage("shader", opt.user.shader, "shader");
+    stage("camera", opt.user.camera, "generate rays");
+    j["user_kernels"] = std::move(u);
+  }
   j["threads"] = opt.threads;
   j["lanes"] = opt.lanes;
   // How the emulator ran the grid walks: in batches or pass by pass (same statistics), and why

@@ -51,6 +51,12 @@ const vgpu::PassRecord& PassRunner::pass(const vgpu::Program& p,
                                          std::initializer_list<const Texture*> in,
                                          std::initializer_list<Texture*> outs,
                                          const Stencil* work) {
+  return pass(p, std::span<const Texture* const>(in.begin(), in.size()), outs, work);
+}
+
+const vgpu::PassRecord& PassRunner::pass(const vgpu::Program& p, std::span<const Texture* const> in,
+                                         std::initializer_list<Texture*> outs,
+                                         const Stencil* work) {
   gpu_.use_program(p);
   gpu_.unbind_textures();
   int unit = 0;

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <initializer_list>
 #include <optional>
+#include <span>
 #include <string>
 #include <utility>
 #include <vector>
@@ -73,6 +74,11 @@ class PassRunner {
                                const vgpu::Stencil* work = nullptr);
   const vgpu::PassRecord& pass(const vgpu::Program& p,
                                std::initializer_list<const vgpu::Texture*> in,
+                               std::initializer_list<vgpu::Texture*> outs,
+                               const vgpu::Stencil* work = nullptr);
+  // The same with the units in a list made at run time (a kernel of one's own binds the
+  // stage's textures it names, host/trace/user_stage.h).
+  const vgpu::PassRecord& pass(const vgpu::Program& p, std::span<const vgpu::Texture* const> in,
                                std::initializer_list<vgpu::Texture*> outs,
                                const vgpu::Stencil* work = nullptr);
   // A counting pass inside an occlusion query: the fragments p does not discard; those are

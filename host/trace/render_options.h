@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "host/model/formats.h"
+#include "host/trace/user_stage.h"
 #include "kernels/shader.h"
 #include "vgpu/vgpu.h"
 
@@ -153,6 +154,9 @@ struct RenderOptions {
   // Called at the start of each ray-tracing iteration (1-based) with the iteration count.
   std::function<void(int iteration, int iterations)> progress;
   PassObserver* observer = nullptr;  // not owned
+  // Stages replaced by kernels of one's own (host/trace/user_stage.h; the stream tracer runs
+  // them on the emulator or a GL device, the CPU tracer refuses them).
+  UserKernels user;
   // The combinations of these options that cannot run are refused in one place,
   // host::validate (host/trace/validate.h).
 };

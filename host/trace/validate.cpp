@@ -2,6 +2,7 @@
 // then those of RenderOptions alone (which every library caller meets too), then the scene's.
 #include "host/trace/validate.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <stdexcept>
 
@@ -262,6 +263,68 @@ void check_options(const RenderOptions& opt, const vgpu::Profile& profile, const
     out.add("--spp", std::to_string(opt.spp), "--spp: " + why);
 }
 
+// The kernels of one's own (host/trace/user_stage.h): what the stage they replace binds and
+// writes, and the modes built on the project's own kernel for it.
+template <class U>
+void check_user_stage(const char* option, const UserStage<U>* k, const char* stage_words,
+                      const Scene* scene, Refusals& out) {
+  if (!k) return;
+  const vgpu::Program& p = k->program();
+  const std::string who = std::string(option) + " '" + p.name() + "'";
+  if (p.outputs() != 1)
+    out.add(option, p.name(),
+            who + " writes " + std::to_string(p.outputs()) + " outputs; the " + stage_words +
+                " writes 1");
+  const std::vector<std::string> units = k->units();
+  std::string known;
+  for (const char* u : U::units) known += std::string(known.empty() ? "" : ", ") + u;
+  for (size_t i = 0; i < units.size(); ++i) {
+    auto at = std::find(U::units.begin(), U::units.end(), units[i]);
+    if (at == U::units.end()) {
+      out.add(option, p.name(),
+              who + ": unit " + std::to_string(i) + " '" + units[i] + "' is not a texture of the " +
+                  stage_words + (known.empty() ? " (it binds none)" : " (it binds " + known + ")"));
+      return;
+    }
+    // kernels::Shader's units from kOrigins on exist on a scene with base-colour textures.
+    if constexpr (std::is_same_v<U, kernels::ShaderStage>)
+      if (scene && scene->textures.empty() && at - U::units.begin() >= kernels::Shader::kOrigins &&
+          units[i] != "origins") {
+        out.add(option, p.name(),
+                who + ": unit " + std::to_string(i) + " '" + units[i] +
+                    "' holds base-colour textures, and this scene has none");
+        return;
+      }
+  }
+}
+
+void check_user_kernels(const RenderOptions& opt, const Request* q, const Scene* scene,
+                        Refusals& out) {
+  const UserKernels& u = opt.user;
+  if (!u.any()) return;
+  check_user_stage("shader", u.shader.get(), "shading stage (one pass per light)", scene, out);
+  check_user_stage("camera", u.camera.get(), "camera stage (the primary rays)", scene, out);
+  const char* option = u.shader ? "shader" : "camera";
+  const std::string name = (u.shader ? u.shader->program() : u.camera->program()).name();
+  if (q && q->engine == "cpu")
+    out.add(option, name,
+            std::string(option) + " '" + name +
+                "': the cpu engine runs no kernels (a double-precision reference); a kernel of "
+                "your own needs --engine stream or gl");
+  if (!u.camera) return;
+  const std::string cam = "camera '" + std::string(u.camera->program().name()) + "'";
+  if (opt.beams || (q && q->beams != "off"))
+    out.add("camera", u.camera->program().name(),
+            cam +
+                ": --beams march the project's camera (generadorRayos) over tiles; a camera "
+                "of your own needs --beams off");
+  if (opt.adaptive || opt.undersample > 0)
+    out.add("camera", u.camera->program().name(),
+            cam + ": --aa " + (opt.adaptive ? std::string("adaptive") : aa_text(opt, q)) +
+                " builds on the project's camera (gated sample rays, dense streams); a camera "
+                "of your own takes --spp N (its jitter as uniforms) or no --aa");
+}
+
 }  // namespace
 
 std::vector<Refusal> validate(const RenderOptions& opt, const vgpu::Profile& profile,
@@ -273,6 +336,7 @@ std::vector<Refusal> validate(const RenderOptions& opt, const vgpu::Profile& pro
   }
   check_options(opt, profile, request, out);
   if (request) check_engines(opt, *request, out);
+  check_user_kernels(opt, request, scene, out);
   // Ray streams (a scene with glass, or --ray-streams on) move a pixel's rays to other texels.
   if (opt.trace_pixel && (opt.ray_streams || (scene && scene_has_glass(*scene))))
     out.add("--trace-pixel", request ? request->trace_pixel : "",

@@ -66,6 +66,9 @@ StreamTracer::StreamTracer(const Scene& scene, const Accel& accel, const RenderO
                                                                {&s.shader, Group::colour},
                                                                {&s.reflected, Group::colour}})
     prog->set_precision(fm.arithmetic(g));
+  // Kernels of one's own compute as the stage they replace.
+  if (opt_.user.shader) opt_.user.shader->program().set_precision(fm.arithmetic(Group::colour));
+  if (opt_.user.camera) opt_.user.camera->program().set_precision(fm.arithmetic(Group::rays));
   const bool sums = opt_.spp > 1 || opt_.undersample > 0;
   const bool marking = (opt_.adaptive && opt_.spp > 1) || opt_.undersample > 0;
 
@@ -410,7 +413,27 @@ void StreamTracer::generate_rays(const Camera& cam, const vgpu::Program& generat
   } else {
     s.walk->set_camera(s.generate.kernel, 0.0f, 0.0f);
   }
-  if (marks && s.dense) {
+  if (opt_.user.camera) {
+    // A camera of one's own (host/trace/user_stage.h): the generator's camera and this frame's
+    // sample position as its uniforms (never a gated frame: validate refuses those modes).
+    const GenerateRays& g = s.generate.kernel;
+    kernels::CameraStage u;
+    u.eye = cam.position;
+    u.forward = g.forward;
+    u.right = g.right;
+    u.up = g.up;
+    u.tan_half_fov = g.tan_half_fov;
+    u.aspect = g.aspect;
+    u.width = g.width;
+    u.height = g.height;
+    if (&generate == &s.sample_generate) {
+      u.jitter_x = s.sample_generate.kernel.jitter_x;
+      u.jitter_y = s.sample_generate.kernel.jitter_y;
+    }
+    opt_.user.camera->bind(u);
+    s.runner->pass(opt_.user.camera->program(), std::span<const Texture* const>{},
+                   {&s.rays.current()});
+  } else if (marks && s.dense) {
     // generadorRayosDensos: each slot's sample through its packed pixel.
     s.runner->pass(s.dense->generate, {&s.dense->pixels(), &s.dense->jitters()}, s.rays.current());
   } else if (marks)
@@ -509,6 +532,10 @@ void StreamTracer::shade_lights(const Camera& cam, Texture& surface, Texture& ra
 void StreamTracer::shader_pass(const Texture& surface, const Texture& rays, const Texture& colour,
                                const Texture& shadow, const Texture& origins, Texture& out) {
   State& s = *s_;
+  if (opt_.user.shader) {
+    user_shader_pass(surface, rays, colour, shadow, origins, out);
+    return;
+  }
   // The shader's inputs, in its binding order (kernels/shader.h); a textured scene's shader
   // also reads the rays' origins (for the ray differentials) and the base-colour textures.
   if (s.textured)
@@ -522,6 +549,57 @@ void StreamTracer::shader_pass(const Texture& surface, const Texture& rays, cons
                    {&surface, &rays, &colour, &shadow, &s.colors, &s.v[0], &s.v[1], &s.v[2],
                     &s.n[0], &s.n[1], &s.n[2]},
                    out);
+}
+
+void StreamTracer::user_shader_pass(const Texture& surface, const Texture& rays,
+                                    const Texture& colour, const Texture& shadow,
+                                    const Texture& origins, Texture& out) {
+  // A shader of one's own (host/trace/user_stage.h): the uniforms the project's shader has for
+  // this light, and the textures it binds, to the units the kernel names.
+  State& s = *s_;
+  const Shader& sh = s.shader.kernel;
+  kernels::ShaderStage u;
+  u.light = sh.light;
+  u.light_color = sh.light_color;
+  u.first_light = sh.first_light ? 1.0f : 0.0f;
+  u.last_light = sh.last_light ? 1.0f : 0.0f;
+  u.shadows = sh.shadows ? 1.0f : 0.0f;
+  u.shadow_transmittance = sh.shadow_transmittance ? 1.0f : 0.0f;
+  u.ambient = sh.ambient;
+  u.background = sh.background;
+  u.specular = sh.specular;
+  u.atten_dist = sh.atten_dist;
+  u.scene_width = sh.scene.width;
+  UserShader& k = *opt_.user.shader;
+  k.bind(u);
+  const std::array<const Texture*, Shader::units.size()> stage{
+      &surface,
+      &rays,
+      &colour,
+      &shadow,
+      &s.colors,
+      &s.v[0],
+      &s.v[1],
+      &s.v[2],
+      &s.n[0],
+      &s.n[1],
+      &s.n[2],
+      &origins,
+      s.textured ? &s.base.uvs01 : nullptr,
+      s.textured ? &s.base.uvs2 : nullptr,
+      s.textured ? &s.base.table : nullptr,
+      s.textured ? &s.base.atlas : nullptr};
+  std::vector<const Texture*> in;
+  for (const std::string& name : k.units()) {
+    const auto at = std::find(Shader::units.begin(), Shader::units.end(), name);
+    const Texture* t =
+        at == Shader::units.end() ? nullptr : stage[size_t(at - Shader::units.begin())];
+    if (!t)  // validate() refuses these before the frame
+      throw vgpu::Error(std::string("shader '") + k.program().name() + "': no texture '" + name +
+                        "' in this frame");
+    in.push_back(t);
+  }
+  s.runner->pass(k.program(), in, {&out});
 }
 
 void StreamTracer::download_aovs(RenderResult& res, Texture& hits) {

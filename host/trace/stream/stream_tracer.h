@@ -112,6 +112,10 @@ class StreamTracer {
   void shader_pass(const vgpu::Texture& surface, const vgpu::Texture& rays,
                    const vgpu::Texture& colour, const vgpu::Texture& shadow,
                    const vgpu::Texture& origins, vgpu::Texture& out);
+  // ... with a shader of one's own (RenderOptions::user).
+  void user_shader_pass(const vgpu::Texture& surface, const vgpu::Texture& rays,
+                        const vgpu::Texture& colour, const vgpu::Texture& shadow,
+                        const vgpu::Texture& origins, vgpu::Texture& out);
   // The primary hits' depths and input triangle ids into res, from `hits` (pixel layout).
   void download_aovs(RenderResult& res, vgpu::Texture& hits);
   // The sampling modes and their resolve (host/trace/stream/sampling_modes.cpp).
