@@ -19,6 +19,8 @@
 #include <tuple>
 #include <vector>
 
+#include "host/trace/user_stage.h"
+#include "kernels/stages.h"
 #include "vgpu/glsl.h"
 #include "vgpu/recorded_program.h"
 #include "vgpu/vgpu.h"
@@ -43,11 +45,11 @@ struct UserProgram {
 // One node as the recorder writes it: (op, a, b, c, unit, value).
 using Node = std::tuple<int, int, int, int, int, float>;
 
-inline UserProgram make_program(const std::string& name, int outputs,
-                                const std::vector<std::string>& units,
-                                const std::vector<Node>& nodes,
-                                const std::vector<std::array<int, 4>>& out_nodes, int kill,
-                                const std::optional<std::array<int, 5>>& loop) {
+inline UserProgram make_program(
+    const std::string& name, int outputs, const std::vector<std::string>& units,
+    const std::vector<Node>& nodes, const std::vector<std::array<int, 4>>& out_nodes, int kill,
+    const std::optional<std::array<int, 5>>& loop,
+    const std::vector<std::pair<std::string, std::vector<int>>>& uniforms) {
   vgpu::Recording rec;
   const int last = int(vgpu::Op::channel);
   for (const auto& [op, a, b, c, unit, value] : nodes) {
@@ -63,6 +65,7 @@ inline UserProgram make_program(const std::string& name, int outputs,
     const auto& l = *loop;
     rec.loops.push_back({l[0], l[1], l[2], l[3], l[4]});
   }
+  for (const auto& [uname, ids] : uniforms) rec.uniforms.push_back({uname, ids});
   return {std::make_shared<vgpu::RecordedProgram>(std::move(rec), name, name, outputs, units)};
 }
 
@@ -114,6 +117,29 @@ inline py::dict analysis(const UserProgram& k) {
   return d;
 }
 
+// The frame's stages a kernel of one's own can replace (kernels/stages.h): each one's texture
+// units and uniforms with their defaults, {stage: (units, {name: default})}.
+inline py::dict stages() {
+  py::dict out;
+  auto one = [&](const char* key, const auto& stage) {
+    py::list units;
+    for (const char* u : stage.units) units.append(u);
+    py::dict uniforms;
+    stage.each([&](const char* name, float v) { uniforms[name] = v; });
+    out[key] = py::make_tuple(units, uniforms);
+  };
+  one(kernels::ShaderStage::stage, kernels::ShaderStage{});
+  one(kernels::CameraStage::stage, kernels::CameraStage{});
+  return out;
+}
+
+// A recorded kernel as the stage it replaces in a frame (host/trace/user_stage.h).
+template <class U>
+std::shared_ptr<host::UserStage<U>> as_stage(const UserProgram& k,
+                                             const std::vector<std::string>& units) {
+  return std::make_shared<host::RecordedStage<U>>(k.program, units);
+}
+
 // The module's functions and the Device's _run_recorded (m.Device bound already).
 template <class RunPass>
 void bind(py::module_& m, RunPass run_pass) {
@@ -131,7 +157,10 @@ void bind(py::module_& m, RunPass run_pass) {
       .def("__len__", [](const UserProgram& k) { return k.program->recording().nodes.size(); });
   m.def("record_kernel", &make_program, py::arg("name"), py::arg("outputs"), py::arg("units"),
         py::arg("nodes"), py::arg("out_nodes"), py::arg("kill"), py::arg("loop"),
+        py::arg("uniforms") = std::vector<std::pair<std::string, std::vector<int>>>{},
         "A RecordedKernel from the recorder's node list (ValueError where it cannot be run).");
+  m.def("stages", &stages,
+        "The frame's stages a kernel can replace: {stage: (units, {uniform: default})}.");
   m.def("check_kernel", &check, py::arg("kernel"), py::arg("profile"),
         "Raises ValueError with the card's rule the kernel breaks on `profile`, if any.");
   m.def("check_units", &check_units, py::arg("name"), py::arg("units"), py::arg("profile"),

@@ -95,9 +95,20 @@ void check_scene(const std::string& scene) {
 
 // What render() returns to the Python side: image, depth, hit ids, the statistics as JSON text
 // (json.loads on the Python side) and the frame's statistics for predict().
-py::tuple render(const std::vector<std::string>& args) {
+// shader, camera: kernels written in Python for those stages, as (RecordedKernel, units), or None.
+using StageArg = std::optional<std::pair<user_kernels::UserProgram, std::vector<std::string>>>;
+void set_stages(cli::RenderArgs& a, const StageArg& shader, const StageArg& camera) {
+  if (shader)
+    a.user.shader = user_kernels::as_stage<kernels::ShaderStage>(shader->first, shader->second);
+  if (camera)
+    a.user.camera = user_kernels::as_stage<kernels::CameraStage>(camera->first, camera->second);
+}
+
+py::tuple render(const std::vector<std::string>& args, const StageArg& shader,
+                 const StageArg& camera) {
   bool lanes_given = false;
-  const cli::RenderArgs a = cli::parse_render_args(args, lanes_given);
+  cli::RenderArgs a = cli::parse_render_args(args, lanes_given);
+  set_stages(a, shader, camera);
   check_scene(a.scene);
   auto outcome = std::make_unique<cli::RenderOutcome>();
   {
@@ -321,8 +332,10 @@ struct PassEvent {
 
 class PassStepper final : public host::PassObserver {
  public:
-  PassStepper(const std::vector<std::string>& args) {
+  PassStepper(const std::vector<std::string>& args, const StageArg& shader,
+              const StageArg& camera) {
     a_ = cli::parse_render_args(args, lanes_given_);
+    set_stages(a_, shader, camera);
     check_scene(a_.scene);
     worker_ = std::thread([this] { work(); });
   }
@@ -506,7 +519,8 @@ PYBIND11_MODULE(_vgpu_rt, m) {
           "json", [](const vgpu::FrameStats& s) { return host::frame_counters_json(s).dump(2); },
           "The per-kernel totals as JSON text.");
 
-  m.def("render", &render, py::arg("args"),
+  m.def("render", &render, py::arg("args"), py::arg("shader") = py::none(),
+        py::arg("camera") = py::none(),
         "Runs `vgpu-rt render` with command-line arguments (the scene first); returns (image, "
         "depth, hit, stats JSON text, FrameStats).");
   m.def(
@@ -643,7 +657,8 @@ PYBIND11_MODULE(_vgpu_rt, m) {
           "The counters of every pass this device ran.");
   py::class_<PassStepper>(m, "PassStepper",
                           "A render on a worker thread that stops after each pass.")
-      .def(py::init<const std::vector<std::string>&>(), py::arg("args"))
+      .def(py::init<const std::vector<std::string>&, const StageArg&, const StageArg&>(),
+           py::arg("args"), py::arg("shader") = py::none(), py::arg("camera") = py::none())
       .def(
           "next",
           [](PassStepper& s) -> py::object {

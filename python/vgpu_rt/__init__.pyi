@@ -166,6 +166,7 @@ class Fragments:
 
 class UserKernel:
     name: str
+    stage: Optional[str]
     units: list[str]
     outputs: int
     uniforms: dict[str, float]
@@ -176,9 +177,18 @@ class UserKernel:
     def instructions(self) -> int: ...
     def glsl(self, uniforms: Optional[dict[str, float]] = None) -> str: ...
 
-def kernel(fn: Optional[Callable[[Fragments], None]] = None, *, units: Sequence[str] = ...,
-           outputs: int = 1, uniforms: Optional[dict[str, float]] = None,
-           name: Optional[str] = None) -> Any: ...
+def kernel(fn: Optional[Callable[[Fragments], None]] = None, *,
+           units: Optional[Sequence[str]] = None, outputs: int = 1,
+           uniforms: Optional[dict[str, float]] = None, name: Optional[str] = None,
+           stage: Optional[str] = None) -> Any: ...
+
+class Stage:
+    name: str
+    units: list[str]
+    default_units: list[str]
+    uniforms: dict[str, float]
+
+def stages() -> dict[str, Stage]: ...
 def select(m: Union[Mask, bool], a: Any, b: Any) -> Any: ...
 def floor(v: Any) -> Any: ...
 def sqrt(v: Any) -> Any: ...
@@ -232,6 +242,8 @@ def render(
     compact: Union[str, bool, None] = ...,
     beams: Union[str, bool, None] = ...,
     beam_tile: Optional[int] = ...,
+    shader: Optional[UserKernel] = ...,
+    camera: Optional[UserKernel] = ...,
 ) -> Frame: ...
 def passes(scene: Union[str, os.PathLike[str]] = "bunny", **options: Any) -> Passes: ...
 def scenes() -> dict[str, str]: ...
