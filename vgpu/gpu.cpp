@@ -56,10 +56,32 @@ void Gpu::fail(const std::string& what) const {
   throw Error(what);
 }
 
+void Gpu::set_recorded(std::vector<std::string> names) {
+  recorded_ = std::move(names);
+  mirrors_.clear();
+}
+
+const Program& Gpu::executing(const Program& p) const {
+  if (recorded_.empty() ||
+      (std::find(recorded_.begin(), recorded_.end(), "all") == recorded_.end() &&
+       std::find(recorded_.begin(), recorded_.end(), p.name()) == recorded_.end()))
+    return p;
+  Mirror& m = mirrors_[p.id()];
+  const std::span<const std::byte> bytes = p.uniform_bytes();
+  if (!m.program || m.precision != p.precision() ||
+      !std::equal(bytes.begin(), bytes.end(), m.uniforms.begin(), m.uniforms.end())) {
+    m.program = RecordedProgram::of(p);
+    m.uniforms.assign(bytes.begin(), bytes.end());
+    m.precision = p.precision();
+  }
+  return *m.program;
+}
+
 void Gpu::use_program(const Program& program) {
   if (in_draw_)
     fail(std::string("program '") + program.name() + "': no recursion (bind inside a pass)");
-  program_ = &program;
+  bound_ = &program;
+  program_ = &executing(program);
   if (program.id() == loaded_program_) return;
   loaded_program_ = program.id();
   count_program_load(stats_, program, profile_);
@@ -355,6 +377,7 @@ Gpu::Chunk Gpu::DrawPlan::sum(const std::vector<Chunk>& chunks) {
 const PassRecord& Gpu::draw(const Rect& rect) {
   const auto t0 = std::chrono::steady_clock::now();
   if (!program_) fail("draw: no program bound");
+  if (!recorded_.empty()) program_ = &executing(*bound_);  // its uniforms may have changed
   const Program& p = *program_;
   const std::string pname = p.name();
   if (in_draw_) fail("program '" + pname + "': no recursion (a pass started inside a pass)");

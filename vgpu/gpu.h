@@ -21,11 +21,14 @@
 #include <mutex>
 #include <span>
 #include <stdexcept>
+#include <string>
 #include <thread>
+#include <unordered_map>
 #include <vector>
 
 #include "vgpu/batch.h"
 #include "vgpu/device.h"
+#include "vgpu/recorded_program.h"
 
 namespace vgpu {
 
@@ -57,6 +60,15 @@ class Gpu final : public Device {
   // The emulator's textures live in host memory: nothing to copy.
   void upload(const Texture&) override {}
   void download(Texture& t) override { count_download(stats_, t); }  // host memory: a count
+
+  // The recorded-program executor on whole frames (vgpu/recorded_program.h): the programs named
+  // here ("all": every one) run as their recordings instead of their compiled code, each
+  // recording kept per program and made again when its uniforms or precision change. Counted as
+  // the program itself (its name, loads and static counts); the images are the compiled code's.
+  // For measuring the executor, and checking it, on the frames the project renders.
+  void set_recorded(std::vector<std::string> names);
+  // What runs for p: p, or its recording where set_recorded names it (host thread only).
+  const Program& executing(const Program& p) const;
 
   // Pipeline state.
   void use_program(const Program& program) override;
@@ -138,7 +150,15 @@ class Gpu final : public Device {
   Profile profile_;
   int lanes_;
   Format precision_ = Format::fp32;
-  const Program* program_ = nullptr;
+  const Program* bound_ = nullptr;    // the program bound
+  const Program* program_ = nullptr;  // what runs: bound_, or its recording
+  std::vector<std::string> recorded_;
+  struct Mirror {
+    std::vector<std::byte> uniforms;
+    Format precision = Format::fp32;
+    std::unique_ptr<RecordedProgram> program;
+  };
+  mutable std::unordered_map<uint32_t, Mirror> mirrors_;
   const PassTally* replay_ = nullptr;
   uint32_t loaded_program_ = 0;
   std::array<const Texture*, kMaxTextureUnits> units_{};

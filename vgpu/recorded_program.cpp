@@ -140,6 +140,9 @@ std::unique_ptr<RecordedProgram> RecordedProgram::of(const Program& p) {
   auto r = std::make_unique<RecordedProgram>(p.record(), p.name(), p.paper_name(), p.outputs(),
                                              std::move(units));
   r->set_precision(p.precision());
+  r->has_passthrough_ = p.has_passthrough();
+  r->idle_discards_ = p.idle_discards();
+  for (int o = 0; o < p.outputs(); ++o) r->passthrough_[size_t(o)] = p.passthrough(o);
   return r;
 }
 

@@ -18,7 +18,8 @@
 // and batch-coherence counters are those of straight-line code; the blocks always run, as on
 // fp30); mask operations with a constant operand were folded when recorded, so the counting run
 // of a recording does not count them; the host shortcut's passthrough and idle-discard flags are
-// not in it, so a recorded program declares none. Its outputs and discards are the functor's, bit
+// not in it (of(p) takes p's). Named uniforms (Recording::uniforms, a kernel written in Python)
+// are set between passes with set_uniform. Its outputs and discards are the functor's, bit
 // for bit, at every width and precision (tests/kernels/test_recorded_program.cpp).
 #pragma once
 
@@ -50,9 +51,13 @@ class RecordedProgram final : public Program {
   const char* name() const override { return name_.c_str(); }
   const char* paper_name() const override { return paper_name_.c_str(); }
   int outputs() const override { return outputs_; }
-  bool has_passthrough() const override { return false; }
-  int passthrough(int) const override { return -1; }
-  bool idle_discards() const override { return false; }
+  // The host shortcut's flags (vgpu/program.h): none for a recording made outside the build,
+  // p's own for of(p) (a recording of p keeps what p says its outputs and discards are).
+  bool has_passthrough() const override { return has_passthrough_; }
+  int passthrough(int output) const override {
+    return output >= 0 && output < kMaxOutputs ? passthrough_[size_t(output)] : -1;
+  }
+  bool idle_discards() const override { return idle_discards_; }
 
   void run(Fragments<SimdLanes<1>>& f) const override;
   void run(Fragments<SimdLanes<4>>& f) const override;
@@ -131,6 +136,13 @@ class RecordedProgram final : public Program {
   // set of values has had: a thread's registers hold the constants of the stamp they were set for.
   std::vector<float> values_;
   uint64_t stamp_ = 0;
+  bool has_passthrough_ = false, idle_discards_ = false;
+  std::array<int, kMaxOutputs> passthrough_ = filled(-1);
+  static constexpr std::array<int, kMaxOutputs> filled(int v) {
+    std::array<int, kMaxOutputs> a{};
+    a.fill(v);
+    return a;
+  }
 };
 
 }  // namespace vgpu

@@ -157,6 +157,10 @@ struct RenderOptions {
   // Stages replaced by kernels of one's own (host/trace/user_stage.h; the stream tracer runs
   // them on the emulator or a GL device, the CPU tracer refuses them).
   UserKernels user;
+  // The recorded-program executor on whole frames (vgpu::Gpu::set_recorded, the emulator only):
+  // the kernels named here ("all": every one) run as their recordings. The images are the same;
+  // for measuring the executor (bench/bench_recorded.cpp) and checking it.
+  std::vector<std::string> recorded_programs;
   // The combinations of these options that cannot run are refused in one place,
   // host::validate (host/trace/validate.h).
 };

@@ -16,6 +16,7 @@
 #pragma once
 
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -89,6 +90,53 @@ class RecordedStage final : public UserStage<U> {
   std::shared_ptr<vgpu::RecordedProgram> program_;
   std::vector<std::string> units_;
 };
+
+// Functor K recorded as a kernel written outside the build is (from Python): a RecordedStage
+// whose named uniforms are the stage uniforms K reads, set by the frame before each pass. Each
+// stage uniform is recorded twice with values no kernel has, and the constants holding them
+// become its nodes; a uniform K folds into another constant on the host (F(stage.x * 2)) or
+// whose value changes the length of K's code is refused (std::invalid_argument, naming K). A
+// uniform K tests on the host is recorded as the test of a value no kernel has (true for
+// stage.shadows != 0): write such a choice with select on the uniform, as a Python kernel must.
+// For measuring and checking the recorded-program executor in a frame.
+template <class K>
+auto recorded_stage(const K& k = K{}) {
+  using U = std::remove_cvref_t<decltype(K::stage)>;
+  auto record_with = [&](float base) {
+    K c = k;
+    c.stage.each([&](const char*, float& v) { v = base, base += 1.0f; });
+    return vgpu::KernelProgram<K>(c).record();
+  };
+  const float a0 = -1000.25f, b0 = -3000.75f;
+  vgpu::Recording a = record_with(a0);
+  const vgpu::Recording b = record_with(b0);
+  const std::string who = std::string("recording '") + K::name + "': ";
+  if (a.nodes.size() != b.nodes.size())
+    throw std::invalid_argument(who + "its code depends on a stage uniform's value");
+  std::vector<bool> named(a.nodes.size(), false);
+  float i = 0;
+  k.stage.each([&](const char* name, float) {
+    vgpu::RecUniform u{name, {}};
+    for (size_t n = 0; n < a.nodes.size(); ++n)
+      if (a.nodes[n].op == vgpu::Op::constant && a.nodes[n].value == a0 + i &&
+          b.nodes[n].value == b0 + i)
+        u.nodes.push_back(int(n)), named[n] = true;
+    if (!u.nodes.empty()) a.uniforms.push_back(std::move(u));
+    i += 1.0f;
+  });
+  for (size_t n = 0; n < a.nodes.size(); ++n)
+    if (!named[n] && (a.nodes[n].op != b.nodes[n].op || a.nodes[n].value != b.nodes[n].value))
+      throw std::invalid_argument(who + "node " + std::to_string(n) +
+                                  " folds a stage uniform into another constant on the host");
+  std::vector<std::string> units;
+  if constexpr (requires { K::units; }) units.assign(K::units.begin(), K::units.end());
+  auto p = std::make_shared<vgpu::RecordedProgram>(std::move(a), K::name, K::paper_name, K::outputs,
+                                                   units);
+  k.stage.each([&](const char* name, float v) {
+    if (p->has_uniform(name)) p->set_uniform(name, v);
+  });
+  return std::make_shared<RecordedStage<U>>(std::move(p), std::move(units));
+}
 
 // The stages of a frame replaced by kernels of one's own (none: the project's kernels).
 struct UserKernels {

@@ -205,6 +205,10 @@ void check_options(const RenderOptions& opt, const vgpu::Profile& profile, const
                    Refusals& out) {
   // The devices without stencil masks (the GL device); the command line refuses these options
   // on --engine gl in its own words.
+  if (!opt.recorded_programs.empty() && opt.device != "vgpu")
+    out.add("recorded_programs", "",
+            "recorded programs run on the emulator's executor; the " + opt.device +
+                " device runs every program from its recording already");
   if (!q && opt.device != "vgpu") {
     if (opt.masks)
       out.add("--masks", "on",

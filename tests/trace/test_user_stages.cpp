@@ -7,6 +7,7 @@
 #include <memory>
 #include <string>
 
+#include "host/accel/accel.h"
 #include "host/accel/grid.h"
 #include "host/scene/camera.h"
 #include "host/scene/gltf_loader.h"
@@ -41,32 +42,6 @@ host::RenderResult render(const host::Scene& scene, const host::RenderOptions& o
 uint64_t passes_of(const host::RenderResult& r, const std::string& name) {
   const vgpu::FrameStats::ProgramTotals* p = r.stats.find(name);
   return p ? p->counters.passes : 0;
-}
-
-// Functor K recorded as a Python kernel is: every stage uniform it reads named. Each is recorded
-// with a value no other constant has (1000.25 + its index), and the constants holding it become
-// its nodes; uniforms K folds on the host would leave none, and the recording would not follow.
-template <class K>
-std::shared_ptr<vgpu::RecordedProgram> recorded_as_python(K k) {
-  float sentinel = 1000.25f;
-  std::vector<std::pair<std::string, float>> named;
-  k.stage.each([&](const char* name, float& v) {
-    v = sentinel;
-    named.emplace_back(name, sentinel);
-    sentinel += 1.0f;
-  });
-  vgpu::KernelProgram<K> p(k);
-  vgpu::Recording rec = p.record();
-  for (const auto& [name, value] : named) {
-    vgpu::RecUniform u{name, {}};
-    for (size_t i = 0; i < rec.nodes.size(); ++i)
-      if (rec.nodes[i].op == vgpu::Op::constant && rec.nodes[i].value == value)
-        u.nodes.push_back(int(i));
-    if (!u.nodes.empty()) rec.uniforms.push_back(u);
-  }
-  std::vector<std::string> units;
-  if constexpr (requires { K::units; }) units.assign(K::units.begin(), K::units.end());
-  return std::make_shared<vgpu::RecordedProgram>(std::move(rec), K::name, K::paper_name, 1, units);
 }
 
 }  // namespace
@@ -139,20 +114,19 @@ TEST_CASE("a recorded shader and camera take the stage's uniforms by name before
     opt.user.shader = host::user_stage<test_support::Toon>();
     opt.user.camera = host::user_stage<test_support::Fisheye>();
     const host::RenderResult functors = render(scene, opt);
-    auto shader = recorded_as_python(test_support::Toon{});
-    auto camera = recorded_as_python(test_support::Fisheye{});
-    CHECK(shader->uniform_names() ==
+    auto shader_stage = host::recorded_stage(test_support::Toon{});
+    auto camera_stage = host::recorded_stage(test_support::Fisheye{});
+    const auto& shader = static_cast<const vgpu::RecordedProgram&>(shader_stage->program());
+    const auto& camera = static_cast<const vgpu::RecordedProgram&>(camera_stage->program());
+    CHECK(shader.uniform_names() ==
           std::vector<std::string>{"light_x", "light_y", "light_z", "light_r", "light_g", "light_b",
                                    "first_light", "last_light", "ambient_r", "scene_width"});
-    CHECK(camera->uniform_names() ==
+    CHECK(camera.uniform_names() ==
           std::vector<std::string>{"forward_x", "forward_y", "forward_z", "right_x", "right_y",
                                    "right_z", "up_x", "up_y", "up_z", "tan_half_fov", "aspect",
                                    "width", "height", "jitter_x", "jitter_y", "far"});
-    opt.user.shader = std::make_shared<host::RecordedStage<kernels::ShaderStage>>(
-        shader, std::vector<std::string>(test_support::Toon::units.begin(),
-                                         test_support::Toon::units.end()));
-    opt.user.camera = std::make_shared<host::RecordedStage<kernels::CameraStage>>(
-        camera, std::vector<std::string>{});
+    opt.user.shader = shader_stage;
+    opt.user.camera = camera_stage;
     const host::RenderResult recorded = render(scene, opt);
     CHECK(same_bits(functors.rgb, recorded.rgb));
     CHECK(same_bits(functors.hit_id, recorded.hit_id));
@@ -175,7 +149,8 @@ TEST_CASE("what a kernel of one's own cannot run is refused before the frame, on
         "shader 'toon': the cpu engine runs no kernels (a double-precision reference); a kernel "
         "of your own needs --engine stream or gl");
   // A unit the stage does not bind, and a base-colour unit on a scene without textures.
-  auto bad = recorded_as_python(test_support::Toon{});
+  std::shared_ptr<vgpu::RecordedProgram> bad =
+      vgpu::RecordedProgram::of(vgpu::KernelProgram<test_support::Toon>{});
   opt.user.shader = std::make_shared<host::RecordedStage<kernels::ShaderStage>>(
       bad, std::vector<std::string>{"surface", "rays", "result", "colours", "normals0", "normals1",
                                     "normals2"});
@@ -210,4 +185,31 @@ TEST_CASE("what a kernel of one's own cannot run is refused before the frame, on
                        "sample rays, dense streams); a camera of your own takes --spp N (its "
                        "jitter as uniforms) or no --aa",
                        vgpu::Error);
+}
+
+TEST_CASE("frames with every kernel run as its recording are the compiled frames bit for bit") {
+  // The recorded-program executor on whole frames (vgpu::Gpu::set_recorded): every structure's
+  // walk, multipass and looping, supersampled; the same images, hits and passes.
+  const host::Scene scene = host::load_scene(host::resolve_scene("bunny-refl"));
+  const host::AccelParams params{host::grid_spec_for({}, scene, vgpu::profile("gf6600"))};
+  for (const host::AccelKind kind : host::kAccelKinds)
+    for (const bool looping : {false, true}) {
+      CAPTURE(host::accel_name(kind));
+      CAPTURE(looping);
+      const std::unique_ptr<host::Accel> accel = host::make_accel(kind, scene, params);
+      host::RenderResult frames[2];
+      for (int recorded = 0; recorded < 2; ++recorded) {
+        host::RenderOptions opt = small(looping ? 1 : 4);
+        opt.profile = "gf6600";
+        opt.looping = looping;
+        if (recorded) opt.recorded_programs = {"all"};
+        host::StreamTracer tracer(scene, *accel, opt);
+        frames[recorded] =
+            tracer.render(host::scene_camera(scene, float(opt.width) / float(opt.height)));
+      }
+      CHECK(same_bits(frames[0].rgb, frames[1].rgb));
+      CHECK(same_bits(frames[0].hit_id, frames[1].hit_id));
+      CHECK(frames[0].stats.totals.passes == frames[1].stats.totals.passes);
+      CHECK(frames[0].stats.totals.texture_fetches == frames[1].stats.totals.texture_fetches);
+    }
 }

@@ -23,6 +23,7 @@ std::unique_ptr<vgpu::Device> make_device(const RenderOptions& opt) {
   if (opt.device == "vgpu") {
     auto gpu = std::make_unique<vgpu::Gpu>(profile, opt.threads, opt.lanes);
     gpu->set_precision(opt.formats.finest());
+    gpu->set_recorded(opt.recorded_programs);
     return gpu;
   }
   if (opt.device == "gl") {

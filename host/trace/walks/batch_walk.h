@@ -18,6 +18,9 @@ namespace host::walk {
 // What one pass of a walk knows about a program, worked out once per walk.
 struct ProgramInfo {
   const vgpu::Program* program = nullptr;
+  // What runs for it: the program, or its recording where the emulator runs recordings
+  // (vgpu::Gpu::set_recorded), made once per walk.
+  const vgpu::Program* run = nullptr;
   vgpu::Format precision = vgpu::Format::fp32;
   int branches = 0;       // f.branch() calls: the batch counters are kept for it
   uint32_t own_only = 0;  // units the program reads only at the fragment's own texel
@@ -227,7 +230,7 @@ class BatchWalker {
       loaded(std::countr_zero(need));
     const ProgramInfo& pi = *plan.info;
     const uint8_t live = plan.work >= 0 ? uint8_t(mask_bits(plan.work) & valid_) : valid_;
-    const vgpu::BatchRun r = vgpu::run_batch(*pi.program, pi.precision, dynamic_, plan.units.data(),
+    const vgpu::BatchRun r = vgpu::run_batch(*pi.run, pi.precision, dynamic_, plan.units.data(),
                                              plan.outputs.data(), plan.nout, live, x0_, y_);
     const uint8_t survivors = uint8_t(live & ~r.killed);
     if (plan.write >= 0)
@@ -355,6 +358,7 @@ bool run_in_batches(PassRunner& r, Walk& walk, typename Walk::Cursor& c) {
     if (it == programs.end()) {
       ProgramInfo i;
       i.program = p.program;
+      i.run = &gpu->executing(*p.program);
       i.precision = gpu->precision_of(*p.program);
       const vgpu::Program::Analysis a = p.program->analyze();
       if (a.loop.loops > 0) return passes(std::string(p.program->name()) + " loops");
