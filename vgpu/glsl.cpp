@@ -5,6 +5,8 @@
 #include <map>
 #include <stdexcept>
 
+#include "vgpu/recorded_program.h"
+
 namespace vgpu {
 
 namespace {
@@ -391,7 +393,8 @@ std::string declarations(const Program& p, const Recording& rec, const GlslProgr
   std::string s;
   s += "#version 330 core\n";
   s += std::string("// ") + p.name() + " (paper: " + p.paper_name() +
-       "), generated from its C++ functor by vgpu's recording lanes.\n";
+       "), generated from its recording (vgpu/record.h: a C++ functor run once on recording "
+       "lanes, or a kernel written in Python).\n";
   s += "// One statement per fragment-program instruction; k[] holds every constant and uniform.\n";
   // No a*b+c fusion: the emulator rounds every operation (-ffp-contract=off).
   s += "#extension GL_ARB_gpu_shader5 : enable\n";

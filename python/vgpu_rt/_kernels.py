@@ -169,6 +169,9 @@ class Vec4(_Arithmetic):
     __slots__ = ("x", "y", "z", "w")
 
     def __init__(self, x, y, z, w):
+        r = _recorder_of(x, y, z, w)  # numbers beside lane values become constants
+        if r is not None:
+            x, y, z, w = (_lanes(r, v) for v in (x, y, z, w))
         self.x, self.y, self.z, self.w = x, y, z, w
 
     @staticmethod
@@ -201,7 +204,9 @@ def _recorder_of(*values):
         if isinstance(v, (Lanes, Mask)):
             return v._r
         if isinstance(v, Vec4):
-            return v.x._r
+            r = _recorder_of(*v)
+            if r is not None:
+                return r
     return None
 
 
