@@ -181,24 +181,6 @@ std::vector<char> live_nodes(const Recording& rec, const LoopPlan& L) {
   return live;
 }
 
-bool is_mask_op(Op op) {
-  switch (op) {
-    case Op::lt:
-    case Op::le:
-    case Op::gt:
-    case Op::ge:
-    case Op::eq:
-    case Op::ne:
-    case Op::mask_const:
-    case Op::mask_and:
-    case Op::mask_or:
-    case Op::mask_not:
-      return true;
-    default:
-      return false;
-  }
-}
-
 std::string loop_var(int v) {
   return "lv" + std::to_string(v);
 }
@@ -219,7 +201,8 @@ struct BodyPrinter {
   // The carried values, then the loop: at most max_iterations, left once no longer active.
   void open_loop() {
     for (size_t v = 0; v < L.vars.size(); ++v)
-      body += indent + (is_mask_op(rec.nodes[size_t(L.vars[v].next)].op) ? "bool " : "float ") +
+      body += indent +
+              (value_of(rec.nodes[size_t(L.vars[v].next)].op) == Value::mask ? "bool " : "float ") +
               loop_var(int(v)) + " = " + expr[size_t(L.vars[v].init)] + ";\n";
     body += indent + "for (int it = 0; it < " + std::to_string(L.lp.max_iterations) + "; ++it) {\n";
     indent = "    ";

@@ -48,6 +48,70 @@ enum class Op : uint8_t {
   channel,    // component `unit` (0..3) of the vec4 node a
 };
 
+// What a node computes: a float, a mask, or (a fetch) a texel of four floats; and what each of its
+// operands a, b, c is (none where it has fewer). The one classification the executor
+// (vgpu/recorded_program.cpp) and the GLSL printer (vgpu/glsl.cpp) read.
+enum class Value : uint8_t { none, number, mask, texel };
+
+constexpr Value value_of(Op op) {
+  switch (op) {
+    case Op::lt:
+    case Op::le:
+    case Op::gt:
+    case Op::ge:
+    case Op::eq:
+    case Op::ne:
+    case Op::mask_const:
+    case Op::mask_and:
+    case Op::mask_or:
+    case Op::mask_not:
+      return Value::mask;
+    case Op::fetch:
+    case Op::fetch_own:
+      return Value::texel;
+    default:
+      return Value::number;
+  }
+}
+
+// The values of a node's operands a, b, c (none where it has fewer).
+constexpr std::array<Value, 3> operands_of(Op op) {
+  using K = Value;
+  switch (op) {
+    case Op::add:
+    case Op::sub:
+    case Op::mul:
+    case Op::div:
+    case Op::min:
+    case Op::max:
+    case Op::lt:
+    case Op::le:
+    case Op::gt:
+    case Op::ge:
+    case Op::eq:
+    case Op::ne:
+    case Op::fetch:
+      return {K::number, K::number, K::none};
+    case Op::neg:
+    case Op::abs:
+    case Op::floor:
+    case Op::sqrt:
+    case Op::rsqrt:
+      return {K::number, K::none, K::none};
+    case Op::select:
+      return {K::mask, K::number, K::number};
+    case Op::mask_and:
+    case Op::mask_or:
+      return {K::mask, K::mask, K::none};
+    case Op::mask_not:
+      return {K::mask, K::none, K::none};
+    case Op::channel:
+      return {K::texel, K::none, K::none};
+    default:  // constant, frag_x, frag_y, mask_const, fetch_own
+      return {K::none, K::none, K::none};
+  }
+}
+
 struct RecNode {
   Op op;
   int a = -1, b = -1, c = -1;

@@ -13,68 +13,6 @@ namespace vgpu {
 
 namespace {
 
-// What a node computes: a float, a mask, or (a fetch) four floats.
-enum class Kind : uint8_t { none, f, m, v4 };
-
-Kind kind_of(Op op) {
-  switch (op) {
-    case Op::lt:
-    case Op::le:
-    case Op::gt:
-    case Op::ge:
-    case Op::eq:
-    case Op::ne:
-    case Op::mask_const:
-    case Op::mask_and:
-    case Op::mask_or:
-    case Op::mask_not:
-      return Kind::m;
-    case Op::fetch:
-    case Op::fetch_own:
-      return Kind::v4;
-    default:
-      return Kind::f;
-  }
-}
-
-// The kinds of a node's operands a, b, c (none where it has fewer).
-std::array<Kind, 3> operand_kinds(Op op) {
-  using K = Kind;
-  switch (op) {
-    case Op::add:
-    case Op::sub:
-    case Op::mul:
-    case Op::div:
-    case Op::min:
-    case Op::max:
-    case Op::lt:
-    case Op::le:
-    case Op::gt:
-    case Op::ge:
-    case Op::eq:
-    case Op::ne:
-    case Op::fetch:
-      return {K::f, K::f, K::none};
-    case Op::neg:
-    case Op::abs:
-    case Op::floor:
-    case Op::sqrt:
-    case Op::rsqrt:
-      return {K::f, K::none, K::none};
-    case Op::select:
-      return {K::m, K::f, K::f};
-    case Op::mask_and:
-    case Op::mask_or:
-      return {K::m, K::m, K::none};
-    case Op::mask_not:
-      return {K::m, K::none, K::none};
-    case Op::channel:
-      return {K::v4, K::none, K::none};
-    default:  // constant, frag_x, frag_y, mask_const, fetch_own
-      return {K::none, K::none, K::none};
-  }
-}
-
 int operand(const RecNode& nd, int slot) {
   return slot == 0 ? nd.a : slot == 1 ? nd.b : nd.c;
 }
@@ -171,11 +109,11 @@ void RecordedProgram::compile() {
   for (int i = 0; i < n; ++i) {
     const RecNode& nd = nodes[size_t(i)];
     if (uint8_t(nd.op) > uint8_t(Op::channel)) fail("node " + std::to_string(i) + ": no such op");
-    const std::array<Kind, 3> want = operand_kinds(nd.op);
+    const std::array<Value, 3> want = operands_of(nd.op);
     for (int slot = 0; slot < 3; ++slot) {
-      if (want[size_t(slot)] == Kind::none) continue;
+      if (want[size_t(slot)] == Value::none) continue;
       const int id = operand(nd, slot);
-      if (id < 0 || id >= i || kind_of(nodes[size_t(id)].op) != want[size_t(slot)])
+      if (id < 0 || id >= i || value_of(nodes[size_t(id)].op) != want[size_t(slot)])
         fail("node " + std::to_string(i) + ": operand " + std::to_string(slot) +
              " is not an earlier node of the right kind");
     }
@@ -218,7 +156,7 @@ void RecordedProgram::compile() {
   if (has_loop_) {
     auto loop_fail = [&](const std::string& why) { fail("its loop cannot be run (" + why + ")"); };
     if (!(0 <= lp.entry && lp.entry < b && b < m && e - m == d && e <= n)) loop_fail("bad bounds");
-    if (kind_of(nodes[size_t(lp.entry)].op) != Kind::m) loop_fail("the entry is not a mask");
+    if (value_of(nodes[size_t(lp.entry)].op) != Value::mask) loop_fail("the entry is not a mask");
     if (lp.max_iterations < 0) loop_fail("a negative iteration budget");
     const RecNode &next = nodes[size_t(m - 1)], &after = nodes[size_t(e - 1)];
     if (next.op != Op::mask_and || next.a != lp.entry || after.op != Op::mask_and ||
@@ -260,11 +198,11 @@ void RecordedProgram::compile() {
       reg[size_t(i)] = reg[size_t(nd.a)] + nd.unit;
       continue;
     }
-    switch (kind_of(nd.op)) {
-      case Kind::m:
+    switch (value_of(nd.op)) {
+      case Value::mask:
         reg[size_t(i)] = mask_regs_++;
         break;
-      case Kind::v4:
+      case Value::texel:
         reg[size_t(i)] = float_regs_;
         float_regs_ += 4;
         break;
@@ -276,7 +214,7 @@ void RecordedProgram::compile() {
   std::vector<int32_t> var_reg(vars.size());
   std::vector<bool> var_mask(vars.size());
   for (size_t v = 0; v < vars.size(); ++v) {
-    var_mask[v] = kind_of(nodes[size_t(vars[v].next)].op) == Kind::m;
+    var_mask[v] = value_of(nodes[size_t(vars[v].next)].op) == Value::mask;
     var_reg[v] = var_mask[v] ? mask_regs_++ : float_regs_++;
   }
 
@@ -309,10 +247,10 @@ void RecordedProgram::compile() {
     in.dst = reg[size_t(i)];
     in.value = nd.value;
     in.node = i;
-    const std::array<Kind, 3> want = operand_kinds(nd.op);
-    if (want[0] != Kind::none) in.a = resolve(i, 0, nd.a);
-    if (want[1] != Kind::none) in.b = resolve(i, 1, nd.b);
-    if (want[2] != Kind::none) in.c = resolve(i, 2, nd.c);
+    const std::array<Value, 3> want = operands_of(nd.op);
+    if (want[0] != Value::none) in.a = resolve(i, 0, nd.a);
+    if (want[1] != Value::none) in.b = resolve(i, 1, nd.b);
+    if (want[2] != Value::none) in.c = resolve(i, 2, nd.c);
     code_.push_back(in);
   }
 
@@ -339,14 +277,14 @@ void RecordedProgram::compile() {
     std::array<int32_t, 4> r{};
     for (int c = 0; c < 4; ++c) {
       const int id = o[size_t(c)];
-      if (id < 0 || id >= n || kind_of(nodes[size_t(id)].op) != Kind::f)
+      if (id < 0 || id >= n || value_of(nodes[size_t(id)].op) != Value::number)
         fail("an output channel that is not a float node");
       r[size_t(c)] = resolve(n, 0, id);
     }
     out_regs_.push_back(r);
   }
   if (rec_.kill >= 0) {
-    if (rec_.kill >= n || kind_of(nodes[size_t(rec_.kill)].op) != Kind::m)
+    if (rec_.kill >= n || value_of(nodes[size_t(rec_.kill)].op) != Value::mask)
       fail("a discard that is not a mask node");
     kill_ = resolve(n, 0, rec_.kill);
   }
