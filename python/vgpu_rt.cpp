@@ -654,7 +654,23 @@ PYBIND11_MODULE(_vgpu_rt, m) {
            "the fragments an occlusion query counted (else None).")
       .def_property_readonly(
           "totals", [](vgpu::Gpu& g) { return counters_dict(g.stats().totals); },
-          "The counters of every pass this device ran.");
+          "The counters of every pass this device ran.")
+      .def(
+          "_frame_stats",
+          [](vgpu::Gpu& g) { return std::make_shared<vgpu::FrameStats>(g.stats()); },
+          "A copy of every pass's statistics, per kernel, for predict().")
+      .def(
+          "_stats_json",
+          [](vgpu::Gpu& g) {
+            nlohmann::ordered_json j = host::frame_counters_json(g.stats());
+            nlohmann::ordered_json out;
+            out["totals"] = std::move(j["totals"]);
+            out["downloads"] = j["downloads"];
+            out["download_bytes"] = j["download_bytes"];
+            out["kernels"] = std::move(j["programs"]);  // the key --stats-json uses
+            return out.dump();
+          },
+          "The statistics as --stats-json writes them: totals, downloads, kernels.");
   py::class_<PassStepper>(m, "PassStepper",
                           "A render on a worker thread that stops after each pass.")
       .def(py::init<const std::vector<std::string>&, const StageArg&, const StageArg&>(),

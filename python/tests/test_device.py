@@ -71,6 +71,30 @@ class DeviceTest(unittest.TestCase):
         self.assertEqual(c["bytes_written"], 3 * 16)
         self.assertEqual(dev.totals["passes"], 1)
 
+    def test_the_device_statistics_per_kernel_are_priced_as_a_frame_s(self):
+        dev = vgpu_rt.Device("gf5700")
+        a, b, out = dev.texture("a", 8, 4), dev.texture("b", 8, 4), dev.texture("out", 8, 4)
+        acc = vgpu_rt.kernels["accumulate samples"]
+        for _ in range(2):
+            dev.run(acc, [a, b, a], [out])
+
+        @vgpu_rt.kernel(units=["v"])
+        def half(f):
+            f.out[0] = f.fetch_own(0) * 0.5
+        dev.run(half, [a], [out])
+        s = dev.stats
+        self.assertEqual([(k["name"], k["passes"]) for k in s["kernels"]],
+                         [("accumulate samples", 2), ("half", 1)])
+        self.assertEqual(s["totals"]["passes"], 3)
+        # The counters are dev.totals'; the JSON adds the host's and the device's times.
+        self.assertEqual({k: v for k, v in s["totals"].items() if k in dev.totals}, dev.totals)
+        # The cost model prices the same figures from the C++ statistics and from the dict.
+        for card in ("gf5700", "gf6600"):
+            from_stats = vgpu_rt.predict(s, card)
+            from_dict = vgpu_rt.predict(dict(s), card)
+            self.assertGreater(from_stats["total_ms"], 0.0)
+            self.assertAlmostEqual(from_stats["total_ms"], from_dict["total_ms"], places=9)
+
     def test_a_pass_with_the_wrong_targets_is_a_value_error(self):
         dev = vgpu_rt.Device("gf5700")
         t = dev.texture("t", 2, 2)

@@ -351,6 +351,12 @@ from ._kernels import (KernelError, UserKernel, Fragments, Lanes, Mask, Vec4, St
 class Device(_ext.Device):
     """The virtual GPU with a hardware profile's limits and counters."""
 
+    @property
+    def stats(self):
+        """Every pass this device ran, per kernel and in total, under --stats-json's keys
+        ("totals", "kernels"): vgpu_rt.predict(dev.stats, "gf5700") prices them."""
+        return Stats(_json.loads(self._stats_json()), self._frame_stats())
+
     def run(self, kernel, units, targets, query=False, uniforms=None):
         """One pass of `kernel` (vgpu_rt.kernels[...] or a @vgpu_rt.kernel function) over the
         whole of targets[0] (its outputs' targets), units[i] bound to texture unit i. Returns
