@@ -19,6 +19,12 @@ namespace vgpu {
 struct Error : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
+// An input that outgrows a limit: of the card (its largest texture), or of how a structure
+// addresses its textures. The user's to change (another profile, structure or scene), so the
+// command line exits 2 with its line, as for a bad file.
+struct LimitError : Error {
+  using Error::Error;
+};
 
 // A rectangle of the render target in pixels: [x0, x1) x [y0, y1).
 struct Rect {

@@ -114,6 +114,9 @@ int main(int argc, char** argv) {
   } catch (const host::InputError& e) {  // a bad input file (or output path): the user's to fix
     std::fprintf(stderr, "vgpu-rt: %s\n", e.what());
     return 2;
+  } catch (const vgpu::LimitError& e) {  // the scene outgrows the card or the structure
+    std::fprintf(stderr, "vgpu-rt: %s\n", e.what());
+    return 2;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "vgpu-rt: %s\n", e.what());
     return 1;

@@ -21,13 +21,13 @@ vgpu::Texture entry_texture(vgpu::Device& gpu, const std::string& name, size_t c
   const int w = int(std::min<size_t>(side, size_t(maxs)));
   const size_t h = (std::max<size_t>(count, 1) + size_t(w) - 1) / size_t(w);
   if (h > size_t(maxs))
-    throw vgpu::Error(what + ": " + std::to_string(count) + " entries; profile " +
-                      gpu.profile().name + " holds at most " +
-                      std::to_string(size_t(maxs) * size_t(maxs)) + " in one " +
-                      std::to_string(maxs) + "x" + std::to_string(maxs) + " texture");
+    throw vgpu::LimitError(what + ": " + std::to_string(count) + " entries; profile " +
+                           gpu.profile().name + " holds at most " +
+                           std::to_string(size_t(maxs) * size_t(maxs)) + " in one " +
+                           std::to_string(maxs) + "x" + std::to_string(maxs) + " texture");
   if (count >= (size_t(1) << 24))
-    throw vgpu::Error(what + ": " + std::to_string(count) +
-                      " entries; indices are exact floats only below 2^24");
+    throw vgpu::LimitError(what + ": " + std::to_string(count) +
+                           " entries; indices are exact floats only below 2^24");
   return gpu.make_texture(name, w, int(h), channels);
 }
 

@@ -22,12 +22,19 @@ void check_addresses(const Formats& fm, const std::string& structure,
     for (const Format f : {fm[u.group], fm.arithmetic(u.group)})
       if (u.count - 1 > exact_addresses(f)) {
         const bool fp32_only = u.count - 1 > exact_addresses(Format::fp24);
-        throw vgpu::Error(structure + ": " + u.kind + " reach " + std::to_string(u.count - 1) +
-                          "; the " + std::string(group_name(u.group)) + " group's " +
-                          std::string(vgpu::format_name(f)) + " addresses texels exactly only to " +
-                          std::to_string(exact_addresses(f)) + " (give it " +
-                          (fp32_only ? "fp32" : "fp24 or fp32") + ": --formats " +
-                          std::string(group_name(u.group)) + "=fp32)");
+        // Past fp32's reach no format helps: the index is linear (entry k at k mod width, k div
+        // width) and outgrows the float, whatever the card's texture size.
+        const std::string advice =
+            f == Format::fp32
+                ? "no format addresses more; a structure whose indices stay below it does: "
+                  "--accel grid or bvh"
+                : std::string("give it ") + (fp32_only ? "fp32" : "fp24 or fp32") + ": --formats " +
+                      std::string(group_name(u.group)) + "=fp32";
+        throw vgpu::LimitError(structure + ": " + u.kind + " reach " + std::to_string(u.count - 1) +
+                               "; the " + std::string(group_name(u.group)) + " group's " +
+                               std::string(vgpu::format_name(f)) +
+                               " addresses texels exactly only to " +
+                               std::to_string(exact_addresses(f)) + " (" + advice + ")");
       }
 }
 
