@@ -23,6 +23,27 @@
 
 namespace host {
 
+namespace {
+
+// Stages replaced by kernels of one's own (host/trace/user_stage.h): each under the stage's name,
+// with the program's name (its passes are under that name in "kernels") and units.
+nlohmann::ordered_json user_kernels_json(const UserKernels& user) {
+  nlohmann::ordered_json u = nlohmann::ordered_json::object();
+  auto stage = [&](const char* key, const auto& k, const char* replaces) {
+    if (!k) return;
+    const vgpu::Program& p = k->program();
+    u[key] = {{"program", p.name()},
+              {"replaces", replaces},
+              {"instructions", p.analyze().instructions},
+              {"units", k->units()}};
+  };
+  stage("shader", user.shader, "shader");
+  stage("camera", user.camera, "generate rays");
+  return u;
+}
+
+}  // namespace
+
 nlohmann::ordered_json frame_stats_json(const FrameStatsInputs& in) {
   const Scene& scene = in.scene;
   StreamTracer* tracer = in.tracer;  // device() is not const
@@ -39,8 +60,7 @@ nlohmann::ordered_json frame_stats_json(const FrameStatsInputs& in) {
   j["triangles"] = scene.triangle_count();
   j["input_triangles"] = scene.input_triangles;
   j["dropped_degenerate"] = scene.dropped_degenerate;
-  // The grid's resolution and references: a structure other than the grid reports the one
-  // voxel of its scene box (Accel::grid_res).
+  // The grid's resolution and references (another structure: its box's one voxel, grid_res).
   const glm::ivec3 grid_res = accel.grid_res();
   j["grid"] = {grid_res.x, grid_res.y, grid_res.z};
   j["grid_references"] = accel.grid_references();
@@ -86,22 +106,7 @@ nlohmann::ordered_json frame_stats_json(const FrameStatsInputs& in) {
   j["fused_programs"] = opt.mrt ? mrt_programs() : std::vector<std::string>{};
   j["kernel_variant"] = in.kernels;  // multipass | looping ("kernels" lists the programs)
   if (opt.looping) j["steps_per_pass"] = opt.steps_per_pass;
-  // Stages replaced by kernels of one's own (host/trace/user_stage.h): each under the stage's
-  // name, with the program's name (its passes are under that name in "kernels") and units.
-  if (opt.user.any()) {
-    nlohmann::ordered_json u = nlohmann::ordered_json::object();
-    auto stage = [&](const char* key, const auto& k, const char* replaces) {
-      if (!k) return;
-      const vgpu::Program& p = k->program();
-      u[key] = {{"program", p.name()},
-                {"replaces", replaces},
-                {"instructions", p.analyze().instructions},
-                {"units", k->units()}};
-    };
-    stage("shader", opt.user.shader, "shader");
-    stage("camera", opt.user.camera, "generate rays");
-    j["user_kernels"] = std::move(u);
-  }
+  if (opt.user.any()) j["user_kernels"] = user_kernels_json(opt.user);
   j["threads"] = opt.threads;
   j["lanes"] = opt.lanes;
   // How the emulator ran the grid walks: in batches or pass by pass (same statistics), and why
