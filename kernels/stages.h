@@ -16,6 +16,7 @@
 
 #include <array>
 #include <glm/glm.hpp>
+#include <type_traits>
 
 #include "kernels/common.h"
 #include "kernels/shader.h"
@@ -37,16 +38,7 @@ struct ShaderStage {
   float scene_width = 1;     // texels per row of the scene's textures: triangle i at
                              // (i mod width + 0.5, floor(i / width) + 0.5)
 
-  // Every uniform with its name, in this order: fn(name, value) (a float& where *this is not
-  // const).
-  template <class Fn>
-  void each(Fn&& fn) const {
-    fields(*this, fn);
-  }
-  template <class Fn>
-  void each(Fn&& fn) {
-    fields(*this, fn);
-  }
+  // Every uniform with its name, in this order (each_uniform below).
   template <class S, class Fn>
   static void fields(S& s, Fn& fn) {
     fn("light_x", s.light.x), fn("light_y", s.light.y), fn("light_z", s.light.z);
@@ -74,14 +66,6 @@ struct CameraStage {
   float jitter_x = 0.5f, jitter_y = 0.5f;
   float far = kFar;  // the tmax of a ray without limit
 
-  template <class Fn>
-  void each(Fn&& fn) const {
-    fields(*this, fn);
-  }
-  template <class Fn>
-  void each(Fn&& fn) {
-    fields(*this, fn);
-  }
   template <class S, class Fn>
   static void fields(S& s, Fn& fn) {
     fn("eye_x", s.eye.x), fn("eye_y", s.eye.y), fn("eye_z", s.eye.z);
@@ -93,5 +77,12 @@ struct CameraStage {
     fn("jitter_x", s.jitter_x), fn("jitter_y", s.jitter_y), fn("far", s.far);
   }
 };
+
+// fn(name, value) for every uniform of a stage's (ShaderStage, CameraStage), in its order; value
+// is a float& where `stage` is not const.
+template <class S, class Fn>
+void each_uniform(S& stage, Fn&& fn) {
+  std::remove_const_t<S>::fields(stage, fn);
+}
 
 }  // namespace kernels

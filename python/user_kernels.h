@@ -125,7 +125,7 @@ inline py::dict stages() {
     py::list units;
     for (const char* u : stage.units) units.append(u);
     py::dict uniforms;
-    stage.each([&](const char* name, float v) { uniforms[name] = v; });
+    kernels::each_uniform(stage, [&](const char* name, float v) { uniforms[name] = v; });
     out[key] = py::make_tuple(units, uniforms);
   };
   one(kernels::ShaderStage::stage, kernels::ShaderStage{});

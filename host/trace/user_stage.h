@@ -81,7 +81,7 @@ class RecordedStage final : public UserStage<U> {
   vgpu::Program& program() const override { return *program_; }
   std::vector<std::string> units() const override { return units_; }
   void bind(const U& uniforms) override {
-    uniforms.each([&](const char* name, float value) {
+    kernels::each_uniform(uniforms, [&](const char* name, float value) {
       if (program_->has_uniform(name)) program_->set_uniform(name, value);
     });
   }
@@ -104,7 +104,7 @@ auto recorded_stage(const K& k = K{}) {
   using U = std::remove_cvref_t<decltype(K::stage)>;
   auto record_with = [&](float base) {
     K c = k;
-    c.stage.each([&](const char*, float& v) { v = base, base += 1.0f; });
+    kernels::each_uniform(c.stage, [&](const char*, float& v) { v = base, base += 1.0f; });
     return vgpu::KernelProgram<K>(c).record();
   };
   const float a0 = -1000.25f, b0 = -3000.75f;
@@ -115,7 +115,7 @@ auto recorded_stage(const K& k = K{}) {
     throw std::invalid_argument(who + "its code depends on a stage uniform's value");
   std::vector<bool> named(a.nodes.size(), false);
   float i = 0;
-  k.stage.each([&](const char* name, float) {
+  kernels::each_uniform(k.stage, [&](const char* name, float) {
     vgpu::RecUniform u{name, {}};
     for (size_t n = 0; n < a.nodes.size(); ++n)
       if (a.nodes[n].op == vgpu::Op::constant && a.nodes[n].value == a0 + i &&
@@ -132,7 +132,7 @@ auto recorded_stage(const K& k = K{}) {
   if constexpr (requires { K::units; }) units.assign(K::units.begin(), K::units.end());
   auto p = std::make_shared<vgpu::RecordedProgram>(std::move(a), K::name, K::paper_name, K::outputs,
                                                    units);
-  k.stage.each([&](const char* name, float v) {
+  kernels::each_uniform(k.stage, [&](const char* name, float v) {
     if (p->has_uniform(name)) p->set_uniform(name, v);
   });
   return std::make_shared<RecordedStage<U>>(std::move(p), std::move(units));
