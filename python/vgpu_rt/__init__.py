@@ -190,11 +190,18 @@ def render(scene="bunny", **options):
     stages()) in place of the project's shading pass and primary rays, on the stream and gl
     engines, counted under their own names (frame.stats["user_kernels"]).
     """
+    image, depth, hit, text, frame_stats = _ext.render(*_render_call(scene, options))
+    return Frame(image, depth, hit, Stats(_json.loads(text), frame_stats))
+
+
+def _render_call(scene, options):
+    """The extension's arguments for render() and passes(): the command line's, then the
+    kernels of your own for the shader and camera stages (None where not given)."""
+    options = dict(options)
     shader, camera = options.pop("shader", None), options.pop("camera", None)
     args = _arguments(scene, options)
-    image, depth, hit, text, frame_stats = _ext.render(
-        args, _stage_kernel("shader", shader, options), _stage_kernel("camera", camera, options))
-    return Frame(image, depth, hit, Stats(_json.loads(text), frame_stats))
+    return (args, _stage_kernel("shader", shader, options),
+            _stage_kernel("camera", camera, options))
 
 
 def _stage_kernel(stage, k, options):
@@ -261,10 +268,7 @@ class Passes:
     there, iterate again to resume it. Once every pass was seen, `frame` is the Frame."""
 
     def __init__(self, scene="bunny", **options):
-        shader, camera = options.pop("shader", None), options.pop("camera", None)
-        args = _arguments(scene, options)
-        self._stepper = _ext.PassStepper(args, _stage_kernel("shader", shader, options),
-                                         _stage_kernel("camera", camera, options))
+        self._stepper = _ext.PassStepper(*_render_call(scene, options))
         # The first pass, fetched now so that options the frame refuses raise here.
         self._first = self._stepper.next()
 
