@@ -80,8 +80,7 @@ const Program& Gpu::executing(const Program& p) const {
 void Gpu::use_program(const Program& program) {
   if (in_draw_)
     fail(std::string("program '") + program.name() + "': no recursion (bind inside a pass)");
-  bound_ = &program;
-  program_ = &executing(program);
+  bound_ = program_ = &program;  // draw() swaps in its recording where set_recorded names it
   if (program.id() == loaded_program_) return;
   loaded_program_ = program.id();
   count_program_load(stats_, program, profile_);
@@ -377,7 +376,8 @@ Gpu::Chunk Gpu::DrawPlan::sum(const std::vector<Chunk>& chunks) {
 const PassRecord& Gpu::draw(const Rect& rect) {
   const auto t0 = std::chrono::steady_clock::now();
   if (!program_) fail("draw: no program bound");
-  if (!recorded_.empty()) program_ = &executing(*bound_);  // its uniforms may have changed
+  // The recording of the program as it is now (its uniforms may change after use_program).
+  if (!recorded_.empty()) program_ = &executing(*bound_);
   const Program& p = *program_;
   const std::string pname = p.name();
   if (in_draw_) fail("program '" + pname + "': no recursion (a pass started inside a pass)");
