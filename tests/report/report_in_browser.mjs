@@ -43,6 +43,8 @@ try {
   const box = await page.locator("#img").boundingBox();
   await page.mouse.click(box.x + (px + 0.5) * box.width / 64, box.y + (py + 0.5) * box.height / 48);
   check(await page.evaluate(() => document.body.dataset.historyPixel) === `${px},${py}`, "the click picks the pixel");
+  // A long history is shown a page at a time: all of it, as a person would ask for it.
+  if (!(await page.isDisabled("#h-all"))) await page.click("#h-all");
   const rows = await page.$$eval("#history tr", trs => trs.slice(1).map(tr => Array.from(tr.children, td => td.textContent)));
   // Columns: #, pass, iteration, trace, paper name, kernel, writes, state/query. Printed as
   // PassRunner::pass and ::count (host/trace/passes.cpp) print them.
@@ -161,6 +163,21 @@ try {
   await page.waitForFunction(() => document.body.dataset.ready === "1" || document.body.dataset.error, null, { timeout: 60000 });
   check(errors.length === 0 && !(await page.evaluate(() => document.body.dataset.error)), `no script errors in the adaptive frame's report (${errors.join("; ")})`);
   check(await page.isVisible("#budget"), "the budget's section is shown for an adaptive frame");
+  // This frame's 74k passes: the centre pixel's history is shown 2,000 rows at a time.
+  const paging = await page.evaluate(() => {
+    const first = () => +document.querySelector("#history tr:nth-child(2) td").textContent;
+    const n = () => document.querySelectorAll("#history tr").length - 1;
+    const [x, y] = document.body.dataset.historyPixel.split(",").map(Number);
+    const total = window.report.historyRows(x, y).length, out = { total, range: document.getElementById("h-range").textContent, rows: n(), first: first() };
+    document.getElementById("h-next").click();
+    Object.assign(out, { nextFirst: first(), nextRows: n() });
+    document.getElementById("h-all").click();
+    return Object.assign(out, { allRows: n(), allDisabled: document.getElementById("h-all").disabled });
+  });
+  check(paging.total > 4000 && paging.rows === 2000 && paging.first === 1 && paging.range === `rows 1 to 2,000 of ${paging.total.toLocaleString("en-US")}`,
+        `the long history's first page: ${paging.rows} rows from ${paging.first}, "${paging.range}" (${paging.total} in all)`);
+  check(paging.nextFirst === 2001 && paging.nextRows === 2000, `the next page starts at row ${paging.nextFirst} (${paging.nextRows} rows)`);
+  check(paging.allRows === paging.total && paging.allDisabled, `all rows: ${paging.allRows} of ${paging.total}`);
   const levels = JSON.parse(fs.readFileSync(astats, "utf8")).sampling.budget_levels;
   const drawn = await page.evaluate(() => {
     const rows = [...document.querySelectorAll("#budget-levels tbody tr")].map(tr => [...tr.cells].map(td => td.textContent));
