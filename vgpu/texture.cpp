@@ -62,12 +62,25 @@ Texture::Texture(std::string name, int width, int height, int channels, Format f
   if (width <= 0 || height <= 0) throw std::invalid_argument("texture " + name_ + ": empty size");
   if (channels < 1 || channels > 4)
     throw std::invalid_argument("texture " + name_ + ": texels have 1 to 4 channels");
-  data_.assign(size_t(width) * height * channels, 0.0f);
+  data_.resize(size_t(width) * height * channels);  // zeros, untouched (ZeroedAllocator)
 }
 
 void Texture::fill(std::span<const float> texel) {
   ++version_;
-  for (size_t i = 0; i < data_.size(); ++i) data_[i] = round_to(format_, texel[i % channels_]);
+  fill_rows(texel, 0, height_);
+}
+
+void Texture::fill_rows(std::span<const float> texel, int y0, int y1) {
+  float v[4];
+  for (int c = 0; c < channels_; ++c) v[c] = round_to(format_, texel[size_t(c)]);
+  float* p = data_.data() + size_t(y0) * size_t(width_) * size_t(channels_);
+  float* const end = data_.data() + size_t(y1) * size_t(width_) * size_t(channels_);
+  if (channels_ == 1) {
+    std::fill(p, end, v[0]);
+    return;
+  }
+  for (; p != end; p += channels_)
+    for (int c = 0; c < channels_; ++c) p[c] = v[c];
 }
 
 bool Texture::replace(std::span<const float> texels) {

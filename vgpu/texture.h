@@ -4,7 +4,9 @@
 #pragma once
 
 #include <cstdint>
+#include <cstdlib>
 #include <memory>
+#include <new>
 #include <span>
 #include <string>
 #include <vector>
@@ -45,6 +47,10 @@ class Texture {
     data_[index(x, y) + c] = round_to(format_, v);
   }
   void fill(std::span<const float> texel);  // every texel = texel (channels() values)
+  // Rows [y0, y1) only, each texel = texel (for a clear split over threads; no version bump:
+  // fill() or the caller's touch() makes it).
+  void fill_rows(std::span<const float> texel, int y0, int y1);
+  void touch() { ++version_; }
   // Every texel at once (channels() floats per texel, row-major, data().size() in all), rounded
   // to the format; returns whether any stored value changed (what a host re-upload must send).
   bool replace(std::span<const float> texels);
@@ -64,7 +70,29 @@ class Texture {
   std::string name_;
   int width_ = 0, height_ = 0, channels_ = 0;
   Format format_ = Format::fp32;
-  std::vector<float> data_;
+  // Zero texels from calloc, which maps a large block's pages zero from the system and leaves
+  // them untouched: a frame's forty 16 MB textures cost nothing at creation and are faulted in by
+  // the first pass that writes them, on every thread, not by a serial memset (0.6 s at 1024x1024).
+  template <class T>
+  struct ZeroedAllocator {
+    using value_type = T;
+    ZeroedAllocator() = default;
+    template <class U>
+    ZeroedAllocator(const ZeroedAllocator<U>&) {}
+    T* allocate(size_t n) {
+      if (void* p = std::calloc(n, sizeof(T))) return static_cast<T*>(p);
+      throw std::bad_alloc();
+    }
+    void deallocate(T* p, size_t) { std::free(p); }
+    template <class U>
+    void construct(U*) {}  // value-initialised: calloc's zeros already are
+    template <class U, class... A>
+    void construct(U* p, A&&... a) {
+      ::new (static_cast<void*>(p)) U(std::forward<A>(a)...);
+    }
+    bool operator==(const ZeroedAllocator&) const { return true; }
+  };
+  std::vector<float, ZeroedAllocator<float>> data_;
   // Emulator bookkeeping, not modeled state: the Gpu skips copying texels it knows two textures
   // already share (gpu.cpp, PairRecord). uid_ is unique per texture object and content lineage
   // (copies and moves get a new one), version_ counts every host write access; the Gpu bumps it
