@@ -13,6 +13,7 @@
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -412,10 +413,45 @@ void attach_recorder(const RenderArgs& a, host::RenderOptions& opt,
   if (a.report_frame) opt.observer = &one_frame.emplace(*recorder);
 }
 
-// The iteration counter on stderr: rewritten in place on a terminal, a line each elsewhere.
-std::function<void(int, int)> progress_line(bool tty) {
-  return [tty](int it, int n) {
-    std::fprintf(stderr, tty ? "\rvgpu-rt: iteration %d/%d" : "vgpu-rt: iteration %d/%d\n", it, n);
+// Progress on stderr: the iteration, and within its walks the passes and the rays still walking
+// (or a walk in batches' share done and its time left), rewritten in place on a terminal every
+// tenth of a second; elsewhere a line per iteration and a line within a walk every 5 s.
+void set_progress(host::RenderOptions& opt, bool tty) {
+  struct Line {
+    bool tty;
+    int it = 0, n = 0;
+    std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
+  };
+  auto line = std::make_shared<Line>(Line{tty});
+  opt.progress = [line](int it, int n) {
+    line->it = it;
+    line->n = n;
+    std::fprintf(stderr,
+                 line->tty ? "\rvgpu-rt: iteration %d/%d\033[K" : "vgpu-rt: iteration %d/%d\n", it,
+                 n);
+    std::fflush(stderr);
+  };
+  opt.progress_every_ms = tty ? 100 : 5000;
+  opt.walk_progress = [line](const host::WalkProgress& w) {
+    const auto now = std::chrono::steady_clock::now();
+    const double s = std::chrono::duration<double>(now - line->start).count();
+    std::string what;
+    if (w.done >= 0) {
+      what = std::string(w.rays) + ", " + std::to_string(int(100 * w.done)) +
+             "% of the pixels walked (in batches)";
+      if (w.left_ms >= 0) {
+        char left[64];
+        std::snprintf(left, sizeof left, ", about %.1f s left in this walk", w.left_ms / 1000);
+        what += left;
+      }
+    } else {
+      what = std::string(w.rays) + ", " + std::to_string(w.rays_walking) + " still walking, " +
+             std::to_string(w.passes) + " passes";
+    }
+    std::fprintf(stderr,
+                 line->tty ? "\rvgpu-rt: iteration %d/%d: %s; %.1f s\033[K"
+                           : "vgpu-rt: iteration %d/%d: %s; %.1f s\n",
+                 line->it, line->n, what.c_str(), s);
     std::fflush(stderr);
   };
 }
@@ -515,7 +551,7 @@ int run_render(const RenderArgs& a, bool lanes_given, RenderOutcome* outcome,
   };
   const bool several = times.size() > 1;
   const bool tty = ::isatty(2) && !a.quiet && !several;
-  if (!a.quiet && !several) opt.progress = progress_line(tty);  // several: a line per frame
+  if (!a.quiet && !several) set_progress(opt, tty);  // several: a line per frame
   std::optional<host::AccelChoice> choice;
   size_t chosen = 0;
   if (auto_accel) {

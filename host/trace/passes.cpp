@@ -111,6 +111,7 @@ uint64_t PassRunner::count(const vgpu::Program& p, const Texture& in, const Sten
   const uint64_t n = gpu_.end_query();
   if (gpu_.has_stencil()) gpu_.set_stencil_write(nullptr);
   if (opt_.observer) opt_.observer->query(n, write, gpu_.stats());
+  report_rays(n);
   if (traced) {
     char line[160];
     const char* mine = !write                                                 ? ""
@@ -121,6 +122,38 @@ uint64_t PassRunner::count(const vgpu::Program& p, const Texture& in, const Sten
     *opt_.trace_out << line;
   }
   return n;
+}
+
+bool PassRunner::due(std::chrono::steady_clock::time_point now) {
+  if (now - last_report_ < std::chrono::duration<double, std::milli>(opt_.progress_every_ms))
+    return false;
+  last_report_ = now;
+  return true;
+}
+
+void PassRunner::report_rays(uint64_t rays) {
+  if (!opt_.walk_progress) return;
+  const std::unique_lock lk(progress_mu_, std::try_to_lock);
+  if (!lk.owns_lock() || !due(std::chrono::steady_clock::now())) return;
+  WalkProgress w;
+  w.rays = walking;
+  w.passes = gpu_.stats().totals.passes;
+  w.rays_walking = int64_t(rays);
+  opt_.walk_progress(w);
+}
+
+void PassRunner::report_batches(int done, int total, std::chrono::steady_clock::time_point start) {
+  if (!opt_.walk_progress || total <= 0) return;
+  const std::unique_lock lk(progress_mu_, std::try_to_lock);
+  const auto now = std::chrono::steady_clock::now();
+  if (!lk.owns_lock() || !due(now)) return;
+  WalkProgress w;
+  w.rays = walking;
+  w.passes = gpu_.stats().totals.passes;  // the walk's own come with its replay
+  w.done = double(done) / double(total);
+  const double ms = std::chrono::duration<double, std::milli>(now - start).count();
+  if (done > 0) w.left_ms = ms * double(total - done) / double(done);
+  opt_.walk_progress(w);
 }
 
 uint32_t PassRunner::own_only_units(const vgpu::Program& p) {

@@ -3,8 +3,10 @@
 #pragma once
 
 #include <array>
+#include <chrono>
 #include <cstdint>
 #include <initializer_list>
+#include <mutex>
 #include <optional>
 #include <span>
 #include <string>
@@ -97,6 +99,14 @@ class PassRunner {
   // Op::fetch): those may come from a batch's registers. Worked out once per program.
   uint32_t own_only_units(const vgpu::Program& p);
 
+  // Progress within a walk (RenderOptions::walk_progress), at most every progress_every_ms:
+  // after a counting pass, the rays it counted; a walk in batches, the share of its tiles walked
+  // since `start` (thread-safe: a report already under way makes the others skip theirs).
+  void report_rays(uint64_t rays);
+  void report_batches(int done, int total, std::chrono::steady_clock::time_point start);
+
+  const char* walking = "rays";  // the rays the next walk walks, as progress names them
+
   WalkCounts counts;  // this frame's; the host loop resets it
   // The rows every pass and count draws (a dense stream of marked pixels fills only its first
   // rows: host/trace/stream/mark_streams.h); nullopt: the whole target.
@@ -107,6 +117,10 @@ class PassRunner {
   const RenderOptions& opt_;
   vgpu::Texture& counter_;
   std::vector<std::pair<const vgpu::Program*, uint32_t>> own_only_;
+  // The last progress report, and the lock that lets one thread report at a time.
+  bool due(std::chrono::steady_clock::time_point now);
+  std::mutex progress_mu_;
+  std::chrono::steady_clock::time_point last_report_{};
 };
 
 }  // namespace host

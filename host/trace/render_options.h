@@ -50,6 +50,18 @@ class PassObserver {
                      const vgpu::FrameStats& stats) = 0;
 };
 
+// Where a walk stands (RenderOptions::walk_progress): the frame's passes so far, the rays still
+// walking by the walk's last occlusion query (-1: a walk in batches runs its queries only when
+// it replays them), the share of a walk in batches' pixels walked (-1: a walk pass by pass, whose
+// rays finish at no rate known in advance), and from that share the walk's time left in ms (-1:
+// not known).
+struct WalkProgress {
+  const char* rays = "rays";  // which walk: "primary rays", "shadow rays", "reflected rays"
+  uint64_t passes = 0;
+  int64_t rays_walking = -1;
+  double done = -1, left_ms = -1;
+};
+
 struct RenderOptions {
   int width = 256, height = 256;  // the paper's image size
   int bounces = 2;                // reflection iterations after the primary one (Fig. 1: 3 in all)
@@ -153,6 +165,10 @@ struct RenderOptions {
   bool keep_pass_records = false;
   // Called at the start of each ray-tracing iteration (1-based) with the iteration count.
   std::function<void(int iteration, int iterations)> progress;
+  // Called within a walk, at most every progress_every_ms (host/trace/passes.cpp), from any of
+  // the emulator's threads but never two at once.
+  std::function<void(const WalkProgress&)> walk_progress;
+  double progress_every_ms = 100;
   PassObserver* observer = nullptr;  // not owned
   // Stages replaced by kernels of one's own (host/trace/user_stage.h; the stream tracer runs
   // them on the emulator or a GL device, the CPU tracer refuses them).

@@ -447,6 +447,7 @@ void StreamTracer::walk_rays(Texture& origins, Texture& rays, bool primary, cons
   if (opt_.observer)
     opt_.observer->trace_begin(primary ? PassObserver::TraceKind::primary
                                        : PassObserver::TraceKind::reflected);
+  s_->runner->walking = primary ? "primary rays" : "reflected rays";
   trace(origins, rays, primary, cam);
   if (opt_.observer) opt_.observer->trace_end();
 }
@@ -514,6 +515,7 @@ void StreamTracer::shade_lights(const Camera& cam, Texture& surface, Texture& ra
       s.shadow.kernel.light = lights[li].position;
       r.pass(s.shadow, {&surface, col.current()}, s.shadow_rays);
       if (opt_.observer) opt_.observer->trace_begin(PassObserver::TraceKind::shadow);
+      r.walking = "shadow rays";
       trace(surface, s.shadow_rays, false, cam);
       if (s.streams && s.streams->glass_scene())
         shadow = &s.streams->shadows_through_glass(r, surface, s.shadow_rays, &s.isect.current(),
@@ -605,16 +607,26 @@ void StreamTracer::user_shader_pass(const Texture& surface, const Texture& rays,
 void StreamTracer::download_aovs(RenderResult& res, Texture& hits) {
   const int W = opt_.width, H = opt_.height;
   gpu_->download(hits);
-  res.depth.assign(size_t(W) * H, 0.0f);
-  res.hit_id.assign(size_t(W) * H, -1.0f);
-  for (int y = 0; y < H; ++y)
-    for (int x = 0; x < W; ++x) {
-      const float* t = hits.texel(x, y);
-      if (t[3] >= 0) {
-        res.depth[size_t(y) * W + x] = t[0];
-        res.hit_id[size_t(y) * W + x] = float(scene_->id[size_t(t[3])]);
+  res.depth.resize(size_t(W) * H);
+  res.hit_id.resize(size_t(W) * H);
+  auto rows = [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y)
+      for (int x = 0; x < W; ++x) {
+        const float* t = hits.texel(x, y);
+        const bool hit = t[3] >= 0;
+        res.depth[size_t(y) * W + x] = hit ? t[0] : 0.0f;
+        res.hit_id[size_t(y) * W + x] = hit ? float(scene_->id[size_t(t[3])]) : -1.0f;
       }
-    }
+  };
+  // On the emulator, over its threads (a serial part of a 16-thread frame otherwise).
+  if (auto* emu = dynamic_cast<vgpu::Gpu*>(gpu_.get()); emu && uint64_t(W) * H >= 65536) {
+    const int blocks = std::min(H, emu->threads() * 4);
+    emu->parallel_for(blocks, [&](int k, int) {
+      rows(int(int64_t(H) * k / blocks), int(int64_t(H) * (k + 1) / blocks));
+    });
+  } else {
+    rows(0, H);
+  }
 }
 
 void StreamTracer::stream_frame(const Camera& cam, const vgpu::Program& generate, RenderResult& res,

@@ -414,6 +414,7 @@ bool run_in_batches(PassRunner& r, Walk& walk, typename Walk::Cursor& c) {
   // An error on a worker thread (a binding the check let through) reaches the caller.
   std::mutex failed_mu;
   std::exception_ptr failed;
+  std::atomic<int> tiles_done{0};
   gpu->parallel_for(tiles_x * tiles_y, [&](int tile, int slot) {
     try {
       BatchWalker& x = *walkers[size_t(slot)];
@@ -427,6 +428,7 @@ bool run_in_batches(PassRunner& r, Walk& walk, typename Walk::Cursor& c) {
           x.finish(pairs.data(), done.current.data(), done.npairs, masks.data(), done.nmasks);
         }
       x.settle_tile(tx, ty);
+      r.report_batches(++tiles_done, tiles_x * tiles_y, t0);
     } catch (...) {
       const std::lock_guard lk(failed_mu);
       if (!failed) failed = std::current_exception();
