@@ -85,7 +85,8 @@ class Texture {
     }
     void deallocate(T* p, size_t) { std::free(p); }
     template <class U>
-    void construct(U*) {}  // value-initialised: calloc's zeros already are
+    void construct(U*) {}  // value-initialised: calloc's zeros already are (data_ is
+                           // resized once, from empty, in the constructor: never over old texels)
     template <class U, class... A>
     void construct(U* p, A&&... a) {
       ::new (static_cast<void*>(p)) U(std::forward<A>(a)...);
