@@ -281,13 +281,28 @@ void Gpu::DrawPlan::set_outputs(Gpu& g, const Program& p, bool carries, bool who
         const uint8_t* bits = g.work_mask_->bits_.data();
         float* dd = dst.data_.data();
         const float* sd = src.data_.data();
-        if (ch == 4) {                           // a fixed-size copy: inlined
-          for (const uint32_t i : *rec->differ)  // the mask is as wide as the target
-            if (bits[i] == 0) std::memcpy(dd + i * 4, sd + i * 4, 4 * sizeof(float));
-        } else {
-          for (const uint32_t i : *rec->differ)
-            if (bits[i] == 0) std::memcpy(dd + i * ch, sd + i * ch, ch * sizeof(float));
-        }
+        // The texels that differ, copied where idle (the mask is as wide as the target); a long
+        // list over the threads (each texel is written once, by whichever thread takes it).
+        const std::vector<uint32_t>& differ = *rec->differ;
+        auto copy = [&](size_t k0, size_t k1) {
+          if (ch == 4) {  // a fixed-size copy: inlined
+            for (size_t k = k0; k < k1; ++k)
+              if (const uint32_t i = differ[k]; bits[i] == 0)
+                std::memcpy(dd + size_t(i) * 4, sd + size_t(i) * 4, 4 * sizeof(float));
+          } else {
+            for (size_t k = k0; k < k1; ++k)
+              if (const uint32_t i = differ[k]; bits[i] == 0)
+                std::memcpy(dd + size_t(i) * ch, sd + size_t(i) * ch, ch * sizeof(float));
+          }
+        };
+        const int blocks = differ.size() < 32768 ? 1 : g.threads() * 4;
+        if (blocks == 1)
+          copy(0, differ.size());
+        else
+          g.parallel_for(blocks, [&](int b, int) {
+            copy(differ.size() * size_t(b) / size_t(blocks),
+                 differ.size() * size_t(b + 1) / size_t(blocks));
+          });
         g.pairs_.erase(rec);  // used up: if the pass fails, no record claims the textures agree
         break;
       }

@@ -4,6 +4,7 @@
 #include <array>
 #include <bit>
 #include <chrono>
+#include <stdexcept>
 #include <vector>
 
 #include "vgpu/gpu.h"
@@ -65,37 +66,51 @@ std::array<uint64_t, 2> idle_in_batches_listed(int w, int h, const uint8_t* flag
                                                const std::vector<uint32_t>& listed,
                                                bool work_masked, uint64_t idle_flags) {
   const int cols8 = (w + 7) / 8, rows4 = (h + 3) / 4, cols32 = (w + 31) / 32;
-  const int rows32 = (h + 31) / 32;
-  // Per 8x4 and 32x32 tile: {listed, took}.
+  std::array<uint64_t, 2> total{idle_flags, idle_flags};
+  // One band of 32 rows at a time (the list is in row order: the passes list their survivors
+  // row by row), its 8x4 and 32x32 tiles' {listed, took} counted, settled and cleared before the
+  // next band: a pass costs its list and the bands it touches, not a scan of every tile of the
+  // target (at 1024x1024 a walk's late passes list a few hundred rays and were paid 32k tiles
+  // each, serially). A tile where no fragment took the branch keeps its idle ones counted.
   thread_local std::vector<std::array<uint32_t, 2>> t8, t32;
-  t8.assign(size_t(cols8) * size_t(rows4), {0, 0});
-  t32.assign(size_t(cols32) * size_t(rows32), {0, 0});
-  int y = 0;
-  uint32_t row0 = 0;
-  for (const uint32_t i : listed) {
-    if (i - row0 >= uint32_t(w)) {
-      y = int(i / uint32_t(w));
-      row0 = uint32_t(y) * uint32_t(w);
+  t8.assign(size_t(cols8) * 8, {0, 0});
+  t32.assign(size_t(cols32), {0, 0});
+  auto settle = [&](int band) {
+    for (int r = 0; r < 8 && band * 8 + r < rows4; ++r)
+      for (int c = 0; c < cols8; ++c) {
+        std::array<uint32_t, 2>& e = t8[size_t(r) * size_t(cols8) + size_t(c)];
+        if (e[1] != 0) {
+          const uint64_t area =
+              uint64_t(std::min(8, w - c * 8)) * uint64_t(std::min(4, h - (band * 8 + r) * 4));
+          total[0] -= (work_masked ? e[0] : area) - e[1];
+        }
+        e = {0, 0};
+      }
+    for (int c = 0; c < cols32; ++c) {
+      std::array<uint32_t, 2>& e = t32[size_t(c)];
+      if (e[1] != 0) {
+        const uint64_t area =
+            uint64_t(std::min(32, w - c * 32)) * uint64_t(std::min(32, h - band * 32));
+        total[1] -= (work_masked ? e[0] : area) - e[1];
+      }
+      e = {0, 0};
     }
-    const int x = int(i - row0);
+  };
+  int band = -1;
+  for (const uint32_t i : listed) {
+    const int y = int(i / uint32_t(w)), x = int(i % uint32_t(w));
+    if (y / 32 != band) {
+      if (y / 32 < band) throw std::logic_error("idle_in_batches_listed: list out of row order");
+      if (band >= 0) settle(band);
+      band = y / 32;
+    }
     const uint32_t took = flags[i] == kTook ? 1 : 0;
-    auto& a = t8[size_t(y / 4) * size_t(cols8) + size_t(x / 8)];
-    auto& b = t32[size_t(y / 32) * size_t(cols32) + size_t(x / 32)];
+    std::array<uint32_t, 2>& a = t8[size_t(y / 4 - band * 8) * size_t(cols8) + size_t(x / 8)];
+    std::array<uint32_t, 2>& b = t32[size_t(x / 32)];
     ++a[0], ++b[0];
     a[1] += took, b[1] += took;
   }
-  std::array<uint64_t, 2> total{idle_flags, idle_flags};
-  auto settle = [&](const std::vector<std::array<uint32_t, 2>>& t, int cols, int tw, int th,
-                    uint64_t& sum) {
-    for (size_t k = 0; k < t.size(); ++k) {
-      if (t[k][1] == 0) continue;  // no fragment took the branch: its idle ones stay counted
-      const int c = int(k % size_t(cols)), r = int(k / size_t(cols));
-      const uint64_t area = uint64_t(std::min(tw, w - c * tw)) * uint64_t(std::min(th, h - r * th));
-      sum -= (work_masked ? t[k][0] : area) - t[k][1];
-    }
-  };
-  settle(t8, cols8, 8, 4, total[0]);
-  settle(t32, cols32, 32, 32, total[1]);
+  if (band >= 0) settle(band);
   return total;
 }
 
