@@ -91,6 +91,10 @@ int main(int argc, char** argv) {
                  "a further `vgpu-rt render` argument, e.g. --render-option=--accel "
                  "--render-option=bvh");
   CLI11_PARSE(app, argc, argv);
+  if (counts.empty() || *std::min_element(counts.begin(), counts.end()) < 1) {
+    std::fprintf(stderr, "bench_threads: --threads needs one or more counts of at least 1\n");
+    return 2;
+  }
   try {
     std::vector<std::vector<double>> frame(counts.size()), rend(counts.size());
     Frame base;

@@ -445,8 +445,8 @@ void set_progress(host::RenderOptions& opt, bool tty) {
         what += left;
       }
     } else {
-      what = std::string(w.rays) + ", " + std::to_string(w.rays_walking) + " still walking, " +
-             std::to_string(w.passes) + " passes";
+      what = std::string(w.rays) + ": " + w.query + " counted " + std::to_string(w.rays_walking) +
+             ", " + std::to_string(w.passes) + " passes";
     }
     std::fprintf(stderr,
                  line->tty ? "\rvgpu-rt: iteration %d/%d: %s; %.1f s\033[K"

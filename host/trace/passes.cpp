@@ -111,7 +111,7 @@ uint64_t PassRunner::count(const vgpu::Program& p, const Texture& in, const Sten
   const uint64_t n = gpu_.end_query();
   if (gpu_.has_stencil()) gpu_.set_stencil_write(nullptr);
   if (opt_.observer) opt_.observer->query(n, write, gpu_.stats());
-  report_rays(n);
+  report_rays(p.name(), n);
   if (traced) {
     char line[160];
     const char* mine = !write                                                 ? ""
@@ -131,15 +131,27 @@ bool PassRunner::due(std::chrono::steady_clock::time_point now) {
   return true;
 }
 
-void PassRunner::report_rays(uint64_t rays) {
+// A progress callback that throws (a full disk under stderr, an allocation) must not fail the
+// frame: progress stops for the rest of it.
+void PassRunner::tell(const WalkProgress& w) {
+  if (progress_failed_) return;
+  try {
+    opt_.walk_progress(w);
+  } catch (...) {
+    progress_failed_ = true;
+  }
+}
+
+void PassRunner::report_rays(const char* query, uint64_t rays) {
   if (!opt_.walk_progress) return;
   const std::unique_lock lk(progress_mu_, std::try_to_lock);
   if (!lk.owns_lock() || !due(std::chrono::steady_clock::now())) return;
   WalkProgress w;
   w.rays = walking;
   w.passes = gpu_.stats().totals.passes;
+  w.query = query;
   w.rays_walking = int64_t(rays);
-  opt_.walk_progress(w);
+  tell(w);
 }
 
 void PassRunner::report_batches(int done, int total, std::chrono::steady_clock::time_point start) {
@@ -153,7 +165,7 @@ void PassRunner::report_batches(int done, int total, std::chrono::steady_clock::
   w.done = double(done) / double(total);
   const double ms = std::chrono::duration<double, std::milli>(now - start).count();
   if (done > 0) w.left_ms = ms * double(total - done) / double(done);
-  opt_.walk_progress(w);
+  tell(w);
 }
 
 uint32_t PassRunner::own_only_units(const vgpu::Program& p) {

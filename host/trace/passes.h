@@ -102,10 +102,11 @@ class PassRunner {
   // Progress within a walk (RenderOptions::walk_progress), at most every progress_every_ms:
   // after a counting pass, the rays it counted; a walk in batches, the share of its tiles walked
   // since `start` (thread-safe: a report already under way makes the others skip theirs).
-  void report_rays(uint64_t rays);
+  void report_rays(const char* query, uint64_t rays);
   void report_batches(int done, int total, std::chrono::steady_clock::time_point start);
 
-  const char* walking = "rays";  // the rays the next walk walks, as progress names them
+  // The rays the walk under way walks, as progress names them ("rays" between walks).
+  const char* walking = "rays";
 
   WalkCounts counts;  // this frame's; the host loop resets it
   // The rows every pass and count draws (a dense stream of marked pixels fills only its first
@@ -119,6 +120,8 @@ class PassRunner {
   std::vector<std::pair<const vgpu::Program*, uint32_t>> own_only_;
   // The last progress report, and the lock that lets one thread report at a time.
   bool due(std::chrono::steady_clock::time_point now);
+  void tell(const WalkProgress& w);  // under progress_mu_
+  bool progress_failed_ = false;
   std::mutex progress_mu_;
   std::chrono::steady_clock::time_point last_report_{};
 };

@@ -50,13 +50,15 @@ class PassObserver {
                      const vgpu::FrameStats& stats) = 0;
 };
 
-// Where a walk stands (RenderOptions::walk_progress): the frame's passes so far, the rays still
-// walking by the walk's last occlusion query (-1: a walk in batches runs its queries only when
-// it replays them), the share of a walk in batches' pixels walked (-1: a walk pass by pass, whose
-// rays finish at no rate known in advance), and from that share the walk's time left in ms (-1:
-// not known).
+// Where a walk stands (RenderOptions::walk_progress): the frame's passes so far, the rays the
+// walk's last occlusion query counted and which query that was (the rays still walking, those
+// with triangles left, the pixels a sampler marked; -1: a walk in batches runs its queries only
+// when it replays them), the share of a walk in batches' pixels walked (-1: a walk pass by pass,
+// whose rays finish at no rate known in advance), and from that share the walk's time left in ms
+// (-1: not known).
 struct WalkProgress {
   const char* rays = "rays";  // which walk: "primary rays", "shadow rays", "reflected rays"
+  const char* query = "";     // the counting pass whose result rays_walking is (its kernel)
   uint64_t passes = 0;
   int64_t rays_walking = -1;
   double done = -1, left_ms = -1;

@@ -48,7 +48,8 @@ def write(out, name, positions, normals, indices, nodes, camera, light):
     nrm = normals.astype("<f4").tobytes()
     idx = indices.astype("<u4").tobytes()
     (out / f"{name}.bin").write_bytes(pos + nrm + idx)
-    lo, hi = positions.min(axis=0).tolist(), positions.max(axis=0).tolist()
+    p32 = positions.astype("<f4")
+    lo, hi = p32.min(axis=0).tolist(), p32.max(axis=0).tolist()
     views = [{"buffer": 0, "byteOffset": 0, "byteLength": len(pos), "target": 34962},
              {"buffer": 0, "byteOffset": len(pos), "byteLength": len(nrm), "target": 34962},
              {"buffer": 0, "byteOffset": len(pos) + len(nrm), "byteLength": len(idx),
@@ -58,14 +59,16 @@ def write(out, name, positions, normals, indices, nodes, camera, light):
          "min": lo, "max": hi},
         {"bufferView": 1, "componentType": 5126, "count": len(normals), "type": "VEC3"},
         {"bufferView": 2, "componentType": 5125, "count": int(indices.size), "type": "SCALAR"}]
+    # The camera looks down its -Z with +Y up: a look-at basis (world up +Y), as a quaternion.
     eye, target = np.array(camera[0], float), np.array(camera[1], float)
-    f = (target - eye) / np.linalg.norm(target - eye)
-    # A camera looks down its -Z: the rotation taking -Z to f (about the axis -Z x f).
-    z = np.array([0.0, 0.0, -1.0])
-    axis, angle = np.cross(z, f), math.acos(max(-1.0, min(1.0, float(z @ f))))
-    axis = axis / (np.linalg.norm(axis) or 1.0)
-    s = math.sin(angle / 2)
-    rot = [float(axis[0] * s), float(axis[1] * s), float(axis[2] * s), math.cos(angle / 2)]
+    back = (eye - target) / np.linalg.norm(eye - target)
+    right = np.cross([0.0, 1.0, 0.0], back)
+    right /= np.linalg.norm(right)
+    up = np.cross(back, right)
+    m = np.stack([right, up, back], axis=1)  # columns: the camera's x, y, z in the world
+    w = math.sqrt(max(0.0, 1.0 + m[0, 0] + m[1, 1] + m[2, 2])) / 2
+    rot = [float((m[2, 1] - m[1, 2]) / (4 * w)), float((m[0, 2] - m[2, 0]) / (4 * w)),
+           float((m[1, 0] - m[0, 1]) / (4 * w)), float(w)]
     gltf_nodes = [{"mesh": 0, "translation": list(map(float, t)), "scale": [float(k)] * 3}
                   for t, k in nodes]
     gltf_nodes.append({"camera": 0, "translation": camera[0], "rotation": rot})

@@ -1,6 +1,6 @@
 // Progress within a walk (RenderOptions::walk_progress, host/trace/passes.cpp): a walk pass by
-// pass reports after its occlusion queries the frame's passes so far and the rays still walking,
-// which are the queries' own results; a walk in batches reports the share of its tiles walked,
+// pass reports after each occlusion query the frame's passes so far, which query it was and what
+// it counted; a walk in batches reports the share of its tiles walked,
 // up to all of them, with a time left that shrinks to zero; a report never changes the frame.
 #include <doctest/doctest.h>
 
@@ -20,7 +20,7 @@
 namespace {
 
 struct Bunny {
-  host::Scene scene = host::load_scene(host::resolve_scene("bunny-low"), host::with_images());
+  host::Scene scene = host::load_scene(host::resolve_scene("bunny-refl"), host::with_images());
   host::Grid grid =
       host::build_grid(scene, host::grid_spec_for({}, scene, vgpu::profile("gf5700")));
   host::Camera camera = host::scene_camera(scene, 1.0f);
@@ -40,7 +40,7 @@ host::RenderOptions options(bool batches) {
 
 }  // namespace
 
-TEST_CASE("a walk pass by pass reports the passes so far and the rays its queries counted") {
+TEST_CASE("a walk pass by pass reports the passes so far, each query and the rays it counted") {
   const Bunny b;
   host::RenderOptions opt = options(false);
   std::vector<host::WalkProgress> seen;
@@ -50,10 +50,12 @@ TEST_CASE("a walk pass by pass reports the passes so far and the rays its querie
   CHECK_FALSE(r.batch_walk);
   // One report per counting pass, each after it: its result, and the passes up to it.
   std::vector<host::WalkProgress> queries;
+  std::vector<std::string> names;
   uint64_t passes = 0;
   for (const vgpu::PassRecord& p : r.stats.passes) {
     ++passes;
     if (p.query_result >= 0) {
+      names.push_back(p.program);
       host::WalkProgress q;
       q.passes = passes;
       q.rays_walking = p.query_result;
@@ -66,11 +68,17 @@ TEST_CASE("a walk pass by pass reports the passes so far and the rays its querie
     CAPTURE(i);
     CHECK(seen[i].passes == queries[i].passes);
     CHECK(seen[i].rays_walking == queries[i].rays_walking);
+    CHECK(std::string(seen[i].query) == names[i]);
     CHECK(seen[i].done == -1);
+    // A count between walks (the reflected rays' count) names no walk.
     const std::string rays = seen[i].rays;
-    CHECK((rays == "primary rays" || rays == "shadow rays" || rays == "reflected rays"));
+    CHECK((rays == "primary rays" || rays == "shadow rays" || rays == "reflected rays" ||
+           rays == "rays"));
     CHECK(seen[i].left_ms == -1);
   }
+  for (const char* walk : {"primary rays", "shadow rays", "reflected rays"})
+    CHECK(std::any_of(seen.begin(), seen.end(),
+                      [&](const auto& w) { return std::string(w.rays) == walk; }));
 }
 
 TEST_CASE("a walk in batches reports the share of its tiles walked, up to all, and the time left") {

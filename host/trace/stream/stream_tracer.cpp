@@ -449,6 +449,7 @@ void StreamTracer::walk_rays(Texture& origins, Texture& rays, bool primary, cons
                                        : PassObserver::TraceKind::reflected);
   s_->runner->walking = primary ? "primary rays" : "reflected rays";
   trace(origins, rays, primary, cam);
+  s_->runner->walking = "rays";
   if (opt_.observer) opt_.observer->trace_end();
 }
 
@@ -517,6 +518,7 @@ void StreamTracer::shade_lights(const Camera& cam, Texture& surface, Texture& ra
       if (opt_.observer) opt_.observer->trace_begin(PassObserver::TraceKind::shadow);
       r.walking = "shadow rays";
       trace(surface, s.shadow_rays, false, cam);
+      r.walking = "rays";
       if (s.streams && s.streams->glass_scene())
         shadow = &s.streams->shadows_through_glass(r, surface, s.shadow_rays, &s.isect.current(),
                                                    [&](Texture& o, Texture& d) {
