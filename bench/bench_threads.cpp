@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "host/cli/render.h"
+#include "tests/support/stats_json.h"
 
 namespace {
 
@@ -25,25 +26,11 @@ double median(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
-// The statistics without what a clock measured.
-host::StatsJson untimed(host::StatsJson j) {
-  if (j.is_array())
-    for (auto& e : j) e = untimed(e);
-  if (!j.is_object()) return j;
-  for (auto it = j.begin(); it != j.end();) {
-    const std::string& k = it.key();
-    if (k.size() > 3 && k.compare(k.size() - 3, 3, "_ms") == 0 && k != "predicted_ms") {
-      it = j.erase(it);
-      continue;
-    }
-    if (k == "threads") {
-      it = j.erase(it);
-      continue;
-    }
-    it.value() = untimed(it.value());
-    ++it;
-  }
-  return j;
+// The statistics without what a clock measured, nor the thread count they were made with.
+host::StatsJson untimed(const host::StatsJson& j) {
+  host::StatsJson out = test_support::without_times(j);
+  out.erase("threads");
+  return out;
 }
 
 struct Frame {

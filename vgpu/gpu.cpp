@@ -111,16 +111,9 @@ void Gpu::clear(Texture& t, std::initializer_list<float> value) {
   // A frame-sized clear (16 MB at 1024x1024) is split over the threads like a pass: serial, it
   // was half of a 16-thread frame's host work outside the passes.
   const std::span<const float> texel(value.begin(), value.size());
-  const int blocks = std::min(t.height(), threads() * 4);
-  if (t.width() * uint64_t(t.height()) < 65536 || blocks <= 1) {
-    t.fill(texel);
-  } else {
-    t.touch();
-    parallel_for(blocks, [&](int k, int) {
-      t.fill_rows(texel, int(int64_t(t.height()) * k / blocks),
-                  int(int64_t(t.height()) * (k + 1) / blocks));
-    });
-  }
+  ++t.version_;
+  parallel_blocks(size_t(t.height()), size_t(65536 / t.width()) + 1,
+                  [&](size_t y0, size_t y1) { t.fill_rows(texel, int(y0), int(y1)); });
   Counters c;
   c.clears = 1;
   c.bytes_written = t.bytes();
@@ -295,14 +288,7 @@ void Gpu::DrawPlan::set_outputs(Gpu& g, const Program& p, bool carries, bool who
                 std::memcpy(dd + size_t(i) * ch, sd + size_t(i) * ch, ch * sizeof(float));
           }
         };
-        const int blocks = differ.size() < 32768 ? 1 : g.threads() * 4;
-        if (blocks == 1)
-          copy(0, differ.size());
-        else
-          g.parallel_for(blocks, [&](int b, int) {
-            copy(differ.size() * size_t(b) / size_t(blocks),
-                 differ.size() * size_t(b + 1) / size_t(blocks));
-          });
+        g.parallel_blocks(differ.size(), 32768, copy);
         g.pairs_.erase(rec);  // used up: if the pass fails, no record claims the textures agree
         break;
       }

@@ -125,6 +125,12 @@ class Gpu final : public Device {
   // body(item, slot) for items [0, n) on the calling thread and the workers; slot <
   // threads() is the running thread's own (for per-thread accumulators).
   void parallel_for(int n, const std::function<void(int, int)>& body);
+  // body(begin, end) over [0, n) split into blocks, four per thread, on the calling thread and
+  // the workers; below `serial_below` items one call on the calling thread (waking the workers
+  // would cost more). Blocks are disjoint: host work that writes each item once (a clear's rows,
+  // a read-back, a copy list) gives the same result on any thread count.
+  void parallel_blocks(size_t n, size_t serial_below,
+                       const std::function<void(size_t, size_t)>& body);
 
  private:
   struct Chunk;

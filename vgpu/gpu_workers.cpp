@@ -101,4 +101,15 @@ void Gpu::parallel_for(int n, const std::function<void(int, int)>& body) {
   run_on_workers(job);
 }
 
+void Gpu::parallel_blocks(size_t n, size_t serial_below,
+                          const std::function<void(size_t, size_t)>& body) {
+  const size_t blocks = std::min(n, size_t(threads()) * 4);
+  if (n < serial_below || blocks <= 1) {
+    body(0, n);
+    return;
+  }
+  parallel_for(int(blocks),
+               [&](int k, int) { body(n * size_t(k) / blocks, n * size_t(k + 1) / blocks); });
+}
+
 }  // namespace vgpu

@@ -47,10 +47,6 @@ class Texture {
     data_[index(x, y) + c] = round_to(format_, v);
   }
   void fill(std::span<const float> texel);  // every texel = texel (channels() values)
-  // Rows [y0, y1) only, each texel = texel (for a clear split over threads; no version bump:
-  // fill() or the caller's touch() makes it).
-  void fill_rows(std::span<const float> texel, int y0, int y1);
-  void touch() { ++version_; }
   // Every texel at once (channels() floats per texel, row-major, data().size() in all), rounded
   // to the format; returns whether any stored value changed (what a host re-upload must send).
   bool replace(std::span<const float> texels);
@@ -66,6 +62,9 @@ class Texture {
  private:
   friend class Gpu;
   static uint64_t fresh_uid();
+  // Rows [y0, y1) only, each texel = texel, without a version step (Gpu::clear splits its rows
+  // over the threads and steps the version once).
+  void fill_rows(std::span<const float> texel, int y0, int y1);
 
   std::string name_;
   int width_ = 0, height_ = 0, channels_ = 0;

@@ -124,17 +124,17 @@ uint64_t PassRunner::count(const vgpu::Program& p, const Texture& in, const Sten
   return n;
 }
 
-bool PassRunner::due(std::chrono::steady_clock::time_point now) {
-  if (now - last_report_ < std::chrono::duration<double, std::milli>(opt_.progress_every_ms))
-    return false;
+// One report at most every progress_every_ms, one thread at a time (a report under way makes
+// the others skip theirs). A callback that throws (a full disk under stderr, an allocation) must
+// not fail the frame: progress stops for the rest of it.
+void PassRunner::report(WalkProgress w, std::chrono::steady_clock::time_point now) {
+  const std::unique_lock lk(progress_mu_, std::try_to_lock);
+  if (!lk.owns_lock() || progress_failed_ ||
+      now - last_report_ < std::chrono::duration<double, std::milli>(opt_.progress_every_ms))
+    return;
   last_report_ = now;
-  return true;
-}
-
-// A progress callback that throws (a full disk under stderr, an allocation) must not fail the
-// frame: progress stops for the rest of it.
-void PassRunner::tell(const WalkProgress& w) {
-  if (progress_failed_) return;
+  w.rays = walking;
+  w.passes = gpu_.stats().totals.passes;  // a batch walk's own come with its replay
   try {
     opt_.walk_progress(w);
   } catch (...) {
@@ -144,28 +144,20 @@ void PassRunner::tell(const WalkProgress& w) {
 
 void PassRunner::report_rays(const char* query, uint64_t rays) {
   if (!opt_.walk_progress) return;
-  const std::unique_lock lk(progress_mu_, std::try_to_lock);
-  if (!lk.owns_lock() || !due(std::chrono::steady_clock::now())) return;
   WalkProgress w;
-  w.rays = walking;
-  w.passes = gpu_.stats().totals.passes;
   w.query = query;
   w.rays_walking = int64_t(rays);
-  tell(w);
+  report(w, std::chrono::steady_clock::now());
 }
 
 void PassRunner::report_batches(int done, int total, std::chrono::steady_clock::time_point start) {
   if (!opt_.walk_progress || total <= 0) return;
-  const std::unique_lock lk(progress_mu_, std::try_to_lock);
   const auto now = std::chrono::steady_clock::now();
-  if (!lk.owns_lock() || !due(now)) return;
   WalkProgress w;
-  w.rays = walking;
-  w.passes = gpu_.stats().totals.passes;  // the walk's own come with its replay
   w.done = double(done) / double(total);
   const double ms = std::chrono::duration<double, std::milli>(now - start).count();
   if (done > 0) w.left_ms = ms * double(total - done) / double(done);
-  tell(w);
+  report(w, now);
 }
 
 uint32_t PassRunner::own_only_units(const vgpu::Program& p) {

@@ -119,8 +119,7 @@ class PassRunner {
   vgpu::Texture& counter_;
   std::vector<std::pair<const vgpu::Program*, uint32_t>> own_only_;
   // The last progress report, and the lock that lets one thread report at a time.
-  bool due(std::chrono::steady_clock::time_point now);
-  void tell(const WalkProgress& w);  // under progress_mu_
+  void report(WalkProgress w, std::chrono::steady_clock::time_point now);
   bool progress_failed_ = false;
   std::mutex progress_mu_;
   std::chrono::steady_clock::time_point last_report_{};

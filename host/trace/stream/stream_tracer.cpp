@@ -621,14 +621,11 @@ void StreamTracer::download_aovs(RenderResult& res, Texture& hits) {
       }
   };
   // On the emulator, over its threads (a serial part of a 16-thread frame otherwise).
-  if (auto* emu = dynamic_cast<vgpu::Gpu*>(gpu_.get()); emu && uint64_t(W) * H >= 65536) {
-    const int blocks = std::min(H, emu->threads() * 4);
-    emu->parallel_for(blocks, [&](int k, int) {
-      rows(int(int64_t(H) * k / blocks), int(int64_t(H) * (k + 1) / blocks));
-    });
-  } else {
+  if (auto* emu = dynamic_cast<vgpu::Gpu*>(gpu_.get()))
+    emu->parallel_blocks(size_t(H), size_t(65536 / W) + 1,
+                         [&](size_t y0, size_t y1) { rows(int(y0), int(y1)); });
+  else
     rows(0, H);
-  }
 }
 
 void StreamTracer::stream_frame(const Camera& cam, const vgpu::Program& generate, RenderResult& res,
