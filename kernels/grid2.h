@@ -16,11 +16,16 @@
 // with proximoTriangulo, rayosIntersectando and rayosEnGrilla as the grid has them. Traversal
 // state (kernels/layout.h): x = sub-cell (-1: done), y = the sub-cell's list start, z, w = t
 // where the ray enters and leaves the sub-cell.
+// Addressed by (x, y) (Grid2Uniforms::xy, for grids past a float's linear reach): the state holds
+// the sub-cell's column and row in x and y, and cargarCelda reads its list start from the
+// sub-cell's texel (list start column, row, coarse cell); a coarse cell's record holds its
+// sub-grid's resolution x + kGrid2ResPack y, z, and its first sub-cell's column and row.
 #pragma once
 
 #include "kernels/common.h"
 #include "kernels/init_traversal.h"
 #include "kernels/lists.h"
+#include "kernels/next_triangle.h"
 
 namespace kernels {
 
@@ -34,6 +39,10 @@ struct Grid2Uniforms : ListUniforms {
   float sub_width = 1;   // width of the sub-cell texture, texels
 };
 
+// By (x, y), a coarse cell's record packs its sub-grid's x and y resolutions in one channel
+// (x + kGrid2ResPack y; sub-grids stop at 128 cells per axis, host/accel/grid2.h).
+inline constexpr float kGrid2ResPack = 1024.0f;
+
 // Index `id` of an x-fastest rx × ry × rz array as (x, y, z); ids below 2^24 decode exactly
 // (the + 1/2 keeps the quotient off the integer below).
 template <class F>
@@ -43,24 +52,34 @@ inline Vec3<F> decode_index(const F& id, const F& rx, const F& ry) {
   return {id - q * rx, q - z * ry, z};
 }
 
-// The sub-grid of coarse cell `cc`: its resolution (xyz) and first sub-cell (w) from the
-// coarse-cell texture, its box minimum and its sub-cell size (world space).
+// The sub-grid of coarse cell `cc`: its resolution and first sub-cell from the coarse-cell
+// texture (linear: xyz and w; by (x, y): packed, see kGrid2ResPack), its box minimum and its
+// sub-cell size (world space).
 template <class L>
 struct SubGrid {
   using F = typename L::F;
-  Vec4<F> rec;
+  Vec3<F> res;
+  Addr<F> first;
   Vec3<F> lo, size;
   SubGrid(const Fragments<L>& f, int unit_cells, const Vec3<F>& cc, const Grid2Uniforms& u)
       : SubGrid(
             cc,
             fetch_id(f, unit_cells, (cc.z * F(u.res.y) + cc.y) * F(u.res.x) + cc.x, u.cell_width),
-            u) {}
-  // The sub-grid of coarse cell `cc` whose record is `record` (no fetch: the beam entry's
-  // empty cells, whose sub-grid is one cell).
-  SubGrid(const Vec3<F>& cc, const Vec4<F>& record, const Grid2Uniforms& u) : rec(record) {
+            u, u.xy > 0.5f) {}
+  // The sub-grid of coarse cell `cc` whose record is `record`, laid out linear or by (x, y) (no
+  // fetch: the beam entry's empty cells, whose sub-grid is one cell, linear).
+  SubGrid(const Vec3<F>& cc, const Vec4<F>& record, const Grid2Uniforms& u, bool xy = false) {
+    if (xy) {
+      const F ry = floor(record.x / F(kGrid2ResPack));
+      res = {record.x - ry * F(kGrid2ResPack), ry, record.y};
+      first = {record.z, record.w};
+    } else {
+      res = record.xyz();
+      first = {record.w, record.w};
+    }
     lo = {F(u.lo.x) + cc.x * F(u.cell.x), F(u.lo.y) + cc.y * F(u.cell.y),
           F(u.lo.z) + cc.z * F(u.cell.z)};
-    size = {F(u.cell.x) / rec.x, F(u.cell.y) / rec.y, F(u.cell.z) / rec.z};
+    size = {F(u.cell.x) / res.x, F(u.cell.y) / res.y, F(u.cell.z) / res.z};
   }
   // Per axis, the t where the ray leaves sub-cell s through that axis' next boundary (kFar
   // for an axis the ray runs parallel to): voxel_exits over the sub-grid.
@@ -76,14 +95,15 @@ struct SubGrid {
 
 // The state of a ray entering coarse cell `cc` at parameter t: per axis, the sub-cell `given`
 // where from_point is 0 (clamped into the sub-grid: a huge value gives the last sub-cell), else
-// the sub-cell holding the point o + t d (clamped). Fetches the sub-cell's list start.
+// the sub-cell holding the point o + t d (clamped). Linear, fetches the sub-cell's list start
+// (state y); by (x, y), only where `list` is given (it receives it), else cargarCelda does.
 template <class L>
 inline Vec4<typename L::F> grid2_cell(const Fragments<L>& f, int unit_cells, int unit_subs,
                                       const Vec3<typename L::F>& o, const Vec3<typename L::F>& d,
                                       const Vec3<typename L::F>& cc, const typename L::F& t,
                                       const Vec3<typename L::F>& given,
-                                      const Vec3<typename L::F>& from_point,
-                                      const Grid2Uniforms& u) {
+                                      const Vec3<typename L::F>& from_point, const Grid2Uniforms& u,
+                                      Addr<typename L::F>* list = nullptr) {
   using F = typename L::F;
   const SubGrid<L> sg(f, unit_cells, cc, u);
   const Vec3<F> p = o + d * t;  // world space
@@ -91,12 +111,21 @@ inline Vec4<typename L::F> grid2_cell(const Fragments<L>& f, int unit_cells, int
     const F v = select(fp > F(0.5f), floor((pa - la) / ca), ga);
     return min(max(v, F(0.0f)), ra - F(1.0f));
   };
-  const Vec3<F> s{sub(p.x, sg.lo.x, sg.size.x, sg.rec.x, given.x, from_point.x),
-                  sub(p.y, sg.lo.y, sg.size.y, sg.rec.y, given.y, from_point.y),
-                  sub(p.z, sg.lo.z, sg.size.z, sg.rec.z, given.z, from_point.z)};
-  const F g = sg.rec.w + (s.z * sg.rec.y + s.y) * sg.rec.x + s.x;
-  const F list = fetch_id(f, unit_subs, g, u.sub_width).x;
-  return {g, list, t, min3(sg.exits(o, d, s))};
+  const Vec3<F> s{sub(p.x, sg.lo.x, sg.size.x, sg.res.x, given.x, from_point.x),
+                  sub(p.y, sg.lo.y, sg.size.y, sg.res.y, given.y, from_point.y),
+                  sub(p.z, sg.lo.z, sg.size.z, sg.res.z, given.z, from_point.z)};
+  const bool xy = u.xy > 0.5f;
+  const Addr<F> g = addr_add(sg.first, (s.z * sg.res.y + s.y) * sg.res.x + s.x, u.sub_width, xy);
+  if (!xy) {
+    const F start = fetch_id(f, unit_subs, g.x, u.sub_width).x;
+    if (list) *list = {start, start};
+    return {g.x, start, t, min3(sg.exits(o, d, s))};
+  }
+  if (list) {
+    const Vec4<F> sub_texel = fetch_at(f, unit_subs, g, u.sub_width, true);
+    *list = {sub_texel.x, sub_texel.y};
+  }
+  return {g.x, g.y, t, min3(sg.exits(o, d, s))};
 }
 
 inline constexpr float kGrid2Far = 1e6f;  // a sub-cell index past any sub-grid's last
@@ -115,7 +144,7 @@ inline Vec4<typename L::F> grid2_entry(const Fragments<L>& f, int unit_cells, in
   const Vec4<F> e = grid_entry<L>(o, d, ray_w, coarse);
   const Vec3<F> zero{F(0.0f), F(0.0f), F(0.0f)}, one{F(1.0f), F(1.0f), F(1.0f)};
   const Vec3<F> cc = select(e.x >= F(0.0f), e.xyz(), zero);  // a done ray reads cell 0
-  const Vec4<F> in = grid2_cell(f, unit_cells, unit_subs, o, d, cc, e.w, zero, one, u);
+  const Vec4<F> in = grid2_cell(f, unit_cells, unit_subs, o, d, cc, e.w, zero, one, u, nullptr);
   return select(e.x >= F(0.0f), in, Vec4<F>{F(kNone), F(kNone), F(0.0f), F(0.0f)});
 }
 
@@ -129,13 +158,17 @@ inline Vec4<typename L::F> grid2_step(const Fragments<L>& f, int unit_cells, int
                                       const Vec4<typename L::F>& trav,
                                       const Vec4<typename L::F>& best, const Vec3<typename L::F>& o,
                                       const Vec3<typename L::F>& d, const typename L::F& tmax,
-                                      const typename L::M& walking, const Grid2Uniforms& u) {
+                                      const typename L::M& walking, const Grid2Uniforms& u,
+                                      Addr<typename L::F>* list = nullptr) {
   using F = typename L::F;
+  const bool xy = u.xy > 0.5f;
   // Climb: the sub-cell's texel names its coarse cell.
-  const F c = fetch_id(f, unit_subs, trav.x, u.sub_width).y;
+  const Addr<F> at = xy ? Addr<F>{trav.x, trav.y} : Addr<F>{trav.x, trav.x};
+  const Vec4<F> sub_texel = fetch_at(f, unit_subs, at, u.sub_width, xy);
+  const F c = xy ? sub_texel.z : sub_texel.y;
   const Vec3<F> cc = decode_index(c, F(u.res.x), F(u.res.y));
   const SubGrid<L> sg(f, unit_cells, cc, u);
-  const Vec3<F> s = decode_index(trav.x - sg.rec.w, sg.rec.x, sg.rec.y);
+  const Vec3<F> s = decode_index(addr_minus(at, sg.first, u.sub_width, xy), sg.res.x, sg.res.y);
   const Vec3<F> exits = sg.exits(o, d, s);
   const F t_exit = min3(exits);
   // Per axis: the step (+-1 where tied at the exit, else 0), the sub-cell after it, and
@@ -145,9 +178,9 @@ inline Vec4<typename L::F> grid2_step(const Fragments<L>& f, int unit_cells, int
   };
   const Vec3<F> st{stepped(d.x, exits.x), stepped(d.y, exits.y), stepped(d.z, exits.z)};
   const Vec3<F> ns = s + st;
-  const auto lx = (ns.x < F(0.0f)) || (ns.x >= sg.rec.x);
-  const auto ly = (ns.y < F(0.0f)) || (ns.y >= sg.rec.y);
-  const auto lz = (ns.z < F(0.0f)) || (ns.z >= sg.rec.z);
+  const auto lx = (ns.x < F(0.0f)) || (ns.x >= sg.res.x);
+  const auto ly = (ns.y < F(0.0f)) || (ns.y >= sg.res.y);
+  const auto lz = (ns.z < F(0.0f)) || (ns.z >= sg.res.z);
   const auto leaving = lx || ly || lz;
   // The coarse cell after the step (moved along the axes that leave the sub-grid).
   const Vec3<F> nc{cc.x + select(lx, st.x, F(0.0f)), cc.y + select(ly, st.y, F(0.0f)),
@@ -168,7 +201,7 @@ inline Vec4<typename L::F> grid2_step(const Fragments<L>& f, int unit_cells, int
   const auto done = found || outside || past;
   const Vec3<F> zero{F(0.0f), F(0.0f), F(0.0f)};
   const Vec4<F> next = grid2_cell(f, unit_cells, unit_subs, o, d, select(outside, zero, nc), t_exit,
-                                  g, from_point, u);
+                                  g, from_point, u, list);
   const Vec4<F> finished{F(kNone), F(kNone), F(0.0f), F(0.0f)};
   return select(walking, select(done, finished, next), trav);
 }
@@ -219,14 +252,16 @@ struct Grid2Step {
   }
 };
 
-// cargarCelda: the first triangle of the sub-cell just reached (traversal y: its list start),
-// for a ray with nothing left to test (voxel state w = -1).
+// cargarCelda: the first triangle of the sub-cell just reached (traversal y: its list start; by
+// (x, y), read from the sub-cell's texel, unit kSubCells), for a ray with nothing left to test
+// (voxel state w = -1).
 struct Grid2LoadCell {
   static constexpr const char* name = "grid2 load cell";
   static constexpr const char* paper_name = "cargarCelda (extension)";
   static constexpr int outputs = 1;  // -> voxel state
-  enum Unit { kTraversal, kVoxelState, kLists };
-  static constexpr std::array<const char*, 3> units{"traversal", "voxel_state", "grid2_lists"};
+  enum Unit { kTraversal, kVoxelState, kLists, kSubCells };
+  static constexpr std::array<const char*, 4> units{"traversal", "voxel_state", "grid2_lists",
+                                                    "grid2_subcells"};
   static constexpr std::array<int, 1> passthrough{kVoxelState};
 
   Grid2Uniforms grid2;
@@ -236,9 +271,17 @@ struct Grid2LoadCell {
     using F = typename L::F;
     const Vec4<F> trav = f.fetch_own(kTraversal);
     const Vec4<F> vs = f.fetch_own(kVoxelState);
-    const auto load = (trav.y >= F(0.0f)) && (vs.w < F(0.0f));
+    const bool xy = grid2.xy > 0.5f;
+    const auto load = (xy ? trav.x >= F(0.0f) : trav.y >= F(0.0f)) && (vs.w < F(0.0f));
     Vec4<F> next = vs;
-    if (f.branch(load)) next = load_list(f, kLists, trav.y, vs, load, grid2);
+    if (f.branch(load)) {
+      if (xy) {
+        const Vec4<F> sub = fetch_at(f, kSubCells, Addr<F>{trav.x, trav.y}, grid2.sub_width, true);
+        next = load_list_at(f, kLists, Addr<F>{sub.x, sub.y}, vs, load, grid2);
+      } else {
+        next = load_list(f, kLists, trav.y, vs, load, grid2);
+      }
+    }
     f.out(0) = next;
   }
 };
@@ -301,9 +344,17 @@ struct Grid2StepLoad {
       const Vec4<F> best = f.fetch_own(kIntersection);
       const Vec3<F> o = f.fetch_own(kOrigins).xyz();
       const Vec4<F> ray = f.fetch_own(kRays);
-      next = grid2_step(f, kCells, kSubCells, trav, best, o, ray.xyz(), ray.w, walking, grid2);
-      const auto load = walking && (next.y >= F(0.0f)) && (vs.w < F(0.0f));
-      nvs = load_list(f, kLists, next.y, vs, load, grid2);
+      if (grid2.xy > 0.5f) {
+        Addr<F> list{trav.x, trav.x};
+        next = grid2_step(f, kCells, kSubCells, trav, best, o, ray.xyz(), ray.w, walking, grid2,
+                          &list);
+        const auto load = walking && (next.x >= F(0.0f)) && (vs.w < F(0.0f));
+        nvs = load_list_at(f, kLists, list, vs, load, grid2);
+      } else {
+        next = grid2_step(f, kCells, kSubCells, trav, best, o, ray.xyz(), ray.w, walking, grid2);
+        const auto load = walking && (next.y >= F(0.0f)) && (vs.w < F(0.0f));
+        nvs = load_list(f, kLists, next.y, vs, load, grid2);
+      }
     }
     f.out(0) = next;
     f.out(1) = nvs;
@@ -336,7 +387,7 @@ struct Grid2IntersectNext {
       const Vec4<F> ray = f.fetch_own(kRays);
       const Vec4<F> trav = f.fetch_own(kTraversal);
       next = nearest_hit_in_segment(f, kV0, o, ray, trav, vs, best, testing, scene, grid2.t_slack);
-      nvs = load_list(f, kLists, vs.x + F(1.0f), vs, testing, grid2);
+      nvs = next_in_list(f, kLists, vs, testing, grid2);
     }
     f.out(0) = next;
     f.out(1) = nvs;
@@ -381,6 +432,30 @@ struct Grid2Looping {
     Vec4<F> best = f.fetch_own(kIntersection);
     const Vec3<F> o = f.fetch_own(kOrigins).xyz();
     const Vec4<F> ray = f.fetch_own(kRays);
+    if (grid2.xy > 0.5f) {
+      // By (x, y): the step's sub-cell fetch brings the list start of the sub-cell it reaches.
+      f.loop(steps, trav.x >= F(0.0f), [&](const M& act) {
+        const M testing = act && (vs.w >= F(0.0f));
+        best =
+            nearest_hit_in_segment(f, kV0, o, ray, trav, vs, best, testing, scene, grid2.t_slack);
+        const Addr<F> pos = addr_next(list_pos(vs, grid2), grid2.list_width, true);
+        const F tri = list_entry_at(f, kLists, pos, grid2);
+        const M stepping = act && !testing;
+        Addr<F> list{pos.x, pos.y};
+        const Vec4<F> next = grid2_step(f, kCells, kSubCells, trav, best, o, ray.xyz(), ray.w,
+                                        stepping, grid2, &list);
+        const M load = stepping && (next.x >= F(0.0f));
+        const F first = list_entry_at(f, kLists, list, grid2);
+        vs = select(testing, Vec4<F>{pos.x, pos.y, F(0.0f), tri},
+                    select(load, Vec4<F>{list.x, list.y, F(0.0f), first}, vs));
+        trav = select(stepping, next, trav);
+        return trav.x >= F(0.0f);
+      });
+      f.out(0) = trav;
+      f.out(1) = vs;
+      f.out(2) = best;
+      return;
+    }
     f.loop(steps, trav.x >= F(0.0f), [&](const M& act) {
       const M testing = act && (vs.w >= F(0.0f));
       best = nearest_hit_in_segment(f, kV0, o, ray, trav, vs, best, testing, scene, grid2.t_slack);

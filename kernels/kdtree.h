@@ -15,10 +15,17 @@
 // state (kernels/layout.h): x = node (-1: done), y = list position of the leaf being tested
 // (-1: none), z = tmin, w = tmax of the segment. Leaves are met front to back, so the first hit
 // inside a leaf's segment is the nearest.
+// Addressed by (x, y) (KdUniforms::xy, for trees past a float's linear reach): the state holds
+// the node's column in x (plus the node texture's width once its leaf was reached: the flag
+// linear y's list position gave) and its row in y; a node texel holds its right child's, or its
+// leaf's list start's, column and row in z and w; cargarHojaKd reads the list start from the
+// leaf's texel (one fetch more), and the looping kernel restarts at the root (push-down's node
+// would need two channels the state has not got).
 #pragma once
 
 #include "kernels/common.h"
 #include "kernels/lists.h"
+#include "kernels/next_triangle.h"
 
 namespace kernels {
 
@@ -44,29 +51,52 @@ inline F along(const Vec3<F>& v, const F& a) {
   return select(a < F(0.5f), v.x, select(a < F(1.5f), v.y, v.z));
 }
 
-// One step of kd-restart for the lanes where `walking` (others keep trav): the node trav.x,
-// fetched as (split, axis, right child, leaf list start). A restart goes to the root, or to
-// `*root` (beams over tiles: the node the ray's tile's beam descended to, whose region holds the
-// ray's whole segment, so every restart from the root would pass through it unchanged).
+// Whether the leaf a kd traversal state stands at was reached in an earlier step (its triangles
+// loaded and tested since): linear, y holds its list position; by (x, y), x is past the width.
+template <class F>
+inline auto kd_reached(const Vec4<F>& trav, const KdUniforms& kd) {
+  return kd.xy > 0.5f ? trav.x >= F(kd.node_width) : trav.y >= F(0.0f);
+}
+
+// The node a kd traversal state stands at (a walking one; linear: y unused).
+template <class F>
+inline Addr<F> kd_node(const Vec4<F>& trav, const KdUniforms& kd) {
+  if (kd.xy <= 0.5f) return {trav.x, trav.x};
+  return {trav.x - select(trav.x >= F(kd.node_width), F(kd.node_width), F(0.0f)), trav.y};
+}
+
+// One step of kd-restart for the lanes where `walking` (others keep trav): the node at
+// kd_node(trav), fetched as (split, axis, right child, leaf list start), or by (x, y) (split,
+// axis, then the right child's or the leaf's list start's column and row). A restart goes to
+// the root, or to `*root` (beams over tiles, linear addresses only: the node the ray's tile's
+// beam descended to, whose region holds the ray's whole segment, so every restart from the root
+// would pass through it unchanged). `leaf_list`, where given, receives the fetched node's list
+// start (a leaf's).
 template <class L>
 inline Vec4<typename L::F> kd_step(const Fragments<L>& f, int unit_nodes,
                                    const Vec4<typename L::F>& trav, const Vec4<typename L::F>& best,
                                    const Vec3<typename L::F>& o, const Vec3<typename L::F>& d,
                                    const typename L::F& ray_w, const typename L::M& walking,
-                                   const KdUniforms& kd, const typename L::F* root = nullptr) {
+                                   const KdUniforms& kd, const typename L::F* root = nullptr,
+                                   Addr<typename L::F>* leaf_list = nullptr) {
   using F = typename L::F;
-  const Vec4<F> node = fetch_id(f, unit_nodes, trav.x, kd.node_width);
+  const bool xy = kd.xy > 0.5f;
+  const Addr<F> at = kd_node(trav, kd);
+  const Vec4<F> node = fetch_at(f, unit_nodes, at, kd.node_width, xy);
   const auto leaf = node.y > F(2.5f);
-  const auto tested = trav.y >= F(0.0f);  // this leaf's triangles were tested in the last step
+  const auto tested = kd_reached(trav, kd);  // this leaf's triangles were tested in the last step
+  if (leaf_list) *leaf_list = xy ? Addr<F>{node.z, node.w} : Addr<F>{node.w, node.w};
   // A leaf just reached: hand it to cargarHoja.
-  const Vec4<F> reach{trav.x, node.w, trav.z, trav.w};
+  const Vec4<F> reach = xy ? Vec4<F>{at.x + F(kd.node_width), at.y, trav.z, trav.w}
+                           : Vec4<F>{trav.x, node.w, trav.z, trav.w};
   // A leaf tested: a hit inside it ends the ray, as does a segment that reached the box's exit
   // (or the ray's tmax); otherwise restart from the root past the leaf.
   F tn, tend;
   ray_box_segment(o, d, kd.lo, kd.hi, ray_w, tn, tend);
   const auto over = (best.w >= F(0.0f)) || (trav.w >= tend);
   const Vec4<F> done{F(kNone), F(kNone), F(0.0f), F(0.0f)};
-  const Vec4<F> restart{root ? *root : F(0.0f), F(kNone), trav.w, tend};
+  const Vec4<F> restart = xy ? Vec4<F>{F(0.0f), F(0.0f), trav.w, tend}
+                             : Vec4<F>{root ? *root : F(0.0f), F(kNone), trav.w, tend};
   // An inner node: the child the segment starts in, cutting the segment at the plane when it
   // reaches the other child; the far child alone when the plane lies before tmin. A ray whose
   // origin lies on the plane (ts = 0, or -0) runs into the child its direction points to
@@ -74,11 +104,14 @@ inline Vec4<typename L::F> kd_step(const Fragments<L>& f, int unit_nodes,
   const F oa = along(o, node.y), da = along(d, node.y);
   const F ts = (node.x - oa) / da;
   const auto below = (oa < node.x) || ((oa == node.x) && (da <= F(0.0f)));
-  const F left = trav.x + F(1.0f), right = node.z;
-  const F near = select(below, left, right), far = select(below, right, left);
+  const Addr<F> left = addr_next(at, kd.node_width, xy);
+  const Addr<F> right = xy ? Addr<F>{node.z, node.w} : Addr<F>{node.z, node.z};
+  const Addr<F> near = addr_select(below, left, right, xy),
+                far = addr_select(below, right, left, xy);
   const auto near_only = (da == F(0.0f)) || (ts >= trav.w) || (ts <= F(0.0f));
   const auto far_only = !near_only && (ts <= trav.z);
-  const Vec4<F> inner{select(far_only, far, near), F(kNone), trav.z,
+  const Addr<F> child = addr_select(far_only, far, near, xy);
+  const Vec4<F> inner{child.x, xy ? child.y : F(kNone), trav.z,
                       select(near_only || far_only, trav.w, ts)};
   const Vec4<F> at_leaf = select(tested, select(over, done, restart), reach);
   return select(walking, select(leaf, at_leaf, inner), trav);
@@ -123,6 +156,7 @@ struct KdEnter {
     using F = typename L::F;
     const Vec4<F> ray = f.fetch_own(kRays);
     Vec4<F> t = kd_entry(f.fetch_own(kOrigins).xyz(), ray.xyz(), ray.w, kd);
+    if (kd.xy > 0.5f) t.y = F(0.0f);  // the root's row (a done ray's y is never read)
     if (beam_tile > 0.0f) {
       const Vec4<F> b = fetch_tile(f, kBeams, beam_tile);
       const auto starts = (t.x >= F(0.0f)) && (b.z <= F(0.0f));
@@ -162,14 +196,16 @@ struct KdStep {
   }
 };
 
-// cargarHojaKd: the first triangle of the leaf just reached (traversal y: its list start), for
-// a ray with nothing left to test (voxel state w = -1).
+// cargarHojaKd: the first triangle of the leaf just reached (traversal y: its list start; by
+// (x, y), read from the leaf's node texel, unit kNodes), for a ray with nothing left to test
+// (voxel state w = -1).
 struct KdLoadLeaf {
   static constexpr const char* name = "kd load leaf";
   static constexpr const char* paper_name = "cargarHojaKd (extension)";
   static constexpr int outputs = 1;  // -> voxel state
-  enum Unit { kTraversal, kVoxelState, kLists };
-  static constexpr std::array<const char*, 3> units{"traversal", "voxel_state", "kd_lists"};
+  enum Unit { kTraversal, kVoxelState, kLists, kNodes };
+  static constexpr std::array<const char*, 4> units{"traversal", "voxel_state", "kd_lists",
+                                                    "kd_nodes"};
   static constexpr std::array<int, 1> passthrough{kVoxelState};
 
   KdUniforms kd;
@@ -179,9 +215,16 @@ struct KdLoadLeaf {
     using F = typename L::F;
     const Vec4<F> trav = f.fetch_own(kTraversal);
     const Vec4<F> vs = f.fetch_own(kVoxelState);
-    const auto load = (trav.y >= F(0.0f)) && (vs.w < F(0.0f));
+    const auto load = kd_reached(trav, kd) && (vs.w < F(0.0f));
     Vec4<F> next = vs;
-    if (f.branch(load)) next = load_list(f, kLists, trav.y, vs, load, kd);
+    if (f.branch(load)) {
+      if (kd.xy > 0.5f) {
+        const Vec4<F> leaf = fetch_at(f, kNodes, kd_node(trav, kd), kd.node_width, true);
+        next = load_list_at(f, kLists, Addr<F>{leaf.z, leaf.w}, vs, load, kd);
+      } else {
+        next = load_list(f, kLists, trav.y, vs, load, kd);
+      }
+    }
     f.out(0) = next;
   }
 };
@@ -243,10 +286,18 @@ struct KdStepLoad {
       const Vec4<F> ray = f.fetch_own(kRays);
       const Vec4<F> best = f.fetch_own(kIntersection);
       const Vec3<F> o = f.fetch_own(kOrigins).xyz();
-      next = kd_step_from_tile(f, kNodes, kBeams, beam_tile, trav, best, o, ray.xyz(), ray.w,
-                               walking, kd);
-      const auto load = walking && (next.y >= F(0.0f)) && (vs.w < F(0.0f));
-      nvs = load_list(f, kLists, next.y, vs, load, kd);
+      if (kd.xy > 0.5f) {
+        // The step's node texel holds the list start of the leaf it reaches.
+        Addr<F> list{trav.x, trav.x};
+        next = kd_step(f, kNodes, trav, best, o, ray.xyz(), ray.w, walking, kd, nullptr, &list);
+        const auto load = walking && kd_reached(next, kd) && (vs.w < F(0.0f));
+        nvs = load_list_at(f, kLists, list, vs, load, kd);
+      } else {
+        next = kd_step_from_tile(f, kNodes, kBeams, beam_tile, trav, best, o, ray.xyz(), ray.w,
+                                 walking, kd);
+        const auto load = walking && (next.y >= F(0.0f)) && (vs.w < F(0.0f));
+        nvs = load_list(f, kLists, next.y, vs, load, kd);
+      }
     }
     f.out(0) = next;
     f.out(1) = nvs;
@@ -279,7 +330,7 @@ struct KdIntersectNext {
       const Vec4<F> ray = f.fetch_own(kRays);
       const Vec4<F> trav = f.fetch_own(kTraversal);
       next = nearest_hit_in_segment(f, kV0, o, ray, trav, vs, best, testing, scene, kd.t_slack);
-      nvs = load_list(f, kLists, vs.x + F(1.0f), vs, testing, kd);
+      nvs = next_in_list(f, kLists, vs, testing, kd);
     }
     f.out(0) = next;
     f.out(1) = nvs;
@@ -329,6 +380,30 @@ struct KdLooping {
     Vec4<F> best = f.fetch_own(kIntersection);
     const Vec3<F> o = f.fetch_own(kOrigins).xyz();
     const Vec4<F> ray = f.fetch_own(kRays);
+    if (kd.xy > 0.5f) {
+      // By (x, y): no push-down (its node would need two more channels), every restart at the
+      // root; the leaf's list start comes with the node texel the step fetched.
+      f.loop(steps, trav.x >= F(0.0f), [&](const M& act) {
+        const M testing = act && (vs.w >= F(0.0f));
+        best = nearest_hit_in_segment(f, kV0, o, ray, trav, vs, best, testing, scene, kd.t_slack);
+        const Addr<F> pos = addr_next(list_pos(vs, kd), kd.list_width, true);
+        const F tri = list_entry_at(f, kLists, pos, kd);
+        const M stepping = act && !testing;
+        Addr<F> list{pos.x, pos.y};
+        const Vec4<F> next =
+            kd_step(f, kNodes, trav, best, o, ray.xyz(), ray.w, stepping, kd, nullptr, &list);
+        const M load = stepping && kd_reached(next, kd);  // reached in this step
+        const F first = list_entry_at(f, kLists, list, kd);
+        vs = select(testing, Vec4<F>{pos.x, pos.y, F(0.0f), tri},
+                    select(load, Vec4<F>{list.x, list.y, F(0.0f), first}, vs));
+        trav = select(stepping, next, trav);
+        return trav.x >= F(0.0f);
+      });
+      f.out(0) = trav;
+      f.out(1) = vs;
+      f.out(2) = best;
+      return;
+    }
     if (beam_tile > 0.0f) vs.y = select(vs.y == F(0.0f), fetch_tile(f, kBeams, beam_tile).x, vs.y);
     f.loop(steps, trav.x >= F(0.0f), [&](const M& act) {
       const M testing = act && (vs.w >= F(0.0f));

@@ -38,6 +38,13 @@
 //                   sub-cells of c follow one another, x fastest
 //   grid2 sub-cells x = the sub-cell's first list entry (0: empty), y = its coarse cell
 //   grid2 lists     x      triangle ids of each sub-cell, closed by -1 (entry 0: a -1)
+// Addressed by (x, y) (ListUniforms::xy, --addressing: past 2^23 entries), a pointer is a texel's
+// column and row: a kd node's z, w hold its right child's (or its leaf's list start's); a
+// coarse cell's record is (sub-grid resolution x + 1024 y, z, first sub-cell's column, row); a
+// sub-cell's texel (list start's column, row, coarse cell). The states below then hold columns
+// and rows: kd traversal x = node column (+ the node texture's width once its leaf is reached),
+// y = node row; grid2 traversal x, y = sub-cell column, row; leaf and cell state x, y = the list
+// position's column, row.
 //
 // Dynamic (per pixel):
 //   origins         xyz = ray origin, world space; w unused    (paper: texturaInicioRayos)
@@ -104,6 +111,11 @@ inline constexpr float kFar = 1e30f;
 struct ListUniforms {
   float list_width = 1;  // width of the triangle-list texture, texels
   float t_slack = 0;     // tolerance of the in-voxel rule, world units along a unit ray
+  // 1: the structure's pointers (list positions, and its nodes' or sub-cells') are (x, y) texel
+  // coordinates, two channels each, instead of one linear index (kernels/lists.h, Addr): a
+  // float addresses linearly only to 2^23 entries, a card's textures by (x, y) far past that.
+  // A float, not a bool, so the uniforms' bytes hold no padding.
+  float xy = 0;
 };
 
 // Uniforms describing the grid (world space), besides its lists'.

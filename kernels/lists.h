@@ -44,6 +44,67 @@ inline void ray_box_segment(const Vec3<F>& o, const Vec3<F>& d, const V& lo, con
   clip_to_slab(o.z, d.z, lo.z, hi.z, tn, tf);
 }
 
+// --- Addresses ---------------------------------------------------------------------------
+
+// A place in a texture of entries (lists, nodes, sub-cells) as a ray's state holds it: linear,
+// entry x at (x mod width, x div width) and y unused; or, where the structure is addressed by
+// (x, y) (ListUniforms::xy), the texel's column x and row y, as a card addresses a texture. A
+// float holds integers exactly to 2^24 and the linear decode is exact to 2^23 (id_to_texel), so
+// past that only (x, y) reaches every entry; it costs a second channel per pointer.
+template <class F>
+struct Addr {
+  F x, y;
+};
+
+// The texel at address a of a texture `width` texels wide.
+template <class L>
+inline Vec4<typename L::F> fetch_at(const Fragments<L>& f, int unit, const Addr<typename L::F>& a,
+                                    float width, bool xy) {
+  using F = typename L::F;
+  if (!xy) return fetch_id(f, unit, a.x, width);
+  return f.fetch(unit, a.x + F(0.5f), a.y + F(0.5f));
+}
+
+// The entry after a (a list's next entry, a node's left child): by (x, y), the next column, or
+// the next row's first past the last column. Widths are powers of two (host/trace/passes.h).
+template <class F>
+inline Addr<F> addr_next(const Addr<F>& a, float width, bool xy) {
+  const F nx = a.x + F(1.0f);
+  if (!xy) return {nx, a.y};
+  const auto wrap = nx >= F(width);
+  return {select(wrap, F(0.0f), nx), select(wrap, a.y + F(1.0f), a.y)};
+}
+
+// The entry k >= 0 entries after a (k small: a sub-grid's sub-cells). Exact: the width is a power
+// of two, so the quotient is.
+template <class F>
+inline Addr<F> addr_add(const Addr<F>& a, const F& k, float width, bool xy) {
+  const F s = a.x + k;
+  if (!xy) return {s, a.y};
+  const F rows = floor(s / F(width));
+  return {s - rows * F(width), a.y + rows};
+}
+
+// How many entries b lies after a (b at or after a, the difference small).
+template <class F>
+inline F addr_minus(const Addr<F>& b, const Addr<F>& a, float width, bool xy) {
+  if (!xy) return b.x - a.x;
+  return (b.y - a.y) * F(width) + (b.x - a.x);
+}
+
+// a where m, else b (linear: y is a's, never read).
+template <class F>
+inline Addr<F> addr_select(const auto& m, const Addr<F>& a, const Addr<F>& b, bool xy) {
+  return {select(m, a.x, b.x), xy ? select(m, a.y, b.y) : a.y};
+}
+
+// The list position a voxel state holds (x, and y where addressed by (x, y); linear, y is a
+// copy of x and never read).
+template <class F>
+inline Addr<F> list_pos(const Vec4<F>& vs, const ListUniforms& lists) {
+  return {vs.x, lists.xy > 0.5f ? vs.y : vs.x};
+}
+
 // --- The list loads -----------------------------------------------------------------------
 
 // Entry `pos` of the triangle lists: a triangle id, or -1 at the end of a list.
@@ -51,6 +112,13 @@ template <class L>
 inline typename L::F list_entry(const Fragments<L>& f, int unit_lists, const typename L::F& pos,
                                 const ListUniforms& lists) {
   return fetch_id(f, unit_lists, pos, lists.list_width).x;
+}
+
+// The same at an address (linear or (x, y), as the lists are).
+template <class L>
+inline typename L::F list_entry_at(const Fragments<L>& f, int unit_lists,
+                                   const Addr<typename L::F>& pos, const ListUniforms& lists) {
+  return fetch_at(f, unit_lists, pos, lists.list_width, lists.xy > 0.5f).x;
 }
 
 // The voxel state standing at list position `pos` (its triangle fetched), for the lanes where
@@ -63,6 +131,18 @@ inline Vec4<typename L::F> load_list(const Fragments<L>& f, int unit_lists,
   using F = typename L::F;
   const F tri = list_entry(f, unit_lists, pos, lists);
   return select(load, Vec4<F>{pos, F(0.0f), F(0.0f), tri}, vs);
+}
+
+// The same at an address: by (x, y), the state holds the position in x and y.
+template <class L>
+inline Vec4<typename L::F> load_list_at(const Fragments<L>& f, int unit_lists,
+                                        const Addr<typename L::F>& pos,
+                                        const Vec4<typename L::F>& vs, const typename L::M& load,
+                                        const ListUniforms& lists) {
+  using F = typename L::F;
+  if (lists.xy <= 0.5f) return load_list(f, unit_lists, pos.x, vs, load, lists);
+  const F tri = list_entry_at(f, unit_lists, pos, lists);
+  return select(load, Vec4<F>{pos.x, pos.y, F(0.0f), tri}, vs);
 }
 
 // --- The triangle tests -------------------------------------------------------------------

@@ -13,8 +13,9 @@ template <class L>
 inline Vec4<typename L::F> next_in_list(const Fragments<L>& f, int unit_lists,
                                         const Vec4<typename L::F>& vs, const typename L::M& testing,
                                         const ListUniforms& lists) {
-  using F = typename L::F;
-  return load_list(f, unit_lists, vs.x + F(1.0f), vs, testing, lists);
+  const bool xy = lists.xy > 0.5f;
+  return load_list_at(f, unit_lists, addr_next(list_pos(vs, lists), lists.list_width, xy), vs,
+                      testing, lists);
 }
 
 struct NextTriangle {

@@ -278,6 +278,13 @@ void add_render_options(CLI::App& render, RenderArgs& a) {
       ->check(CLI::Range(1, 256))
       ->capture_default_str();
   render
+      .add_option("--addressing", a.addressing,
+                  "How the kd-tree and the two-level grid address their textures: linear (one "
+                  "float per pointer, exact to 2^23 entries in fp32), xy (a texel's column and "
+                  "row, two channels, to the largest texture) or auto (linear while exact)")
+      ->check(CLI::IsMember({"auto", "linear", "xy"}))
+      ->capture_default_str();
+  render
       .add_option("--ray-streams", a.ray_streams,
                   "Ray streams (glass, docs/studies/materials.md): auto, only for a scene with a "
                   "transmissive material; on, the paper's reflections through them too")

@@ -32,6 +32,7 @@ struct RenderArgs {
   std::string mrt = "off";
   std::string beams = "off";
   int beam_tile = 8;
+  std::string addressing = "auto";
   std::string ray_streams = "auto";
   std::string compact = "on";
   std::string stats = "table";

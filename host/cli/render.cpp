@@ -150,6 +150,9 @@ RenderPlan parse_render(const RenderArgs& a, bool lanes_given, bool observer) {
   opt.mrt = a.mrt == "on";
   opt.beams = a.beams == "on";
   opt.beam_tile = a.beam_tile;
+  opt.addressing = a.addressing == "linear" ? host::RenderOptions::Addressing::linear
+                   : a.addressing == "xy"   ? host::RenderOptions::Addressing::xy
+                                            : host::RenderOptions::Addressing::automatic;
   opt.ray_streams = a.ray_streams == "on";
   opt.compact = a.compact == "on";
   opt.looping = a.kernels == "looping";

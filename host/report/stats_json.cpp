@@ -8,6 +8,8 @@
 #endif
 #include "host/report/stats_json.h"
 
+#include <sys/resource.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -42,6 +44,50 @@ nlohmann::ordered_json user_kernels_json(const UserKernels& user) {
   return u;
 }
 
+// The `accel` object: the structure, how its textures are addressed, its own statistics, the
+// walk's work and --accel auto's choice.
+nlohmann::ordered_json accel_json(const FrameStatsInputs& in) {
+  const Accel& accel = in.accel;
+  const RenderOptions& opt = in.options;
+  const RenderResult& r = in.result;
+  StreamTracer* tracer = in.tracer;
+  const bool cpu = in.engine == "cpu";
+  nlohmann::ordered_json acc;
+  acc["structure"] = accel.name();
+  // How the stream engines' walk addresses the structure's textures (RenderOptions::addressing).
+  if (tracer) acc["addressing"] = tracer->addresses_by_xy() ? "xy" : "linear";
+  const nlohmann::ordered_json own = accel_stats_json(accel.stats());  // the structure's fields
+  for (const auto& [key, v] : own.items()) acc[key] = v;
+  if (!cpu) {
+    const WalkWork w = walk_work(r.stats, r.rays_traced);
+    acc["work"] = {{"voxel_steps", w.voxel_steps},
+                   {"nodes_visited", w.nodes_visited},
+                   {"triangle_tests", w.triangle_tests},
+                   {"loop_iterations", w.loop_iterations}};
+    // kd-restart's restarts, where the passes show them (WalkWork::restarts); else null.
+    acc["work"]["restarts"] =
+        w.restarts >= 0 ? nlohmann::ordered_json(w.restarts) : nlohmann::ordered_json();
+  }
+  if (in.choice) {
+    nlohmann::ordered_json au;
+    au["probe_size"] = {in.choice->probe_width, in.choice->probe_height};
+    au["profile"] = opt.profile;
+    au["predicted_ms"] = in.choice->predicted_ms;
+    au["probe_passes"] = in.choice->probe_passes;
+    au["probe_ms"] = in.choice->probe_ms;
+    au["why"] = in.choice->why;
+    acc["auto"] = au;
+  }
+  return acc;
+}
+
+// The process's peak resident memory so far (getrusage), for the memory study.
+uint64_t peak_rss_bytes() {
+  rusage ru{};
+  getrusage(RUSAGE_SELF, &ru);
+  return uint64_t(ru.ru_maxrss) * 1024;
+}
+
 }  // namespace
 
 nlohmann::ordered_json frame_stats_json(const FrameStatsInputs& in) {
@@ -64,33 +110,7 @@ nlohmann::ordered_json frame_stats_json(const FrameStatsInputs& in) {
   const glm::ivec3 grid_res = accel.grid_res();
   j["grid"] = {grid_res.x, grid_res.y, grid_res.z};
   j["grid_references"] = accel.grid_references();
-  {
-    nlohmann::ordered_json acc;
-    acc["structure"] = accel.name();
-    const nlohmann::ordered_json own = accel_stats_json(accel.stats());  // the structure's fields
-    for (const auto& [key, v] : own.items()) acc[key] = v;
-    if (!cpu) {
-      const WalkWork w = walk_work(r.stats, r.rays_traced);
-      acc["work"] = {{"voxel_steps", w.voxel_steps},
-                     {"nodes_visited", w.nodes_visited},
-                     {"triangle_tests", w.triangle_tests},
-                     {"loop_iterations", w.loop_iterations}};
-      // kd-restart's restarts, where the passes show them (WalkWork::restarts); else null.
-      acc["work"]["restarts"] =
-          w.restarts >= 0 ? nlohmann::ordered_json(w.restarts) : nlohmann::ordered_json();
-    }
-    if (in.choice) {
-      nlohmann::ordered_json au;
-      au["probe_size"] = {in.choice->probe_width, in.choice->probe_height};
-      au["profile"] = opt.profile;
-      au["predicted_ms"] = in.choice->predicted_ms;
-      au["probe_passes"] = in.choice->probe_passes;
-      au["probe_ms"] = in.choice->probe_ms;
-      au["why"] = in.choice->why;
-      acc["auto"] = au;
-    }
-    j["accel"] = acc;
-  }
+  j["accel"] = accel_json(in);
   j["profile"] = opt.profile;
   j["size"] = {r.width, r.height};
   j["bounces"] = opt.bounces;
@@ -121,6 +141,7 @@ nlohmann::ordered_json frame_stats_json(const FrameStatsInputs& in) {
   j["grid_build_ms"] = accel.grid_build_ms();
   j["render_ms"] = r.render_ms;
   if (tracer) j["texture_bytes"] = tracer->texture_bytes();
+  j["peak_rss_bytes"] = peak_rss_bytes();
   if (cpu)
     j["cpu"] = {{"rays", cpu_stats.rays},
                 {"voxel_steps", cpu_stats.voxel_steps},

@@ -10,7 +10,7 @@
 namespace host {
 
 vgpu::Texture entry_texture(vgpu::Device& gpu, const std::string& name, size_t count, int channels,
-                            const std::string& what) {
+                            const std::string& what, bool xy) {
   const int maxs = gpu.profile().max_texture_size;
   // About square: the width is the smallest power of two whose square holds the entries, so a
   // GL driver whose textures stop at 16384 texels (llvmpipe) takes what one long row of 32768
@@ -20,12 +20,25 @@ vgpu::Texture entry_texture(vgpu::Device& gpu, const std::string& name, size_t c
   while (side * side < std::max<size_t>(count, 1)) side *= 2;
   const int w = int(std::min<size_t>(side, size_t(maxs)));
   const size_t h = (std::max<size_t>(count, 1) + size_t(w) - 1) / size_t(w);
-  if (h > size_t(maxs))
-    throw vgpu::LimitError(what + ": " + std::to_string(count) + " entries; profile " +
-                           gpu.profile().name + " holds at most " +
-                           std::to_string(size_t(maxs) * size_t(maxs)) + " in one " +
-                           std::to_string(maxs) + "x" + std::to_string(maxs) + " texture");
-  if (count >= (size_t(1) << 24))
+  if (h > size_t(maxs)) {
+    // A profile whose largest texture holds them (the smallest such), for the advice.
+    std::string fits;
+    int fits_size = 0;
+    for (const vgpu::Profile& p : vgpu::profiles())
+      if (size_t(p.max_texture_size) * size_t(p.max_texture_size) >= count &&
+          (fits.empty() || p.max_texture_size < fits_size)) {
+        fits = p.name;
+        fits_size = p.max_texture_size;
+      }
+    throw vgpu::LimitError(
+        what + ": " + std::to_string(count) + " entries; profile " + gpu.profile().name +
+        " holds at most " + std::to_string(size_t(maxs) * size_t(maxs)) + " in one " +
+        std::to_string(maxs) + "x" + std::to_string(maxs) + " texture" +
+        (fits.empty() ? std::string(", and no profile holds more")
+                      : " (--profile " + fits + "'s " + std::to_string(fits_size) + "x" +
+                            std::to_string(fits_size) + " textures hold them)"));
+  }
+  if (!xy && count >= (size_t(1) << 24))
     throw vgpu::LimitError(what + ": " + std::to_string(count) +
                            " entries; indices are exact floats only below 2^24");
   return gpu.make_texture(name, w, int(h), channels);

@@ -52,11 +52,13 @@ struct WriteBack {
   int nmasks = 0;
 };
 
-// A static texture of `count` entries of `channels`, entry k at (k mod width, k div width), for a
-// structure's nodes or lists; throws vgpu::Error, "WHAT: N entries; ...", when the profile's
-// largest texture cannot hold them or an index would pass 2^24 (no longer an exact float).
+// A static texture of `count` entries of `channels`, entry k at (k mod width, k div width), its
+// width a power of two, for a structure's nodes or lists; throws vgpu::LimitError, "WHAT: N
+// entries; ...", naming a profile whose textures hold them, when the profile's largest texture
+// cannot, or (linear addresses, `xy` false) when an index would pass 2^24 (no longer an exact
+// float).
 vgpu::Texture entry_texture(vgpu::Device& gpu, const std::string& name, size_t count, int channels,
-                            const std::string& what);
+                            const std::string& what, bool xy = false);
 
 class PassRunner {
  public:

@@ -118,6 +118,16 @@ struct RenderOptions {
   // (validate says so); every engine.
   bool beams = false;
   int beam_tile = 8;
+  // How the kd-tree and the two-level grid address their textures (kernels/lists.h, Addr):
+  // linear, one float per pointer (entry k at k mod width, k div width), exact only to 2^23
+  // entries in fp32 and 2^10 in fp16; or by (x, y), a texel's column and row in two channels, as
+  // a card addresses a texture, to its largest texture. Automatic: linear where every index stays
+  // within what fp32 addresses exactly (and within linear_address_limit, where set: tests lower
+  // it so that a small structure crosses it), else (x, y). A narrower format that cannot hold a
+  // linear index is refused, naming the one that can.
+  enum class Addressing { automatic, linear, xy };
+  Addressing addressing = Addressing::automatic;
+  uint64_t linear_address_limit = 0;  // 0: the formats' own
   // Supersampling (host/trace/sampling.h): rays per pixel, a square from 1 to 256, on a
   // stratified, jittered grid drawn from sample_seed; the box filter resolves them. 1: one ray
   // through each pixel's centre, the paper's image.

@@ -244,6 +244,7 @@ def render(
     compact: Union[str, bool, None] = ...,
     beams: Union[str, bool, None] = ...,
     beam_tile: Optional[int] = ...,
+    addressing: Optional[str] = ...,
     shader: Optional[UserKernel] = ...,
     camera: Optional[UserKernel] = ...,
 ) -> Frame: ...

@@ -51,8 +51,10 @@ struct Sampling {
 };
 
 Frame render(host::AccelKind kind, const std::string& scene_name, const std::string& device,
-             int size, Variant v, const std::string& profile = "gf6600", Sampling sampling = {}) {
+             int size, Variant v, const std::string& profile = "gf6600", Sampling sampling = {},
+             bool xy = false) {
   host::RenderOptions opt;
+  if (xy) opt.addressing = host::RenderOptions::Addressing::xy;
   opt.width = opt.height = size;
   opt.spp = sampling.spp;
   opt.adaptive = sampling.adaptive;
@@ -110,6 +112,31 @@ TEST_CASE_TEMPLATE("frames on the GL device give the vgpu's queries, hit ids, de
                                                                    : "intersections");
     gltest::check_same_frame(gf.device, depth_kernel, a.hit_id, b.hit_id, a.depth, b.depth, a.rgb,
                              b.rgb);
+  }
+}
+
+TEST_CASE_TEMPLATE(
+    "frames addressed by (x, y) on the GL device give the vgpu's queries, hit ids, depths and "
+    "image",
+    T, Grid2, KdTree) {
+  // --addressing xy (docs/studies/scale.md): the kernels' second address channel, the carry into
+  // the row and the list starts read again from the leaf's or sub-cell's texel, as GLSL.
+  for (const Variant v : {Variant::multipass, Variant::looping}) {
+    CAPTURE(int(v));
+    const Frame vf = render(T::kind, "bunny-low", "vgpu", 32, v, "gf6600", {}, true);
+    const Frame gf = render(T::kind, "bunny-low", "gl", 32, v, "gf6600", {}, true);
+    const host::RenderResult &a = vf.result, &b = gf.result;
+    REQUIRE(a.stats.passes.size() == b.stats.passes.size());
+    for (size_t i = 0; i < a.stats.passes.size(); ++i) {
+      CAPTURE(i);
+      REQUIRE(a.stats.passes[i].program == b.stats.passes[i].program);
+      CHECK(a.stats.passes[i].query_result == b.stats.passes[i].query_result);
+    }
+    CHECK(a.rays_unfinished == 0);
+    const std::string prefix = std::string(T::prefix) + " ";
+    gltest::check_same_frame(
+        gf.device, prefix + (v == Variant::looping ? "looping traversal" : "intersections"),
+        a.hit_id, b.hit_id, a.depth, b.depth, a.rgb, b.rgb);
   }
 }
 

@@ -660,3 +660,112 @@ TEST_CASE(
   CHECK_TEXEL(l[1], 3, 0, glm::vec4(1, 3, 0, 2));
   check_same(l[2], isect, r.n);
 }
+
+// --- Addressed by (x, y) (KdUniforms::xy) ---------------------------------------------------
+// The same tree laid out 2 texels wide, as (x, y) needs (a power of two): node i at (i mod 2,
+// i div 2), its texel (split, axis, right child's column, row) or, for a leaf, (0, 3, its list
+// start's column, row); list entry k at (k mod 2, k div 2). Node 6, the left child of node 5 at
+// (1, 2), sits at the start of the next row: the left-child step carries into the row.
+namespace {
+
+const std::vector<glm::vec4> kNodesXy = {{2, 0, 0, 1}, {0, 3, 1, 0}, {2, 1, 0, 2}, {0, 3, 0, 0},
+                                         {0, 3, 1, 1}, {3, 2, 1, 3}, {0, 3, 0, 0}, {0, 3, 0, 0}};
+
+kernels::KdUniforms kd_uniforms_xy() {
+  kernels::KdUniforms u = kd_uniforms();
+  u.node_width = 2;
+  u.list_width = 2;
+  u.xy = 1;
+  return u;
+}
+
+struct TreeXy {
+  Texture nodes = texels("kd nodes", 2, 4, kNodesXy);
+  Texture lists = scalars("kd lists", 2, 3, {kNone, 0, kNone, 1, kNone, 0});
+};
+
+}  // namespace
+
+TEST_CASE("kd enter by (x, y) starts a ray at the root's column and row") {
+  const Rays r({{1, 1, 1}, {-1, 5, 1}}, {{1, 0, 0, 100}, {1, 0, 0, 100}});
+  kernels::KdEnter k;
+  k.kd = kd_uniforms_xy();
+  const Texture out = ktest::run(k, {&r.origins, &r.rays}, r.n, 1, glm::vec4(7));
+  CHECK_TEXEL(out, 0, 0, glm::vec4(0, 0, 0, 3));
+  CHECK_TEXEL(out, 1, 0, glm::vec4(kNone, 0, 0, 0));  // done: x -1 (y is never read)
+}
+
+TEST_CASE("kd step by (x, y) moves to children by column and row and flags a leaf reached") {
+  // The traversal state: (column, plus the width 2 once the leaf was reached; row; tmin; tmax).
+  const TreeXy t;
+  const Rays r({{0.5f, 1, 1},   // 0: root, +x, ts = 1.5: left child, node 1 at (1, 0)
+                {1, 1, 0.5f},   // 1: node 5 at (1, 2), +z, ts = 2.5: left child, node 6: (0, 3)
+                {1, 1, 3.5f},   // 2: node 5, -z, ts = 0.5: right child, node 7 at (1, 3)
+                {3, 2.5f, 1},   // 3: leaf 4 at (0, 2), not yet reached: flag it (x + 2)
+                {3, 2.5f, 1},   // 4: leaf 4 reached and tested, no hit, segment ends at 0.5
+                                //    before the box's exit 1.5: restart at the root (0, 0)
+                {3, 2.5f, 1},   // 5: the same, its segment reaching the exit: done
+                {3, 2.5f, 1}},  // 6: the same with a hit: done
+               {{1, 0, 0, 100},
+                {0, 0, 1, 100},
+                {0, 0, -1, 100},
+                {0, 1, 0, 100},
+                {0, 1, 0, 100},
+                {0, 1, 0, 100},
+                {0, 1, 0, 100}});
+  const Texture trav = texels("traversal", r.n, 1,
+                              {{0, 0, 0, 3.5f},
+                               {1, 2, 0, 3.5f},
+                               {1, 2, 0, 3.5f},
+                               {0, 2, 0, 1.5f},
+                               {2, 2, 0, 0.5f},
+                               {2, 2, 0, 1.5f},
+                               {2, 2, 0, 0.5f}});
+  std::vector<glm::vec4> hits(size_t(r.n), kNoHit);
+  hits[6] = {0.25f, 0.1f, 0.1f, 1};
+  const Texture isect = texels("intersection", r.n, 1, hits);
+  kernels::KdStep k;
+  k.kd = kd_uniforms_xy();
+  const Texture out = ktest::run(k, {&r.origins, &r.rays, &trav, &isect, &t.nodes}, r.n, 1);
+  CHECK_TEXEL(out, 0, 0, glm::vec4(1, 0, 0, 1.5f));
+  CHECK_TEXEL(out, 1, 0, glm::vec4(0, 3, 0, 2.5f));
+  CHECK_TEXEL(out, 2, 0, glm::vec4(1, 3, 0, 0.5f));
+  CHECK_TEXEL(out, 3, 0, glm::vec4(2, 2, 0, 1.5f));
+  CHECK_TEXEL(out, 4, 0, glm::vec4(0, 0, 0.5f, 1.5f));
+  CHECK_TEXEL(out, 5, 0, kDone);
+  CHECK_TEXEL(out, 6, 0, kDone);
+}
+
+TEST_CASE("kd load leaf by (x, y) reads the list start from the leaf's node texel") {
+  const TreeXy t;
+  // Rays at: leaf 4 reached (list at (1, 1): triangle 1), leaf 1 reached (list at (1, 0):
+  // triangle 0), node 0 not a reached leaf (kept), leaf 4 reached with a triangle still to
+  // test (kept), and a done ray (kept).
+  const Texture trav =
+      texels("traversal", 5, 1,
+             {{2, 2, 0, 4}, {3, 0, 0, 4}, {0, 0, 0, 4}, {2, 2, 0, 4}, {kNone, 0, 0, 0}});
+  const Texture vs = texels(
+      "leaf state", 5, 1,
+      {{0, 0, 0, kNone}, {0, 0, 0, kNone}, {0, 0, 0, kNone}, {1, 1, 0, 1}, {0, 0, 0, kNone}});
+  kernels::KdLoadLeaf k;
+  k.kd = kd_uniforms_xy();
+  const Texture out = ktest::run(k, {&trav, &vs, &t.lists, &t.nodes}, 5, 1);
+  CHECK_TEXEL(out, 0, 0, glm::vec4(1, 1, 0, 1));
+  CHECK_TEXEL(out, 1, 0, glm::vec4(1, 0, 0, 0));
+  CHECK_TEXEL(out, 2, 0, glm::vec4(0, 0, 0, kNone));
+  CHECK_TEXEL(out, 3, 0, glm::vec4(1, 1, 0, 1));
+  CHECK_TEXEL(out, 4, 0, glm::vec4(0, 0, 0, kNone));
+}
+
+TEST_CASE("next triangle by (x, y) carries a list position into the next row") {
+  const TreeXy t;
+  // At (1, 1) (entry 3) the next entry is (0, 2): the -1 closing the list; at (1, 0) (entry 1)
+  // it is (0, 1), also a -1; at (0, 2) with nothing to test the state is kept.
+  const Texture vs = texels("leaf state", 3, 1, {{1, 1, 0, 1}, {1, 0, 0, 0}, {0, 2, 0, kNone}});
+  kernels::NextTriangle k;
+  k.lists = kd_uniforms_xy();
+  const Texture out = ktest::run(k, {&vs, &t.lists}, 3, 1);
+  CHECK_TEXEL(out, 0, 0, glm::vec4(0, 2, 0, kNone));
+  CHECK_TEXEL(out, 1, 0, glm::vec4(0, 1, 0, kNone));
+  CHECK_TEXEL(out, 2, 0, glm::vec4(0, 2, 0, kNone));
+}

@@ -59,15 +59,15 @@ TEST_CASE("between frames only the static textures whose texels changed are uplo
   CHECK_FALSE(host::holds(b, 5));
 }
 
-TEST_CASE("past fp32's reach the refusal names the structures that address the scene") {
-  // No format addresses more than fp32's 2^23 - 1 exactly: the advice is another structure, and
-  // the refusal is a limit of the input (vgpu::LimitError: the command line exits 2).
+TEST_CASE("past fp32's linear reach the refusal advises addressing textures by (x, y)") {
+  // No format addresses more than fp32's 2^23 - 1 exactly by a linear index: the advice is (x,
+  // y) addressing (--addressing linear forces this check), and the refusal is a limit of the
+  // input (vgpu::LimitError: the command line exits 2).
   const host::Formats fm = host::Formats::all(vgpu::Format::fp32);
   CHECK(refusal(fm, {{8388608, host::Group::traversal, "node indices"}}).empty());
   CHECK(refusal(fm, {{8388609, host::Group::traversal, "node indices"}}) ==
         "toy: node indices reach 8388608; the traversal group's fp32 addresses texels exactly "
-        "only to 8388607 (no format addresses more; a structure whose indices stay below it "
-        "does: --accel grid or bvh)");
+        "only to 8388607 (address its textures by (x, y): --addressing auto or xy)");
   CHECK_THROWS_AS(host::check_addresses(fm, "toy", {{8388609, host::Group::voxel, "lists"}}),
                   vgpu::LimitError);
 }

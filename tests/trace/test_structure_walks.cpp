@@ -95,8 +95,9 @@ TYPE_TO_STRING_AS("bvh", Bvh);
 TYPE_TO_STRING_AS("kdtree", KdTree);
 TYPE_TO_STRING_AS("grid2", Grid2);
 
-TEST_CASE_TEMPLATE("the walk gives the grid walk's hit ids on every bundled scene, ties apart" * doctest::test_suite("sweep"), T,
-                   KdTree, Grid2) {
+TEST_CASE_TEMPLATE("the walk gives the grid walk's hit ids on every bundled scene, ties apart" *
+                       doctest::test_suite("sweep"),
+                   T, KdTree, Grid2) {
   const auto scenes = host::list_scenes();
   REQUIRE(scenes.size() >= 8);
   int ties = 0, crowded = 0;
@@ -153,8 +154,9 @@ TEST_CASE_TEMPLATE("the walk gives the grid walk's hit ids on every stability ca
 }
 
 TEST_CASE_TEMPLATE(
-    "the walk in batches gives the frame of pass by pass at 1 and 2 threads, masks on/off" * doctest::test_suite("sweep"), T,
-    KdTree, Grid2) {
+    "the walk in batches gives the frame of pass by pass at 1 and 2 threads, masks on/off" *
+        doctest::test_suite("sweep"),
+    T, KdTree, Grid2) {
   for (const char* name : {"bunny-refl", "classic"}) {
     const Structures s = test_support::bundled_structures(T::kind, name, 40, 36);
     for (int threads : {1, 2})
@@ -229,6 +231,61 @@ TEST_CASE_TEMPLATE("the looping walk gives the multipass hit ids and depths", T,
     CHECK(l.stats.find(T::looping) != nullptr);
     CHECK(l.stats.find(T::step) == nullptr);
   }
+}
+
+TEST_CASE_TEMPLATE(
+    "past a lowered linear limit the walk addresses by (x, y) and gives the linear frame's images "
+    "and passes",
+    T, KdTree, Grid2) {
+  // The boundary of automatic addressing on a small structure: with the limit just below its
+  // largest index the walk goes by (x, y), at it the walk stays linear; by (x, y) every variant
+  // (multipass, --mrt on, looping) renders the linear frame's image, depths and hit ids, and the
+  // multipass ones in the same passes (the same states, addressed otherwise).
+  const Structures s = test_support::bundled_structures(T::kind, "bunny-refl", 32, 32, "gf6600");
+  uint64_t largest = 0;  // the structure's largest linear index
+  if (T::kind == host::AccelKind::kdtree)
+    largest = std::max<uint64_t>(s.accel().kd()->nodes.size(), s.accel().kd()->lists.size()) - 1;
+  else
+    largest = std::max<uint64_t>({s.g2().sub_cells(), s.g2().lists.size()}) - 1;
+  for (const char* variant : {"multipass", "mrt", "looping"}) {
+    CAPTURE(std::string(variant));
+    host::RenderOptions opt = options(32, 32, "gf6600");
+    opt.bounces = 1;
+    opt.shadows = true;
+    opt.mrt = std::string(variant) == "mrt";
+    opt.looping = std::string(variant) == "looping";
+    opt.linear_address_limit = largest;
+    host::StreamTracer at_limit(s.scene, s.accel(), opt);
+    CHECK_FALSE(at_limit.addresses_by_xy());
+    const host::RenderResult linear = at_limit.render(s.camera);
+    opt.linear_address_limit = largest - 1;
+    host::StreamTracer past(s.scene, s.accel(), opt);
+    CHECK(past.addresses_by_xy());
+    const host::RenderResult xy = past.render(s.camera);
+    CHECK(xy.rays_unfinished == 0);
+    CHECK(same_bits(linear.rgb, xy.rgb));
+    CHECK(same_bits(linear.depth, xy.depth));
+    CHECK(same_bits(linear.hit_id, xy.hit_id));
+    CHECK(linear.rays_traced == xy.rays_traced);
+    if (!opt.looping) CHECK(linear.stats.totals.passes == xy.stats.totals.passes);
+    // Forced: --addressing xy on the same frame.
+    opt.linear_address_limit = 0;
+    opt.addressing = host::RenderOptions::Addressing::xy;
+    host::StreamTracer forced(s.scene, s.accel(), opt);
+    CHECK(forced.addresses_by_xy());
+    CHECK(same_bits(forced.render(s.camera).hit_id, linear.hit_id));
+  }
+}
+
+TEST_CASE_TEMPLATE("addressed by (x, y) the walk refuses beams over tiles in one line", T, KdTree,
+                   Grid2) {
+  const Structures s = test_support::bundled_structures(T::kind, "bunny", 16, 16, "gf6600");
+  host::RenderOptions opt = options(16, 16, "gf6600");
+  opt.beams = true;
+  opt.addressing = host::RenderOptions::Addressing::xy;
+  CHECK_THROWS_WITH_AS(host::StreamTracer(s.scene, s.accel(), opt),
+                       doctest::Contains("addressed by (x, y); beams over tiles"),
+                       vgpu::LimitError);
 }
 
 TEST_CASE_TEMPLATE("the CPU tracer's walk gives its grid walk's hit ids, ties apart", T, KdTree,

@@ -256,6 +256,10 @@ uint64_t StreamTracer::static_bytes() const {
   return b;
 }
 
+bool StreamTracer::addresses_by_xy() const {
+  return s_->walk->addresses_by_xy();
+}
+
 uint64_t StreamTracer::texture_bytes() const {
   uint64_t b = s_->walk->texture_bytes();
   for (const Texture* t : {&s_->v[0], &s_->v[1], &s_->v[2], &s_->n[0], &s_->n[1], &s_->n[2],

@@ -50,6 +50,8 @@ class StreamTracer {
   double init_ms() const { return init_ms_; }
   vgpu::Device& device() { return *gpu_; }
   uint64_t texture_bytes() const;  // static + dynamic textures, as the modeled card holds them
+  // Whether the structure's textures are addressed by (x, y) (RenderOptions::addressing).
+  bool addresses_by_xy() const;
 
  private:
   struct State;

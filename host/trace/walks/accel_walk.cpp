@@ -2,6 +2,8 @@
 // rewrite between frames, the per-pixel state, and the looping variant's host loop.
 #include "host/trace/walks/accel_walk.h"
 
+#include <algorithm>
+
 namespace host {
 
 using vgpu::Format;
@@ -16,18 +18,18 @@ Format looping_arithmetic(const Formats& fm) {
 }
 
 void check_addresses(const Formats& fm, const std::string& structure,
-                     std::initializer_list<AddressUse> uses) {
+                     std::initializer_list<AddressUse> uses, bool xy) {
   // Checked at construction and for each frame's rebuilt structure.
   for (const AddressUse& u : uses)
     for (const Format f : {fm[u.group], fm.arithmetic(u.group)})
       if (u.count - 1 > exact_addresses(f)) {
         const bool fp32_only = u.count - 1 > exact_addresses(Format::fp24);
-        // Past fp32's reach no format helps: the index is linear (entry k at k mod width, k div
-        // width) and outgrows the float, whatever the card's texture size.
+        // Past fp32's reach no format holds a linear index (entry k at k mod width, k div
+        // width), whatever the card's texture size; a texel's column and row it does.
         const std::string advice =
             f == Format::fp32
-                ? "no format addresses more; a structure whose indices stay below it does: "
-                  "--accel grid or bvh"
+                ? (xy ? std::string("no format addresses more")
+                      : std::string("address its textures by (x, y): --addressing auto or xy"))
                 : std::string("give it ") + (fp32_only ? "fp32" : "fp24 or fp32") + ": --formats " +
                       std::string(group_name(u.group)) + "=fp32";
         throw vgpu::LimitError(structure + ": " + u.kind + " reach " + std::to_string(u.count - 1) +
@@ -36,6 +38,18 @@ void check_addresses(const Formats& fm, const std::string& structure,
                                " addresses texels exactly only to " +
                                std::to_string(exact_addresses(f)) + " (" + advice + ")");
       }
+}
+
+bool addresses_by_xy(const RenderOptions& opt, std::initializer_list<AddressUse> uses) {
+  using A = RenderOptions::Addressing;
+  if (opt.addressing != A::automatic) return opt.addressing == A::xy;
+  // Past fp32's linear reach (a narrower format is a choice of format: check_addresses refuses
+  // it, naming the one that holds the index).
+  uint64_t limit = exact_addresses(Format::fp32);
+  if (opt.linear_address_limit) limit = std::min(limit, opt.linear_address_limit);
+  for (const AddressUse& u : uses)
+    if (u.count - 1 > limit) return true;
+  return false;
 }
 
 bool holds(const Texture& t, size_t count) {

@@ -45,7 +45,9 @@ class AccelWalk {
   // are set. Returns the bytes uploaded. Throws vgpu::Error past the profile's limits.
   virtual uint64_t rebuild(vgpu::Device& gpu, const Accel& accel, float scene_width,
                            std::vector<std::string>& uploaded) = 0;
-  virtual uint64_t static_bytes() const = 0;   // the structure's textures, as upload() sends
+  virtual uint64_t static_bytes() const = 0;  // the structure's textures, as upload() sends
+  // Whether its pointers are (x, y) texel coordinates (RenderOptions::addressing).
+  virtual bool addresses_by_xy() const { return false; }
   virtual uint64_t texture_bytes() const = 0;  // those and the per-pixel state
   // One stream of rays: enter the structure, then walk it until no ray is walking. Leaves the
   // nearest hits in the current intersection texture.
@@ -71,9 +73,15 @@ struct AddressUse {
 };
 // Refuses a format that cannot hold the addresses (a walk would stall at an index that no
 // longer counts up, as the grid's does past its cap): throws vgpu::Error "STRUCTURE: KIND
-// reach N; ...". The advice names fp32 alone where fp24 cannot hold them either.
+// reach N; ...". The advice names fp32 alone where fp24 cannot hold them either, and (x, y)
+// addressing where no format holds a linear index (`xy`: the uses are (x, y) coordinates).
 void check_addresses(const Formats& formats, const std::string& structure,
-                     std::initializer_list<AddressUse> uses);
+                     std::initializer_list<AddressUse> uses, bool xy = false);
+
+// Whether a structure addresses its textures by (x, y) (RenderOptions::addressing): as forced,
+// or, automatic, where one of its linear indices `uses` passes what fp32 addresses exactly
+// (2^23 - 1) or RenderOptions::linear_address_limit, where lower.
+bool addresses_by_xy(const RenderOptions& options, std::initializer_list<AddressUse> uses);
 
 // Whether a static texture holds `count` entries (between frames it is kept where it does).
 bool holds(const vgpu::Texture& t, size_t count);
@@ -191,6 +199,9 @@ class ListWalk : public AccelWalk {
 
   const RenderOptions& opt_;
   std::vector<const vgpu::Texture*> statics_;
+  // Addressed by (x, y) (kernels/lists.h, Addr): the texture step_and_load's load pass reads
+  // the list start from (the traversal state has no channel left for it); null: linear.
+  const vgpu::Texture* load_reads_ = nullptr;
   WalkShared sh_{};
   // Per-pixel state (ping-pong pairs): traversal and list state.
   PingPong<vgpu::Texture> trav_, vs_;
@@ -276,8 +287,12 @@ void ListWalk::step_and_load(X& x, Cursor& c, const Key& key, int step, const St
   else
     x.pass(key_s, step_p, {&origins, &rays, trav, hits, &nodes}, {&c.trav.next()}, grid_mask);
   c.trav.swap();
-  x.pass(key(step, -1, site.load), load, {&c.trav.current(), &c.vs.current(), &lists},
-         {&c.vs.next()}, grid_mask);
+  if (load_reads_)  // addressed by (x, y): the load reads the list start from this texture
+    x.pass(key(step, -1, site.load), load,
+           {&c.trav.current(), &c.vs.current(), &lists, load_reads_}, {&c.vs.next()}, grid_mask);
+  else
+    x.pass(key(step, -1, site.load), load, {&c.trav.current(), &c.vs.current(), &lists},
+           {&c.vs.next()}, grid_mask);
   c.vs.swap();
 }
 

@@ -30,12 +30,30 @@ Grid2Walk::Grid2Walk(vgpu::Device& gpu, const Grid2& g2, const RenderOptions& op
 
 uint64_t Grid2Walk::set_grid(vgpu::Device& gpu, const Grid2& g2, float scene_width, float t_slack,
                              std::vector<std::string>* uploaded) {
-  // Cell and sub-cell indices and list positions are texel addresses (as the kd-tree's are).
-  check_addresses(opt_.formats, "two-level grid",
-                  {{g2.sub_cells(), Group::traversal, "sub-cell indices"},
-                   {g2.cells(), Group::traversal, "coarse cell indices"},
-                   {g2.lists.size(), Group::traversal, "list positions"},
-                   {g2.lists.size(), Group::voxel, "list positions"}});
+  // Cell and sub-cell indices and list positions are texel addresses (as the kd-tree's are):
+  // linear, or the sub-cells' and lists' by (x, y) where a linear index would pass what its
+  // group's format holds exactly. Coarse cells stay linear (a sub-cell's texel names its cell).
+  const std::initializer_list<AddressUse> linear{
+      {g2.sub_cells(), Group::traversal, "sub-cell indices"},
+      {g2.cells(), Group::traversal, "coarse cell indices"},
+      {g2.lists.size(), Group::traversal, "list positions"},
+      {g2.lists.size(), Group::voxel, "list positions"}};
+  xy_ = host::addresses_by_xy(opt_, linear);
+  if (!xy_) check_addresses(opt_.formats, "two-level grid", linear);
+  if (xy_) {
+    check_addresses(opt_.formats, "two-level grid",
+                    {{g2.cells(), Group::traversal, "coarse cell indices"}});
+    if (beams_)
+      throw vgpu::LimitError("two-level grid: " + std::to_string(g2.sub_cells()) +
+                             " sub-cells and " + std::to_string(g2.lists.size()) +
+                             " list positions, addressed by (x, y); beams over tiles enter "
+                             "sub-cells by linear index (--beams off)");
+    for (const glm::ivec3& r : g2.sub_res)
+      if (r.x >= int(kGrid2ResPack) || r.y >= int(kGrid2ResPack))
+        throw vgpu::LimitError("two-level grid: a sub-grid of " + std::to_string(r.x) + "x" +
+                               std::to_string(r.y) + " cells; (x, y) addressing packs at most " +
+                               std::to_string(int(kGrid2ResPack) - 1) + " per axis");
+  }
   max_list_ = g2.max_list;
   // A ray crosses at most res.x + res.y + res.z coarse cells, and in each at most the sum of
   // its sub-grid's resolutions.
@@ -46,25 +64,53 @@ uint64_t Grid2Walk::set_grid(vgpu::Device& gpu, const Grid2& g2, float scene_wid
   const bool fresh = uploaded == nullptr;
   // Coarse cell c: (sub-grid resolution x, y, z, first sub-cell); sub-cell k: (list start,
   // coarse cell); lists: triangle ids closed by -1.
+  // By (x, y) a sub-cell's texel holds its list start's column and row, then its coarse cell.
+  const int sub_channels = xy_ ? 3 : 2;
   if (fresh || !holds(cells_, g2.cells()))
     cells_ = entry_texture(gpu, "grid2 cells", g2.cells(), 4, "two-level grid coarse cells");
-  if (fresh || !holds(subs_, g2.sub_cells()))
-    subs_ = entry_texture(gpu, "grid2 sub-cells", g2.sub_cells(), 2, "two-level grid sub-cells");
+  if (fresh || !holds(subs_, g2.sub_cells()) || subs_.channels() != sub_channels)
+    subs_ = entry_texture(gpu, "grid2 sub-cells", g2.sub_cells(), sub_channels,
+                          "two-level grid sub-cells", xy_);
   if (fresh || !holds(lists_, g2.lists.size()))
-    lists_ = entry_texture(gpu, "grid2 lists", g2.lists.size(), 1, "two-level grid lists");
+    lists_ = entry_texture(gpu, "grid2 lists", g2.lists.size(), 1, "two-level grid lists", xy_);
+  const int sw = subs_.width(), lw = lists_.width();
+  // By (x, y) the traversal state holds a sub-cell's column and row, the cell state a list
+  // position's.
+  if (xy_)
+    check_addresses(opt_.formats, "two-level grid",
+                    {{uint64_t(sw), Group::traversal, "sub-cell columns"},
+                     {uint64_t(subs_.height()), Group::traversal, "sub-cell rows"},
+                     {uint64_t(lw), Group::voxel, "list columns"},
+                     {uint64_t(lists_.height()), Group::voxel, "list rows"}},
+                    true);
+  load_reads_ = xy_ ? &subs_ : nullptr;
   std::vector<float> cells(cells_.data().begin(), cells_.data().end());
   std::vector<float> subs(subs_.data().begin(), subs_.data().end());
   std::vector<float> entries(lists_.data().begin(), lists_.data().end());
   for (size_t c = 0; c < g2.cells(); ++c) {
     float* t = cells.data() + 4 * c;
-    t[0] = float(g2.sub_res[c].x);
-    t[1] = float(g2.sub_res[c].y);
-    t[2] = float(g2.sub_res[c].z);
-    t[3] = float(g2.first[c]);
+    if (xy_) {
+      t[0] = float(g2.sub_res[c].x) + kGrid2ResPack * float(g2.sub_res[c].y);
+      t[1] = float(g2.sub_res[c].z);
+      t[2] = float(g2.first[c] % uint32_t(sw));
+      t[3] = float(g2.first[c] / uint32_t(sw));
+    } else {
+      t[0] = float(g2.sub_res[c].x);
+      t[1] = float(g2.sub_res[c].y);
+      t[2] = float(g2.sub_res[c].z);
+      t[3] = float(g2.first[c]);
+    }
   }
   for (size_t k = 0; k < g2.sub_cells(); ++k) {
-    subs[2 * k] = float(g2.list_start[k]);
-    subs[2 * k + 1] = float(g2.cell_of[k]);
+    float* t = subs.data() + size_t(sub_channels) * k;
+    if (xy_) {
+      t[0] = float(g2.list_start[k] % lw);
+      t[1] = float(g2.list_start[k] / lw);
+      t[2] = float(g2.cell_of[k]);
+    } else {
+      t[0] = float(g2.list_start[k]);
+      t[1] = float(g2.cell_of[k]);
+    }
   }
   for (size_t k = 0; k < g2.lists.size(); ++k) entries[k] = float(g2.lists[k]);
   const uint64_t bytes =
@@ -78,6 +124,7 @@ uint64_t Grid2Walk::set_grid(vgpu::Device& gpu, const Grid2& g2, float scene_wid
   u.sub_width = float(subs_.width());
   u.list_width = float(lists_.width());
   u.t_slack = t_slack;
+  u.xy = xy_ ? 1.0f : 0.0f;
   const SceneUniforms su{scene_width};
   enter_.kernel.grid2 = u;
   step_.kernel.grid2 = u;
@@ -127,7 +174,10 @@ void Grid2Walk::trace(PassRunner& r, Texture& origins, Texture& rays, bool prima
   trav_.swap();
   if (opt_.looping) {
     const uint64_t walking = count_entered(r);
-    r.pass(load_, {&trav_.current(), &vs_.current(), &lists_}, vs_.next(), sh_.grid_mask);
+    if (xy_)  // by (x, y) the list start is read from the sub-cell's texel
+      r.pass(load_, {&trav_.current(), &vs_.current(), &lists_, &subs_}, vs_.next(), sh_.grid_mask);
+    else
+      r.pass(load_, {&trav_.current(), &vs_.current(), &lists_}, vs_.next(), sh_.grid_mask);
     vs_.swap();
     // Per sub-cell visited: one step and its triangles.
     walk_looping(r, looping_, origins, rays, {&cells_, &subs_, &lists_},
@@ -147,8 +197,12 @@ void Grid2Walk::walk(X& x, Cursor& c) {
   auto walking = x.count(key(-1, -1, kEnter), walking_, c.trav.current(), nullptr, &grid_mask);
   x.traced(walking);
   if (!X::any(walking)) return;
-  x.pass(key(-1, -1, kLoadFirst), load_, {&c.trav.current(), &c.vs.current(), &lists_},
-         {&c.vs.next()}, &grid_mask);
+  if (xy_)  // by (x, y) the list start is read from the sub-cell's texel
+    x.pass(key(-1, -1, kLoadFirst), load_, {&c.trav.current(), &c.vs.current(), &lists_, &subs_},
+           {&c.vs.next()}, &grid_mask);
+  else
+    x.pass(key(-1, -1, kLoadFirst), load_, {&c.trav.current(), &c.vs.current(), &lists_},
+           {&c.vs.next()}, &grid_mask);
   c.vs.swap();
   for (int64_t step = 0;; ++step) {
     // The triangles of the sub-cell each walking ray stands in, one per pass.

@@ -44,6 +44,7 @@ class Grid2Walk : public ListWalk {
   Grid2Walk(vgpu::Device& gpu, const Grid2& g2, const RenderOptions& options, float scene_width,
             float t_slack);
   void make_state(vgpu::Device& gpu, const WalkShared& shared) override;
+  bool addresses_by_xy() const override { return xy_; }
   // The textures and the uniforms that depend on them; with `uploaded` (between frames,
   // AccelWalk::rebuild), the textures are kept where the new structure fits them and each one
   // whose texels changed is uploaded again and named there. Returns those bytes.
@@ -67,6 +68,7 @@ class Grid2Walk : public ListWalk {
 
  private:
   int max_list_ = 0;
+  bool xy_ = false;        // addressed by (x, y) (RenderOptions::addressing)
   int64_t max_steps_ = 0;  // sub-cells a ray can visit at most
   vgpu::Texture cells_, subs_, lists_;
   vgpu::KernelProgram<kernels::Grid2Enter> enter_;

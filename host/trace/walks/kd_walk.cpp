@@ -32,10 +32,18 @@ KdWalk::KdWalk(vgpu::Device& gpu, const KdTree& kd, const RenderOptions& options
 
 uint64_t KdWalk::set_tree(vgpu::Device& gpu, const KdTree& kd, float scene_width, float t_slack,
                           std::vector<std::string>* uploaded) {
-  // Node indices and list positions are texel addresses.
-  check_addresses(opt_.formats, "kd-tree",
-                  {{kd.nodes.size(), Group::traversal, "node indices"},
-                   {kd.lists.size(), Group::voxel, "list positions"}});
+  // Node indices and list positions are texel addresses: linear, or (x, y) where a linear index
+  // would pass what its group's format holds exactly.
+  const std::initializer_list<AddressUse> linear{
+      {kd.nodes.size(), Group::traversal, "node indices"},
+      {kd.lists.size(), Group::voxel, "list positions"}};
+  xy_ = host::addresses_by_xy(opt_, linear);
+  if (!xy_) check_addresses(opt_.formats, "kd-tree", linear);
+  if (xy_ && beams_)
+    throw vgpu::LimitError("kd-tree: " + std::to_string(kd.nodes.size()) + " nodes and " +
+                           std::to_string(kd.lists.size()) +
+                           " list positions, addressed by (x, y); beams over tiles address the "
+                           "tree's nodes linearly (--beams off)");
   nodes_ = int(kd.nodes.size());
   max_leaf_ = kd.max_leaf;
   depth_ = kd.depth;
@@ -45,10 +53,20 @@ uint64_t KdWalk::set_tree(vgpu::Device& gpu, const KdTree& kd, float scene_width
   const bool fresh = uploaded == nullptr;
   // Node i: (split, axis or 3 for a leaf, right child, leaf list start).
   if (fresh || !holds(tree_, kd.nodes.size()))
-    tree_ = entry_texture(gpu, "kd nodes", kd.nodes.size(), 4, "kd-tree nodes");
+    tree_ = entry_texture(gpu, "kd nodes", kd.nodes.size(), 4, "kd-tree nodes", xy_);
   if (fresh || !holds(lists_, kd.lists.size()))
-    lists_ = entry_texture(gpu, "kd lists", kd.lists.size(), 1, "kd-tree lists");
+    lists_ = entry_texture(gpu, "kd lists", kd.lists.size(), 1, "kd-tree lists", xy_);
   const int nw = tree_.width(), lw = lists_.width();
+  // By (x, y) the traversal state holds a node's column plus the width once its leaf is
+  // reached, and its row; the leaf state a list position's column and row.
+  if (xy_)
+    check_addresses(opt_.formats, "kd-tree",
+                    {{uint64_t(2 * nw), Group::traversal, "node columns (with the reached flag)"},
+                     {uint64_t(tree_.height()), Group::traversal, "node rows"},
+                     {uint64_t(lw), Group::voxel, "list columns"},
+                     {uint64_t(lists_.height()), Group::voxel, "list rows"}},
+                    true);
+  load_reads_ = xy_ ? &tree_ : nullptr;
   std::vector<float> nodes(tree_.data().begin(), tree_.data().end());
   std::vector<float> entries(lists_.data().begin(), lists_.data().end());
   for (size_t i = 0; i < kd.nodes.size(); ++i) {
@@ -56,8 +74,16 @@ uint64_t KdWalk::set_tree(vgpu::Device& gpu, const KdTree& kd, float scene_width
     float* t = nodes.data() + 4 * i;
     t[0] = n.split;
     t[1] = float(n.axis);
-    t[2] = float(n.right);
-    t[3] = n.axis == 3 ? float(n.leaf) : kNone;
+    if (xy_) {
+      // The right child's column and row, or the leaf's list start's.
+      const int32_t p = n.axis == 3 ? n.leaf : n.right;
+      const int w = n.axis == 3 ? lw : nw;
+      t[2] = float(p % w);
+      t[3] = float(p / w);
+    } else {
+      t[2] = float(n.right);
+      t[3] = n.axis == 3 ? float(n.leaf) : kNone;
+    }
   }
   for (size_t k = 0; k < kd.lists.size(); ++k) entries[k] = float(kd.lists[k]);
   uint64_t bytes = replace_texels(gpu, {{&tree_, &nodes}, {&lists_, &entries}}, uploaded);
@@ -81,6 +107,7 @@ uint64_t KdWalk::set_tree(vgpu::Device& gpu, const KdTree& kd, float scene_width
   u.node_width = float(nw);
   u.list_width = float(lw);
   u.t_slack = t_slack;
+  u.xy = xy_ ? 1.0f : 0.0f;
   const SceneUniforms su{scene_width};
   enter_.kernel.kd = u;
   step_.kernel.kd = u;

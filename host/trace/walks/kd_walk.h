@@ -55,6 +55,7 @@ class KdWalk : public ListWalk {
   void set_camera(const kernels::GenerateRays& camera, float offset_x, float offset_y) override {
     if (beams_) beams_->set_camera(camera, offset_x, offset_y);
   }
+  bool addresses_by_xy() const override { return xy_; }
   // Beams over tiles (RenderOptions::beams; null: off).
   const BvhBeams* beams() const { return beams_.get(); }
   uint64_t extra_bytes() const override { return beams_ ? beams_->state_bytes() : 0; }
@@ -65,6 +66,7 @@ class KdWalk : public ListWalk {
 
  private:
   int nodes_ = 0, max_leaf_ = 0, depth_ = 0, leaves_ = 0;
+  bool xy_ = false;  // addressed by (x, y) (RenderOptions::addressing)
   vgpu::Texture tree_, lists_;
   vgpu::KernelProgram<kernels::KdEnter> enter_;
   vgpu::KernelProgram<kernels::KdStep> step_;
