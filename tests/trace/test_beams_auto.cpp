@@ -113,6 +113,23 @@ TEST_CASE(
   check_off(*grid, dense, "stream", "--compact off");
 }
 
+TEST_CASE("beams auto is off, saying why, where a structure addressed by (x, y) refuses beams") {
+  // The kd-tree and the two-level grid by (x, y) (docs/studies/scale.md) refuse beams once
+  // built: auto takes that refusal for its answer instead of failing the frame.
+  const host::Scene scene = host::load_scene(host::resolve_scene("bunny-low"));
+  const host::Camera cam = host::scene_camera(scene);
+  host::RenderOptions opt = small(16, 16);
+  opt.addressing = host::RenderOptions::Addressing::xy;
+  for (const host::AccelKind kind : {host::AccelKind::kdtree, host::AccelKind::grid2}) {
+    const auto accel = built(scene, kind, opt);
+    const host::BeamsChoice c = host::choose_beams(scene, *accel, opt, cam, "stream");
+    CAPTURE(c.why);
+    CHECK_FALSE(c.on);
+    CHECK(c.why.rfind("off: ", 0) == 0);
+    CHECK(c.why.find("addressed by (x, y); beams over tiles") != std::string::npos);
+  }
+}
+
 TEST_CASE("the tile map holds each tile where the image has it, missed tiles without a hit") {
   // 48x32 in 8x8 tiles: 6 tiles across and 4 down, so a map read across its rows fails.
   const host::Scene scene = host::load_scene(host::resolve_scene("bunny-low"));

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <optional>
 
 #include "host/model/cost_model.h"
 #include "host/trace/stream/stream_tracer.h"
@@ -169,8 +170,20 @@ BeamsChoice choose_beams(const Scene& scene, const Accel& accel, const RenderOpt
   c.probe_height = probe.height;
   for (const bool on : {false, true}) {
     probe.beams = on;
-    StreamTracer tracer(scene, accel, probe);
-    const RenderResult r = tracer.render(camera);
+    std::optional<StreamTracer> tracer;
+    try {
+      tracer.emplace(scene, accel, probe);
+    } catch (const vgpu::LimitError& e) {
+      // A refusal the structure makes once built (beams need linear addresses: its indices
+      // outgrew them, docs/studies/scale.md): off, saying why.
+      if (!on) throw;
+      c.on = false;
+      c.why = std::string("off: ") + e.what();
+      c.probe_ms =
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+      return c;
+    }
+    const RenderResult r = tracer->render(camera);
     const CostBreakdown b = predict(r.stats, profile);
     (on ? c.on_ms : c.off_ms) = b.total_ms;
     c.probe_model_ms += b.total_ms;
