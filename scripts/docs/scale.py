@@ -165,7 +165,7 @@ def chart(points, devices, many, png):
     import matplotlib.pyplot as plt
     fig, axes = plt.subplots(2, 4, figsize=(17, 8.5), sharey="row")
     for row, (axis, xlabel) in enumerate((("tris", "triangles (heightfields, 256x256)"),
-                                          ("pixels", "pixels (the bunny, 69k triangles)"))):
+                                          ("pixels", "pixels (the bunny, 3,674 triangles)"))):
         for col, accel in enumerate(ACCELS):
             ax = axes[row][col]
             for src, label, colour in SOURCES:
@@ -201,8 +201,8 @@ def chart(points, devices, many, png):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--runs", nargs="+",
-                    default=sorted(glob.glob(os.path.join(ROOT, "results", "scale", "*.csv"))),
-                    help="CSV files packed from runs (default: results/scale/*.csv), or a "
+                    default=sorted(glob.glob(os.path.join(ROOT, "results", "scale", "h100_*.csv"))),
+                    help="CSV files packed from runs (default: results/scale/h100_*.csv, the GPU host's), or a "
                          "folder of scale.sh's runs (OUT, holding json/)")
     ap.add_argument("--pack", help="write the runs' rows to this CSV and stop")
     ap.add_argument("--png", default=os.path.join(ROOT, "docs", "studies", "scale.png"))
