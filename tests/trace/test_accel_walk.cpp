@@ -59,6 +59,40 @@ TEST_CASE("between frames only the static textures whose texels changed are uplo
   CHECK_FALSE(host::holds(b, 5));
 }
 
+TEST_CASE(
+    "a texture just made takes its structure's texels in place; a kept one through a copy that "
+    "uploads it again only where a texel changed") {
+  vgpu::Gpu gpu(vgpu::profile("gf6600"), 1);
+  vgpu::Texture t = gpu.make_texture("t", 4, 1, 1);
+  {
+    // Made: the writer's texels are the texture's own (no copy beside them), kept as written.
+    host::StaticTexels w(t, true);
+    CHECK(w.span().data() == t.texel(0, 0));
+    for (size_t i = 0; i < 4; ++i) w[i] = float(i + 1);
+    std::vector<std::string> uploaded;
+    CHECK(host::replace_texels(gpu, {&w}, &uploaded) == t.bytes());  // a new texture: uploaded
+    CHECK(uploaded == std::vector<std::string>{"t"});
+  }
+  CHECK(t.get(3, 0) == 4.0f);
+  {
+    // Kept between frames: a copy, compared; the same texels upload nothing.
+    host::StaticTexels w(t, false);
+    CHECK(w.span().data() != t.texel(0, 0));
+    CHECK(w[2] == 3.0f);
+    std::vector<std::string> uploaded;
+    CHECK(host::replace_texels(gpu, {&w}, &uploaded) == 0);
+    CHECK(uploaded.empty());
+  }
+  {
+    host::StaticTexels w(t, false);
+    w[0] = 9.0f;
+    CHECK(t.get(0, 0) == 1.0f);  // not written until kept
+    std::vector<std::string> uploaded;
+    CHECK(host::replace_texels(gpu, {&w}, &uploaded) == t.bytes());
+    CHECK(t.get(0, 0) == 9.0f);
+  }
+}
+
 TEST_CASE("past fp32's linear reach the refusal advises addressing textures by (x, y)") {
   // No format addresses more than fp32's 2^23 - 1 exactly by a linear index: the advice is (x,
   // y) addressing (--addressing linear forces this check), and the refusal is a limit of the

@@ -52,6 +52,32 @@ bool addresses_by_xy(const RenderOptions& opt, std::initializer_list<AddressUse>
   return false;
 }
 
+StaticTexels::StaticTexels(Texture& t, bool made)
+    : t_(&t), n_(t.data().size()), in_place_(made && t.format() == Format::fp32) {
+  if (in_place_) {
+    p_ = n_ ? t.texel_mut(0, 0) : nullptr;
+  } else {
+    copy_.assign(t.data().begin(), t.data().end());
+    p_ = copy_.data();
+  }
+}
+
+bool StaticTexels::keep() {
+  return in_place_ ? true : t_->replace(copy_);
+}
+
+uint64_t replace_texels(vgpu::Device& gpu, std::initializer_list<StaticTexels*> textures,
+                        std::vector<std::string>* uploaded) {
+  uint64_t bytes = 0;
+  for (StaticTexels* s : textures)
+    if (s->keep() && uploaded) {
+      gpu.upload(s->texture());
+      bytes += s->texture().bytes();
+      uploaded->push_back(s->texture().name());
+    }
+  return bytes;
+}
+
 bool holds(const Texture& t, size_t count) {
   return uint64_t(t.width()) * uint64_t(t.height()) >= count;
 }

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <glm/glm.hpp>
 #include <initializer_list>
+#include <span>
 #include <string>
 #include <utility>
 #include <vector>
@@ -86,8 +87,33 @@ bool addresses_by_xy(const RenderOptions& options, std::initializer_list<Address
 // Whether a static texture holds `count` entries (between frames it is kept where it does).
 bool holds(const vgpu::Texture& t, size_t count);
 
+// A static texture's texels as a walk writes them (a structure's nodes, cells, lists): into the
+// texture itself where it was just `made` (its untouched zeros: nothing to compare, and no copy
+// of the whole texture beside it, which held a large structure's textures twice while they
+// were written), else into a copy that replace_texels compares with the texture (between
+// frames, only a texture whose texels changed is uploaded again). Static textures are fp32:
+// nothing to round in place.
+class StaticTexels {
+ public:
+  StaticTexels(vgpu::Texture& t, bool made);
+  std::span<float> span() { return {p_, n_}; }
+  float& operator[](size_t i) { return p_[i]; }
+  vgpu::Texture& texture() { return *t_; }
+  // Whether the texture now holds other texels than before (one just made: yes).
+  bool keep();
+
+ private:
+  vgpu::Texture* t_;
+  std::vector<float> copy_;
+  float* p_ = nullptr;
+  size_t n_ = 0;
+  bool in_place_ = false;
+};
+
 // Static textures get their new texels; with `uploaded` (between frames), each one whose texels
 // changed is uploaded again and named there. Returns the bytes uploaded.
+uint64_t replace_texels(vgpu::Device& gpu, std::initializer_list<StaticTexels*> textures,
+                        std::vector<std::string>* uploaded);
 uint64_t replace_texels(
     vgpu::Device& gpu,
     std::initializer_list<std::pair<vgpu::Texture*, const std::vector<float>*>> textures,

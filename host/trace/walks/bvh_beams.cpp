@@ -98,7 +98,7 @@ Bvh kd_beam_nodes(const KdTree& kd) {
   return b;
 }
 
-void bvh_node_texels(const Bvh& bvh, std::vector<float>& lo, std::vector<float>& hi) {
+void bvh_node_texels(const Bvh& bvh, std::span<float> lo, std::span<float> hi) {
   for (size_t i = 0; i < bvh.nodes.size(); ++i) {
     const BvhNode& n = bvh.nodes[i];
     for (int a = 0; a < 3; ++a) lo[4 * i + size_t(a)] = n.lo[a], hi[4 * i + size_t(a)] = n.hi[a];

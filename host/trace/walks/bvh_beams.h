@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "host/accel/bvh.h"
@@ -34,7 +35,7 @@ Bvh kd_beam_nodes(const KdTree& kd);
 // The BVH walk's node texels (kernels/bvh.h): node i's lo texel holds its box's low corner and
 // its escape, its hi texel the high corner and its leaf's list (-1 for an inner node or an empty
 // leaf), written at 4 i onward of `lo` and `hi` (each at least 4 floats per node).
-void bvh_node_texels(const Bvh& bvh, std::vector<float>& lo, std::vector<float>& hi);
+void bvh_node_texels(const Bvh& bvh, std::span<float> lo, std::span<float> hi);
 
 class BvhBeams {
  public:

@@ -32,20 +32,18 @@ uint64_t BvhWalk::set_bvh(vgpu::Device& gpu, const Bvh& bvh, float scene_width,
   // Between frames the textures are kept where the new hierarchy fits them (entries past its
   // nodes and lists are never reached: escapes end the walk, lists are closed by -1).
   const bool fresh = uploaded == nullptr;
-  if (fresh || !holds(nodes_lo_, bvh.nodes.size())) {
+  const bool made_nodes = fresh || !holds(nodes_lo_, bvh.nodes.size());
+  if (made_nodes) {
     nodes_lo_ = entry_texture(gpu, "bvh nodes lo", bvh.nodes.size(), 4, "bvh nodes");
     nodes_hi_ = entry_texture(gpu, "bvh nodes hi", bvh.nodes.size(), 4, "bvh nodes");
   }
-  if (fresh || !holds(lists_, bvh.lists.size()))
-    lists_ = entry_texture(gpu, "bvh lists", bvh.lists.size(), 1, "bvh lists");
+  const bool made_lists = fresh || !holds(lists_, bvh.lists.size());
+  if (made_lists) lists_ = entry_texture(gpu, "bvh lists", bvh.lists.size(), 1, "bvh lists");
   const int nw = nodes_lo_.width(), lw = lists_.width();
-  std::vector<float> lo(nodes_lo_.data().begin(), nodes_lo_.data().end());
-  std::vector<float> hi(nodes_hi_.data().begin(), nodes_hi_.data().end());
-  std::vector<float> entries(lists_.data().begin(), lists_.data().end());
-  bvh_node_texels(bvh, lo, hi);
+  StaticTexels lo(nodes_lo_, made_nodes), hi(nodes_hi_, made_nodes), entries(lists_, made_lists);
+  bvh_node_texels(bvh, lo.span(), hi.span());
   for (size_t k = 0; k < bvh.lists.size(); ++k) entries[k] = float(bvh.lists[k]);
-  const uint64_t bytes =
-      replace_texels(gpu, {{&nodes_lo_, &lo}, {&nodes_hi_, &hi}, {&lists_, &entries}}, uploaded);
+  const uint64_t bytes = replace_texels(gpu, {&lo, &hi, &entries}, uploaded);
 
   BvhUniforms u;
   u.node_width = float(nw);

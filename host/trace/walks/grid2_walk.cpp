@@ -66,12 +66,15 @@ uint64_t Grid2Walk::set_grid(vgpu::Device& gpu, const Grid2& g2, float scene_wid
   // coarse cell); lists: triangle ids closed by -1.
   // By (x, y) a sub-cell's texel holds its list start's column and row, then its coarse cell.
   const int sub_channels = xy_ ? 3 : 2;
-  if (fresh || !holds(cells_, g2.cells()))
+  const bool made_cells = fresh || !holds(cells_, g2.cells());
+  if (made_cells)
     cells_ = entry_texture(gpu, "grid2 cells", g2.cells(), 4, "two-level grid coarse cells");
-  if (fresh || !holds(subs_, g2.sub_cells()) || subs_.channels() != sub_channels)
+  const bool made_subs = fresh || !holds(subs_, g2.sub_cells()) || subs_.channels() != sub_channels;
+  if (made_subs)
     subs_ = entry_texture(gpu, "grid2 sub-cells", g2.sub_cells(), sub_channels,
                           "two-level grid sub-cells", xy_);
-  if (fresh || !holds(lists_, g2.lists.size()))
+  const bool made_lists = fresh || !holds(lists_, g2.lists.size());
+  if (made_lists)
     lists_ = entry_texture(gpu, "grid2 lists", g2.lists.size(), 1, "two-level grid lists", xy_);
   const int sw = subs_.width(), lw = lists_.width();
   // By (x, y) the traversal state holds a sub-cell's column and row, the cell state a list
@@ -84,11 +87,9 @@ uint64_t Grid2Walk::set_grid(vgpu::Device& gpu, const Grid2& g2, float scene_wid
                      {uint64_t(lists_.height()), Group::voxel, "list rows"}},
                     true);
   load_reads_ = xy_ ? &subs_ : nullptr;
-  std::vector<float> cells(cells_.data().begin(), cells_.data().end());
-  std::vector<float> subs(subs_.data().begin(), subs_.data().end());
-  std::vector<float> entries(lists_.data().begin(), lists_.data().end());
+  StaticTexels cells(cells_, made_cells), subs(subs_, made_subs), entries(lists_, made_lists);
   for (size_t c = 0; c < g2.cells(); ++c) {
-    float* t = cells.data() + 4 * c;
+    float* t = &cells[4 * c];
     if (xy_) {
       t[0] = float(g2.sub_res[c].x) + kGrid2ResPack * float(g2.sub_res[c].y);
       t[1] = float(g2.sub_res[c].z);
@@ -102,7 +103,7 @@ uint64_t Grid2Walk::set_grid(vgpu::Device& gpu, const Grid2& g2, float scene_wid
     }
   }
   for (size_t k = 0; k < g2.sub_cells(); ++k) {
-    float* t = subs.data() + size_t(sub_channels) * k;
+    float* t = &subs[size_t(sub_channels) * k];
     if (xy_) {
       t[0] = float(g2.list_start[k] % lw);
       t[1] = float(g2.list_start[k] / lw);
@@ -113,8 +114,7 @@ uint64_t Grid2Walk::set_grid(vgpu::Device& gpu, const Grid2& g2, float scene_wid
     }
   }
   for (size_t k = 0; k < g2.lists.size(); ++k) entries[k] = float(g2.lists[k]);
-  const uint64_t bytes =
-      replace_texels(gpu, {{&cells_, &cells}, {&subs_, &subs}, {&lists_, &entries}}, uploaded);
+  const uint64_t bytes = replace_texels(gpu, {&cells, &subs, &entries}, uploaded);
 
   Grid2Uniforms u;
   u.lo = g2.coarse.lo;

@@ -67,13 +67,13 @@ uint64_t GridWalk::set_grid(vgpu::Device& gpu, const Grid& grid, float scene_wid
   // Between frames the textures are kept where the new grid fits them (the lists' texels past
   // the last list are never read), so a moving scene's frames reuse the device's textures.
   const bool fresh = uploaded == nullptr;
-  if (fresh || uint64_t(lists_.width()) * uint64_t(lists_.height()) < list_len)
-    lists_ = gpu.make_texture("triangle lists", lw, int(lh), 1);
-  if (fresh || pointers_.width() != r.x * r.y || pointers_.height() != r.z)
-    pointers_ = gpu.make_texture("voxel pointers", r.x * r.y, r.z, 1);
+  const bool made_lists = fresh || uint64_t(lists_.width()) * uint64_t(lists_.height()) < list_len;
+  if (made_lists) lists_ = gpu.make_texture("triangle lists", lw, int(lh), 1);
+  const bool made_pointers = fresh || pointers_.width() != r.x * r.y || pointers_.height() != r.z;
+  if (made_pointers) pointers_ = gpu.make_texture("voxel pointers", r.x * r.y, r.z, 1);
   const int width = lists_.width();
-  std::vector<float> lists(lists_.data().begin(), lists_.data().end());
-  std::vector<float> pointers(pointers_.data().size(), 0.0f);
+  StaticTexels lists(lists_, made_lists), pointers(pointers_, made_pointers);
+  // (Every voxel's pointer is written below, 0 for an empty one.)
   size_t k = 0;
   auto put = [&](float value) { lists[k++] = value; };
   put(kNone);
@@ -89,8 +89,7 @@ uint64_t GridWalk::set_grid(vgpu::Device& gpu, const Grid& grid, float scene_wid
         }
         pointers[size_t(z) * size_t(r.x * r.y) + size_t(x * r.y + y)] = start;
       }
-  const uint64_t bytes =
-      replace_texels(gpu, {{&lists_, &lists}, {&pointers_, &pointers}}, uploaded);
+  const uint64_t bytes = replace_texels(gpu, {&lists, &pointers}, uploaded);
 
   // Uniforms that do not change during a frame.
   GridUniforms g;

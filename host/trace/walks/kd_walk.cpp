@@ -52,10 +52,10 @@ uint64_t KdWalk::set_tree(vgpu::Device& gpu, const KdTree& kd, float scene_width
   // and lists are never reached: children and list starts point inside, lists end with -1).
   const bool fresh = uploaded == nullptr;
   // Node i: (split, axis or 3 for a leaf, right child, leaf list start).
-  if (fresh || !holds(tree_, kd.nodes.size()))
-    tree_ = entry_texture(gpu, "kd nodes", kd.nodes.size(), 4, "kd-tree nodes", xy_);
-  if (fresh || !holds(lists_, kd.lists.size()))
-    lists_ = entry_texture(gpu, "kd lists", kd.lists.size(), 1, "kd-tree lists", xy_);
+  const bool made_tree = fresh || !holds(tree_, kd.nodes.size());
+  if (made_tree) tree_ = entry_texture(gpu, "kd nodes", kd.nodes.size(), 4, "kd-tree nodes", xy_);
+  const bool made_lists = fresh || !holds(lists_, kd.lists.size());
+  if (made_lists) lists_ = entry_texture(gpu, "kd lists", kd.lists.size(), 1, "kd-tree lists", xy_);
   const int nw = tree_.width(), lw = lists_.width();
   // By (x, y) the traversal state holds a node's column plus the width once its leaf is
   // reached, and its row; the leaf state a list position's column and row.
@@ -67,11 +67,10 @@ uint64_t KdWalk::set_tree(vgpu::Device& gpu, const KdTree& kd, float scene_width
                      {uint64_t(lists_.height()), Group::voxel, "list rows"}},
                     true);
   load_reads_ = xy_ ? &tree_ : nullptr;
-  std::vector<float> nodes(tree_.data().begin(), tree_.data().end());
-  std::vector<float> entries(lists_.data().begin(), lists_.data().end());
+  StaticTexels nodes(tree_, made_tree), entries(lists_, made_lists);
   for (size_t i = 0; i < kd.nodes.size(); ++i) {
     const KdNode& n = kd.nodes[i];
-    float* t = nodes.data() + 4 * i;
+    float* t = &nodes[4 * i];
     t[0] = n.split;
     t[1] = float(n.axis);
     if (xy_) {
@@ -86,19 +85,19 @@ uint64_t KdWalk::set_tree(vgpu::Device& gpu, const KdTree& kd, float scene_width
     }
   }
   for (size_t k = 0; k < kd.lists.size(); ++k) entries[k] = float(kd.lists[k]);
-  uint64_t bytes = replace_texels(gpu, {{&tree_, &nodes}, {&lists_, &entries}}, uploaded);
+  uint64_t bytes = replace_texels(gpu, {&nodes, &entries}, uploaded);
   Bvh boxes;
   if (beams_) {
     // The nodes' boxes for the beams' descent, laid out as the BVH walk lays out its nodes.
     boxes = kd_beam_nodes(kd);
-    if (fresh || !holds(boxes_lo_, kd.nodes.size())) {
+    const bool made = fresh || !holds(boxes_lo_, kd.nodes.size());
+    if (made) {
       boxes_lo_ = entry_texture(gpu, "kd boxes lo", kd.nodes.size(), 4, "kd-tree nodes");
       boxes_hi_ = entry_texture(gpu, "kd boxes hi", kd.nodes.size(), 4, "kd-tree nodes");
     }
-    std::vector<float> lo(boxes_lo_.data().begin(), boxes_lo_.data().end());
-    std::vector<float> hi(boxes_hi_.data().begin(), boxes_hi_.data().end());
-    bvh_node_texels(boxes, lo, hi);
-    bytes += replace_texels(gpu, {{&boxes_lo_, &lo}, {&boxes_hi_, &hi}}, uploaded);
+    StaticTexels lo(boxes_lo_, made), hi(boxes_hi_, made);
+    bvh_node_texels(boxes, lo.span(), hi.span());
+    bytes += replace_texels(gpu, {&lo, &hi}, uploaded);
   }
 
   KdUniforms u;
