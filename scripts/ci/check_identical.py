@@ -109,7 +109,8 @@ TRACES = [
     ("bunny-refl", S64 + ["--trace-pixel", "30,34", "--accel", "kdtree"] + LOOPING),
     ("classic", S64 + ["--trace-pixel", "20,40", "--spp", "4"] + MRT),
 ]
-DROPPED = ("threads", "lanes", "walk", "walk_passes_because", "scene_path", "version")
+DROPPED = ("threads", "lanes", "walk", "walk_passes_because", "scene_path", "version",
+           "peak_rss_bytes")
 
 
 def strip(j):

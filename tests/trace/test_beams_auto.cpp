@@ -125,6 +125,7 @@ TEST_CASE("beams auto is off, saying why, where a structure addressed by (x, y) 
     const host::BeamsChoice c = host::choose_beams(scene, *accel, opt, cam, "stream");
     CAPTURE(c.why);
     CHECK_FALSE(c.on);
+    CHECK_FALSE(c.probed);  // the refusal comes before any probe renders
     CHECK(c.why.rfind("off: ", 0) == 0);
     CHECK(c.why.find("addressed by (x, y); beams over tiles") != std::string::npos);
   }

@@ -555,4 +555,12 @@ TEST_CASE("a format that cannot address the two-level grid's sub-cells or lists 
                             std::to_string(s.g2().lists.size() - 1) + "; the voxel group's fp16";
   CHECK_THROWS_WITH_AS(host::StreamTracer(s.scene, s.accel(), opt),
                        doctest::Contains(lists.c_str()), vgpu::Error);
+  // By (x, y) the traversal group still carries a sub-cell's offset in its sub-grid and the
+  // packed sub-grid resolution (x + 1024 y): fp16 holds neither exactly.
+  opt.formats = host::Formats::all(vgpu::Format::fp32);
+  opt.formats.set(host::Group::traversal, vgpu::Format::fp16, vgpu::Format::fp16);
+  opt.addressing = host::RenderOptions::Addressing::xy;
+  CHECK_THROWS_WITH_AS(host::StreamTracer(s.scene, s.accel(), opt),
+                       doctest::Contains("; the traversal group's fp16 addresses texels exactly"),
+                       vgpu::LimitError);
 }

@@ -168,7 +168,7 @@ BeamsChoice choose_beams(const Scene& scene, const Accel& accel, const RenderOpt
   c.probed = true;
   c.probe_width = probe.width;
   c.probe_height = probe.height;
-  for (const bool on : {false, true}) {
+  for (const bool on : {true, false}) {  // on first: a structure refusing beams renders nothing
     probe.beams = on;
     std::optional<StreamTracer> tracer;
     try {
@@ -178,6 +178,7 @@ BeamsChoice choose_beams(const Scene& scene, const Accel& accel, const RenderOpt
       // outgrew them, docs/studies/scale.md): off, saying why.
       if (!on) throw;
       c.on = false;
+      c.probed = false;
       c.why = std::string("off: ") + e.what();
       c.probe_ms =
           std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();

@@ -18,7 +18,7 @@ Format looping_arithmetic(const Formats& fm) {
 }
 
 void check_addresses(const Formats& fm, const std::string& structure,
-                     std::initializer_list<AddressUse> uses, bool xy) {
+                     std::initializer_list<AddressUse> uses, std::string_view past_fp32) {
   // Checked at construction and for each frame's rebuilt structure.
   for (const AddressUse& u : uses)
     for (const Format f : {fm[u.group], fm.arithmetic(u.group)})
@@ -27,11 +27,9 @@ void check_addresses(const Formats& fm, const std::string& structure,
         // Past fp32's reach no format holds a linear index (entry k at k mod width, k div
         // width), whatever the card's texture size; a texel's column and row it does.
         const std::string advice =
-            f == Format::fp32
-                ? (xy ? std::string("no format addresses more")
-                      : std::string("address its textures by (x, y): --addressing auto or xy"))
-                : std::string("give it ") + (fp32_only ? "fp32" : "fp24 or fp32") + ": --formats " +
-                      std::string(group_name(u.group)) + "=fp32";
+            f == Format::fp32 ? std::string(past_fp32)
+                              : std::string("give it ") + (fp32_only ? "fp32" : "fp24 or fp32") +
+                                    ": --formats " + std::string(group_name(u.group)) + "=fp32";
         throw vgpu::LimitError(structure + ": " + u.kind + " reach " + std::to_string(u.count - 1) +
                                "; the " + std::string(group_name(u.group)) + " group's " +
                                std::string(vgpu::format_name(f)) +

@@ -10,6 +10,7 @@
 #include <initializer_list>
 #include <span>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -74,10 +75,14 @@ struct AddressUse {
 };
 // Refuses a format that cannot hold the addresses (a walk would stall at an index that no
 // longer counts up, as the grid's does past its cap): throws vgpu::Error "STRUCTURE: KIND
-// reach N; ...". The advice names fp32 alone where fp24 cannot hold them either, and (x, y)
-// addressing where no format holds a linear index (`xy`: the uses are (x, y) coordinates).
+// reach N; ...". The advice names fp32 alone where fp24 cannot hold them either, and
+// `past_fp32` where fp32 cannot (by default (x, y) addressing, for the kd-tree's and the
+// two-level grid's linear indices).
+inline constexpr std::string_view kAddressByXy =
+    "address its textures by (x, y): --addressing auto or xy";
 void check_addresses(const Formats& formats, const std::string& structure,
-                     std::initializer_list<AddressUse> uses, bool xy = false);
+                     std::initializer_list<AddressUse> uses,
+                     std::string_view past_fp32 = kAddressByXy);
 
 // Whether a structure addresses its textures by (x, y) (RenderOptions::addressing): as forced,
 // or, automatic, where one of its linear indices `uses` passes what fp32 addresses exactly

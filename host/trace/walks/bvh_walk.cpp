@@ -26,7 +26,9 @@ uint64_t BvhWalk::set_bvh(vgpu::Device& gpu, const Bvh& bvh, float scene_width,
   // Node indices and list positions are texel addresses.
   check_addresses(opt_.formats, "bvh",
                   {{bvh.nodes.size(), Group::traversal, "node indices"},
-                   {bvh.lists.size(), Group::voxel, "list positions"}});
+                   {bvh.lists.size(), Group::voxel, "list positions"}},
+                  "the BVH addresses linearly; the kd-tree and the two-level grid address by "
+                  "(x, y): --accel kdtree or grid2");
   nodes_ = int(bvh.nodes.size());
   max_leaf_ = bvh.max_leaf;
   // Between frames the textures are kept where the new hierarchy fits them (entries past its

@@ -79,13 +79,24 @@ uint64_t Grid2Walk::set_grid(vgpu::Device& gpu, const Grid2& g2, float scene_wid
   const int sw = subs_.width(), lw = lists_.width();
   // By (x, y) the traversal state holds a sub-cell's column and row, the cell state a list
   // position's.
+  // The step also carries list columns and rows (the fused and looping kernels), a sub-cell's
+  // offset in its sub-grid and the packed sub-grid resolution, in traversal arithmetic.
+  uint64_t packed = 1, offsets = 1;
+  for (const glm::ivec3& r : g2.sub_res) {
+    packed = std::max<uint64_t>(packed, uint64_t(r.x) + uint64_t(kGrid2ResPack) * uint64_t(r.y));
+    offsets = std::max<uint64_t>(offsets, uint64_t(r.x) * uint64_t(r.y) * uint64_t(r.z));
+  }
   if (xy_)
     check_addresses(opt_.formats, "two-level grid",
                     {{uint64_t(sw), Group::traversal, "sub-cell columns"},
                      {uint64_t(subs_.height()), Group::traversal, "sub-cell rows"},
                      {uint64_t(lw), Group::voxel, "list columns"},
-                     {uint64_t(lists_.height()), Group::voxel, "list rows"}},
-                    true);
+                     {uint64_t(lists_.height()), Group::voxel, "list rows"},
+                     {uint64_t(lw), Group::traversal, "list columns"},
+                     {uint64_t(lists_.height()), Group::traversal, "list rows"},
+                     {offsets, Group::traversal, "sub-cell offsets in a sub-grid"},
+                     {packed + 1, Group::traversal, "packed sub-grid resolutions"}},
+                    "no format addresses more");
   load_reads_ = xy_ ? &subs_ : nullptr;
   StaticTexels cells(cells_, made_cells), subs(subs_, made_subs), entries(lists_, made_lists);
   for (size_t c = 0; c < g2.cells(); ++c) {

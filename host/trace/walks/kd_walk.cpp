@@ -65,7 +65,7 @@ uint64_t KdWalk::set_tree(vgpu::Device& gpu, const KdTree& kd, float scene_width
                      {uint64_t(tree_.height()), Group::traversal, "node rows"},
                      {uint64_t(lw), Group::voxel, "list columns"},
                      {uint64_t(lists_.height()), Group::voxel, "list rows"}},
-                    true);
+                    "no format addresses more");
   load_reads_ = xy_ ? &tree_ : nullptr;
   StaticTexels nodes(tree_, made_tree), entries(lists_, made_lists);
   for (size_t i = 0; i < kd.nodes.size(); ++i) {
