@@ -8,6 +8,34 @@
 
 namespace vgpu {
 
+namespace {
+std::atomic<uint64_t> g_storage{0}, g_peak_storage{0};
+}  // namespace
+
+void Texture::count_storage(size_t bytes, bool allocated) {
+  if (!allocated) {
+    g_storage.fetch_sub(bytes, std::memory_order_relaxed);
+    return;
+  }
+  const uint64_t now = g_storage.fetch_add(bytes, std::memory_order_relaxed) + bytes;
+  uint64_t peak = g_peak_storage.load(std::memory_order_relaxed);
+  while (now > peak &&
+         !g_peak_storage.compare_exchange_weak(peak, now, std::memory_order_relaxed)) {
+  }
+}
+
+uint64_t Texture::storage_bytes() {
+  return g_storage.load(std::memory_order_relaxed);
+}
+
+uint64_t Texture::peak_storage_bytes() {
+  return g_peak_storage.load(std::memory_order_relaxed);
+}
+
+void Texture::reset_peak_storage() {
+  g_peak_storage.store(g_storage.load(std::memory_order_relaxed), std::memory_order_relaxed);
+}
+
 uint64_t Texture::fresh_uid() {
   static std::atomic<uint64_t> next{1};
   return next.fetch_add(1, std::memory_order_relaxed);

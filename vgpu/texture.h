@@ -32,6 +32,14 @@ class Texture {
   // same as the emulator's uid, new for a copy or a moved-to texture.
   uint64_t id() const { return uid_; }
 
+  // The emulator's texel storage, every texture of the process together: 4 bytes a channel
+  // whatever the format (bytes() is the modeled card's), counted when allocated, alive now and
+  // at most since the last reset_peak_storage() (the memory model's texture term,
+  // host/report/memory_json.h).
+  static uint64_t storage_bytes();
+  static uint64_t peak_storage_bytes();
+  static void reset_peak_storage();
+
   const std::string& name() const { return name_; }
   int width() const { return width_; }
   int height() const { return height_; }
@@ -62,6 +70,7 @@ class Texture {
  private:
   friend class Gpu;
   static uint64_t fresh_uid();
+  static void count_storage(size_t bytes, bool allocated);
   // Rows [y0, y1) only, each texel = texel, without a version step (Gpu::clear splits its rows
   // over the threads and steps the version once).
   void fill_rows(std::span<const float> texel, int y0, int y1);
@@ -79,10 +88,16 @@ class Texture {
     template <class U>
     ZeroedAllocator(const ZeroedAllocator<U>&) {}
     T* allocate(size_t n) {
-      if (void* p = std::calloc(n, sizeof(T))) return static_cast<T*>(p);
+      if (void* p = std::calloc(n, sizeof(T))) {
+        count_storage(n * sizeof(T), true);
+        return static_cast<T*>(p);
+      }
       throw std::bad_alloc();
     }
-    void deallocate(T* p, size_t) { std::free(p); }
+    void deallocate(T* p, size_t n) {
+      count_storage(n * sizeof(T), false);
+      std::free(p);
+    }
     template <class U>
     void construct(U*) {}  // value-initialised: calloc's zeros already are (data_ is
                            // resized once, from empty, in the constructor: never over old texels)

@@ -92,6 +92,9 @@ class Accel {
   // The structure's own statistics (accel_stats.h: the alternative of its kind), which the
   // report room writes as the statistics' "accel" object, after "structure".
   virtual AccelStats stats() const = 0;
+  // The host's copy of the structure, bytes (its arrays' sizes: the pages it wrote): the memory model's
+  // structure term (host/report/memory_json.h). The walk's textures are counted apart.
+  virtual uint64_t host_bytes() const = 0;
   // A later frame of a moving scene (the same triangles, moved): the structure follows `scene`
   // as --update `how` says ("rebuild"; for a BVH also "refit" or "auto", see BvhAccel). Returns
   // what was done: "rebuild" or "refit".
@@ -128,6 +131,7 @@ class GridAccel : public Accel {
   double build_ms() const override { return grid_.build_ms; }
   uint64_t list_entries() const override { return 0; }
   AccelStats stats() const override;
+  uint64_t host_bytes() const override;
   // Rebuilt at the first build's resolution (so the voxel pointers keep their texture).
   std::string update(const Scene& scene, const std::string& how) override;
 
@@ -147,6 +151,7 @@ class Grid2Accel : public Accel {
   double build_ms() const override { return g2_.build_ms; }  // its coarse grid finds the box
   uint64_t list_entries() const override;
   AccelStats stats() const override;
+  uint64_t host_bytes() const override;
   std::string update(const Scene& scene, const std::string& how) override;
 
  private:
@@ -165,6 +170,7 @@ class BvhAccel : public Accel {
   double build_ms() const override { return box_ms_ + bvh_.build_ms; }
   uint64_t list_entries() const override { return bvh_.lists.size(); }
   AccelStats stats() const override;
+  uint64_t host_bytes() const override;
   // --update refit keeps the topology and moves the boxes (refit_bvh); auto refits until the
   // refitted tree's SAH cost passes kRefitLimit times the last build's, then builds again;
   // rebuild builds again.
@@ -189,6 +195,7 @@ class KdAccel : public Accel {
   double build_ms() const override { return box_ms_ + kd_.build_ms; }
   uint64_t list_entries() const override { return kd_.lists.size(); }
   AccelStats stats() const override;
+  uint64_t host_bytes() const override;
   std::string update(const Scene& scene, const std::string& how) override;
 
  private:

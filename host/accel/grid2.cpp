@@ -112,7 +112,19 @@ Grid2 build_grid2(const Scene& scene, unsigned threads) {
   for (auto& e : errors)
     if (e) std::rethrow_exception(e);
 
-  // The textures' arrays: every cell's sub-cells in cell order, the lists after entry 0's -1.
+  // The textures' arrays: every cell's sub-cells in cell order, the lists after entry 0's -1,
+  // reserved whole (no array grows by doubling), each sub-grid freed once copied.
+  size_t sub_cells = 0, entries = 1;
+  for (size_t v = 0, k = 0; v < cells; ++v) {
+    const bool own = k < crowded.size() && crowded[k] == v;
+    const size_t n = own ? sub[k].voxels() : 1;
+    sub_cells += n;
+    entries += n + (own ? sub[k].tris.size() : c.triangles_in(v).size());
+    k += own;
+  }
+  g.list_start.reserve(sub_cells);
+  g.cell_of.reserve(sub_cells);
+  g.lists.reserve(entries);
   g.first.resize(cells);
   g.lists.push_back(-1);
   auto add_list = [&](std::span<const uint32_t> tris, uint32_t cell) {
@@ -137,6 +149,7 @@ Grid2 build_grid2(const Scene& scene, unsigned threads) {
       g.sub_cell[v] = s.cell;
       g.crowded += s.voxels() > 1;
       for (size_t k = 0; k < s.voxels(); ++k) add_list(s.triangles_in(k), uint32_t(v));
+      sub[next_crowded - 1] = Grid{};
     } else {
       add_list(c.triangles_in(v), uint32_t(v));
     }

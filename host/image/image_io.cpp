@@ -6,12 +6,14 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cstdio>
 #include <filesystem>
 #include <mutex>
 #include <stdexcept>
 
 #include "host/common/install_paths.h"
+#include "host/common/memory.h"
 #include "host/image/image_module.h"
 #include "host/scene/scene.h"
 
@@ -92,11 +94,37 @@ const ImageModule& image_module(const std::string& user) {
   return m;
 }
 
+// The image module's first use, measured: the anonymous resident bytes before it, and after it
+// those it added (image_library_bytes; its code is the process term's, file pages).
+std::atomic<bool> g_used{false};
+std::atomic<uint64_t> g_library_bytes{0};
+
+class FirstUse {
+ public:
+  FirstUse() : first_(!g_used.exchange(true)), before_(first_ ? anon_resident_bytes() : 0) {}
+  ~FirstUse() {
+    if (!first_) return;
+    const uint64_t after = anon_resident_bytes();
+    g_library_bytes = after > before_ ? after - before_ : 0;
+  }
+  FirstUse(const FirstUse&) = delete;
+  FirstUse& operator=(const FirstUse&) = delete;
+
+ private:
+  bool first_;
+  uint64_t before_;
+};
+
 }  // namespace
+
+uint64_t image_library_bytes() {
+  return g_library_bytes;
+}
 
 void write_image(const std::string& path, int width, int height, int channels,
                  const std::vector<float>& pixels) {
   check_image_path(path);
+  const FirstUse use;
   const ImageModule& im = image_module(path);
   // Same extension, so the module picks the right writer for the temporary file.
   const fs::path p(path);
@@ -118,6 +146,7 @@ void write_image(const std::string& path, int width, int height, int channels,
 }
 
 ImagePixels decode_image(const std::vector<unsigned char>& bytes) {
+  const FirstUse use;
   const ImageModule& im = image_module("an image");
   ImagePixels out;
   auto alloc = [](void* ctx, size_t count) -> float* {
@@ -133,6 +162,7 @@ ImagePixels decode_image(const std::vector<unsigned char>& bytes) {
 }
 
 ImageComparison compare_images(const std::string& a, const std::string& b, double threshold) {
+  const FirstUse use;
   const ImageModule& im = image_module(a);
   VgpuImageComparison r{};
   char err[512] = "";

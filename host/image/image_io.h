@@ -2,6 +2,7 @@
 // images (share of differing pixels, RMS error, PSNR). OpenImageIO is loaded on first use.
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -41,6 +42,12 @@ inline LoadOptions with_images(LoadOptions options = {}) {
 }
 
 // OpenImageIO's ImageBufAlgo::compare over every channel.
+// The anonymous resident bytes the image module's first use added to the process (OpenImageIO
+// and the libraries it links, loaded and first called: their tables, relocated data and
+// allocations; 0 before), for the memory model
+// (host/report/memory_json.h).
+uint64_t image_library_bytes();
+
 ImageComparison compare_images(const std::string& a, const std::string& b, double threshold);
 
 }  // namespace host

@@ -8,17 +8,17 @@
 #endif
 #include "host/report/stats_json.h"
 
-#include <sys/resource.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
 
+#include "host/common/memory.h"
 #include "host/common/version.h"
 #include "host/model/cost_model.h"
 #include "host/model/formats.h"
 #include "host/report/counters_json.h"
+#include "host/report/memory_json.h"
 #include "host/report/stats_parts_json.h"
 #include "host/trace/mrt.h"
 #include "vgpu/vgpu.h"
@@ -81,13 +81,6 @@ nlohmann::ordered_json accel_json(const FrameStatsInputs& in) {
   return acc;
 }
 
-// The process's peak resident memory so far (getrusage), for the memory study.
-uint64_t peak_rss_bytes() {
-  rusage ru{};
-  getrusage(RUSAGE_SELF, &ru);
-  return uint64_t(ru.ru_maxrss) * 1024;
-}
-
 }  // namespace
 
 nlohmann::ordered_json frame_stats_json(const FrameStatsInputs& in) {
@@ -140,8 +133,11 @@ nlohmann::ordered_json frame_stats_json(const FrameStatsInputs& in) {
   j["init_ms"] = in.init_ms;
   j["grid_build_ms"] = accel.grid_build_ms();
   j["render_ms"] = r.render_ms;
-  if (tracer) j["texture_bytes"] = tracer->texture_bytes();
-  j["peak_rss_bytes"] = peak_rss_bytes();
+  const MemoryTerms memory = memory_terms(scene, accel, tracer, r);
+  if (tracer) j["texture_bytes"] = memory.textures;
+  const uint64_t peak = peak_resident_bytes();
+  j["peak_rss_bytes"] = peak;
+  j["memory"] = memory_json(memory, peak);
   if (cpu)
     j["cpu"] = {{"rays", cpu_stats.rays},
                 {"voxel_steps", cpu_stats.voxel_steps},

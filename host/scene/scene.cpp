@@ -1,9 +1,10 @@
-// The scene's padded box (scene.h): the one place the padding rule lives.
+// The scene's padded box (scene.h), the one place the padding rule lives, and its host bytes.
 #include "host/scene/scene.h"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <type_traits>
 
 namespace host {
 
@@ -19,6 +20,17 @@ float round_float(double x, bool up) {
 }
 
 }  // namespace
+
+uint64_t Scene::host_bytes() const {
+  auto bytes = [](const auto& v) {
+    return uint64_t(v.size()) * sizeof(typename std::decay_t<decltype(v)>::value_type);
+  };
+  uint64_t b = bytes(p0) + bytes(p1) + bytes(p2) + bytes(n0) + bytes(n1) + bytes(n2) +
+               bytes(material) + bytes(id) + bytes(materials) + bytes(uv0) + bytes(uv1) +
+               bytes(uv2) + bytes(textures) + bytes(lights);
+  for (const SceneTexture& t : textures) b += bytes(t.texels);
+  return b;
+}
 
 Bounds Scene::box() const {
   const Bounds b = bounds();

@@ -96,6 +96,9 @@ struct Scene {
   std::vector<std::string> warnings;  // e.g. "skipped 2 LINES primitives"
 
   size_t triangle_count() const { return p0.size(); }
+  // The host's copy of the triangles, their materials and texture images, bytes (the arrays' sizes:
+  // the pages written): the memory model's scene term (host/report/memory_json.h).
+  uint64_t host_bytes() const;
   // Appends a triangle: corners, corner normals (unit), material index and input id.
   void add_triangle(glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 na, glm::vec3 nb, glm::vec3 nc,
                     uint32_t mat, uint32_t input_id) {

@@ -23,6 +23,9 @@ struct WalkCounts {
   uint64_t rays_traced = 0;      // rays entering a trace
   uint64_t rays_unfinished = 0;  // rays stopped by a walk's pass cap (reduced precision)
   bool batch_walk = false;       // a walk of this frame ran in batches (host/trace/walks/walk.h)
+  // The most host memory one batch walk's tallies held (every thread's and their sum), bytes:
+  // the memory model's walk term (host/report/memory_json.h).
+  uint64_t batch_bytes = 0;
   // Whether the frame's walks may run in batches, decided once, at its first walk, from the
   // options and the device (walk::frame_batch_refusal); empty: they may.
   bool batch_decided = false;

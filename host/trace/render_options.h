@@ -254,10 +254,11 @@ struct RenderResult {
   std::vector<float> hit_id;  // input triangle id of the primary hit, -1 where it misses
   vgpu::FrameStats stats;
   double render_ms = 0;
-  int iterations = 0;            // ray-tracing iterations run (primary included)
-  uint64_t rays_traced = 0;      // rays entering a trace (primary, reflected, shadow)
-  uint64_t rays_unfinished = 0;  // rays stopped by the pass cap (only under reduced precision)
-  bool batch_walk = false;       // the grid walks ran in batches (RenderOptions::batch_walk)
+  int iterations = 0;             // ray-tracing iterations run (primary included)
+  uint64_t rays_traced = 0;       // rays entering a trace (primary, reflected, shadow)
+  uint64_t rays_unfinished = 0;   // rays stopped by the pass cap (only under reduced precision)
+  bool batch_walk = false;        // the grid walks ran in batches (RenderOptions::batch_walk)
+  uint64_t batch_walk_bytes = 0;  // the most host memory a batch walk's tallies held (WalkCounts)
   // Why a walk ran pass by pass (WalkCounts::passes_reason; empty: every walk ran in batches).
   std::string walk_reason;
   // Beams over tiles (RenderOptions::beams): beam passes, tiles marched, tiles that missed.

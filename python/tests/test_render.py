@@ -14,7 +14,7 @@ import vgpu_rt
 CLI = os.environ.get("VGPU_RT_CLI", "")
 # Fields that time the host or describe this run's machine: they differ between two runs.
 TIMED = {"init_ms", "grid_build_ms", "render_ms", "host_ms", "build_ms", "probe_ms", "threads",
-         "peak_rss_bytes"}
+         "peak_rss_bytes", "memory"}
 
 
 def untimed(value):

@@ -110,7 +110,7 @@ TRACES = [
     ("classic", S64 + ["--trace-pixel", "20,40", "--spp", "4"] + MRT),
 ]
 DROPPED = ("threads", "lanes", "walk", "walk_passes_because", "scene_path", "version",
-           "peak_rss_bytes")
+           "peak_rss_bytes", "memory")
 
 
 def strip(j):

@@ -49,9 +49,12 @@ def count(label):
     return float(label[:-1] if scale > 1 else label) * scale
 
 
+# The memory model's terms (the statistics' "memory" object, host/report/memory_json.h).
+MEMORY = ["texture_storage", "scene", "structure", "frame", "walk_tallies", "image_library",
+          "process", "predicted_peak", "peak_resident"]
 FIELDS = ["name", "device", "triangles", "width", "height", "render_ms", "gf6600_ms", "h200_ms",
           "passes", "rays_traced", "voxel_steps", "nodes_visited", "triangle_tests", "addressing",
-          "texture_bytes", "peak_rss_bytes"]
+          "texture_bytes", "peak_rss_bytes", "threads"] + ["memory_" + k for k in MEMORY]
 
 
 def read_json_runs(folder):
@@ -80,7 +83,8 @@ def read_json_runs(folder):
                      "triangle_tests": work.get("triangle_tests", ""),
                      "addressing": j["accel"].get("addressing", ""),
                      "texture_bytes": j.get("texture_bytes", ""),
-                     "peak_rss_bytes": j.get("peak_rss_bytes", "")})
+                     "peak_rss_bytes": j.get("peak_rss_bytes", ""), "threads": j.get("threads", ""),
+                     **{"memory_" + k: j.get("memory", {}).get(k, "") for k in MEMORY}})
     return rows
 
 

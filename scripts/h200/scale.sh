@@ -22,6 +22,7 @@ tris=${SCALE_TRIS:-10k 100k 320k 1M 4M}
 sizes=${SCALE_SIZES:-64x64 256x256 1024x1024 1920x1080 3840x2160}
 budget_s=${SCALE_BUDGET_S:-540}  # stop starting runs past this many seconds
 many=${SCALE_THREADS:-16}         # the many-thread runs' threads (the host's cores)
+one=${SCALE_ONE_THREAD:-1}        # 0: no one-thread runs (the memory sweep needs none)
 start=$(date +%s)
 
 # run NAME ARGS...: one frame, its statistics as $out/json/NAME.json.
@@ -54,8 +55,8 @@ for phase in "$@"; do
             --size 256x256 --threads $many
           run "tris-$n-$a-looping-t$many" "$scenes/heightfield-$n.gltf" --accel $a $frame \
             --size 256x256 --threads $many --kernels looping
-          run "tris-$n-$a-multipass-t1" "$scenes/heightfield-$n.gltf" --accel $a $frame \
-            --size 256x256 --threads 1
+          ((one)) && run "tris-$n-$a-multipass-t1" "$scenes/heightfield-$n.gltf" --accel $a \
+            $frame --size 256x256 --threads 1
         done
       done
       ;;
@@ -66,8 +67,8 @@ for phase in "$@"; do
             --threads $many
           run "pixels-$z-$a-looping-t$many" scenes/bunny.gltf --accel $a $frame --size $z \
             --threads $many --kernels looping
-          run "pixels-$z-$a-multipass-t1" scenes/bunny.gltf --accel $a $frame --size $z \
-            --threads 1
+          ((one)) && run "pixels-$z-$a-multipass-t1" scenes/bunny.gltf --accel $a $frame \
+            --size $z --threads 1
         done
       done
       ;;

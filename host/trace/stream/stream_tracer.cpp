@@ -107,7 +107,10 @@ StreamTracer::StreamTracer(const Scene& scene, const Accel& accel, const RenderO
     s.isect[i] = gpu.make_texture("intersection" + sfx, W, H, 4, fm[Group::hits]);
     s.result[i] = gpu.make_texture("result" + sfx, W, H, 4, fm[Group::colour]);
   }
-  s.shadow_rays = gpu.make_texture("shadow rays", W, H, 4, fm[Group::rays]);
+  // The shadow rays, one per pixel where the frame casts them; a frame without shadows makes
+  // none, and holds one texel in their place.
+  s.shadow_rays = gpu.make_texture("shadow rays", opt_.shadows ? W : 1, opt_.shadows ? H : 1, 4,
+                                   fm[Group::rays]);
   // Counting passes need a colour target; only their query result matters.
   s.counter = gpu.make_texture("counter", W, H, 1, Format::fp16);
   if (sums)
@@ -343,6 +346,8 @@ RenderResult StreamTracer::render(const Camera& cam) {
   res.rays_traced = r.counts.rays_traced;
   res.rays_unfinished = r.counts.rays_unfinished;
   res.batch_walk = r.counts.batch_walk;
+  res.batch_walk_bytes = r.counts.batch_bytes;
+  res.batch_walk_bytes = r.counts.batch_bytes;
   res.walk_reason = r.counts.passes_reason;
   res.beam_passes = r.counts.beam_passes;
   res.beam_tiles = r.counts.beam_tiles;

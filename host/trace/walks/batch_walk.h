@@ -436,7 +436,8 @@ bool run_in_batches(PassRunner& r, Walk& walk, typename Walk::Cursor& c) {
   });
   if (failed) std::rethrow_exception(failed);
   Keyed<vgpu::PassTally> tallies;
-  uint64_t ran = 0;
+  uint64_t ran = 0, bytes = 0;
+  for (const auto& w : walkers) bytes += w->entries.bytes();
   for (auto& w : walkers)
     w->entries.for_each([&](const PassKey& key, const BatchWalker::Entry& e) {
       tallies.at(key) += e.tally;
@@ -449,6 +450,7 @@ bool run_in_batches(PassRunner& r, Walk& walk, typename Walk::Cursor& c) {
   });
   // The same walk on the device, each pass charged from its tally: the statistics, the program
   // loads and the query read-backs come out as a pass-by-pass walk's.
+  r.counts.batch_bytes = std::max(r.counts.batch_bytes, bytes + tallies.bytes());
   DeviceWalker replay{r, &tallies};
   walk.walk(replay, c);
   r.counts.batch_walk = true;

@@ -77,6 +77,15 @@ class Keyed {
       row->resize(j + 1);
     return (*row)[j];
   }
+  // The host memory its rows hold, bytes.
+  uint64_t bytes() const {
+    uint64_t b = 0;
+    for (const auto& by_step : v_) {
+      b += by_step.capacity() * sizeof(std::vector<T>);
+      for (const std::vector<T>& row : by_step) b += row.capacity() * sizeof(T);
+    }
+    return b;
+  }
   // f(key, value) for every pass seen.
   template <class Fn>
   void for_each(Fn&& f) {
