@@ -176,6 +176,8 @@ py::dict profile_dict(const vgpu::Profile& p) {
   d["mem_gbps"] = p.mem_gbps;
   d["bus_mbps"] = p.bus_mbps;
   d["max_outputs"] = p.max_outputs;
+  d["max_texture_size"] = p.max_texture_size;
+  d["memory_mib"] = p.memory_mib;
   d["max_loop_iterations"] = p.max_loop_iterations;
   // What the cost model prices with (host/model/cost_model.cpp): the arithmetic, texture and
   // fixed-cost figures, and whether batches of idle fragments can skip a branch's body.

@@ -19,7 +19,8 @@ const std::vector<Profile>& profiles() {
     fx.max_instructions = 1024;      // Mesa MAX_NV_FRAGMENT_PROGRAM_INSTRUCTIONS
     fx.branching = Branching::none;  // NVIDIA Cg docs, fp30: no data-dependent branching/loops
     fx.branch_granularity = 1;
-    fx.max_texture_size = 4096;   // NV3x GL_MAX_TEXTURE_SIZE / RECTANGLE size (driver caps)
+    fx.max_texture_size = 4096;  // NV3x GL_MAX_TEXTURE_SIZE / RECTANGLE size (driver caps)
+    fx.memory_mib = 256;  // boards of 128 MB, the chip takes 256 at most (tecchannel.de, FX 5700 U)
     // NVIDIA's developer FAQ: GL_MAX_TEXTURE_UNITS is 4 on GeForce FX and GeForce 6 "since those
     // GPUs have 16 texture units", reached through ARB_fragment_program's texture image units.
     fx.texture_units = 16;        // GL_MAX_TEXTURE_IMAGE_UNITS_ARB on NV3x (NVIDIA developer FAQ)
@@ -86,9 +87,10 @@ const std::vector<Profile>& profiles() {
     g6.branching = Branching::dynamic;  // NVIDIA Cg docs, fp40
     g6.branch_granularity = 1024;       // ~1000 pixels on NV4x (AnandTech)
     g6.max_texture_size = 4096;         // NV4x driver caps
-    g6.texture_units = 16;              // GL_MAX_TEXTURE_IMAGE_UNITS on NV4x (NVIDIA developer FAQ)
-    g6.precision = Format::fp32;        // FP32 and FP16 equal speed on GeForce 6 (CineFX 3.0 brief)
-    g6.bus_mbps = 4000;  // PCI Express x16, one direction (PCI-SIG 1.0a: 250 MB/s/lane)
+    g6.memory_mib = 256;    // 128 or 256 MB boards (hexus.net, XFX GeForce 6600 DDR2 review p.2)
+    g6.texture_units = 16;  // GL_MAX_TEXTURE_IMAGE_UNITS on NV4x (NVIDIA developer FAQ)
+    g6.precision = Format::fp32;  // FP32 and FP16 equal speed on GeForce 6 (CineFX 3.0 brief)
+    g6.bus_mbps = 4000;           // PCI Express x16, one direction (PCI-SIG 1.0a: 250 MB/s/lane)
     // Fixed costs: fitted as on the FX 5700, on Table 1 Bunny3 on this card (1079 ms).
     g6.program_load_us = 160;  // fitted (Table 1 Bunny3), driver cost of a program switch
     g6.readback_us = 320;      // fitted (Table 1 Bunny3)
@@ -119,6 +121,7 @@ const std::vector<Profile>& profiles() {
     m.branching = Branching::dynamic;
     m.branch_granularity = 32;   // one warp (NVIDIA CUDA programming guide)
     m.max_texture_size = 32768;  // D3D12 feature level 12 max texture dimension
+    m.memory_mib = 24 * 1024;    // 24 GB GDDR6X (NVIDIA RTX 4090 specifications)
     m.texture_units = 32;        // GL_MAX_TEXTURE_IMAGE_UNITS on NVIDIA's current GL drivers
     m.precision = Format::fp32;
     m.bus_mbps = 32000;     // PCI Express 4.0 x16, one direction
@@ -151,9 +154,10 @@ const std::vector<Profile>& profiles() {
     m.max_outputs = 8;  // GL_MAX_DRAW_BUFFERS on NVIDIA drivers
     m.max_instructions = 1 << 20;  // effectively unlimited (model parameter)
     m.branching = Branching::dynamic;
-    m.branch_granularity = 32;   // one warp (NVIDIA CUDA programming guide)
-    m.max_texture_size = 32768;  // GL_MAX_TEXTURE_SIZE on NVIDIA drivers
-    m.texture_units = 32;        // GL_MAX_TEXTURE_IMAGE_UNITS on NVIDIA's current GL drivers
+    m.branch_granularity = 32;              // one warp (NVIDIA CUDA programming guide)
+    m.max_texture_size = 32768;             // GL_MAX_TEXTURE_SIZE on NVIDIA drivers
+    m.memory_mib = int(141e9 / (1 << 20));  // 141 GB HBM3e (NVIDIA H200 datasheet)
+    m.texture_units = 32;  // GL_MAX_TEXTURE_IMAGE_UNITS on NVIDIA's current GL drivers
     m.precision = Format::fp32;
     m.bus_mbps = 64000;  // PCI Express 5.0 x16, one direction (H200 datasheet)
     // Fixed costs measured by bench_gl on this H200 (NVIDIA 580 driver, EGL, 1x1 passes, medians

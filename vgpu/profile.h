@@ -26,8 +26,11 @@ struct Profile {
   int max_outputs = 1;       // color outputs (render targets) one program may write
   int max_instructions = 0;  // static instructions per fragment program
   Branching branching = Branching::none;
-  int branch_granularity = 1;       // pixels that branch together (dynamic branching only)
-  int max_texture_size = 0;         // texels per side
+  int branch_granularity = 1;  // pixels that branch together (dynamic branching only)
+  int max_texture_size = 0;    // texels per side
+  // The board's memory, MiB, the largest board sold with the part (0: not recorded): a frame
+  // whose textures (as this card holds them, by format) need more is refused.
+  int memory_mib = 0;
   // Texture image units a fragment program may read (OpenGL's GL_MAX_TEXTURE_IMAGE_UNITS under
   // ARB_fragment_program, Direct3D 9's samplers): unit u exists where u < texture_units. The
   // emulator binds at most kMaxTextureUnits (vgpu/fragment.h) whatever the profile says.

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <string>
 
 #include "host/accel/accel.h"
 #include "host/report/memory_json.h"
@@ -101,4 +102,24 @@ TEST_CASE(
   // The shadow rays' texture: 4 fp32 channels per pixel, one texel without shadows.
   CHECK(with->texture_bytes() - without.texture_bytes() == (40 * 24 - 1) * 16);
   with.reset();
+}
+
+TEST_CASE(
+    "a frame whose textures outgrow a 2004 board's memory is refused in one line naming the "
+    "scene, the figures and a profile that holds them") {
+  const host::Scene scene = host::load_scene(host::resolve_scene("bunny-low"));
+  host::RenderOptions opt = small(1536, 1536);  // 16 fp32 bytes a texel, 473 MiB in all
+  opt.profile = "gf6600";
+  const host::AccelParams params{host::grid_spec_for({}, scene, vgpu::profile(opt.profile))};
+  const auto accel = host::make_accel(host::AccelKind::grid, scene, params);
+  try {
+    const host::StreamTracer tracer(scene, *accel, opt);
+    FAIL("no refusal");
+  } catch (const vgpu::LimitError& e) {
+    const std::string what = e.what();
+    CHECK(what.find(scene.source + ": the frame's textures need ") == 0);
+    CHECK(what.find("profile gf6600's board holds 256 MiB") != std::string::npos);
+    CHECK(what.find("(--profile rtx4090's 24576 MiB hold them)") != std::string::npos);
+    CHECK(what.find('\n') == std::string::npos);
+  }
 }

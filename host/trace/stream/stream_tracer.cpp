@@ -142,6 +142,8 @@ StreamTracer::StreamTracer(const Scene& scene, const Accel& accel, const RenderO
       MarkStreams::fits(gpu.profile(), opt_))
     s.dense = std::make_unique<MarkStreams>(gpu, opt_);
 
+  check_memory();
+
   s.shader.kernel.model = opt_.shading;
   s.shader.kernel.shadows = opt_.shadows;
   set_uniforms();
@@ -150,6 +152,25 @@ StreamTracer::StreamTracer(const Scene& scene, const Accel& accel, const RenderO
 }
 
 StreamTracer::~StreamTracer() = default;
+
+void StreamTracer::check_memory() const {
+  const vgpu::Profile& p = gpu_->profile();
+  const uint64_t need = texture_bytes(), mib = uint64_t(1) << 20;
+  if (p.memory_mib == 0 || need <= uint64_t(p.memory_mib) * mib) return;
+  // The profile with the least memory that holds them, for the advice.
+  const vgpu::Profile* fits = nullptr;
+  for (const vgpu::Profile& q : vgpu::profiles())
+    if (q.memory_mib > 0 && uint64_t(q.memory_mib) * mib >= need &&
+        (!fits || q.memory_mib < fits->memory_mib))
+      fits = &q;
+  const auto in_mib = [&](uint64_t b) { return std::to_string((b + mib - 1) / mib) + " MiB"; };
+  throw vgpu::LimitError(scene_->source + ": the frame's textures need " + in_mib(need) +
+                         "; profile " + p.name + "'s board holds " +
+                         in_mib(uint64_t(p.memory_mib) * mib) +
+                         (fits ? " (--profile " + fits->name + "'s " +
+                                     in_mib(uint64_t(fits->memory_mib) * mib) + " hold them)"
+                               : std::string(", and no profile holds more")));
+}
 
 uint64_t StreamTracer::write_scene(std::vector<std::string>* uploaded) {
   State& s = *s_;

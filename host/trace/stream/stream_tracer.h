@@ -55,6 +55,11 @@ class StreamTracer {
 
  private:
   struct State;
+  // Refuses (LimitError, naming the scene) a frame whose textures outgrow the profile's board
+  // memory (vgpu::Profile::memory_mib), advising the profile with the least memory that holds
+  // them. Checked once they are made: the static ones written, the per-pixel ones not yet
+  // touched (their pages cost nothing until a pass writes them, vgpu/texture.h).
+  void check_memory() const;
   // One ray stream (primary, shadow or reflected) through the grid: the walk of
   // host/trace/walks/grid_walk.h.
   void trace(vgpu::Texture& origins, vgpu::Texture& rays, bool primary, const Camera& cam);
