@@ -133,12 +133,10 @@ struct AluChain {
   }
 };
 
-// The cost model's parameters for a profile. The h200 runs the GLSL the recorder prints, which
-// has no branches (every f.branch() block runs, under a select): no batch skips a branch body.
+// The cost model's parameters for a profile: the CLI's (--predict), so that one frame has one
+// price (the h200's GLSL runs its branches as selects: Profile::branches_as_selects).
 host::CostParams params_for(const vgpu::Profile& p) {
-  host::CostParams c = host::defaults_for(p);
-  if (p.name == "h200") c.branch_body_share = 0;
-  return c;
+  return host::defaults_for(p);
 }
 
 struct Fixed {
@@ -356,7 +354,7 @@ FrameRun run_frames(const host::Scene& scene, const host::Accel& accel, const ho
 
 // The command line.
 struct Args {
-  std::string device = "auto", json_path, grid_text = "15";
+  std::string device = "auto", json_path, grid_text = "auto";  // the CLI's --grid default
   std::vector<std::string> scenes = {"sphere-alone", "bunny", "bunny-mirror"};
   std::vector<int> sizes = {256};
   int runs = 3, micro_passes = 200, threads = 0, warmup_ms = 0;
@@ -594,7 +592,9 @@ json frame_json(const FrameKey& key, const host::RenderOptions& opt, const Frame
   if (!gl) {
     json pred;
     for (const vgpu::Profile& p : vgpu::profiles())
-      pred[p.name] = host::predict(fr.stats, p, params_for(p)).total_ms;
+      pred[p.name] = host::prices(p, opt.looping, opt.steps_per_pass)
+                         ? json(host::predict(fr.stats, p, params_for(p)).total_ms)
+                         : json(nullptr);  // the looping program cannot run there
     f["predicted_ms"] = pred;
     json h200 = json::object();
     const vgpu::Profile& hp = vgpu::profile("h200");
@@ -676,16 +676,23 @@ std::vector<std::string> refused_frames(const Args& a) {
 // mode and engine, appended to frames.
 void scene_frames(const Args& a, const host::Scene& scene, int size,
                   const std::vector<std::string>& engines, json& frames) {
-  const host::AccelParams params{
-      host::grid_spec_for(host::parse_grid_spec(a.grid_text), scene, vgpu::profile("gf5700"))};
-  std::map<std::string, std::unique_ptr<host::Accel>> built;  // each structure named, once
-  for (const std::string& name : a.accels)
-    if (!built.count(name))
-      built[name] = host::make_accel(host::parse_accel_kind(name), scene, params);
+  // Each structure once per profile, as the CLI builds it for the frame's profile (the grid's
+  // auto resolution is capped by the profile's largest texture).
+  std::map<std::pair<std::string, std::string>, std::unique_ptr<host::Accel>> built;
+  auto structure = [&](const std::string& name, const std::string& profile) -> host::Accel& {
+    auto& s = built[{name, profile}];
+    if (!s) {
+      const host::AccelParams params{
+          host::grid_spec_for(host::parse_grid_spec(a.grid_text), scene, vgpu::profile(profile))};
+      s = host::make_accel(host::parse_accel_kind(name), scene, params);
+    }
+    return *s;
+  };
   const host::Camera cam = host::scene_camera(scene);
   for (const std::string& accel_name : a.accels)
     for (const std::string& variant : a.variants) {
-      const host::Accel& accel = *built.at(accel_name);
+      const host::Accel& accel = structure(
+          accel_name, frame_options(a, size, variant, "off", "spp:1", "off", "stream").profile);
       for (const std::string& streams : a.ray_streams)
         for (const std::string& mode : a.sampling)
           for (const std::string& beams : a.beams)

@@ -155,6 +155,7 @@ const std::vector<Profile>& profiles() {
     m.max_instructions = 1 << 20;  // effectively unlimited (model parameter)
     m.branching = Branching::dynamic;
     m.branch_granularity = 32;              // one warp (NVIDIA CUDA programming guide)
+    m.branches_as_selects = true;           // the generated GLSL has no branches (vgpu/glsl.cpp)
     m.max_texture_size = 32768;             // GL_MAX_TEXTURE_SIZE on NVIDIA drivers
     m.memory_mib = int(141e9 / (1 << 20));  // 141 GB HBM3e (NVIDIA H200 datasheet)
     m.texture_units = 32;  // GL_MAX_TEXTURE_IMAGE_UNITS on NVIDIA's current GL drivers

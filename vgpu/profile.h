@@ -27,7 +27,11 @@ struct Profile {
   int max_instructions = 0;  // static instructions per fragment program
   Branching branching = Branching::none;
   int branch_granularity = 1;  // pixels that branch together (dynamic branching only)
-  int max_texture_size = 0;    // texels per side
+  // The frames run as the GLSL the recorder generates (the GL device's profiles), whose
+  // f.branch() blocks run under a select, not a branch: no batch of idle fragments skips a
+  // branch's body, whatever the part's branching (the cost model's branch_body_share is 0).
+  bool branches_as_selects = false;
+  int max_texture_size = 0;  // texels per side
   // The board's memory, MiB, the largest board sold with the part (0: not recorded): a frame
   // whose textures (as this card holds them, by format) need more is refused.
   int memory_mib = 0;

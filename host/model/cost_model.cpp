@@ -11,6 +11,7 @@ CostParams defaults_for(const vgpu::Profile& profile) {
   p.pass_us = profile.pass_us;
   p.program_load_us = profile.program_load_us;
   p.readback_us = profile.readback_us;
+  if (profile.branches_as_selects) p.branch_body_share = 0;  // no batch skips a body
   return p;
 }
 

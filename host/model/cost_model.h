@@ -91,6 +91,12 @@ struct CostBreakdown {
   std::vector<std::pair<std::string, double>> items() const;
 };
 
+// Whether a frame has a price on `profile`: a looping frame needs loops of steps_per_pass
+// iterations there (the statistics' predicted_ms is null elsewhere, the CLI's and bench_gl's).
+inline bool prices(const vgpu::Profile& profile, bool looping, int steps_per_pass) {
+  return !looping || profile.max_loop_iterations >= steps_per_pass;
+}
+
 // Uses stats.passes (one record per pass) when it holds every pass, else each program's totals
 // spread evenly over its passes.
 CostBreakdown predict(const vgpu::FrameStats& stats, const vgpu::Profile& profile);

@@ -240,7 +240,7 @@ nlohmann::ordered_json frame_stats_json(const FrameStatsInputs& in) {
   nlohmann::ordered_json predicted_ms, predicted_breakdown;
   for (const vgpu::Profile& p : vgpu::profiles()) {
     if (cpu || gl) break;  // no passes, or no SIMD counters to predict from
-    if (opt.looping && p.max_loop_iterations < opt.steps_per_pass) {
+    if (!prices(p, opt.looping, opt.steps_per_pass)) {
       predicted_ms[p.name] = nullptr;  // the looping program cannot run there
       continue;
     }

@@ -164,14 +164,14 @@ def measure(args):
     local = os.path.join(RESULTS, "real_gpu_llvmpipe.json")
     preds = os.path.join(RESULTS, "real_gpu_predictions.json")
     if not args.reuse or not os.path.exists(local):
-        run([args.bench, "--runs", str(args.runs), "--json", local])
+        run([args.bench, "--runs", str(args.runs), "--grid", "15", "--json", local])
     if not args.reuse or not os.path.exists(preds):
         run([args.bench, "--runs", "1", "--sizes", "256", "1024", "--readback-wait", "none",
-             "--json", preds])
+             "--grid", "15", "--json", preds])
     preds_var = os.path.join(RESULTS, "real_gpu_predictions_variants.json")
     if args.add_variants and (not args.reuse or not os.path.exists(preds_var)):
         run([args.bench, "--runs", "1", "--sizes", "256", "1024", "--readback-wait", "none",
-             "--variants", "mrt", "looping", "--json", preds_var])
+             "--grid", "15", "--variants", "mrt", "looping", "--json", preds_var])
     return local, preds, preds_var
 
 

@@ -30,11 +30,11 @@ trap 'kill $sampler 2>/dev/null || true' EXIT
 if [ "$phase" = all ] || [ "$phase" = frames ]; then
 # Frames with both read-back waits (the emulator's counts and the predictions are the same on
 # every machine: scripts/docs/real_gpu.py computes them here with --readback-wait none).
-.bin/bench_gl --runs 5 --sizes 256 1024 --threads 16 --no-stream --readback-wait both \
+.bin/bench_gl --runs 5 --sizes 256 1024 --threads 16 --no-stream --readback-wait both --grid 15 \
   --scenes scenes/sphere-alone.gltf scenes/bunny.gltf scenes/bunny-mirror.gltf \
   --json "$out/real_gpu_h200.json" 2>&1 | tee "$out/bench_gl.log"
 # NVIDIA's driver reads __GL_YIELD for how a waiting thread yields; NOTHING never yields.
-__GL_YIELD=NOTHING .bin/bench_gl --runs 5 --sizes 256 --no-stream --readback-wait block \
+__GL_YIELD=NOTHING .bin/bench_gl --runs 5 --sizes 256 --no-stream --readback-wait block --grid 15 \
   --micro-passes 50 --scenes scenes/bunny.gltf --json "$out/real_gpu_h200_yield.json" 2>&1 |
   tee "$out/bench_gl_yield.log"
 fi
@@ -42,7 +42,7 @@ fi
 # the multipass pipeline, polled read-backs (real_gpu.py: --variants).
 if [ "$phase" = all ] || [ "$phase" = variants ]; then
   .bin/bench_gl --runs 5 --sizes 256 1024 --threads 16 --no-stream --readback-wait poll \
-    --variants multipass mrt looping --micro-passes 50 \
+    --variants multipass mrt looping --micro-passes 50 --grid 15 \
     --scenes scenes/sphere-alone.gltf scenes/bunny.gltf scenes/bunny-mirror.gltf \
     --json "$out/real_gpu_h200_variants.json" 2>&1 | tee "$out/bench_gl_variants.log"
 fi

@@ -1,7 +1,7 @@
 // bench_gl's frame options as a user meets them: ray streams and sampling modes are run and
 // priced per frame (on the emulator alone, --readback-wait none, so no GL driver is needed),
 // and a bad mode is refused with exit 2 and nothing written; --warmup-ms runs GL frames (llvmpipe
-// here, as test_gl) before timing.
+// here, as test_gl) before timing; and bench_gl prices a frame as vgpu-rt render does.
 #include <doctest/doctest.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -242,4 +242,51 @@ TEST_CASE("bench_gl runs GL and emulator frames with beams off and on, counting 
     CHECK(gl["beam_tiles_missed"] == em["beam_tiles_missed"]);
     CHECK(gl["passes"] == em["passes"]);
   }
+}
+
+TEST_CASE(
+    "one frame has one price: bench_gl and vgpu-rt render count the same passes and predict the "
+    "same ms on every profile, for several scenes, both walks, every structure") {
+  const std::string scenes = VGPU_SCENES;
+  for (const char* scene : {"bunny", "classic", "bunny-mirror"})
+    for (const char* accel : {"grid", "grid2", "bvh", "kdtree"})
+      for (const bool looping : {false, true}) {
+        CAPTURE(scene);
+        CAPTURE(accel);
+        CAPTURE(looping);
+        // bench_gl's multipass frames run on Table 1's profile, its looping ones on the h200's.
+        const std::string profile = looping ? "h200" : "gf5700";
+        const std::string gltf = scenes + "/" + scene + ".gltf";
+        const fs::path bj = json_path();
+        const Outcome o = bench(
+            "--readback-wait none --no-fixed --sizes 24 --runs 1 --threads 2 "
+            "--bounces 1 --variants " +
+            std::string(looping ? "looping" : "multipass") + " --accel " + accel + " --scenes " +
+            gltf + " --json " + bj.string());
+        REQUIRE(o.status == 0);
+        std::ifstream bf(bj);
+        const nlohmann::json frame = nlohmann::json::parse(bf)["frames"].at(0);
+        fs::remove(bj);
+        const fs::path cj = json_path().string() + ".cli.json";
+        const std::string cmd = std::string(VGPU_RT) + " render " + gltf +
+                                " --size 24x24 --threads 2 --bounces 1 --shadows off --accel " +
+                                accel + " --profile " + profile +
+                                (looping ? " --kernels looping" : "") +
+                                " --stats none --quiet --stats-json " + cj.string();
+        REQUIRE(std::system(cmd.c_str()) == 0);
+        std::ifstream cf(cj);
+        const nlohmann::json cli = nlohmann::json::parse(cf);
+        fs::remove(cj);
+        CHECK(frame["passes"] == cli["totals"]["passes"]);
+        CHECK(frame["query_readbacks"] == cli["totals"]["query_readbacks"]);
+        for (const auto& [p, ms] : frame["predicted_ms"].items()) {
+          CAPTURE(p);
+          if (ms.is_null()) {
+            CHECK(cli["predicted_ms"][p].is_null());
+            continue;
+          }
+          CHECK(ms.get<double>() ==
+                doctest::Approx(cli["predicted_ms"][p].get<double>()).epsilon(1e-12));
+        }
+      }
 }
