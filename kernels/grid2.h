@@ -434,23 +434,13 @@ struct Grid2Looping {
     const Vec4<F> ray = f.fetch_own(kRays);
     if (grid2.xy > 0.5f) {
       // By (x, y): the step's sub-cell fetch brings the list start of the sub-cell it reaches.
-      f.loop(steps, trav.x >= F(0.0f), [&](const M& act) {
-        const M testing = act && (vs.w >= F(0.0f));
-        best =
-            nearest_hit_in_segment(f, kV0, o, ray, trav, vs, best, testing, scene, grid2.t_slack);
-        const Addr<F> pos = addr_next(list_pos(vs, grid2), grid2.list_width, true);
-        const F tri = list_entry_at(f, kLists, pos, grid2);
-        const M stepping = act && !testing;
-        Addr<F> list{pos.x, pos.y};
-        const Vec4<F> next = grid2_step(f, kCells, kSubCells, trav, best, o, ray.xyz(), ray.w,
-                                        stepping, grid2, &list);
-        const M load = stepping && (next.x >= F(0.0f));
-        const F first = list_entry_at(f, kLists, list, grid2);
-        vs = select(testing, Vec4<F>{pos.x, pos.y, F(0.0f), tri},
-                    select(load, Vec4<F>{list.x, list.y, F(0.0f), first}, vs));
-        trav = select(stepping, next, trav);
-        return trav.x >= F(0.0f);
-      });
+      walk_lists_by_xy(
+          f, steps, kV0, kLists, o, ray, trav, vs, best, grid2, scene,
+          [&](const M& stepping, Addr<F>& list) {
+            return grid2_step(f, kCells, kSubCells, trav, best, o, ray.xyz(), ray.w, stepping,
+                              grid2, &list);
+          },
+          [](const Vec4<F>& next) { return next.x >= F(0.0f); });
       f.out(0) = trav;
       f.out(1) = vs;
       f.out(2) = best;

@@ -383,22 +383,13 @@ struct KdLooping {
     if (kd.xy > 0.5f) {
       // By (x, y): no push-down (its node would need two more channels), every restart at the
       // root; the leaf's list start comes with the node texel the step fetched.
-      f.loop(steps, trav.x >= F(0.0f), [&](const M& act) {
-        const M testing = act && (vs.w >= F(0.0f));
-        best = nearest_hit_in_segment(f, kV0, o, ray, trav, vs, best, testing, scene, kd.t_slack);
-        const Addr<F> pos = addr_next(list_pos(vs, kd), kd.list_width, true);
-        const F tri = list_entry_at(f, kLists, pos, kd);
-        const M stepping = act && !testing;
-        Addr<F> list{pos.x, pos.y};
-        const Vec4<F> next =
-            kd_step(f, kNodes, trav, best, o, ray.xyz(), ray.w, stepping, kd, nullptr, &list);
-        const M load = stepping && kd_reached(next, kd);  // reached in this step
-        const F first = list_entry_at(f, kLists, list, kd);
-        vs = select(testing, Vec4<F>{pos.x, pos.y, F(0.0f), tri},
-                    select(load, Vec4<F>{list.x, list.y, F(0.0f), first}, vs));
-        trav = select(stepping, next, trav);
-        return trav.x >= F(0.0f);
-      });
+      walk_lists_by_xy(
+          f, steps, kV0, kLists, o, ray, trav, vs, best, kd, scene,
+          [&](const M& stepping, Addr<F>& list) {
+            return kd_step(f, kNodes, trav, best, o, ray.xyz(), ray.w, stepping, kd, nullptr,
+                           &list);
+          },
+          [&](const Vec4<F>& next) { return kd_reached(next, kd); });
       f.out(0) = trav;
       f.out(1) = vs;
       f.out(2) = best;

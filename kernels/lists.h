@@ -205,4 +205,36 @@ inline Vec4<typename L::F> nearest_hit_anywhere(
   return select(nearer, Vec4<F>{t, bu, bv, vs.w}, best);
 }
 
+// The looping walk of a list structure addressed by (x, y) (KdLooping, Grid2Looping), within
+// f.loop: one iteration either tests the next triangle of the list a ray stands in, or takes one
+// step of the structure and, where the step reaches a leaf or cell, loads the first entry of its
+// list. `step(stepping, list)` returns the next traversal state and leaves in `list` the list
+// start of what it reached (read from the same texel the step fetched); `reached(next)` says where
+// it reached one. The list position is (column, row) in vs.xy; vs.w the triangle to test.
+template <class L, class Step, class Reached>
+inline void walk_lists_by_xy(Fragments<L>& f, int steps, int unit_v0, int unit_lists,
+                             const Vec3<typename L::F>& o, const Vec4<typename L::F>& ray,
+                             Vec4<typename L::F>& trav, Vec4<typename L::F>& vs,
+                             Vec4<typename L::F>& best, const ListUniforms& lists,
+                             const SceneUniforms& scene, Step step, Reached reached) {
+  using F = typename L::F;
+  using M = typename L::M;
+  f.loop(steps, trav.x >= F(0.0f), [&](const M& act) {
+    const M testing = act && (vs.w >= F(0.0f));
+    best =
+        nearest_hit_in_segment(f, unit_v0, o, ray, trav, vs, best, testing, scene, lists.t_slack);
+    const Addr<F> pos = addr_next(list_pos(vs, lists), lists.list_width, true);
+    const F tri = list_entry_at(f, unit_lists, pos, lists);
+    const M stepping = act && !testing;
+    Addr<F> list{pos.x, pos.y};
+    const Vec4<F> next = step(stepping, list);
+    const M load = stepping && reached(next);  // reached in this step
+    const F first = list_entry_at(f, unit_lists, list, lists);
+    vs = select(testing, Vec4<F>{pos.x, pos.y, F(0.0f), tri},
+                select(load, Vec4<F>{list.x, list.y, F(0.0f), first}, vs));
+    trav = select(stepping, next, trav);
+    return trav.x >= F(0.0f);
+  });
+}
+
 }  // namespace kernels
