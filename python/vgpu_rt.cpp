@@ -191,6 +191,7 @@ py::dict profile_dict(const vgpu::Profile& p) {
   d["program_load_us"] = p.program_load_us;
   d["readback_us"] = p.readback_us;
   d["dynamic_branching"] = p.branching == vgpu::Branching::dynamic;
+  d["branches_as_selects"] = p.branches_as_selects;
   d["branch_granularity"] = p.branch_granularity;
   return d;
 }

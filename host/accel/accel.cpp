@@ -2,16 +2,15 @@
 // structure's build, summary, statistics and update for a moved scene.
 #include "host/accel/accel.h"
 
-#ifdef __GLIBC__
-#include <malloc.h>
-#endif
-
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <iterator>
 #include <stdexcept>
 #include <string>
+#ifdef __GLIBC__  // defined by the C library's headers above
+#include <malloc.h>
+#endif
 
 #include "host/common/parallel.h"
 

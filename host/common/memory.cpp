@@ -27,10 +27,6 @@ Statm statm() {
 }
 }  // namespace
 
-uint64_t resident_bytes() {
-  return statm().resident;
-}
-
 uint64_t file_resident_bytes() {
   return statm().shared;
 }

@@ -6,9 +6,9 @@
 
 namespace host {
 
-uint64_t resident_bytes();  // now (/proc/self/statm); 0 where the system does not say
-// Of those, the pages of files (the program's and its libraries' code and data, shared with
-// other processes) and the rest (anonymous: what the process allocated).
+// The pages resident now (/proc/self/statm; 0 where the system does not say): those of files
+// (the program's and its libraries' code and data, shared with other processes), and the rest
+// (anonymous: what the process allocated).
 uint64_t file_resident_bytes();
 uint64_t anon_resident_bytes();
 uint64_t peak_resident_bytes();  // the peak so far (getrusage's ru_maxrss)

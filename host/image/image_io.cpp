@@ -104,15 +104,17 @@ class FirstUse {
   FirstUse() : first_(!g_used.exchange(true)), before_(first_ ? anon_resident_bytes() : 0) {}
   ~FirstUse() {
     if (!first_) return;
-    const uint64_t after = anon_resident_bytes();
+    const uint64_t now = anon_resident_bytes(), after = now > kept_ ? now - kept_ : 0;
     g_library_bytes = after > before_ ? after - before_ : 0;
   }
+  // Bytes the call hands back to its caller (a decoded image's pixels): not the library's.
+  void keep(uint64_t bytes) { kept_ = bytes; }
   FirstUse(const FirstUse&) = delete;
   FirstUse& operator=(const FirstUse&) = delete;
 
  private:
   bool first_;
-  uint64_t before_;
+  uint64_t before_, kept_ = 0;
 };
 
 }  // namespace
@@ -146,7 +148,7 @@ void write_image(const std::string& path, int width, int height, int channels,
 }
 
 ImagePixels decode_image(const std::vector<unsigned char>& bytes) {
-  const FirstUse use;
+  FirstUse use;
   const ImageModule& im = image_module("an image");
   ImagePixels out;
   auto alloc = [](void* ctx, size_t count) -> float* {
@@ -158,6 +160,7 @@ ImagePixels decode_image(const std::vector<unsigned char>& bytes) {
   if (im.read(bytes.data(), bytes.size(), alloc, &out, &out.width, &out.height, &out.channels, err,
               sizeof err) != 0)
     throw std::runtime_error(err);
+  use.keep(out.pixels.capacity() * sizeof(float));
   return out;
 }
 

@@ -41,13 +41,13 @@ inline LoadOptions with_images(LoadOptions options = {}) {
   return options;
 }
 
-// OpenImageIO's ImageBufAlgo::compare over every channel.
 // The anonymous resident bytes the image module's first use added to the process (OpenImageIO
 // and the libraries it links, loaded and first called: their tables, relocated data and
-// allocations; 0 before), for the memory model
+// allocations, not a decoded image handed back; 0 before), for the memory model
 // (host/report/memory_json.h).
 uint64_t image_library_bytes();
 
+// OpenImageIO's ImageBufAlgo::compare over every channel.
 ImageComparison compare_images(const std::string& a, const std::string& b, double threshold);
 
 }  // namespace host

@@ -47,7 +47,9 @@ struct CostParams {
   // Dynamic branching (Branching::dynamic) is not a parameter: the virtual GPU counts the
   // branch-idle fragments that sit in batches idle as a whole (Counters::idle_in_batch32 and
   // idle_in_batch1024, 8x4 and 32x32 pixel tiles); the profile's branch_granularity picks one
-  // (1024 for >= 256, else 32). Without dynamic branching (fp30) nothing is skipped.
+  // (1024 for >= 256, else 32). Without dynamic branching (fp30) nothing is skipped, nor on a
+  // profile whose programs run their branches as selects (Profile::branches_as_selects, the
+  // generated GLSL: defaults_for sets branch_body_share 0).
   // Share of a program's operations, fetches and bytes read inside its f.branch() block, i.e.
   // what a skipping batch saves. Assumed 0.75 from the kernels' code: intersecciones (most of
   // every frame) keeps 132 of 135 operations but only 6 of 8 fetches (84 of 116 bytes) inside.

@@ -1,7 +1,8 @@
 #pragma once
 // The memory model (docs/studies/scale.md, "Memory"): the bytes a frame holds, term by term,
-// and their sum against the process's measured peak. Every term is an exact count of what the
-// program allocated (capacities, texels), not a sample of the system's pages:
+// and their sum against the process's measured peak. The terms of what the program allocated
+// are exact counts (texels, array sizes, the tallies' capacities); those of the code and the
+// image library are the system's pages, read when the frame's statistics are written:
 //   process         the code and libraries' pages resident now (file pages, shared), and the
 //                   anonymous pages resident when the program started
 //   image_library   the anonymous pages the image module's first use added (OpenImageIO and its
@@ -10,7 +11,8 @@
 //   structure       the host's copy of the structure (Accel::host_bytes)
 //   texture_storage the emulator's texels at their peak, 4 bytes a channel (Texture::
 //                   peak_storage_bytes); the card's own bytes, by format, are `textures`
-//   frame           the frame read back: colour, depth and hit ids (RenderResult)
+//   frame           the frame read back: colour, depth, hit ids and rays per pixel
+//                   (RenderResult)
 //   walk_tallies    a batch walk's per-pass tallies, every thread's (RenderResult::
 //                   batch_walk_bytes): the emulator's bookkeeping, not the card's
 // predicted = the sum; measured = getrusage's peak.

@@ -28,9 +28,9 @@ def runs(rows):
     out = []
     for r in rows:
         m = scale.NAME.match(r["name"])
-        if not m or m.group(1) or not r.get("memory_peak_resident"):
+        if not m or m.group(1) or int(r.get("memory_peak_resident") or 0) <= 0:
             continue  # GL runs hold the driver's memory too: not modeled
-        kind, size, accel, walk, threads = m.group(2), m.group(3), m.group(4), m.group(5), m.group(6)
+        kind, accel, walk, threads = m.group(2), m.group(4), m.group(5), m.group(6)
         value = int(r["triangles"]) if kind == "tris" else int(r["width"]) * int(r["height"])
         out.append((kind, accel, walk, int(threads or 1), value, r))
     return out

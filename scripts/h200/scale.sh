@@ -55,8 +55,10 @@ for phase in "$@"; do
             --size 256x256 --threads $many
           run "tris-$n-$a-looping-t$many" "$scenes/heightfield-$n.gltf" --accel $a $frame \
             --size 256x256 --threads $many --kernels looping
-          ((one)) && run "tris-$n-$a-multipass-t1" "$scenes/heightfield-$n.gltf" --accel $a \
-            $frame --size 256x256 --threads 1
+          if ((one)); then
+            run "tris-$n-$a-multipass-t1" "$scenes/heightfield-$n.gltf" --accel $a $frame \
+              --size 256x256 --threads 1
+          fi
         done
       done
       ;;
@@ -67,8 +69,10 @@ for phase in "$@"; do
             --threads $many
           run "pixels-$z-$a-looping-t$many" scenes/bunny.gltf --accel $a $frame --size $z \
             --threads $many --kernels looping
-          ((one)) && run "pixels-$z-$a-multipass-t1" scenes/bunny.gltf --accel $a $frame \
-            --size $z --threads 1
+          if ((one)); then
+            run "pixels-$z-$a-multipass-t1" scenes/bunny.gltf --accel $a $frame --size $z \
+              --threads 1
+          fi
         done
       done
       ;;

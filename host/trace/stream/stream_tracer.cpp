@@ -368,7 +368,6 @@ RenderResult StreamTracer::render(const Camera& cam) {
   res.rays_unfinished = r.counts.rays_unfinished;
   res.batch_walk = r.counts.batch_walk;
   res.batch_walk_bytes = r.counts.batch_bytes;
-  res.batch_walk_bytes = r.counts.batch_bytes;
   res.walk_reason = r.counts.passes_reason;
   res.beam_passes = r.counts.beam_passes;
   res.beam_tiles = r.counts.beam_tiles;

@@ -448,9 +448,9 @@ bool run_in_batches(PassRunner& r, Walk& walk, typename Walk::Cursor& c) {
   tallies.for_each([&](const PassKey&, vgpu::PassTally& t) {
     t.host_ms = ran ? ms * double(t.ran) / double(ran) : 0.0;
   });
+  r.counts.batch_bytes = std::max(r.counts.batch_bytes, bytes + tallies.bytes());
   // The same walk on the device, each pass charged from its tally: the statistics, the program
   // loads and the query read-backs come out as a pass-by-pass walk's.
-  r.counts.batch_bytes = std::max(r.counts.batch_bytes, bytes + tallies.bytes());
   DeviceWalker replay{r, &tallies};
   walk.walk(replay, c);
   r.counts.batch_walk = true;
