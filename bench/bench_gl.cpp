@@ -133,12 +133,6 @@ struct AluChain {
   }
 };
 
-// The cost model's parameters for a profile: the CLI's (--predict), so that one frame has one
-// price (the h200's GLSL runs its branches as selects: Profile::branches_as_selects).
-host::CostParams params_for(const vgpu::Profile& p) {
-  return host::defaults_for(p);
-}
-
 struct Fixed {
   double wall_us = 0, gpu_us = 0;
 };
@@ -539,7 +533,7 @@ json kernel_json(const FrameRun& fr, const vgpu::FrameStats::ProgramTotals& p, b
     one.programs = {p};
     one.totals = p.counters;
     const vgpu::Profile& hp = vgpu::profile("h200");
-    const host::CostBreakdown b = host::predict(one, hp, params_for(hp));
+    const host::CostBreakdown b = host::predict(one, hp);
     k["predicted_h200_ms"] = b.total_ms;
     k["predicted_h200_work_ms"] = b.arithmetic_ms + b.texture_ms + b.memory_ms;
     k["predicted_h200_latency_ms"] = b.latency_ms;
@@ -593,12 +587,12 @@ json frame_json(const FrameKey& key, const host::RenderOptions& opt, const Frame
     json pred;
     for (const vgpu::Profile& p : vgpu::profiles())
       pred[p.name] = host::prices(p, opt.looping, opt.steps_per_pass)
-                         ? json(host::predict(fr.stats, p, params_for(p)).total_ms)
+                         ? json(host::predict(fr.stats, p).total_ms)
                          : json(nullptr);  // the looping program cannot run there
     f["predicted_ms"] = pred;
     json h200 = json::object();
     const vgpu::Profile& hp = vgpu::profile("h200");
-    for (const auto& [k, v] : host::predict(fr.stats, hp, params_for(hp)).items()) h200[k] = v;
+    for (const auto& [k, v] : host::predict(fr.stats, hp).items()) h200[k] = v;
     f["predicted_h200"] = h200;
   }
   std::printf("%-14s %4dx%-4d %-6s %-9s %-7s streams %-3s %-13s beams %-3s wall %9.1f ms",
@@ -617,6 +611,13 @@ json frame_json(const FrameKey& key, const host::RenderOptions& opt, const Frame
   return f;
 }
 
+// The profile a variant's frames run on: the paper's pipeline at Table 1's profile (the CLI's
+// default); its future work (MRT fused passes, the looping kernels) needs a profile with several
+// outputs and loops: the h200's.
+std::string profile_for(const std::string& variant) {
+  return variant == "multipass" ? "gf5700" : "h200";
+}
+
 // One frame's options: docs/studies/table1.md's settings at `size`, with a variant, a ray-stream
 // setting, a sampling mode, beams and an engine.
 host::RenderOptions frame_options(const Args& a, int size, const std::string& variant,
@@ -629,11 +630,9 @@ host::RenderOptions frame_options(const Args& a, int size, const std::string& va
   opt.shadows = a.shadows;
   opt.threads = a.threads;
   opt.gl_device = a.device;
-  // The paper's pipeline at Table 1's profile; its future work (MRT fused passes, the
-  // looping kernels) needs a profile with several outputs and loops: the h200's.
   opt.mrt = variant == "mrt";
   opt.looping = variant == "looping";
-  opt.profile = variant == "multipass" ? "gf5700" : "h200";
+  opt.profile = profile_for(variant);
   opt.ray_streams = streams == "on";
   opt.beams = beams == "on";
   parse_sampling(mode, opt);  // checked when parsed
@@ -691,8 +690,7 @@ void scene_frames(const Args& a, const host::Scene& scene, int size,
   const host::Camera cam = host::scene_camera(scene);
   for (const std::string& accel_name : a.accels)
     for (const std::string& variant : a.variants) {
-      const host::Accel& accel = structure(
-          accel_name, frame_options(a, size, variant, "off", "spp:1", "off", "stream").profile);
+      const host::Accel& accel = structure(accel_name, profile_for(variant));
       for (const std::string& streams : a.ray_streams)
         for (const std::string& mode : a.sampling)
           for (const std::string& beams : a.beams)

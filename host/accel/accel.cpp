@@ -12,6 +12,7 @@
 #include <malloc.h>
 #endif
 
+#include "host/common/memory.h"
 #include "host/common/parallel.h"
 
 namespace host {
@@ -106,10 +107,6 @@ std::unique_ptr<Accel> GridAccel::build(const Scene& scene, const AccelParams& p
 }
 
 namespace {
-template <class V>
-uint64_t vector_bytes(const V& v) {
-  return uint64_t(v.size()) * sizeof(typename V::value_type);
-}
 uint64_t grid_bytes(const Grid& g) {
   return vector_bytes(g.start) + vector_bytes(g.tris);
 }

@@ -143,13 +143,12 @@ Grid2 build_grid2(const Scene& scene, unsigned threads) {
   for (size_t v = 0; v < cells; ++v) {
     g.first[v] = uint32_t(g.list_start.size());
     if (next_crowded < crowded.size() && crowded[next_crowded] == v) {
-      const Grid& s = sub[next_crowded++];
+      const Grid s = std::move(sub[next_crowded++]);  // freed once copied
       g.sub_res[v] = s.res;
       g.sub_lo[v] = s.lo;
       g.sub_cell[v] = s.cell;
       g.crowded += s.voxels() > 1;
       for (size_t k = 0; k < s.voxels(); ++k) add_list(s.triangles_in(k), uint32_t(v));
-      sub[next_crowded - 1] = Grid{};
     } else {
       add_list(c.triangles_in(v), uint32_t(v));
     }

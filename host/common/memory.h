@@ -1,10 +1,18 @@
 // The process's resident memory, for the memory model (host/report/memory_json.h): what it
-// holds now and its peak so far, as the system counts them (pages touched, code included).
+// holds now and its peak so far, as the system counts them (pages touched, code included), and
+// the bytes of the arrays the model counts.
 #pragma once
 
 #include <cstdint>
 
 namespace host {
+
+// The bytes a vector's elements take (its size, not its capacity: the pages it wrote), for the
+// memory model's counted terms.
+template <class V>
+uint64_t vector_bytes(const V& v) {
+  return uint64_t(v.size()) * sizeof(typename V::value_type);
+}
 
 // The pages resident now (/proc/self/statm; 0 where the system does not say): those of files
 // (the program's and its libraries' code and data, shared with other processes), and the rest

@@ -7,13 +7,6 @@
 
 namespace host {
 
-namespace {
-template <class V>
-uint64_t vector_bytes(const V& v) {
-  return uint64_t(v.size()) * sizeof(typename V::value_type);
-}
-}  // namespace
-
 MemoryTerms memory_terms(const Scene& scene, const Accel& accel, const StreamTracer* tracer,
                          const RenderResult& r) {
   MemoryTerms m;

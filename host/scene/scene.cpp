@@ -4,7 +4,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <type_traits>
+
+#include "host/common/memory.h"
 
 namespace host {
 
@@ -22,13 +23,12 @@ float round_float(double x, bool up) {
 }  // namespace
 
 uint64_t Scene::host_bytes() const {
-  auto bytes = [](const auto& v) {
-    return uint64_t(v.size()) * sizeof(typename std::decay_t<decltype(v)>::value_type);
-  };
-  uint64_t b = bytes(p0) + bytes(p1) + bytes(p2) + bytes(n0) + bytes(n1) + bytes(n2) +
-               bytes(material) + bytes(id) + bytes(materials) + bytes(uv0) + bytes(uv1) +
-               bytes(uv2) + bytes(textures) + bytes(lights);
-  for (const SceneTexture& t : textures) b += bytes(t.texels);
+  uint64_t b = 0;
+  for (const auto* v : {&p0, &p1, &p2, &n0, &n1, &n2}) b += vector_bytes(*v);
+  for (const auto* v : {&uv0, &uv1, &uv2}) b += vector_bytes(*v);
+  b += vector_bytes(material) + vector_bytes(id) + vector_bytes(materials) +
+       vector_bytes(textures) + vector_bytes(lights);
+  for (const SceneTexture& t : textures) b += vector_bytes(t.texels);
   return b;
 }
 

@@ -94,30 +94,10 @@ def main():
                                                           "memory_*.csv"))))
     ap.add_argument("--doc", default=os.path.join(ROOT, "docs", "studies", "scale.md"))
     a = ap.parse_args()
-    if len(a.runs) == 1 and os.path.isdir(a.runs[0]):
-        rows = scale.read_json_runs(a.runs[0])
-    else:
-        rows = scale.read_csv_runs(a.runs)
-    rs = runs(rows)
+    rs = runs(scale.read_runs(a.runs))
     if not rs:
         scale.fail("no runs with the memory model's terms (scale.sh's runs since issue 50)")
-    text = tables(rs)
-    if a.doc == "-":
-        print(text)
-        return
-    try:
-        with open(a.doc) as fh:
-            doc = fh.read()
-    except OSError as e:
-        scale.fail(f"{a.doc}: {e.strerror}")
-    begin, end = "<!-- memory.py: begin -->", "<!-- memory.py: end -->"
-    if begin not in doc or end not in doc:
-        scale.fail(f"{a.doc}: no block between '{begin}' and '{end}'")
-    head, rest = doc.split(begin, 1)
-    _, tail = rest.split(end, 1)
-    with open(a.doc, "w") as fh:
-        fh.write(f"{head}{begin}\n{text}\n{end}{tail}")
-    print(f"wrote {a.doc}")
+    scale.write_block(a.doc, "memory.py", tables(rs))
 
 
 if __name__ == "__main__":

@@ -212,10 +212,7 @@ def main():
     ap.add_argument("--png", default=os.path.join(ROOT, "docs", "studies", "scale.png"))
     ap.add_argument("--doc", default=os.path.join(ROOT, "docs", "studies", "scale.md"))
     a = ap.parse_args()
-    if len(a.runs) == 1 and os.path.isdir(a.runs[0]):
-        rows = read_json_runs(a.runs[0])
-    else:
-        rows = read_csv_runs(a.runs)
+    rows = read_runs(a.runs)
     if a.pack:
         with open(a.pack, "w", newline="") as fh:
             w = csv.DictWriter(fh, fieldnames=FIELDS)
@@ -229,22 +226,35 @@ def main():
     text = table(points, many)
     if a.png:
         chart(points, devices, many, a.png)
-    if a.doc == "-":
+    write_block(a.doc, "scale.py", text)
+
+
+def read_runs(paths):
+    """The runs of --runs: scale.sh's OUT folder (its json/), or CSV files packed from runs."""
+    if len(paths) == 1 and os.path.isdir(paths[0]):
+        return read_json_runs(paths[0])
+    return read_csv_runs(paths)
+
+
+def write_block(doc_path, name, text):
+    """Replaces the block between '<!-- NAME: begin -->' and '<!-- NAME: end -->' of the
+    Markdown file with text ('-': prints text instead)."""
+    if doc_path == "-":
         print(text)
         return
     try:
-        with open(a.doc) as fh:
+        with open(doc_path) as fh:
             doc = fh.read()
     except OSError as e:
-        fail(f"{a.doc}: {e.strerror}")
-    begin, end = "<!-- scale.py: begin -->", "<!-- scale.py: end -->"
+        fail(f"{doc_path}: {e.strerror}")
+    begin, end = f"<!-- {name}: begin -->", f"<!-- {name}: end -->"
     if begin not in doc or end not in doc:
-        fail(f"{a.doc}: no block between '{begin}' and '{end}'")
+        fail(f"{doc_path}: no block between '{begin}' and '{end}'")
     head, rest = doc.split(begin, 1)
     _, tail = rest.split(end, 1)
-    with open(a.doc, "w") as fh:
+    with open(doc_path, "w") as fh:
         fh.write(f"{head}{begin}\n{text}\n{end}{tail}")
-    print(f"wrote {a.doc}")
+    print(f"wrote {doc_path}")
 
 
 if __name__ == "__main__":
