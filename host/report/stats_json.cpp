@@ -73,6 +73,12 @@ nlohmann::ordered_json accel_json(const FrameStatsInputs& in) {
     au["probe_size"] = {in.choice->probe_width, in.choice->probe_height};
     au["profile"] = opt.profile;
     au["predicted_ms"] = in.choice->predicted_ms;
+    au["coarse_ms"] = in.choice->coarse_ms;
+    au["refine_size"] =
+        in.choice->refine_width > 0
+            ? nlohmann::ordered_json{in.choice->refine_width, in.choice->refine_height}
+            : nlohmann::ordered_json();  // the first probes were the frame
+    au["refined"] = in.choice->refined;
     au["probe_passes"] = in.choice->probe_passes;
     au["probe_ms"] = in.choice->probe_ms;
     au["why"] = in.choice->why;

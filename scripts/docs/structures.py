@@ -38,6 +38,7 @@ import textwrap
 
 import matplotlib
 import numpy as np
+import accel_auto
 import structures_trials as st
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "lib"))
@@ -497,6 +498,10 @@ def write_doc(a, rows, h200):
     worse = [(sc, mode) for sc in BUNDLED for mode in MODES
              if get(rows, sc, mode, "auto gf6600")["gf6600"] >
              1.10 * get(rows, sc, mode, "grid")["gf6600"]]
+    auto_rows = []  # scripts/docs/accel_auto.py's judgement of --accel auto, where it ran
+    if os.path.exists(accel_auto.DEFAULT_JSON):
+        with open(accel_auto.DEFAULT_JSON) as fh:
+            auto_rows = json.load(fh)
     doc = f"""# Acceleration structures: the grid, a two-level grid, a BVH, a kd-tree, and `--accel auto`
 
 Written by `scripts/docs/structures.py` (run it again to refresh every figure here); the chart is
@@ -518,7 +523,7 @@ the host steering passes by occlusion queries.
 | `grid2` | a coarse uniform grid (the automatic rule at 0.25 cells per triangle) whose crowded cells (more than 8 triangles) hold a grid of their own, at the automatic resolution of the part their triangles occupy carried over the cell, at most 64 sub-cells per triangle (Jevans & Wyvill 1989; Kalojanov et al. 2011) | 3D-DDA on two levels without a stack: one sub-cell per pass; leaving a sub-grid steps the coarse grid and descends into the next cell's sub-grid on the face crossed | sub-cell, its list, segment [t in, t out] |
 | `bvh` | binned SAH (16 bins), leaves of up to 4 triangles | stackless: nodes in depth-first order, each with the index to jump to when the ray misses it (Thrane & Simonsen 2005); one node per pass | next node, leaf to load |
 | `kdtree` | SAH over the triangles' clipped box faces, depth 8 + 1.3 log2 n | kd-restart (Foley & Sugerman 2005): descend to the first leaf the ray's segment reaches, test it (a hit counts only inside the leaf's segment), restart from the root past it; one node per pass | node, leaf to load, segment [tmin, tmax] |
-| `auto` | all four | the one the cost model predicts cheapest on `--profile`, from a probe frame at a quarter of the size in x and y (the fixed per-pass, program-load and read-back costs as measured, the fragment work scaled by the pixel ratio) | |
+| `auto` | all four | the one the cost model predicts cheapest on `--profile`: a probe frame at a quarter of the size in x and y (at least 16x16) with each, then those priced within 20% of the cheapest again at half the size (the fixed per-pass, program-load and read-back costs and the looping passes' longest lanes as measured, the fragment work scaled by the pixel ratio: every term of the model's total) | |
 
 Each walk is the grid's pass sequence with its own kernels in the places of the paper's: a step
 pass (`recorridoGrilla2` / `recorridoBVH` / `recorridoKd` where the grid has `traversal`), a
@@ -539,11 +544,7 @@ checked in double (`tests/trace/test_structure_walks.cpp`), and llvmpipe gives t
 ## The figures
 
 {size}, one run per row on this 2-core machine (2 host threads; emulator and CPU ms are medians
-of {a.runs} runs, and were taken while other builds ran: read them as ratios within a row group).
-The two-level grid's rows come from a later run (`--reuse --only grid2 ...`), and the `auto`
-rows and the bunny's grid row from a third (`--reuse --only "auto gf6600" "auto h200"
-bunny:grid`, once `auto` kept the grid by a margin, below), on the same machine under other
-loads: emulator and CPU ms compare only within one run (the modeled ms and the counts do not
+of {a.runs} runs; read them as ratios within a row group: the modeled ms and the counts do not
 depend on the load).
 "primary" is primary rays only (`--bounces 0 --shadows off`, as the issue's table); "full" is the
 default frame (2 bounces, shadows). Steps: voxels stepped (grid) or nodes visited (BVH, kd-tree)
@@ -561,12 +562,34 @@ its width) and "scales" (25 bunnies from 5% to 15 times its size, 92k triangles)
 {auto_table(rows)}
 
 `auto` is never more than 10% worse than `grid` in modeled gf6600 time on a bundled scene: {"met" if not worse else "missed on " + ", ".join(f"{s} ({m})" for s, m in worse)}.
-The probes cost host time at initialization (the column "probes ms", builds of all four
-structures included); the frame's own render time is the same as with the chosen structure.
-The grid is kept unless another structure is predicted at least 10% cheaper
-(`kAutoGridMargin`): the 64x64 probes misjudge the full frame by about that much. Without the
-margin, `auto` took the two-level grid for the bunny's primary rays (predicted 6% cheaper than
-the grid, 12% dearer at 256x256: its longest walks grow with the image).
+The probes cost host time at initialization (the column "probes ms", both rounds; the builds of
+all four structures come before them); the frame's own render time is the same as with the
+chosen structure.
+
+**Two rounds of probes.** A 64x64 probe misjudges how two structures compare at 256x256 where a
+walk's longest rays grow with the image: the bunny's primary rays on gf6600 priced the two-level
+grid 6% under the grid from 64x64 probes, and it is 12% over at 256x256. Until issue 51 the grid
+was kept unless another structure was predicted at least 10% cheaper, which covered that case
+but cost others: it kept the grid at 1.26x the BVH's frame (classic, full frame, looping,
+gf6600). Now every candidate priced within 20% of the cheapest (`kAutoProbeBand`: the largest
+misjudgment measured between two candidates was 17%) is probed again at half the size, and the
+cheapest of those is taken; no structure is preferred.
+
+{accel_auto.section(auto_rows)}
+
+The choice is not cheap. The probes render at least four frames of a quarter of the pixels and
+up to three of half, and a probe costs more than its share of the pixels: a multipass walk runs
+as many passes at 64x64 as at 256x256, each with its fixed host work. Where one structure is
+slow (the grid on stadium and scales) its probe alone outlasts the chosen frame, and where a
+build is slow (scales: the kd-tree's 1.2 s) so does that. A choice within a quarter of the
+frame's host time needs a predictor that renders nothing: not built here.
+
+**The longest-lane term (issue 34).** Until issue 34 the price of a candidate left out the
+cost model's `latency_ms` (a looping pass waits for its longest lane: `docs/studies/table1.md`),
+which only the looping kernels on the `h200` profile have. With `--kernels looping --profile
+h200` the price now includes it (unscaled: one lane's walk does not grow with the pixel count),
+and at a size where the probe is the whole frame (16x16 or less) each candidate's price is the
+model's `total_ms` of that structure's frame (`tests/trace/test_structure_walks.cpp`).
 
 ### Uneven scenes against the object alone
 

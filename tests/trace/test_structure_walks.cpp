@@ -84,6 +84,19 @@ host::RenderResult stream(const host::Scene& scene, const host::Accel& accel,
   return tracer.render(cam);
 }
 
+// Every structure built for a scene on a profile, as --accel auto's candidates.
+struct Candidates {
+  std::vector<std::unique_ptr<host::Accel>> built;
+  std::vector<host::AccelCandidate> candidates;
+  Candidates(const host::Scene& scene, const vgpu::Profile& p) {
+    const host::AccelParams params{host::grid_spec_for({}, scene, p)};
+    for (host::AccelKind k : host::kAccelKinds) {
+      built.push_back(host::make_accel(k, scene, params));
+      candidates.push_back({built.back().get(), host::resolve({}, scene, *built.back(), p)});
+    }
+  }
+};
+
 uint64_t passes_of(const host::RenderResult& r, const char* program) {
   const auto* p = r.stats.find(program);
   return p ? p->counters.passes : 0;
@@ -390,7 +403,7 @@ TEST_CASE("accel auto picks the BVH or the kd-tree for a small bunny on a huge f
 
 TEST_CASE(
     "accel auto prices each structure at the model's total for its frame and picks the "
-    "cheapest, keeping the grid within 10%") {
+    "cheapest") {
   // A 16x16 frame: the probe is the whole frame (scale 1), so each candidate's price must be the
   // cost model's total_ms of that structure's frame, every term of it; the looping kernels on
   // the h200 profile have a longest-lane (latency) term, which a price without it misses. On
@@ -401,13 +414,8 @@ TEST_CASE(
   const host::Camera cam = host::scene_camera(scene, float(w) / float(h));
   const std::string profile = "h200";
   const vgpu::Profile& p = vgpu::profile(profile);
-  const host::AccelParams params{host::grid_spec_for({}, scene, p)};
-  std::vector<std::unique_ptr<host::Accel>> built;
-  std::vector<host::AccelCandidate> cands;
-  for (host::AccelKind k : host::kAccelKinds) {
-    built.push_back(host::make_accel(k, scene, params));
-    cands.push_back({built.back().get(), host::resolve({}, scene, *built.back(), p)});
-  }
+  const Candidates all(scene, p);
+  const std::vector<host::AccelCandidate>& cands = all.candidates;
   host::RenderOptions opt;
   opt.width = w;
   opt.height = h;
@@ -437,15 +445,70 @@ TEST_CASE(
     CHECK(c.predicted_ms.at(name) == doctest::Approx(b.total_ms).epsilon(1e-12));
   }
   CHECK(latency > 0);  // the term the price must not leave out is there
-  // The pick: the cheapest total, unless that is not the grid and is within 10% of the grid's.
+  // The pick: the cheapest total (a probe the size of the frame has nothing to refine).
   auto cheapest = std::min_element(
       total.begin(), total.end(), [](const auto& x, const auto& y) { return x.second < y.second; });
-  const std::string grid(host::accel_name(host::AccelKind::grid));
-  const std::string want =
-      cheapest->second > (1.0 - host::kAutoGridMargin) * total.at(grid) ? grid : cheapest->first;
+  const std::string want = cheapest->first;
+  CHECK(c.refined.empty());
+  CHECK(c.refine_width == 0);
   CHECK(std::string(host::accel_name(c.kind)) == want);
   CHECK(want == "grid");  // the teapot's case (above): the grid, by more than a tie
   CHECK(total.at("grid2") > total.at("grid"));
+}
+
+TEST_CASE(
+    "accel auto probes every structure priced within its band of the cheapest again at half the "
+    "size, and takes the cheapest of those") {
+  // The bunny's primary rays on gf6600 at 96x96: first probes of 24x24, second of 48x48. Each
+  // price is the probe's full-frame extrapolation (its fixed terms as counted, its fragment work
+  // times the pixel ratio), recomputed here from renders of those sizes.
+  const host::Scene scene = host::load_scene(host::resolve_scene("bunny"));
+  const int w = 96, h = 96;
+  const host::Camera cam = host::scene_camera(scene, float(w) / float(h));
+  const std::string profile = "gf6600";
+  const vgpu::Profile& p = vgpu::profile(profile);
+  const Candidates all(scene, p);
+  const std::vector<host::AccelCandidate>& cands = all.candidates;
+  host::RenderOptions opt = options(w, h, profile);
+  opt.bounces = 0;
+  opt.shadows = false;
+  const host::AccelChoice c = host::choose_accel(scene, cands, opt, cam);
+  CHECK(c.probe_width == 24);
+  CHECK(c.refine_width == 48);
+  auto price = [&](const host::AccelCandidate& cand, int size) {
+    host::RenderOptions frame = opt;
+    frame.width = frame.height = size;
+    frame.formats = cand.formats;
+    frame.keep_pass_records = true;
+    const host::CostBreakdown b = host::predict(stream(scene, *cand.accel, cam, frame).stats, p);
+    const double scale = double(w * h) / double(size * size);
+    return b.per_pass_ms + b.program_load_ms + b.readback_ms + b.latency_ms +
+           scale * (b.arithmetic_ms + b.texture_ms + b.memory_ms + b.download_ms);
+  };
+  double cheapest = 1e300;
+  for (const host::AccelCandidate& cand : cands) {
+    const std::string name(cand.accel->name());
+    CAPTURE(name);
+    REQUIRE(c.coarse_ms.count(name) == 1);
+    CHECK(c.coarse_ms.at(name) == doctest::Approx(price(cand, 24)).epsilon(1e-9));
+    cheapest = std::min(cheapest, c.coarse_ms.at(name));
+  }
+  std::vector<std::string> band;
+  std::string want;
+  for (const host::AccelCandidate& cand : cands) {
+    const std::string name(cand.accel->name());
+    CAPTURE(name);
+    if (c.coarse_ms.at(name) > (1.0 + host::kAutoProbeBand) * cheapest) {
+      CHECK(c.predicted_ms.at(name) == c.coarse_ms.at(name));  // priced once
+      continue;
+    }
+    band.push_back(name);
+    CHECK(c.predicted_ms.at(name) == doctest::Approx(price(cand, 48)).epsilon(1e-9));
+    if (want.empty() || c.predicted_ms.at(name) < c.predicted_ms.at(want)) want = name;
+  }
+  CHECK(c.refined == band);
+  CHECK(band.size() == 3);  // grid, grid2 and the BVH within 20%; the kd-tree far off
+  CHECK(std::string(host::accel_name(c.kind)) == want);
 }
 
 // Cases of the two-level grid alone.

@@ -49,11 +49,11 @@ double full_frame_ms(const CostBreakdown& b, double scale) {
          scale * (b.arithmetic_ms + b.texture_ms + b.memory_ms + b.download_ms);
 }
 
-// The options of a probe frame: a quarter of the size in x and y (at least 16x16), quiet.
-RenderOptions probe_options(const RenderOptions& options) {
+// The options of a probe frame: 1/`divisor` of the size in x and y (at least 16x16), quiet.
+RenderOptions probe_options(const RenderOptions& options, int divisor = 4) {
   RenderOptions probe = options;
-  probe.width = std::min(options.width, std::max(16, options.width / 4));
-  probe.height = std::min(options.height, std::max(16, options.height / 4));
+  probe.width = std::min(options.width, std::max(16, options.width / divisor));
+  probe.height = std::min(options.height, std::max(16, options.height / divisor));
   probe.observer = nullptr;
   probe.progress = nullptr;
   probe.trace_pixel.reset();
@@ -68,64 +68,98 @@ double probe_scale(const RenderOptions& options, const RenderOptions& probe) {
          (double(probe.width) * double(probe.height));
 }
 
+// One candidate's probe: its full-frame price (every term, full_frame_ms) and passes; throws
+// vgpu::Error where the profile's limits refuse it.
+std::pair<double, uint64_t> probe_price(const Scene& scene, const AccelCandidate& cand,
+                                        RenderOptions probe, const RenderOptions& options,
+                                        const Camera& camera, const vgpu::Profile& profile) {
+  probe.formats = cand.formats;
+  StreamTracer tracer(scene, *cand.accel, probe);
+  const RenderResult r = tracer.render(camera);
+  return {full_frame_ms(predict(r.stats, profile), probe_scale(options, probe)),
+          r.stats.totals.passes};
+}
+
 }  // namespace
 
 AccelChoice choose_accel(const Scene& scene, const std::vector<AccelCandidate>& candidates,
                          const RenderOptions& options, const Camera& camera) {
   const auto t0 = std::chrono::steady_clock::now();
   AccelChoice c;
-  RenderOptions probe = probe_options(options);
+  const RenderOptions probe = probe_options(options, 4);
   c.probe_width = probe.width;
   c.probe_height = probe.height;
-  const double scale = probe_scale(options, probe);
   const vgpu::Profile& profile = vgpu::profile(options.profile);
+  // The first round: every candidate at a quarter of the size.
   std::string refused;
-  double best = 0;
-  bool any = false;
+  std::vector<const AccelCandidate*> priced;
+  double cheapest = 0;
   for (const AccelCandidate& cand : candidates) {
-    const Accel& accel = *cand.accel;
-    const AccelKind kind = accel.kind();
-    const std::string name(accel.name());
-    probe.formats = cand.formats;
+    const std::string name(cand.accel->name());
     try {
-      StreamTracer tracer(scene, accel, probe);
-      const RenderResult r = tracer.render(camera);
-      const CostBreakdown b = predict(r.stats, profile);
-      const double ms = full_frame_ms(b, scale);
-      c.predicted_ms[name] = ms;
-      c.probe_passes[name] = r.stats.totals.passes;
-      if (!any || ms < best) {
-        best = ms;
-        c.kind = kind;
-        any = true;
-      }
+      const auto [ms, passes] = probe_price(scene, cand, probe, options, camera, profile);
+      c.coarse_ms[name] = c.predicted_ms[name] = ms;
+      c.probe_passes[name] = passes;
+      cheapest = priced.empty() ? ms : std::min(cheapest, ms);
+      priced.push_back(&cand);
     } catch (const vgpu::Error& e) {
       refused += (refused.empty() ? "" : "; ") + name + ": " + e.what();
     }
   }
-  if (!any) throw vgpu::Error("--accel auto: no structure fits: " + refused);
-  // The grid unless another is predicted clearly cheaper (kAutoGridMargin).
-  const auto grid = c.predicted_ms.find(std::string(accel_name(AccelKind::grid)));
-  bool kept = false;
-  if (c.kind != AccelKind::grid && grid != c.predicted_ms.end() &&
-      best > (1.0 - kAutoGridMargin) * grid->second) {
-    c.kind = AccelKind::grid;
-    best = grid->second;
-    kept = true;
+  if (priced.empty()) throw vgpu::Error("--accel auto: no structure fits: " + refused);
+  // The second round: those within kAutoProbeBand of the cheapest, at half the size (where that
+  // is larger than the first probes; at the first probes' size their prices stand).
+  const RenderOptions fine = probe_options(options, 2);
+  const bool larger = fine.width > probe.width || fine.height > probe.height;
+  if (larger) {
+    c.refine_width = fine.width;
+    c.refine_height = fine.height;
+  }
+  std::vector<const AccelCandidate*> band;
+  for (const AccelCandidate* cand : priced)
+    if (c.coarse_ms.at(std::string(cand->accel->name())) <= (1.0 + kAutoProbeBand) * cheapest)
+      band.push_back(cand);
+  if (larger && band.size() > 1) {
+    std::vector<const AccelCandidate*> kept;
+    for (const AccelCandidate* cand : band) {
+      const std::string name(cand->accel->name());
+      try {
+        c.predicted_ms[name] = probe_price(scene, *cand, fine, options, camera, profile).first;
+        c.refined.push_back(name);
+        kept.push_back(cand);
+      } catch (const vgpu::Error& e) {  // the larger probe outgrew a limit: the frame would too
+        c.predicted_ms.erase(name);
+        refused += (refused.empty() ? "" : "; ") + name + ": " + e.what();
+      }
+    }
+    if (!kept.empty()) band = kept;
+  }
+  // The cheapest of the band, a tie going to the candidate listed first.
+  double best = 0;
+  for (size_t i = 0; i < band.size(); ++i) {
+    const double ms = c.predicted_ms.at(std::string(band[i]->accel->name()));
+    if (i == 0 || ms < best) {
+      best = ms;
+      c.kind = band[i]->accel->kind();
+    }
   }
   std::string others;
   for (const auto& [name, ms] : c.predicted_ms)
     if (name != accel_name(c.kind)) {
-      char part[96];
-      std::snprintf(part, sizeof part, "%s%s %.1f ms (%.2fx)", others.empty() ? "" : ", ",
-                    name.c_str(), ms, ms / best);
+      const bool again = std::find(c.refined.begin(), c.refined.end(), name) != c.refined.end();
+      char part[128];
+      std::snprintf(part, sizeof part, "%s%s %.1f ms (%.2fx%s)", others.empty() ? "" : ", ",
+                    name.c_str(), ms, ms / best, again || c.refined.empty() ? "" : ", first probe");
       others += part;
     }
-  char line[640];
+  char round2[96] = "";
+  if (!c.refined.empty())
+    std::snprintf(round2, sizeof round2, ", the %zu within %.0f%% again at %dx%d", c.refined.size(),
+                  100.0 * kAutoProbeBand, c.refine_width, c.refine_height);
+  char line[768];
   std::snprintf(line, sizeof line, "%s predicted %.1f ms on %s against %s, from %dx%d probes%s%s%s",
                 std::string(accel_name(c.kind)).c_str(), best, profile.name.c_str(),
-                others.empty() ? "nothing else" : others.c_str(), probe.width, probe.height,
-                kept ? " (the grid is kept unless another is predicted 10% cheaper)" : "",
+                others.empty() ? "nothing else" : others.c_str(), probe.width, probe.height, round2,
                 refused.empty() ? "" : "; refused: ", refused.c_str());
   c.why = line;
   c.probe_ms =

@@ -5,8 +5,9 @@
 // looping passes' longest lanes (latency) as measured (they follow the pass count and the
 // longest walk, which the image size hardly changes), the fragment work (arithmetic, texture,
 // memory, downloads) scaled by the pixel ratio: every term of the model's total, so that a
-// probe of the whole frame is priced at its predict().total_ms. The cheapest wins, within
-// kAutoGridMargin of the grid.
+// probe of the whole frame is priced at its predict().total_ms. The candidates priced within
+// kAutoProbeBand of the cheapest are probed again at half the size in x and y, and the cheapest
+// of those is taken.
 #pragma once
 
 #include <map>
@@ -21,18 +22,26 @@
 
 namespace host {
 
-// The grid (the paper's structure, and the default) is kept unless another is predicted at least
-// this share cheaper: the probe's extrapolation errs by about that much (measured at 256x256
-// primary rays on the bunny: the two-level grid predicted 6% cheaper than the grid from 64x64
-// probes, 12% dearer in the full frame, its longest walk growing with the image).
-inline constexpr double kAutoGridMargin = 0.10;
+// The quarter-size probes misjudge how two structures compare in the full frame, most where a
+// walk's longest rays grow with the image: the bunny's primary rays on gf6600 priced the
+// two-level grid 6% under the grid from 64x64 probes, and it is 12% over at 256x256: 17% between
+// the two. So every candidate priced within this band of the cheapest is probed again at half
+// the size. Measured on the 13 bundled and uneven scenes, primary rays and full frames, both
+// walks, on gf6600, h200 and h100 at 256x256 (docs/studies/structures.md, "--accel auto"): all
+// 156 picks within 3.1% of the cheapest structure's frame. The band protects against the
+// quarter-size probes' misjudgment; the half-size probes' own is the error left.
+inline constexpr double kAutoProbeBand = 0.20;
 
 struct AccelChoice {
   AccelKind kind = AccelKind::grid;
-  int probe_width = 0, probe_height = 0;
-  std::map<std::string, double> predicted_ms;  // per candidate, full frame, options.profile
-  std::map<std::string, uint64_t> probe_passes;
-  double probe_ms = 0;  // host wall time of the probes (builds included)
+  int probe_width = 0, probe_height = 0;    // the first probes' size (every candidate)
+  int refine_width = 0, refine_height = 0;  // the second probes' size (those within the band)
+  // Per candidate, the full frame on options.profile: from the second probe where it had one,
+  // else from the first; coarse_ms from the first probes alone.
+  std::map<std::string, double> predicted_ms, coarse_ms;
+  std::vector<std::string> refined;              // the candidates probed again, in order
+  std::map<std::string, uint64_t> probe_passes;  // the first probes' passes
+  double probe_ms = 0;  // host wall time of both rounds of probes (the builds before them apart)
   std::string why;      // one sentence
 };
 
