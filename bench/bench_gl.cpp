@@ -532,11 +532,13 @@ json kernel_json(const FrameRun& fr, const vgpu::FrameStats::ProgramTotals& p, b
     vgpu::FrameStats one;
     one.programs = {p};
     one.totals = p.counters;
-    const vgpu::Profile& hp = vgpu::profile("h200");
-    const host::CostBreakdown b = host::predict(one, hp);
-    k["predicted_h200_ms"] = b.total_ms;
-    k["predicted_h200_work_ms"] = b.arithmetic_ms + b.texture_ms + b.memory_ms;
-    k["predicted_h200_latency_ms"] = b.latency_ms;
+    for (const vgpu::Profile& hp : vgpu::profiles()) {  // every card the GL device measures
+      if (hp.gl_renderer.empty()) continue;
+      const host::CostBreakdown b = host::predict(one, hp);
+      k["predicted_" + hp.name + "_ms"] = b.total_ms;
+      k["predicted_" + hp.name + "_work_ms"] = b.arithmetic_ms + b.texture_ms + b.memory_ms;
+      k["predicted_" + hp.name + "_latency_ms"] = b.latency_ms;
+    }
   }
   return k;
 }
@@ -590,10 +592,12 @@ json frame_json(const FrameKey& key, const host::RenderOptions& opt, const Frame
                          ? json(host::predict(fr.stats, p).total_ms)
                          : json(nullptr);  // the looping program cannot run there
     f["predicted_ms"] = pred;
-    json h200 = json::object();
-    const vgpu::Profile& hp = vgpu::profile("h200");
-    for (const auto& [k, v] : host::predict(fr.stats, hp).items()) h200[k] = v;
-    f["predicted_h200"] = h200;
+    for (const vgpu::Profile& hp : vgpu::profiles()) {  // every card the GL device measures
+      if (hp.gl_renderer.empty()) continue;
+      json card = json::object();
+      for (const auto& [k, v] : host::predict(fr.stats, hp).items()) card[k] = v;
+      f["predicted_" + hp.name] = card;
+    }
   }
   std::printf("%-14s %4dx%-4d %-6s %-9s %-7s streams %-3s %-13s beams %-3s wall %9.1f ms",
               key.scene.c_str(), key.size, key.size, key.accel.c_str(), key.variant.c_str(),
@@ -751,6 +755,10 @@ int main(int argc, char** argv) {
       out["device"] = d.description();
       out["renderer"] = d.context().renderer();
       out["gl_version"] = d.context().version();
+      // The profile measured on this card, which its frames are to be compared with (null where
+      // none was: scripts/docs/cells.py then refuses them).
+      const vgpu::Profile* card = vgpu::profile_for_renderer(d.context().renderer());
+      out["card_profile"] = card ? json(card->name) : json();
       std::printf("device: %s\n", d.description().c_str());
     }
     if (a.wait_mode != "none" && !a.no_fixed) measure_fixed_costs(a, out);
@@ -758,7 +766,10 @@ int main(int argc, char** argv) {
       gl::GlDevice d(vgpu::profile("h200"), a.device, gl::GlDevice::ReadbackWait::poll);
       out["latency"] = measure_latencies(d, a.runs, std::max(a.warmup_ms, 200));
     }
-    if (!a.no_frames) out["frames"] = measure_frames(a);
+    if (!a.no_frames) {
+      out["grid"] = a.grid_text;  // --grid, which the frames record nowhere else
+      out["frames"] = measure_frames(a);
+    }
     if (!a.json_path.empty()) {
       std::ofstream f(a.json_path);
       f << out.dump(2) << "\n";

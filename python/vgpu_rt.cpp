@@ -193,6 +193,8 @@ py::dict profile_dict(const vgpu::Profile& p) {
   d["dynamic_branching"] = p.branching == vgpu::Branching::dynamic;
   d["branches_as_selects"] = p.branches_as_selects;
   d["branch_granularity"] = p.branch_granularity;
+  // The card the GL device measured it on, as its GL_RENDERER names it ("" for modeled cards).
+  d["gl_renderer"] = p.gl_renderer;
   return d;
 }
 

@@ -5,6 +5,12 @@
 
 namespace vgpu {
 
+namespace {
+// The cards the GL device was measured on, defined below the table.
+Profile measured_h200();
+Profile measured_h100();
+}  // namespace
+
 const std::vector<Profile>& profiles() {
   static const std::vector<Profile> table = [] {
     std::vector<Profile> t;
@@ -137,74 +143,137 @@ const std::vector<Profile>& profiles() {
     m.loop_overhead_clocks = 1;       // model parameter (assumed: a compare and a branch)
     t.push_back(m);
 
-    // The H200 the GL device is measured on (docs/studies/real_gpu.md): a 2026 GPU running the
-    // paper's multipass loop through OpenGL 3.3 (EGL, NVIDIA 580 driver).
-    m = Profile{};
-    m.name = "h200";
-    m.display = "NVIDIA H200 SXM (GH100), through OpenGL 3.3";
-    m.cg_profile = "GLSL 3.30 (generated)";
-    // GH100 is a compute part: of its 66 TPCs (132 SMs) only 2 TPCs, 4 SMs, can run vertex and
-    // pixel shaders (NVIDIA H100 Tensor Core GPU Architecture whitepaper, 2022). Fragment
-    // programs run on those: 4 SMs x 128 FP32 cores.
-    // nvidia-smi showed the boost clock through the measured frames, ~1 GHz when the GPU sat
-    // idle between passes (docs/studies/real_gpu.md).
-    m.pipelines = 512;  // 4 graphics-capable SMs x 128 FP32 cores (H100 architecture whitepaper)
-    m.core_mhz = 1980;  // boost clock, SXM (NVIDIA H100 SXM5 specifications; H200 same GH100)
-    m.mem_gbps = 4800;  // HBM3e, 4.8 TB/s (NVIDIA H200 datasheet)
-    m.max_outputs = 8;  // GL_MAX_DRAW_BUFFERS on NVIDIA drivers
-    m.max_instructions = 1 << 20;  // effectively unlimited (model parameter)
-    m.branching = Branching::dynamic;
-    m.branch_granularity = 32;              // one warp (NVIDIA CUDA programming guide)
-    m.branches_as_selects = true;           // the generated GLSL has no branches (vgpu/glsl.cpp)
-    m.max_texture_size = 32768;             // GL_MAX_TEXTURE_SIZE on NVIDIA drivers
-    m.memory_mib = int(141e9 / (1 << 20));  // 141 GB HBM3e (NVIDIA H200 datasheet)
-    m.texture_units = 32;  // GL_MAX_TEXTURE_IMAGE_UNITS on NVIDIA's current GL drivers
-    m.precision = Format::fp32;
-    m.bus_mbps = 64000;  // PCI Express 5.0 x16, one direction (H200 datasheet)
-    // Fixed costs measured by bench_gl on this H200 (NVIDIA 580 driver, EGL, 1x1 passes, medians
-    // of two runs, docs/studies/real_gpu.md): a pass 10.0 and 10.8 us, a polled query read-back 9
-    // to 14 us more, a program switch under 1 us. The blocking GL_QUERY_RESULT wait costs up to
-    // 140 us more after a long pass (the driver sleeps); the model prices the polled wait.
-    m.pass_us = 10.4;                // measured (bench_gl)
-    m.readback_us = 12;              // measured (bench_gl, polled)
-    m.program_load_us = 0.5;         // measured (bench_gl: within noise of 0)
-    m.alu_lanes = 1;                 // scalar CUDA cores: every scalar operation is one instruction
-    m.alu_per_clock = 1;             // one FP32 FMA per core per clock (Hopper whitepaper)
-    m.fp32_rate = 1;                 // FP32 is the full rate (Hopper whitepaper)
-    m.texels_per_clock = 4.0 / 128;  // 4 texture units per SM (Hopper whitepaper)
-    // 16 texture units (4 SMs) fetching one 32-bit component a clock each (RGBA32F in 4).
-    m.texture_bytes_per_clock = 64;  // model parameter (assumed rate per texture unit)
-    // The ROPs: bench_gl's 1024x1024 copy pass writes 16 MB in 301.6 us of GPU time at 1980 MHz
-    // and two targets take twice as long: 28 bytes a clock. Measured on tiny programs, not on the
-    // frames it predicts.
-    m.output_bytes_per_clock = 28;  // model parameter (measured by bench_gl's copy pass)
-    // A glGetTexImage of one RGBA32F texture to the host: 330 us for 1 MB, 5.43 ms for 16 MB,
-    // 28.1 ms for 64 MB (bench_gl, results/real_gpu/real_gpu_h200_texture_io.json): 3.1 GB/s, no
-    // fixed part.
-    m.download_us = 0;      // measured (bench_gl: within noise of 0)
-    m.download_gbps = 3.1;  // measured (bench_gl, 16 MB read-back)
-
-    m.max_loop_iterations = 1 << 20;  // model parameter: no loop count limit
-    m.loop_overhead_clocks = 1;       // model parameter (assumed: a compare and a branch)
-    // One fragment on this H200 (bench_gl --latency,
-    // results/structures/structures_h200_latency.json, GPU timer queries, 1024 against 8192
-    // iterations): following links through RGBA32F textures of 512x512 and 2048x2048 texels, 235.4
-    // and 238.8 ns an iteration (473 clocks at 1980 MHz for the larger; 212 where the 16x16 texture
-    // stays in the first-level cache); 16 dependent multiply-adds, 77.3 ns (153 clocks). Priced as
-    // the model counts those loops (vgpu/span.h: the multiply-adds' iteration is 35 operation
-    // units, the chase's one fetch and 6 units):
-    m.operation_latency_clocks = 4.37;  // measured: 153 clocks / 35
-    m.fetch_latency_clocks = 447;       // measured: 473 clocks - 6 x 4.37
-    t.push_back(m);
+    t.push_back(measured_h200());
+    t.push_back(measured_h100());
     return t;
   }();
   return table;
+}
+
+const Profile* profile_for_renderer(std::string_view renderer) {
+  for (const Profile& p : profiles())
+    if (!p.gl_renderer.empty() && renderer.find(p.gl_renderer) != std::string_view::npos) return &p;
+  return nullptr;
 }
 
 Format Profile::computes(Format f) const {
   const Format g = coarser(f, precision);
   return g == Format::fp16 && !has_fp16 ? precision : g;
 }
+
+namespace {
+
+// The H200 the GL device is measured on (docs/studies/real_gpu.md): a 2026 GPU running the
+// paper's multipass loop through OpenGL 3.3 (EGL, NVIDIA 580 driver).
+Profile measured_h200() {
+  Profile m;
+  m.name = "h200";
+  m.display = "NVIDIA H200 SXM (GH100), through OpenGL 3.3";
+  m.cg_profile = "GLSL 3.30 (generated)";
+  m.gl_renderer = "H200";  // "NVIDIA H200/PCIe/SSE2" (NVIDIA 580 driver)
+  // GH100 is a compute part: of its 66 TPCs (132 SMs) only 2 TPCs, 4 SMs, can run vertex and
+  // pixel shaders (NVIDIA H100 Tensor Core GPU Architecture whitepaper, 2022). Fragment
+  // programs run on those: 4 SMs x 128 FP32 cores.
+  // nvidia-smi showed the boost clock through the measured frames, ~1 GHz when the GPU sat
+  // idle between passes (docs/studies/real_gpu.md).
+  m.pipelines = 512;  // 4 graphics-capable SMs x 128 FP32 cores (H100 architecture whitepaper)
+  m.core_mhz = 1980;  // boost clock, SXM (NVIDIA H100 SXM5 specifications; H200 same GH100)
+  m.mem_gbps = 4800;  // HBM3e, 4.8 TB/s (NVIDIA H200 datasheet)
+  m.max_outputs = 8;  // GL_MAX_DRAW_BUFFERS on NVIDIA drivers
+  m.max_instructions = 1 << 20;  // effectively unlimited (model parameter)
+  m.branching = Branching::dynamic;
+  m.branch_granularity = 32;              // one warp (NVIDIA CUDA programming guide)
+  m.branches_as_selects = true;           // the generated GLSL has no branches (vgpu/glsl.cpp)
+  m.max_texture_size = 32768;             // GL_MAX_TEXTURE_SIZE on NVIDIA drivers
+  m.memory_mib = int(141e9 / (1 << 20));  // 141 GB HBM3e (NVIDIA H200 datasheet)
+  m.texture_units = 32;  // GL_MAX_TEXTURE_IMAGE_UNITS on NVIDIA's current GL drivers
+  m.precision = Format::fp32;
+  m.bus_mbps = 64000;  // PCI Express 5.0 x16, one direction (H200 datasheet)
+  // Fixed costs measured by bench_gl on this H200 (NVIDIA 580 driver, EGL, 1x1 passes, medians
+  // of two runs, docs/studies/real_gpu.md): a pass 10.0 and 10.8 us, a polled query read-back 9
+  // to 14 us more, a program switch under 1 us. The blocking GL_QUERY_RESULT wait costs up to
+  // 140 us more after a long pass (the driver sleeps); the model prices the polled wait.
+  m.pass_us = 10.4;                // measured (bench_gl)
+  m.readback_us = 12;              // measured (bench_gl, polled)
+  m.program_load_us = 0.5;         // measured (bench_gl: within noise of 0)
+  m.alu_lanes = 1;                 // scalar CUDA cores: every scalar operation is one instruction
+  m.alu_per_clock = 1;             // one FP32 FMA per core per clock (Hopper whitepaper)
+  m.fp32_rate = 1;                 // FP32 is the full rate (Hopper whitepaper)
+  m.texels_per_clock = 4.0 / 128;  // 4 texture units per SM (Hopper whitepaper)
+  // 16 texture units (4 SMs) fetching one 32-bit component a clock each (RGBA32F in 4).
+  m.texture_bytes_per_clock = 64;  // model parameter (assumed rate per texture unit)
+  // The ROPs: bench_gl's 1024x1024 copy pass writes 16 MB in 301.6 us of GPU time at 1980 MHz
+  // and two targets take twice as long: 28 bytes a clock. Measured on tiny programs, not on the
+  // frames it predicts.
+  m.output_bytes_per_clock = 28;  // model parameter (measured by bench_gl's copy pass)
+  // A glGetTexImage of one RGBA32F texture to the host: 330 us for 1 MB, 5.43 ms for 16 MB,
+  // 28.1 ms for 64 MB (bench_gl, results/real_gpu/real_gpu_h200_texture_io.json): 3.1 GB/s, no
+  // fixed part.
+  m.download_us = 0;      // measured (bench_gl: within noise of 0)
+  m.download_gbps = 3.1;  // measured (bench_gl, 16 MB read-back)
+  // The looping frames' wall time beyond the GPU's timer queries and the fixed costs above
+  // grows with the image: 8x8 0.10 ms, 64x64 0.11, 256x256 0.49, 512x512 2.08 ms (medians,
+  // results/structures/structures_h200_sizes_looping.json: 84 frames), 7.8 ns a pixel by least
+  // squares: the host filling the frame's image, depth and hit ids from the two RGBA32F
+  // textures it read back (32 bytes a pixel) into memory fresh each frame.
+  m.download_host_gbps = 32 / 7.8;  // measured: 32 bytes read back a pixel in 7.8 ns
+
+  m.max_loop_iterations = 1 << 20;  // model parameter: no loop count limit
+  m.loop_overhead_clocks = 1;       // model parameter (assumed: a compare and a branch)
+  // One fragment on this H200 (bench_gl --latency,
+  // results/structures/structures_h200_latency.json, GPU timer queries, 1024 against 8192
+  // iterations): following links through RGBA32F textures of 512x512 and 2048x2048 texels, 235.4
+  // and 238.8 ns an iteration (473 clocks at 1980 MHz for the larger; 212 where the 16x16 texture
+  // stays in the first-level cache); 16 dependent multiply-adds, 77.3 ns (153 clocks). Priced as
+  // the model counts those loops (vgpu/span.h: the multiply-adds' iteration is 35 operation
+  // units, the chase's one fetch and 6 units):
+  m.operation_latency_clocks = 4.37;  // measured: 153 clocks / 35
+  m.fetch_latency_clocks = 447;       // measured: 473 clocks - 6 x 4.37
+  return m;
+}
+
+// The H100 the GL device hands out as often as the H200 (issue 51), measured the way the h200
+// was: bench_gl's fixed costs and latency probes on it (results/real_gpu/h100/, NVIDIA 580
+// driver, EGL). The same GH100 chip with the same 4 graphics SMs: the h200's figures, but for
+// its memory and what was measured on this card.
+Profile measured_h100() {
+  Profile m = measured_h200();
+  m.name = "h100";
+  m.display = "NVIDIA H100 SXM5 80GB (GH100), through OpenGL 3.3";
+  m.gl_renderer = "H100";  // "NVIDIA H100 80GB HBM3/PCIe/SSE2" (NVIDIA 580 driver)
+  m.core_mhz = 1980;       // measured: nvidia-smi clocks.max.sm, and the SM clock while busy
+  m.mem_gbps = 3350;       // HBM3, 3.35 TB/s (NVIDIA H100 SXM5 datasheet)
+  m.memory_mib = 81559;    // measured: nvidia-smi memory.total (80 GB HBM3)
+  m.bus_mbps = 64000;      // PCI Express 5.0 x16, one direction (nvidia-smi: gen 5, width 16)
+  // Fixed costs measured by bench_gl on this H100 (medians of 5 runs of 50 passes), as what
+  // a pass adds to the wall clock beyond its GPU time (the model prices the GPU's work
+  // apart): 12.1 us (1x1), 11.1 (64x64), 10.1 (256x256), 11.1 and 11.7 with the program
+  // switched every pass: 11.1 (the median). A polled query read-back adds 8.0 (1x1), 10.5
+  // (256x256) and 10.3 us (1024x1024) more: 10.3. A program switch: within noise of 0. (The
+  // H200's run of the same rows gives 12.3, 8.0 and 10.3 us a pass: its profile's 10.4.)
+  m.pass_us = 11.1;       // measured (bench_gl: wall minus GPU time, tiny passes)
+  m.readback_us = 10.3;   // measured (bench_gl, polled)
+  m.program_load_us = 0;  // measured (bench_gl: within noise of 0)
+  // The 1024x1024 copy pass writes 16 MB in 301.9 us of GPU time at 1980 MHz: 28 bytes a
+  // clock, as on the H200.
+  m.output_bytes_per_clock = 28;  // measured (bench_gl's copy pass)
+  // glGetTexImage of one RGBA32F texture: 290 us for 1 MB, 3,958 us for 16 MB, 18,231 us for
+  // 64 MB.
+  m.download_us = 0;       // measured (bench_gl: within noise of 0)
+  m.download_gbps = 4.24;  // measured (bench_gl, 16 MB read-back)
+  // The looping frames' wall time beyond the GPU's timer queries and the fixed costs above,
+  // by size (scripts/docs/cells.py --host-fit, results/real_gpu/h100/sizes.json: 36 frames):
+  // 8x8 0.06 ms, 64x64 0.06, 256x256 0.27, 512x512 1.54 ms; 6.6 ns a pixel by least squares.
+  m.download_host_gbps = 32 / 6.6;  // measured: 32 bytes read back a pixel in 6.6 ns
+  // One fragment on this H100 (bench_gl --latency, GPU timer queries, 1024 against 8192
+  // iterations): 462 clocks an iteration through RGBA32F textures of 512x512 and 2048x2048
+  // texels (212 in the 16x16 one), 153 clocks for 16 dependent multiply-adds: as the H200's.
+  m.operation_latency_clocks = 4.37;  // measured: 153 clocks / 35
+  m.fetch_latency_clocks = 436;       // measured: 462 clocks - 6 x 4.37
+  return m;
+}
+
+}  // namespace
 
 const Profile& profile(std::string_view name) {
   for (const Profile& p : profiles())

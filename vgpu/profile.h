@@ -20,6 +20,9 @@ struct Profile {
   std::string name;     // CLI name, e.g. "gf5700"
   std::string display;  // e.g. "GeForce FX 5700 (NV36), Cg fp30"
   std::string cg_profile;
+  // A card the GL device measures: a word its driver's GL_RENDERER string holds ("H200"), so
+  // that measurements on it are priced with this profile. Empty for the cards only modeled.
+  std::string gl_renderer;
   int pipelines = 0;         // fragment pipelines (pixels shaded per clock)
   double core_mhz = 0;       // core clock
   double mem_gbps = 0;       // memory bandwidth, GB/s (1e9 bytes/s)
@@ -49,6 +52,10 @@ struct Profile {
   // rate (0: not modelled; the 2004 cards' read-backs are outside Table 1's timings).
   double download_us = 0;
   double download_gbps = 0;
+  // The host's own pass over what it read back, in bytes read back a second (0: not modelled):
+  // the frame's image and its depth and hit-id arrays are filled from the downloaded textures
+  // into memory fresh each frame (host/trace/stream/stream_tracer.cpp).
+  double download_host_gbps = 0;
   int instruction_bytes = 16;  // bytes of one encoded instruction (program upload size)
   // Fragment-unit throughput, for the cost model (host/model/cost_model.h).
   int alu_lanes = 4;            // scalar lanes one arithmetic instruction drives (4: vec4 ALU)
@@ -90,9 +97,12 @@ constexpr Format coarser(Format a, Format b) {
   return significand_bits(a) <= significand_bits(b) ? a : b;
 }
 
-// The built-in profiles: gf5700, r300, gf6600, rtx4090.
+// The built-in profiles: gf5700, r300, gf6600, rtx4090, h200 and the cards measured since.
 const std::vector<Profile>& profiles();
 // Looks a profile up by name; throws std::invalid_argument naming the known ones.
 const Profile& profile(std::string_view name);
+// The profile measured on the card whose GL_RENDERER string this is (Profile::gl_renderer), or
+// nullptr where no profile was measured on that card.
+const Profile* profile_for_renderer(std::string_view renderer);
 
 }  // namespace vgpu

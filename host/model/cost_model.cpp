@@ -164,6 +164,8 @@ CostBreakdown predict(const vgpu::FrameStats& stats, const vgpu::Profile& hw, co
   if (hw.download_gbps > 0)
     b.download_ms = 1e-3 * hw.download_us * double(stats.downloads) +
                     1e3 * double(stats.download_bytes) / (hw.download_gbps * 1e9);
+  if (hw.download_host_gbps > 0)  // the host then fills the frame's arrays from them
+    b.download_ms += 1e3 * double(stats.download_bytes) / (hw.download_host_gbps * 1e9);
   b.total_ms = b.arithmetic_ms + b.texture_ms + b.memory_ms + b.latency_ms + b.per_pass_ms +
                b.program_load_ms + b.readback_ms + b.download_ms;
   return b;

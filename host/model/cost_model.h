@@ -21,7 +21,8 @@
 //                longest lane: the bound a greedy schedule keeps (Brent 1974).
 // Per frame:  + program loads (bytes over the bus + program_load_us each)
 //             + query read-backs (readback_us each: a pipeline drain and a CPU round trip)
-//             + texture downloads (download_us each + bytes / download_gbps, where modelled)
+//             + texture downloads (download_us each + bytes / download_gbps, where modelled,
+//               + bytes / download_host_gbps: the host filling the frame's arrays from them)
 //             + clears (bytes / bandwidth, counted with memory)
 #pragma once
 
@@ -79,6 +80,7 @@ struct CostBreakdown {
   double bus_ms = 0;           // of program_load_ms: the program bytes over the bus alone
   double readback_ms = 0;      // query read-backs x readback_us
   double download_ms = 0;      // texture read-backs: download_us each + bytes / download_gbps
+                               // + bytes / download_host_gbps
   double wasted_ms = 0;        // of the pass work: idle fragments (finished rays)
   // Looping passes (Counters::loop_*): of the pass work, the lanes already out of the loop while
   // their batch iterates; of the arithmetic, the loop/break overhead (Profile).
@@ -107,7 +109,7 @@ CostBreakdown predict(const vgpu::FrameStats& stats, const vgpu::Profile& profil
 
 // A moving scene's update between two frames (issue 23, --frames): the static textures uploaded
 // again cross the profile's host-to-GPU bus at Profile::bus_mbps, the figure program uploads use
-// (AGP 8x, 2112 MB/s, for gf5700 and r300; PCI Express for gf6600, rtx4090 and h200); the
+// (AGP 8x, 2112 MB/s, for gf5700 and r300; PCI Express for gf6600, rtx4090, h200 and h100); the
 // structure's build is host work, charged as the host measured it (no 2004 CPU is modeled).
 struct UpdateCost {
   double upload_ms = 0;  // uploaded bytes / bus_mbps

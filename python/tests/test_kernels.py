@@ -209,12 +209,12 @@ class KernelsFromPythonTest(unittest.TestCase):
 
         cases = [
             (long, [a], [o], "program 'long' has 1100 instructions; profile gf5700 allows 1024; "
-                             "it fits gf6600, rtx4090 and h200"),
+                             "it fits gf6600, rtx4090, h200 and h100"),
             (two, [a], [o, o2], "program 'two' writes 2 outputs; profile gf5700 allows 1 (no "
-                                "multiple render targets); it fits r300, gf6600, rtx4090 and h200"),
+                                "multiple render targets); it fits r300, gf6600, rtx4090, h200 and h100"),
             (halvings, [a], [o], "program 'halvings' has a data-dependent loop of up to 16 "
                                  "iterations; profile gf5700 (fp30) has no dynamic branching or "
-                                 "loops (0 iterations); it fits gf6600, rtx4090 and h200"),
+                                 "loops (0 iterations); it fits gf6600, rtx4090, h200 and h100"),
             (many, [a], [o], "program 'many' reads texture unit 16 (17 units); profile gf5700 has "
                              "16 texture units (GL_MAX_TEXTURE_IMAGE_UNITS)"),
             (double, [o], [o], "program 'double' reads texture 'o' (unit 0) while rendering to it: "
@@ -235,7 +235,7 @@ class KernelsFromPythonTest(unittest.TestCase):
         with self.assertRaises(ValueError) as e:
             vgpu_rt.Device("r300").run(long, [a], [o])
         self.assertEqual(str(e.exception), "program 'long' has 1100 instructions; profile r300 "
-                                           "allows 288; it fits gf6600, rtx4090 and h200")
+                                           "allows 288; it fits gf6600, rtx4090, h200 and h100")
 
     def test_a_python_if_on_a_lane_value_raises_naming_the_user_s_line(self):
         @vgpu_rt.kernel(units=["values"])

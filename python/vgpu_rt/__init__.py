@@ -321,7 +321,7 @@ def scenes_dir():
 
 
 def profiles():
-    """The built-in hardware profiles (gf5700, r300, gf6600, rtx4090, h200), each a dict of
+    """The built-in hardware profiles (gf5700, r300, gf6600, rtx4090, h200, h100), each a dict of
     its main figures: name, display, core_mhz, mem_gbps, bus_mbps, max_outputs,
     max_loop_iterations, and what the cost model prices with: pipelines, alu_lanes, alu_per_clock,
     fp32_rate, texels_per_clock, pass_us, program_load_us, readback_us, dynamic_branching and

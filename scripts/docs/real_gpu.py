@@ -260,8 +260,8 @@ def variants_section(name, d, clk, pred, pv, source):
     multipass ones; PV holds this machine's predictions of the variants."""
     lines = [f"### The paper's future work on the {name}: MRT and looping kernels", "",
              "The same frames with the fused two-output passes (`--mrt on`) and with the "
-             "looping kernels (`--kernels looping`, 32 steps a pass), on the `h200` profile, "
-             "polled read-backs, measured in one run beside the multipass pipeline "
+             "looping kernels (`--kernels looping`, 32 steps a pass), priced on the "
+             f"`{name}` profile, polled read-backs, measured beside the multipass pipeline "
              f"(`{os.path.relpath(os.path.abspath(source), ROOT)}`)."]
     if clk:
         lines[-1] += (f" SM clock while busy: median {statistics.median(clk):.0f} MHz, "
@@ -340,7 +340,8 @@ def main():
         lines += remote_section(name, d, clk, pred)
     for name, (d, clk) in variants.items():
         pv = load(preds_var) if os.path.exists(preds_var) else {"frames": []}
-        lines += variants_section(name, d, clk, pred, pv, args.add_variants[0].partition("=")[2])
+        source = next(a.partition("=")[2] for a in args.add_variants if a.startswith(name + "="))
+        lines += variants_section(name, d, clk, pred, pv, source)
     for name, (d, clk) in earlier.items():
         lines += earlier_section(name, d, clk)
     lines += llvmpipe_section(llvm)

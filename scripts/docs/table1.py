@@ -116,7 +116,7 @@ def parse_parameters():
             current[v] = value.strip('"')
             rows.setdefault(current[v], [])
             continue
-        if field in ("display", "cg_profile"):
+        if field in ("display", "cg_profile", "gl_renderer"):
             continue
         if "fitted" in source:
             status = "fitted"
@@ -484,7 +484,8 @@ def parameters_section():
       "x `instruction_bytes`) over `bus_mbps` plus `program_load_us`; per query read-back "
       "`readback_us`; per clear its bytes over `mem_gbps` (or `output_bytes_per_clock` where "
       "given); per texture download (the image at the end of a frame) `download_us` plus its "
-      "bytes over `download_gbps` where given (the H200; 0 elsewhere). Arithmetic: counted "
+      "bytes over `download_gbps` where given, and over `download_host_gbps` (the host filling "
+      "the frame's arrays from them; the H200; 0 elsewhere). Arithmetic: counted "
       "operations minus "
       "fetches, / `scalar_ops_per_instruction`, / (`pipelines` x `core_mhz` x `alu_per_clock` x "
       "the part's rate for the precision each operation ran at: `fp32_rate`, `fp24_rate`, or 1 "

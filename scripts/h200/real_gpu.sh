@@ -5,8 +5,9 @@
 #   mkdir -p .gl && (cd .gl && apt-get download libegl1 libglvnd0 libopengl0 libgl1 libglx0)
 # copy the repository with .bin and .gl to the GPU host and run there, from its root:
 #   scripts/h200/real_gpu.sh OUTPUT_DIR
-# then copy OUTPUT_DIR's real_gpu_h200.json and gpu_clocks.csv to results/real_gpu/ (the clocks as
-# real_gpu_h200_clocks.csv) and run here:
+# then copy OUTPUT_DIR's real_gpu_CARD.json (CARD: h200 or h100, the card the device gave) and
+# gpu_clocks.csv to results/real_gpu/ (the clocks as real_gpu_CARD_clocks.csv) and run here
+# (results/real_gpu/README.md has the command with both cards):
 #   /usr/bin/python3 scripts/docs/real_gpu.py --reuse --add h200=results/real_gpu/real_gpu_h200.json \
 #     --add-variants h200=results/real_gpu/real_gpu_h200_variants.json --add-run h200-run1=results/real_gpu/real_gpu_h200_run1.json
 set -euo pipefail
@@ -20,6 +21,11 @@ fi
 nvidia_json=/usr/local/nvidia/share/glvnd/egl_vendor.d/10_nvidia.json
 [ -f "$nvidia_json" ] && export __EGL_VENDOR_LIBRARY_FILENAMES="$nvidia_json"
 smi() { command -v nvidia-smi >/dev/null && nvidia-smi "$@" || true; }
+# The card the device gave (an H100 or an H200): the files are named after its profile, which
+# bench_gl also records as card_profile (vgpu::profile_for_renderer).
+card=$(smi --query-gpu=name --format=csv,noheader | grep -o 'H[12]00' | head -1 | tr H h)
+card=${card:-h200}
+echo "card: $card"
 smi --query-gpu=name,driver_version,clocks.sm,clocks.max.sm,clocks.mem,power.draw --format=csv \
   > "$out/gpu_before.csv"
 # The GPU clock while measured: sampled every 200 ms in the background.
@@ -32,10 +38,10 @@ if [ "$phase" = all ] || [ "$phase" = frames ]; then
 # every machine: scripts/docs/real_gpu.py computes them here with --readback-wait none).
 .bin/bench_gl --runs 5 --sizes 256 1024 --threads 16 --no-stream --readback-wait both --grid 15 \
   --scenes scenes/sphere-alone.gltf scenes/bunny.gltf scenes/bunny-mirror.gltf \
-  --json "$out/real_gpu_h200.json" 2>&1 | tee "$out/bench_gl.log"
+  --json "$out/real_gpu_$card.json" 2>&1 | tee "$out/bench_gl.log"
 # NVIDIA's driver reads __GL_YIELD for how a waiting thread yields; NOTHING never yields.
 __GL_YIELD=NOTHING .bin/bench_gl --runs 5 --sizes 256 --no-stream --readback-wait block --grid 15 \
-  --micro-passes 50 --scenes scenes/bunny.gltf --json "$out/real_gpu_h200_yield.json" 2>&1 |
+  --micro-passes 50 --scenes scenes/bunny.gltf --json "$out/real_gpu_${card}_yield.json" 2>&1 |
   tee "$out/bench_gl_yield.log"
 fi
 # The paper's future work executed on the GPU: MRT fused passes and the looping kernels beside
@@ -44,11 +50,11 @@ if [ "$phase" = all ] || [ "$phase" = variants ]; then
   .bin/bench_gl --runs 5 --sizes 256 1024 --threads 16 --no-stream --readback-wait poll \
     --variants multipass mrt looping --micro-passes 50 --grid 15 \
     --scenes scenes/sphere-alone.gltf scenes/bunny.gltf scenes/bunny-mirror.gltf \
-    --json "$out/real_gpu_h200_variants.json" 2>&1 | tee "$out/bench_gl_variants.log"
+    --json "$out/real_gpu_${card}_variants.json" 2>&1 | tee "$out/bench_gl_variants.log"
 fi
 # Texture work outside passes (clears, read-backs of a frame's image to the host), for the cost
 # model's download term; the fixed costs again beside them.
 if [ "$phase" = all ] || [ "$phase" = texture-io ]; then
   .bin/bench_gl --runs 5 --micro-passes 50 --no-frames --readback-wait block \
-    --json "$out/real_gpu_h200_texture_io.json" 2>&1 | tee "$out/bench_gl_texture_io.log"
+    --json "$out/real_gpu_${card}_texture_io.json" 2>&1 | tee "$out/bench_gl_texture_io.log"
 fi

@@ -120,6 +120,21 @@ TEST_CASE("Texture downloads cost their fixed part and their bytes where a profi
   CHECK(b.total_ms == doctest::Approx(without.total_ms + 3.5));
 }
 
+TEST_CASE("the host's pass over what a frame read back adds its bytes at the profile's host rate") {
+  vgpu::FrameStats s = frame(kernel_passes(2));
+  s.downloads = 2;
+  s.download_bytes = 3000000;
+  vgpu::Profile hw = card();
+  hw.download_host_gbps = 2;  // alone: priced even where the transfer is not
+  CHECK(host::predict(s, hw, params()).download_ms == doctest::Approx(1.5));
+  hw.download_gbps = 1;  // 3 MB at 1 GB/s: 3 ms, then 1.5 ms on the host
+  hw.download_us = 250;  // and 0.25 ms each
+  const host::CostBreakdown b = host::predict(s, hw, params());
+  CHECK(b.download_ms == doctest::Approx(5.0));
+  const host::CostBreakdown without = host::predict(frame(kernel_passes(2)), hw, params());
+  CHECK(b.total_ms == doctest::Approx(without.total_ms + 5.0));
+}
+
 TEST_CASE("Pass records and per-program totals predict the same for identical passes") {
   vgpu::FrameStats s = frame(kernel_passes(2));
   const host::CostBreakdown totals = host::predict(s, card(), params());

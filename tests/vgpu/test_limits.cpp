@@ -278,7 +278,8 @@ TEST_CASE("queries must be begun before they are ended, and not twice") {
 TEST_CASE("only lane widths 1, 4, 8 and 16 and known profiles exist") {
   CHECK_THROWS_WITH_AS(Gpu(profile("gf5700"), 1, 3), Contains("lane width must be 1, 4, 8 or 16"),
                        Error);
-  CHECK_THROWS_WITH_AS(profile("voodoo2"), Contains("known: gf5700, r300, gf6600, rtx4090, h200"),
+  CHECK_THROWS_WITH_AS(profile("voodoo2"),
+                       Contains("known: gf5700, r300, gf6600, rtx4090, h200, h100"),
                        std::invalid_argument);
   CHECK(profile("gf5700").max_outputs == 1);
   CHECK(profile("gf5700").max_instructions == 1024);
@@ -290,6 +291,22 @@ TEST_CASE("only lane widths 1, 4, 8 and 16 and known profiles exist") {
   CHECK(profile("r300").computes(Format::fp16) == Format::fp24);
   CHECK(profile("gf5700").computes(Format::fp16) == Format::fp16);
   CHECK(profile("gf5700").rate(Format::fp16) == 2 * profile("gf5700").rate(Format::fp32));
-  CHECK(profiles().size() == 5);
+  CHECK(profiles().size() == 6);
   CHECK(profile("h200").max_outputs == 8);
+}
+
+TEST_CASE("a GL renderer string names the profile measured on that card, and no other") {
+  // The strings NVIDIA's 580 driver gave on the two cards the GL device was measured on.
+  const Profile* h200 = profile_for_renderer("NVIDIA H200/PCIe/SSE2");
+  const Profile* h100 = profile_for_renderer("NVIDIA H100 80GB HBM3/PCIe/SSE2");
+  REQUIRE(h200 != nullptr);
+  REQUIRE(h100 != nullptr);
+  CHECK(h200->name == "h200");
+  CHECK(h100->name == "h100");
+  // A card no profile was measured on, and the modeled cards of 2004, have none.
+  CHECK(profile_for_renderer("llvmpipe (LLVM 15.0.6, 256 bits)") == nullptr);
+  CHECK(profile_for_renderer("NVIDIA GeForce RTX 4090/PCIe/SSE2") == nullptr);
+  CHECK(profile_for_renderer("") == nullptr);
+  for (const Profile& p : profiles())
+    CHECK((p.gl_renderer.empty() == (p.name != "h200" && p.name != "h100")));
 }
