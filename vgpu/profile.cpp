@@ -170,7 +170,7 @@ Profile measured_h200() {
   m.name = "h200";
   m.display = "NVIDIA H200 SXM (GH100), through OpenGL 3.3";
   m.cg_profile = "GLSL 3.30 (generated)";
-  m.gl_renderer = "H200";  // "NVIDIA H200/PCIe/SSE2" (NVIDIA 580 driver)
+  m.gl_renderer = "NVIDIA H200/";  // "NVIDIA H200/PCIe/SSE2" (NVIDIA 580 driver)
   // GH100 is a compute part: of its 66 TPCs (132 SMs) only 2 TPCs, 4 SMs, can run vertex and
   // pixel shaders (NVIDIA H100 Tensor Core GPU Architecture whitepaper, 2022). Fragment
   // programs run on those: 4 SMs x 128 FP32 cores.
@@ -240,11 +240,11 @@ Profile measured_h100() {
   Profile m = measured_h200();
   m.name = "h100";
   m.display = "NVIDIA H100 SXM5 80GB (GH100), through OpenGL 3.3";
-  m.gl_renderer = "H100";  // "NVIDIA H100 80GB HBM3/PCIe/SSE2" (NVIDIA 580 driver)
-  m.core_mhz = 1980;       // measured: nvidia-smi clocks.max.sm, and the SM clock while busy
-  m.mem_gbps = 3350;       // HBM3, 3.35 TB/s (NVIDIA H100 SXM5 datasheet)
-  m.memory_mib = 81559;    // measured: nvidia-smi memory.total (80 GB HBM3)
-  m.bus_mbps = 64000;      // PCI Express 5.0 x16, one direction (nvidia-smi: gen 5, width 16)
+  m.gl_renderer = "NVIDIA H100 80GB HBM3/";  // the NVIDIA 580 driver's GL_RENDERER start
+  m.core_mhz = 1980;     // measured: nvidia-smi clocks.max.sm, and the SM clock while busy
+  m.mem_gbps = 3350;     // HBM3, 3.35 TB/s (NVIDIA H100 SXM5 datasheet)
+  m.memory_mib = 81559;  // measured: nvidia-smi memory.total (80 GB HBM3)
+  m.bus_mbps = 64000;    // PCI Express 5.0 x16, one direction (nvidia-smi: gen 5, width 16)
   // Fixed costs measured by bench_gl on this H100 (medians of 5 runs of 50 passes), as what
   // a pass adds to the wall clock beyond its GPU time (the model prices the GPU's work
   // apart): 12.1 us (1x1), 11.1 (64x64), 10.1 (256x256), 11.1 and 11.7 with the program

@@ -20,8 +20,9 @@ struct Profile {
   std::string name;     // CLI name, e.g. "gf5700"
   std::string display;  // e.g. "GeForce FX 5700 (NV36), Cg fp30"
   std::string cg_profile;
-  // A card the GL device measures: a word its driver's GL_RENDERER string holds ("H200"), so
-  // that measurements on it are priced with this profile. Empty for the cards only modeled.
+  // A card the GL device measures: what its driver's GL_RENDERER string holds ("NVIDIA H200/",
+  // not a GH200's), so that measurements on it are priced with this profile. Empty for the
+  // cards only modeled.
   std::string gl_renderer;
   int pipelines = 0;         // fragment pipelines (pixels shaded per clock)
   double core_mhz = 0;       // core clock

@@ -29,8 +29,9 @@ std::string accel_help() {
   for (const host::AccelRow& row : host::kAccelRows)
     help += std::string(row.name) + " (" + std::string(row.description) + ") | ";
   help +=
-      "auto (builds each, renders a probe at a quarter of the size with each and keeps the one "
-      "the cost model predicts cheapest on --profile). ";
+      "auto (builds each, renders a probe at a quarter of the size with each, again at half the "
+      "size with those priced within 20% of the cheapest, and keeps the one the cost model "
+      "predicts cheapest on --profile). ";
   const size_t n = std::size(host::kAccelRows);
   for (size_t i = 1; i < n; ++i)
     help += (i == 1 ? "" : i + 1 < n ? ", " : " and ") + std::string(host::kAccelRows[i].name);

@@ -77,7 +77,7 @@ nlohmann::ordered_json accel_json(const FrameStatsInputs& in) {
     au["refine_size"] =
         in.choice->refine_width > 0
             ? nlohmann::ordered_json{in.choice->refine_width, in.choice->refine_height}
-            : nlohmann::ordered_json();  // the first probes were the frame
+            : nlohmann::ordered_json();  // half the size is no larger than the first probes
     au["refined"] = in.choice->refined;
     au["probe_passes"] = in.choice->probe_passes;
     au["probe_ms"] = in.choice->probe_ms;

@@ -211,7 +211,8 @@ class KernelsFromPythonTest(unittest.TestCase):
             (long, [a], [o], "program 'long' has 1100 instructions; profile gf5700 allows 1024; "
                              "it fits gf6600, rtx4090, h200 and h100"),
             (two, [a], [o, o2], "program 'two' writes 2 outputs; profile gf5700 allows 1 (no "
-                                "multiple render targets); it fits r300, gf6600, rtx4090, h200 and h100"),
+                                "multiple render targets); it fits r300, gf6600, rtx4090, "
+                                "h200 and h100"),
             (halvings, [a], [o], "program 'halvings' has a data-dependent loop of up to 16 "
                                  "iterations; profile gf5700 (fp30) has no dynamic branching or "
                                  "loops (0 iterations); it fits gf6600, rtx4090, h200 and h100"),

@@ -3,9 +3,9 @@
 
 For each scene (scenes/*.gltf and the uneven scenes of scripts/scenes/uneven_scenes.py), primary
 rays (--bounces 0 --shadows off) and the full frame (the defaults), both walks (--kernels
-multipass and looping) and the profiles gf6600, h200 and h100: renders the full frame with each of the
-four structures (the cost model's ms of each, the truth `auto` is judged against) and once with
---accel auto (what it chose, what its probes cost). Writes results/structures/accel_auto.json;
+multipass and looping) and the profiles gf6600, h200 and h100: renders the full frame with each
+of the four structures (the cost model's ms of each, the truth `auto` is judged against) and once
+with --accel auto (what it chose, what its probes cost). Writes results/structures/accel_auto.json;
 scripts/docs/structures.py turns it into the "--accel auto" section of
 docs/studies/structures.md.
 
@@ -13,7 +13,7 @@ Usage: /usr/bin/python3 scripts/docs/accel_auto.py [--vgpu-rt build/host/vgpu-rt
                                                    [--threads 1] [--scene-dir .h200]
                                                    [--json results/structures/accel_auto.json]
 Host times are taken on --threads threads (default 1, so that two runs of the sweep compare).
-About 8 minutes on 2 cores."""
+About 8 minutes on 2 cores. The default --json is the committed file, written over."""
 import argparse
 import glob
 import json
@@ -120,13 +120,16 @@ def section(rows):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--vgpu-rt", default=os.path.join(ROOT, "build", "host", "vgpu-rt"))
-    ap.add_argument("--size", type=int, default=256)
-    ap.add_argument("--threads", type=int, default=1)
+    ap = argparse.ArgumentParser(description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--vgpu-rt", default=os.path.join(ROOT, "build", "host", "vgpu-rt"),
+                    help="the renderer (default: %(default)s)")
+    ap.add_argument("--size", type=int, default=256, help="square frames, pixels a side")
+    ap.add_argument("--threads", type=int, default=1, help="host threads of every render")
     ap.add_argument("--scene-dir", default=os.path.join(ROOT, ".h200"),
                     help="where scripts/scenes/uneven_scenes.py wrote stadium and scales")
-    ap.add_argument("--json", default=DEFAULT_JSON)
+    ap.add_argument("--json", default=DEFAULT_JSON,
+                    help="where to write the rows (default: the committed %(default)s)")
     a = ap.parse_args()
     uneven = [os.path.join(a.scene_dir, f"{s}.gltf") for s in ("stadium", "scales")]
     for u in uneven:

@@ -6,14 +6,16 @@ names its card (GL_RENDERER; "card_profile" where bench_gl knew the profile meas
 every GL frame (the polled read-back where both waits ran) the prediction is the emulator's frame
 of the same options priced on that profile by the model as it stands: bench_gl run here with
 --readback-wait none (the counts are the same on every machine; predictions stored beside the
-measurements are the model of their day and are not read). A cell is within its target where |predicted / wall - 1| is at most 10% for the
-multipass pipeline and 15% for the looping and MRT pipelines (issue 51's targets).
+measurements are the model of their day and are not read). A cell is within its target where
+|predicted / wall - 1| is at most 10% for the multipass pipeline and 15% for the looping and
+MRT pipelines (issue 51's targets).
 
 Usage: /usr/bin/python3 scripts/docs/cells.py FILE.json[@GRID] ... [--bench build/bench/bench_gl]
-           [--scene-dir DIR ...] [--block DOC.md NAME]
-FILE@GRID: the frames ran with bench_gl --grid GRID (files written before bench_gl recorded it;
-default auto). --block writes the table between '<!-- NAME: begin -->' and
-'<!-- NAME: end -->' of DOC.md."""
+           [--scene-dir DIR ...] [--block DOC.md NAME] [--host-fit]
+FILE@GRID: the frames ran with bench_gl --grid GRID, for files written before bench_gl recorded
+it (default auto; a file that records its grid is refused another). --block writes the table
+between '<!-- NAME: begin -->' and '<!-- NAME: end -->' of DOC.md. --host-fit prints, instead,
+what the frames' wall time holds per pixel beyond the GPU and the modeled fixed costs."""
 import argparse
 import json
 import os
@@ -33,7 +35,7 @@ DEFAULTS = {"accel": "grid", "bounces": 2, "shadows": False, "ray_streams": "off
 KEY = ("scene", "accel", "variant", "bounces", "shadows", "ray_streams", "sampling", "beams",
        "size")
 # Cards named by their driver, for files written before bench_gl recorded card_profile.
-RENDERERS = {"H200": "h200", "H100": "h100"}
+RENDERERS = {"NVIDIA H200/": "h200", "NVIDIA H100 80GB HBM3/": "h100"}
 
 
 def fail(msg):
@@ -87,13 +89,17 @@ def emulate(bench, k, dirs, grid, cache):
 def cells(paths, bench, dirs):
     cache, rows = {}, []
     for spec in paths:
-        path, _, grid = spec.partition("@")
+        path, at, grid = spec.rpartition("@")
+        if not at:
+            path, grid = spec, ""
         try:
             with open(path) as fh:
                 doc = json.load(fh)
         except (OSError, ValueError) as e:
             fail(f"{path}: {e}")
         card = card_of(path, doc)
+        if grid and doc.get("grid") and grid != doc["grid"]:
+            fail(f"{spec}: the file records --grid {doc['grid']}")
         grid = grid or doc.get("grid", "auto")
         frames = doc.get("frames", [])
         gl = {}
@@ -121,8 +127,8 @@ def cells(paths, bench, dirs):
 
 
 def changed(r):
-    """A stored frame the program no longer renders alike (more than 1% or 3 passes apart: the
-    kernels changed since it was measured), which its prediction cannot judge."""
+    """A stored frame the program no longer renders alike (more than 3 passes and more than 1%
+    apart: the kernels changed since it was measured), which its prediction cannot judge."""
     return abs(r["passes"] - r["emulated_passes"]) > max(3, 0.01 * r["emulated_passes"])
 
 
@@ -165,31 +171,41 @@ def host_fit(rows):
     """What the wall clock holds beyond the GPU's timer queries and the modeled fixed costs
     (passes, program loads, read-backs, downloads), against the frame's pixels: ns a pixel by
     least squares through zero (Profile::download_host_gbps)."""
-    pts = [(r["key"][8] ** 2, r["wall"] - r["gpu"] - r["fixed"]) for r in rows
-           if r["gpu"] is not None]
-    if not pts:
-        fail("--host-fit needs GL frames with GPU times")
-    ns = 1e6 * sum(p * m for p, m in pts) / sum(p * p for p, _ in pts)
-    lines = [f"{len(pts)} frames; the remainder beyond the GPU and the fixed costs, by size:"]
-    for size in sorted({r["key"][8] for r in rows}):
-        rem = [m for p, m in pts if p == size * size]
-        lines.append(f"  {size}x{size}: median {statistics.median(rem):.3f} ms over {len(rem)}")
-    lines.append(f"least squares: {ns:.2f} ns a pixel beyond the profile as it stands (its "
-                 "download_host_gbps was fitted so, with it at 0)")
+    lines = []
+    for card in sorted({r["card"] for r in rows}):
+        pts = [(r["key"][8] ** 2, r["wall"] - r["gpu"] - r["fixed"]) for r in rows
+               if r["card"] == card and r["gpu"] is not None and not changed(r)]
+        if not pts:
+            fail(f"--host-fit: no {card} frame with GPU times")
+        ns = 1e6 * sum(p * m for p, m in pts) / sum(p * p for p, _ in pts)
+        lines.append(f"{card}: {len(pts)} frames; the remainder beyond the GPU and the fixed "
+                     "costs, by size:")
+        for px in sorted({p for p, _ in pts}):
+            rem = [m for p, m in pts if p == px]
+            lines.append(f"  {int(px ** 0.5)}x{int(px ** 0.5)}: median "
+                         f"{statistics.median(rem):.3f} ms over {len(rem)}")
+        lines.append(f"  least squares: {ns:.2f} ns a pixel beyond the profile as it stands (its "
+                     "download_host_gbps was fitted so, with it at 0)")
     return "\n".join(lines)
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("files", nargs="+")
-    ap.add_argument("--bench", default=os.path.join(ROOT, "build", "bench", "bench_gl"))
-    ap.add_argument("--scene-dir", nargs="*", default=[os.path.join(ROOT, ".h200")],
-                    help="where the generated scenes are (scenes/ is always searched)")
-    ap.add_argument("--block", nargs=2, metavar=("DOC", "NAME"))
+    ap = argparse.ArgumentParser(description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("files", nargs="+", metavar="FILE.json[@GRID]",
+                    help="bench_gl JSON measured on a GPU")
+    ap.add_argument("--bench", default=os.path.join(ROOT, "build", "bench", "bench_gl"),
+                    help="the bench_gl that emulates the frames here (default: %(default)s)")
+    ap.add_argument("--scene-dir", action="extend", nargs="+", default=[],
+                    help="where the generated scenes are (scenes/ is always searched; "
+                    "default .h200)")
+    ap.add_argument("--block", nargs=2, metavar=("DOC", "NAME"),
+                    help="write the table into DOC's block NAME instead of printing it")
     ap.add_argument("--host-fit", action="store_true",
                     help="print the frames' remainder per pixel instead (download_host_gbps)")
     a = ap.parse_args()
-    rows = cells(a.files, a.bench, [os.path.join(ROOT, "scenes")] + a.scene_dir)
+    dirs = a.scene_dir or [os.path.join(ROOT, ".h200")]
+    rows = cells(a.files, a.bench, [os.path.join(ROOT, "scenes")] + dirs)
     if a.host_fit:
         print(host_fit(rows))
         return

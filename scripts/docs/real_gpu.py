@@ -278,7 +278,7 @@ def variants_section(name, d, clk, pred, pv, source):
                 continue
             src = pred if v == "multipass" else frames_by(pv, v)
             pr = src.get((scene, size, "stream"))
-            # multipass predictions are the gf5700-profile run's counts priced on the h200
+            # multipass predictions are the gf5700-profile run's counts priced on this card's profile
             pm = pr["predicted_ms"].get(name) if pr else None
             b = base.get((scene, size, "gl-poll"))
             lines.append(

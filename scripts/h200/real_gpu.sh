@@ -23,8 +23,11 @@ nvidia_json=/usr/local/nvidia/share/glvnd/egl_vendor.d/10_nvidia.json
 smi() { command -v nvidia-smi >/dev/null && nvidia-smi "$@" || true; }
 # The card the device gave (an H100 or an H200): the files are named after its profile, which
 # bench_gl also records as card_profile (vgpu::profile_for_renderer).
-card=$(smi --query-gpu=name --format=csv,noheader | grep -o 'H[12]00' | head -1 | tr H h)
-card=${card:-h200}
+case "$(smi --query-gpu=name --format=csv,noheader | head -1)" in
+  "NVIDIA H100 80GB HBM3"*) card=h100 ;;
+  "NVIDIA H200"*) card=h200 ;;
+  *) card=h200 ;;  # no profile was measured on this card: named as the first one was
+esac
 echo "card: $card"
 smi --query-gpu=name,driver_version,clocks.sm,clocks.max.sm,clocks.mem,power.draw --format=csv \
   > "$out/gpu_before.csv"

@@ -431,7 +431,11 @@ TEST_CASE(
     if (au["coarse_ms"][k].get<double>() <= 1.2 * coarse)
       band_best = std::min(band_best, au["predicted_ms"][k].get<double>());
   CHECK(au["predicted_ms"][chosen].get<double>() == band_best);
-  CHECK(best <= band_best);
+  // A 32x32 frame: its first probes are 16x16, as large as half the frame, so no second round.
+  CHECK(au["probe_size"] == nlohmann::json::array({16, 16}));
+  CHECK(au["refine_size"].is_null());
+  CHECK(au["refined"].empty());
+  CHECK(au["coarse_ms"] == au["predicted_ms"]);
   const std::string why = au["why"].get<std::string>();
   CHECK(why.rfind(chosen + " predicted ", 0) == 0);  // a sentence naming the choice first
   CHECK(why.find('\n') == std::string::npos);

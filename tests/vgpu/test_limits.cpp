@@ -306,6 +306,10 @@ TEST_CASE("a GL renderer string names the profile measured on that card, and no 
   // A card no profile was measured on, and the modeled cards of 2004, have none.
   CHECK(profile_for_renderer("llvmpipe (LLVM 15.0.6, 256 bits)") == nullptr);
   CHECK(profile_for_renderer("NVIDIA GeForce RTX 4090/PCIe/SSE2") == nullptr);
+  // Nor do the cards whose names hold the words: a GH200, and an H100 of the PCIe kind (other
+  // clocks and memory).
+  CHECK(profile_for_renderer("NVIDIA GH200 480GB/PCIe/SSE2") == nullptr);
+  CHECK(profile_for_renderer("NVIDIA H100 PCIe/PCIe/SSE2") == nullptr);
   CHECK(profile_for_renderer("") == nullptr);
   for (const Profile& p : profiles())
     CHECK((p.gl_renderer.empty() == (p.name != "h200" && p.name != "h100")));

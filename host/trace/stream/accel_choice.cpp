@@ -119,7 +119,8 @@ AccelChoice choose_accel(const Scene& scene, const std::vector<AccelCandidate>& 
   for (const AccelCandidate* cand : priced)
     if (c.coarse_ms.at(std::string(cand->accel->name())) <= (1.0 + kAutoProbeBand) * cheapest)
       band.push_back(cand);
-  if (larger && band.size() > 1) {
+  const size_t probed_again = larger && band.size() > 1 ? band.size() : 0;
+  if (probed_again) {
     std::vector<const AccelCandidate*> kept;
     for (const AccelCandidate* cand : band) {
       const std::string name(cand->accel->name());
@@ -132,7 +133,11 @@ AccelChoice choose_accel(const Scene& scene, const std::vector<AccelCandidate>& 
         refused += (refused.empty() ? "" : "; ") + name + ": " + e.what();
       }
     }
-    if (!kept.empty()) band = kept;
+    band = kept;
+    if (band.empty())  // every one refused: the cheapest of the others, at their first price
+      for (const AccelCandidate* cand : priced)
+        if (c.predicted_ms.count(std::string(cand->accel->name()))) band.push_back(cand);
+    if (band.empty()) throw vgpu::Error("--accel auto: no structure fits: " + refused);
   }
   // The cheapest of the band, a tie going to the candidate listed first.
   double best = 0;
@@ -153,8 +158,8 @@ AccelChoice choose_accel(const Scene& scene, const std::vector<AccelCandidate>& 
       others += part;
     }
   char round2[96] = "";
-  if (!c.refined.empty())
-    std::snprintf(round2, sizeof round2, ", the %zu within %.0f%% again at %dx%d", c.refined.size(),
+  if (probed_again)
+    std::snprintf(round2, sizeof round2, ", the %zu within %.0f%% again at %dx%d", probed_again,
                   100.0 * kAutoProbeBand, c.refine_width, c.refine_height);
   char line[768];
   std::snprintf(line, sizeof line, "%s predicted %.1f ms on %s against %s, from %dx%d probes%s%s%s",

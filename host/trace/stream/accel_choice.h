@@ -34,8 +34,9 @@ inline constexpr double kAutoProbeBand = 0.20;
 
 struct AccelChoice {
   AccelKind kind = AccelKind::grid;
-  int probe_width = 0, probe_height = 0;    // the first probes' size (every candidate)
-  int refine_width = 0, refine_height = 0;  // the second probes' size (those within the band)
+  int probe_width = 0, probe_height = 0;  // the first probes' size (every candidate)
+  // The second probes' size (0 where half the size is no larger than the first probes).
+  int refine_width = 0, refine_height = 0;
   // Per candidate, the full frame on options.profile: from the second probe where it had one,
   // else from the first; coarse_ms from the first probes alone.
   std::map<std::string, double> predicted_ms, coarse_ms;
