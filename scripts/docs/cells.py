@@ -20,30 +20,22 @@ import argparse
 import json
 import os
 import statistics
-import subprocess
 import sys
-import tempfile
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.join(ROOT, "scripts", "lib"))
+import bench_frames  # noqa: E402
+from bench_frames import key  # noqa: E402
 from scale import write_block  # noqa: E402
 
 TARGETS = {"multipass": 0.10, "mrt": 0.15, "looping": 0.15}
-# What bench_gl did before a frame recorded the option (its defaults then).
-DEFAULTS = {"accel": "grid", "bounces": 2, "shadows": False, "ray_streams": "off",
-            "sampling": "spp:1", "beams": "off"}
-KEY = ("scene", "accel", "variant", "bounces", "shadows", "ray_streams", "sampling", "beams",
-       "size")
 # Cards named by their driver, for files written before bench_gl recorded card_profile.
 RENDERERS = {"NVIDIA H200/": "h200", "NVIDIA H100 80GB HBM3/": "h100"}
 
 
 def fail(msg):
     sys.exit(f"cells: {msg}")
-
-
-def key(frame):
-    return tuple(DEFAULTS.get(k) if frame.get(k) is None else frame[k] for k in KEY)
 
 
 def card_of(path, doc):
@@ -56,34 +48,11 @@ def card_of(path, doc):
     fail(f"{path}: no profile was measured on '{doc.get('renderer', '?')}'")
 
 
-def scene_path(name, dirs):
-    for d in dirs:
-        p = os.path.join(d, name + ".gltf")
-        if os.path.exists(p):
-            return p
-    fail(f"scene '{name}' is in none of {', '.join(dirs)}")
-
-
 def emulate(bench, k, dirs, grid, cache):
-    """The emulator's frame of options k (bench_gl --readback-wait none), cached by k."""
-    if (k, grid) in cache:
-        return cache[(k, grid)]
-    scene, accel, variant, bounces, shadows, streams, sampling, beams, size = k
-    with tempfile.TemporaryDirectory() as tmp:
-        out = os.path.join(tmp, "f.json")
-        cmd = [bench, "--readback-wait", "none", "--no-fixed", "--runs", "1", "--grid", grid,
-               "--sizes", str(size), "--scenes", scene_path(scene, dirs), "--accel", accel,
-               "--variants", variant, "--bounces", str(bounces), "--ray-streams", streams,
-               "--sampling", sampling, "--beams", beams, "--json", out]
-        cmd += ["--shadows"] if shadows else []
-        r = subprocess.run(cmd, capture_output=True, text=True)
-        if r.returncode != 0:
-            fail(f"{' '.join(cmd)}: {r.stderr.strip()}")
-        frames = [f for f in json.load(open(out))["frames"] if key(f) == k]
-    if len(frames) != 1:
-        fail(f"bench_gl gave {len(frames)} frames for {k}")
-    cache[(k, grid)] = frames[0]
-    return frames[0]
+    """The emulator's frame of options k, cached by k and the grid."""
+    if (k, grid) not in cache:
+        cache[(k, grid)] = bench_frames.emulate(bench, k, dirs, grid, "cells")
+    return cache[(k, grid)]
 
 
 def cells(paths, bench, dirs):

@@ -17,44 +17,12 @@ import argparse
 import datetime
 import json
 import os
-import subprocess
 import sys
-import tempfile
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-KEY = ("scene", "accel", "variant", "bounces", "shadows", "ray_streams", "sampling", "size")
-# What bench_gl did before a frame recorded the option (its defaults then).
-DEFAULTS = {"accel": "grid", "bounces": 2, "shadows": False, "ray_streams": "off",
-            "sampling": "spp:1"}
-
-
-def key(frame):
-    return tuple(DEFAULTS.get(k) if frame.get(k) is None else frame[k] for k in KEY)
-
-
-def scene_path(name, dirs):
-    for d in dirs:
-        p = os.path.join(d, name + ".gltf")
-        if os.path.exists(p):
-            return p
-    sys.exit(f"h200_repredict: scene '{name}' is in none of {', '.join(dirs)}")
-
-
-def emulate(bench, frame, dirs, grid):
-    scene, accel, variant, bounces, shadows, streams, sampling, size = key(frame)
-    with tempfile.TemporaryDirectory() as tmp:
-        out = os.path.join(tmp, "f.json")
-        cmd = [bench, "--readback-wait", "none", "--no-fixed", "--runs", "1", "--grid", grid,
-               "--sizes", str(size), "--scenes", scene_path(scene, dirs), "--accel", accel,
-               "--variants", variant, "--bounces", str(bounces), "--ray-streams", streams,
-               "--sampling", sampling, "--json", out] + (["--shadows"] if shadows else [])
-        r = subprocess.run(cmd, capture_output=True, text=True)
-        if r.returncode != 0:
-            sys.exit(f"h200_repredict: {' '.join(cmd)} failed: {r.stderr.strip()}")
-        frames = [f for f in json.load(open(out))["frames"] if key(f) == key(frame)]
-    if len(frames) != 1:
-        sys.exit(f"h200_repredict: bench_gl gave {len(frames)} frames for {key(frame)}")
-    return frames[0]
+sys.path.insert(0, os.path.join(ROOT, "scripts", "lib"))
+import bench_frames  # noqa: E402
+from bench_frames import key  # noqa: E402
 
 
 def main():
@@ -74,7 +42,7 @@ def main():
         for f in doc["frames"]:
             if f["engine"] != "stream" or f["variant"] not in a.variants:
                 continue
-            new = emulate(a.bench, f, dirs, a.grid)
+            new = bench_frames.emulate(a.bench, key(f), dirs, a.grid, "h200_repredict")
             if new["passes"] != f["passes"]:
                 sys.exit(f"h200_repredict: {path}: {key(f)} now takes {new['passes']} passes, "
                          f"stored {f['passes']}: the frame itself changed, measure it again")
