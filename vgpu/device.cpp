@@ -2,6 +2,7 @@
 #include "vgpu/device.h"
 
 #include <algorithm>
+#include <array>
 
 namespace vgpu {
 
@@ -98,6 +99,35 @@ void check_pass(const Profile& profile, const Program& p, const Program::Analysi
     fail("program '" + pname + "': drawn rectangle outside the render target");
 }
 
+namespace {
+
+// Counters::footprint_bytes' read part: per distinct texture, the bytes fetched from it (each unit
+// u fetched fetches[u] texels) or its size, whichever is less.
+uint64_t read_footprint(const Texture* const* units,
+                        const std::array<uint64_t, kMaxTextureUnits>& fetches) {
+  std::array<const Texture*, kMaxTextureUnits> seen{};
+  std::array<uint64_t, kMaxTextureUnits> bytes{};
+  size_t distinct = 0;
+  for (int u = 0; u < kMaxTextureUnits; ++u) {
+    if (!fetches[size_t(u)]) continue;
+    size_t i = 0;
+    while (i < distinct && seen[i] != units[u]) ++i;
+    if (i == distinct) seen[distinct++] = units[u];
+    bytes[i] += fetches[size_t(u)] * uint64_t(units[u]->bytes_per_texel());
+  }
+  uint64_t sum = 0;
+  for (size_t i = 0; i < distinct; ++i) sum += std::min(bytes[i], seen[i]->bytes());
+  return sum;
+}
+
+std::array<uint64_t, kMaxTextureUnits> fetched(const FetchTally& per_fragment, uint64_t fragments) {
+  std::array<uint64_t, kMaxTextureUnits> n{};
+  for (size_t u = 0; u < n.size(); ++u) n[u] = uint64_t(per_fragment.per_unit[u]) * fragments;
+  return n;
+}
+
+}  // namespace
+
 Counters pass_counters(const Program::Analysis& a, const Texture* const* units,
                        const std::vector<Texture*>& targets, uint64_t launched, uint64_t shaded,
                        uint64_t discarded) {
@@ -116,6 +146,7 @@ Counters pass_counters(const Program::Analysis& a, const Texture* const* units,
   uint64_t write_per_frag = 0;
   for (const Texture* t : targets) write_per_frag += uint64_t(t->bytes_per_texel());
   c.bytes_written = (shaded - discarded) * write_per_frag;
+  c.footprint_bytes = read_footprint(units, fetched(a.fetches, shaded)) + launched * write_per_frag;
   return c;
 }
 
@@ -132,6 +163,13 @@ void add_loop_counters(Counters& c, const Program::Analysis& a, const Texture* c
   c.instructions = c.instructions - n.shaded * body + n.iterations * body;
   c.texture_fetches = c.texture_fetches - n.shaded * fetches + n.iterations * fetches;
   c.bytes_read = c.bytes_read - n.shaded * bytes + n.iterations * bytes;
+  // The footprint's read part again, the body's fetches once per active iteration.
+  std::array<uint64_t, kMaxTextureUnits> per_unit = fetched(a.fetches, n.shaded);
+  for (size_t u = 0; u < per_unit.size(); ++u)
+    per_unit[u] = per_unit[u] - n.shaded * lp.body_fetches.per_unit[u] +
+                  n.iterations * lp.body_fetches.per_unit[u];
+  c.footprint_bytes = c.footprint_bytes - read_footprint(units, fetched(a.fetches, n.shaded)) +
+                      read_footprint(units, per_unit);
   c.loop_iterations = n.iterations;
   c.loop_lane_slots = n.slots;
   c.loop_lanes_idle = n.slots - n.iterations;

@@ -70,6 +70,13 @@ struct Profile {
   // per clock, and writes its render targets through a few raster-output units.
   double texture_bytes_per_clock = 0;  // texel bytes fetched per clock, all texture units
   double output_bytes_per_clock = 0;   // render-target bytes written per clock, all ROPs
+  // The cache between the texture units and memory (0: not modelled). A pass whose footprint
+  // (Counters::footprint_bytes: what it fetches and writes) is larger than l2_bytes finds what
+  // the passes before it wrote evicted, and fetches at texture_spilled_bytes_per_clock instead of
+  // texture_bytes_per_clock: a stream read in order through a least-recently-used cache smaller
+  // than it hits nothing.
+  double l2_bytes = 0;
+  double texture_spilled_bytes_per_clock = 0;
   // Data-dependent loops (Fragments::loop): 0 where the profile has none (fp30, ps_2_0), else the
   // most iterations one loop may be given. A looping program's batch is branch_granularity
   // pixels: it iterates until its last pixel leaves the loop.

@@ -30,8 +30,12 @@ struct Counters {
   // the arithmetic ran at fp32. The cost model charges each at the profile's rate for it.
   uint64_t alu_fp24 = 0;
   uint64_t alu_fp16 = 0;
-  uint64_t bytes_read = 0;       // bytes fetched through texture units
-  uint64_t bytes_written = 0;    // bytes written to render targets
+  uint64_t bytes_read = 0;     // bytes fetched through texture units
+  uint64_t bytes_written = 0;  // bytes written to render targets
+  // The bytes a pass can touch, the cost model's cache footprint: of each texture it fetches
+  // from, the bytes it fetched or the whole texture, whichever is less (a texture bound to two
+  // units once), plus its targets' texels under the drawn rectangle.
+  uint64_t footprint_bytes = 0;
   uint64_t program_loads = 0;    // binds of a program different from the last one
   uint64_t program_bytes = 0;    // bytes of program code uploaded by those loads
   uint64_t clears = 0;           // render-target clears (glClear: no fragment program)
@@ -83,6 +87,7 @@ inline constexpr std::pair<const char*, uint64_t Counters::*> kCounterFields[] =
     {"alu_fp16", &Counters::alu_fp16},
     {"bytes_read", &Counters::bytes_read},
     {"bytes_written", &Counters::bytes_written},
+    {"footprint_bytes", &Counters::footprint_bytes},
     {"program_loads", &Counters::program_loads},
     {"program_bytes", &Counters::program_bytes},
     {"clears", &Counters::clears},

@@ -25,6 +25,7 @@ std::vector<std::pair<std::string, double>> CostBreakdown::items() const {
           {"readback_ms", readback_ms},
           {"download_ms", download_ms},
           {"wasted_ms", wasted_ms},
+          {"l2_spill_ms", l2_spill_ms},
           {"loop_idle_ms", loop_idle_ms},
           {"loop_overhead_ms", loop_overhead_ms},
           {"latency_ms", latency_ms},
@@ -77,10 +78,16 @@ void add_passes(const vgpu::Counters& c, double n, const vgpu::Profile& hw, cons
       (rate_ops * keep + idle_rate_ops) / packing / (hw.pipelines * hz * hw.alu_per_clock) +
       overhead_s;
   double tex_s = (fetches * keep + idle_fetches) / (hw.pipelines * hz * hw.texels_per_clock);
+  double in_cache_s = tex_s;             // tex_s had the pass fitted in the profile's L2
   if (hw.texture_bytes_per_clock > 0) {  // idle loop lanes fetch texels of the average size
     const double per_fetch = fetches > 0 ? double(c.bytes_read) / n / fetches : 0.0;
-    tex_s = std::max(tex_s, (double(c.bytes_read) / n * keep + idle_fetches * per_fetch) /
-                                (hw.texture_bytes_per_clock * hz));
+    const double bytes = double(c.bytes_read) / n * keep + idle_fetches * per_fetch;
+    // A pass larger than the cache finds what earlier passes wrote evicted (Profile::l2_bytes).
+    const bool spills = hw.l2_bytes > 0 && hw.texture_spilled_bytes_per_clock > 0 &&
+                        double(c.footprint_bytes) / n > hw.l2_bytes;
+    in_cache_s = std::max(tex_s, bytes / (hw.texture_bytes_per_clock * hz));
+    tex_s =
+        spills ? std::max(tex_s, bytes / (hw.texture_spilled_bytes_per_clock * hz)) : in_cache_s;
   }
   double mem_s =
       (double(c.bytes_read) / n * keep + double(c.bytes_written) / n) / (hw.mem_gbps * 1e9);
@@ -100,6 +107,7 @@ void add_passes(const vgpu::Counters& c, double n, const vgpu::Profile& hw, cons
   out.arithmetic_demand_ms += arith_s * ms;
   out.texture_demand_ms += tex_s * ms;
   out.memory_demand_ms += mem_s * ms;
+  out.l2_spill_ms += std::max(0.0, work_s - std::max({arith_s, in_cache_s, mem_s})) * ms;
   if (work_s == arith_s)
     out.arithmetic_ms += work_s * ms;
   else if (work_s == tex_s)
@@ -268,6 +276,7 @@ vgpu::FrameStats with_merged_passes(const vgpu::FrameStats& in,
     c.instructions -= std::min(c.instructions, shared);  // a fetch is one counted operation
     c.texture_fetches -= std::min(c.texture_fetches, shared);
     c.bytes_read -= std::min(c.bytes_read, uint64_t(m.shared_bytes) * c.fragments_shaded);
+    c.footprint_bytes -= std::min(c.footprint_bytes, uint64_t(m.shared_bytes) * c.fragments_shaded);
     // One program for both: a load wherever either used to be loaded first in the pair.
     c.program_loads = std::min(k, std::max(ma.program_loads, mb.program_loads));
     const double bytes_per_load =

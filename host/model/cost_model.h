@@ -8,7 +8,9 @@
 //                at the rate of the precision it ran at (Counters::alu_fp24 / alu_fp16,
 //                Profile::rate: NV3x fp16 full speed, fp32 and fp24 half)
 //   texture    = texel fetches / (pipelines x clock x texels_per_clock), or where the profile
-//                gives one, texel bytes / (texture_bytes_per_clock x clock) if that is longer
+//                gives one, texel bytes / (texture_bytes_per_clock x clock) if that is longer;
+//                at texture_spilled_bytes_per_clock instead where the pass's footprint
+//                (Counters::footprint_bytes) is larger than the profile's l2_bytes
 //   memory     = (bytes read + bytes written) / bandwidth, or where the profile gives one,
 //                bytes written / (output_bytes_per_clock x clock) if that is longer (the ROPs)
 // Looping passes add, per lane slot of a batch still iterating (Counters::loop_lane_slots),
@@ -82,6 +84,9 @@ struct CostBreakdown {
   double download_ms = 0;      // texture read-backs: download_us each + bytes / download_gbps
                                // + bytes / download_host_gbps
   double wasted_ms = 0;        // of the pass work: idle fragments (finished rays)
+  // Of the pass work: what passes larger than the profile's L2 spend fetching beyond the
+  // in-cache rate (Profile::l2_bytes, texture_spilled_bytes_per_clock).
+  double l2_spill_ms = 0;
   // Looping passes (Counters::loop_*): of the pass work, the lanes already out of the loop while
   // their batch iterates; of the arithmetic, the loop/break overhead (Profile).
   double loop_idle_ms = 0;

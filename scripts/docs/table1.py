@@ -491,7 +491,8 @@ def parameters_section():
       "the part's rate for the precision each operation ran at: `fp32_rate`, `fp24_rate`, or 1 "
       "for fp16, counted per pass as `alu_fp24` / `alu_fp16`). Texture: fetches / (`pipelines` x `core_mhz` x "
       "`texels_per_clock`), or texel bytes / (`texture_bytes_per_clock` x `core_mhz`) where "
-      "given and longer. Memory: bytes / `mem_gbps`, or written bytes / "
+      "given and longer, at `texture_spilled_bytes_per_clock` instead where the pass's footprint "
+      "(`footprint_bytes`, counted) is over `l2_bytes` (the H200 and the H100). Memory: bytes / `mem_gbps`, or written bytes / "
       "(`output_bytes_per_clock` x `core_mhz`) where given and longer. Looping passes: idle lane "
       "slots pay the body's operations and fetches, every slot `loop_overhead_clocks`; each "
       "looping pass also waits for its longest lane, added to its work: the most iterations one "
@@ -500,8 +501,8 @@ def parameters_section():
       "(measured on the H200 and the H100 by `bench_gl --latency`; 0, not modeled, "
       "elsewhere). Dynamic branching (6600, RTX 4090): "
       "the pass's branch-idle fragments that sit in all-idle batches of the profile's granularity "
-      "(counted) skip `branch_body_share` of the program's operations, fetches and bytes read. Not modeled: texture caches (every fetched "
-      "byte is charged to memory), the branch instruction's own cost, early-z rejection cost "
+      "(counted) skip `branch_body_share` of the program's operations, fetches and bytes read. Not modeled: texture caches other than "
+      "the H200's and the H100's L2 (every fetched byte is charged to memory), the branch instruction's own cost, early-z rejection cost "
       "(masked fragments are free), CPU-GPU overlap beyond the fitted fixed costs.\n")
     return L
 

@@ -106,6 +106,39 @@ TEST_CASE("Texel-byte and output-byte rates bound a pass where a profile gives t
   CHECK(rop.total_ms == doctest::Approx(1.280 + 0.020 + 0.040992 + 0.040));
 }
 
+TEST_CASE("a pass whose footprint is larger than the profile's L2 fetches at the spilled rate") {
+  // Two passes of 4000 fragments reading and writing 16 B each: a footprint of 128000 B a pass.
+  vgpu::Counters k = kernel_passes(2);
+  k.footprint_bytes = 2 * 128000;
+  vgpu::Profile hw = card();
+  hw.mem_gbps = 1000;              // memory out of the way
+  hw.texture_bytes_per_clock = 1;  // 64000 B at 1e8 B/s: 640 us a pass, over the ALU's 200
+  const host::CostBreakdown none = host::predict(frame(k, 1, 0), hw, params());
+  CHECK(none.texture_ms == doctest::Approx(1.280));
+  CHECK(none.l2_spill_ms == 0.0);
+  hw.l2_bytes = 128000;  // the footprint just fits: the in-cache rate
+  hw.texture_spilled_bytes_per_clock = 0.5;
+  const host::CostBreakdown fits = host::predict(frame(k, 1, 0), hw, params());
+  CHECK(fits.texture_ms == doctest::Approx(1.280));
+  CHECK(fits.l2_spill_ms == 0.0);
+  hw.l2_bytes = 127999;  // one byte over: 0.5 B a clock, 1280 us a pass
+  const host::CostBreakdown spills = host::predict(frame(k, 1, 0), hw, params());
+  CHECK(spills.texture_ms == doctest::Approx(2.560));
+  CHECK(spills.l2_spill_ms == doctest::Approx(1.280));
+  CHECK(spills.total_ms == doctest::Approx(fits.total_ms + 1.280));
+  // Averaged per pass: the same footprint over four passes is 64000 B a pass, inside the L2.
+  vgpu::Counters four = kernel_passes(4);
+  four.footprint_bytes = k.footprint_bytes;
+  CHECK(host::predict(frame(four, 1, 0), hw, params()).l2_spill_ms == 0.0);
+  // The spill is what the pass takes beyond its next bound: in the cache at 4 B a clock the
+  // pass would take the ALU's 200 us; spilled at 2 B a clock, 320 us: 120 us of spill a pass.
+  hw.texture_bytes_per_clock = 4;
+  hw.texture_spilled_bytes_per_clock = 2;
+  const host::CostBreakdown alu = host::predict(frame(k, 1, 0), hw, params());
+  CHECK(alu.texture_ms == doctest::Approx(0.640));
+  CHECK(alu.l2_spill_ms == doctest::Approx(0.240));
+}
+
 TEST_CASE("Texture downloads cost their fixed part and their bytes where a profile prices them") {
   vgpu::FrameStats s = frame(kernel_passes(2));
   s.downloads = 2;

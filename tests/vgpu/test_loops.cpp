@@ -36,6 +36,26 @@ struct LongBody {
   }
 };
 
+// CountTo with a fetch of unit 1's texel (iteration, 0) in its body.
+struct FetchInLoop {
+  static constexpr const char* name = "fetch in loop";
+  static constexpr const char* paper_name = "-";
+  static constexpr int outputs = 1;
+  template <class L>
+  void operator()(Fragments<L>& f) const {
+    using F = typename L::F;
+    using M = typename L::M;
+    const F n = f.fetch_own(0).x;
+    F c = F(0.0f), s = F(0.0f);
+    f.loop(16, n > F(0.0f), [&](const M& active) {
+      s = vgpu::select(active, s + f.fetch(1, c, F(0.0f)).x, s);
+      c = vgpu::select(active, c + F(1.0f), c);
+      return c < n;
+    });
+    f.out(0) = {c, s, F(0.0f), F(0.0f)};
+  }
+};
+
 // A loop body with a branch in it.
 struct BranchInLoop {
   static constexpr const char* name = "branch in loop";
@@ -84,6 +104,26 @@ std::string refusal(const Profile& profile, const K& k) {
 }
 
 }  // namespace
+
+TEST_CASE("a looping pass's footprint holds the texels its body fetched on every iteration") {
+  Gpu gpu(profile("gf6600"), 1, 8);
+  KernelProgram<FetchInLoop> p;
+  const Texture in = row({1, 3, 7});                        // 11 iterations in all
+  const Texture wide = row(std::vector<float>(64, 1.0f));   // 64 texels, 1024 B
+  const Texture narrow = row(std::vector<float>(8, 1.0f));  // 8 texels, 128 B
+  Texture out("out", 3, 1, 4);
+  gpu.use_program(p);
+  gpu.bind_texture(0, in);
+  gpu.bind_texture(1, wide);
+  gpu.set_targets({&out});
+  const Counters c = gpu.draw().counters;
+  CHECK(c.loop_iterations == 11);
+  CHECK(c.bytes_read == 3 * 16 + 11 * 16);
+  // in's 48 B, 11 body fetches of 16 B from wide, the target's 48 B.
+  CHECK(c.footprint_bytes == 48 + 11 * 16 + 48);
+  gpu.bind_texture(1, narrow);  // 176 B fetched from a texture of 128
+  CHECK(gpu.draw().counters.footprint_bytes == 48 + 128 + 48);
+}
 
 TEST_CASE("the counting run gives a loop body's static instructions and its budget") {
   KernelProgram<CountTo> p;

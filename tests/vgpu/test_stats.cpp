@@ -28,6 +28,21 @@ struct Split {
   }
 };
 
+// Own texels of unit 0 and unit 2 (one texture bound to both in the test) and two fetches of
+// texel (0, 0) of unit 1.
+struct Gather {
+  static constexpr const char* name = "gather";
+  static constexpr const char* paper_name = "-";
+  static constexpr int outputs = 1;
+  template <class L>
+  void operator()(Fragments<L>& f) const {
+    using F = typename L::F;
+    const auto a = f.fetch_own(0), b = f.fetch_own(2);
+    const auto t = f.fetch(1, F(0.0f), F(0.0f)), u = f.fetch(1, F(0.0f), F(0.0f));
+    f.out(0) = {a.x + b.x, t.y + u.y, a.z, b.w};
+  }
+};
+
 }  // namespace
 
 TEST_CASE("a 64x64 pass of three fp32x4 fetches counts 12288 fetches and 196608 bytes read") {
@@ -75,6 +90,26 @@ TEST_CASE("multiple render targets add their texel sizes to the bytes written") 
   CHECK(c.bytes_written == 50 * (16 + 4));
   CHECK(c.bytes_read == 50 * 16);
   CHECK(c.instructions == 50 * 2);  // a fetch and a multiply
+}
+
+TEST_CASE("a pass's footprint counts each texture once, at most its size, and its drawn targets") {
+  Gpu gpu(profile("gf6600"), 1);
+  // in: 10x10 fp32x4, 1600 B, on units 0 and 2; table: 2x2 fp32x4, 64 B; out: 10x10 fp32x4.
+  Texture in = gpu.make_texture("in", 10, 10, 4), table = gpu.make_texture("table", 2, 2, 4),
+          out = gpu.make_texture("out", 10, 10, 4);
+  KernelProgram<Gather> gather;
+  gpu.use_program(gather);
+  gpu.bind_texture(0, in);
+  gpu.bind_texture(1, table);
+  gpu.bind_texture(2, in);
+  gpu.set_targets({&out});
+  // 10x8 = 80 fragments: 2 x 80 x 16 = 2560 B fetched of in, capped at its 1600 B; 2 x 80 x 16
+  // of table, capped at 64 B; 80 x 16 = 1280 B of the target.
+  const Counters c = gpu.draw(Rect{0, 0, 10, 8}).counters;
+  CHECK(c.bytes_read == 80 * 4 * 16);
+  CHECK(c.footprint_bytes == 1600 + 64 + 1280);
+  // 2x2 = 4 fragments: 128 B of in, the 64 B table, 64 B of the target.
+  CHECK(gpu.draw(Rect{0, 0, 2, 2}).counters.footprint_bytes == 128 + 64 + 64);
 }
 
 TEST_CASE("a program load is counted only when the program changes, at 16 bytes an instruction") {
