@@ -25,6 +25,11 @@ struct Error : std::runtime_error {
 struct LimitError : Error {
   using Error::Error;
 };
+// A frame stopped by its budget (Gpu::set_stop_when): a probe already priced out of a choice
+// (--accel auto).
+struct BudgetError : Error {
+  using Error::Error;
+};
 
 // A rectangle of the render target in pixels: [x0, x1) x [y0, y1).
 struct Rect {

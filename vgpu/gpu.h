@@ -53,6 +53,9 @@ class Gpu final : public Device {
   // Texture formats are set per texture.
   void set_precision(Format f) { precision_ = f; }
   Format precision() const { return precision_; }
+  // Called with the statistics' totals as each pass is counted (batch walks' replayed passes
+  // too); true stops the frame there: the pass throws BudgetError. Empty: never.
+  void set_stop_when(std::function<bool(const Counters&)> stop) { stop_when_ = std::move(stop); }
   Format precision_of(const Program& p) const {
     return profile_.computes(coarser(precision_, p.precision()));
   }
@@ -156,6 +159,7 @@ class Gpu final : public Device {
   Profile profile_;
   int lanes_;
   Format precision_ = Format::fp32;
+  std::function<bool(const Counters&)> stop_when_;
   const Program* bound_ = nullptr;    // the program bound
   const Program* program_ = nullptr;  // what runs: bound_, or its recording
   std::vector<std::string> recorded_;

@@ -248,6 +248,9 @@ const PassRecord& Gpu::settle(const Program& p, const Program::Analysis& a, cons
     add(totals.loop_idle, loop_idle);
   }
   stats_.totals += c;
+  if (stop_when_ && stop_when_(stats_.totals))
+    throw BudgetError("the frame stopped after " + std::to_string(stats_.totals.passes) +
+                      " passes: over its budget");
   PassRecord rec{pname, rect.width(), rect.height(), c, -1};
   rec.loop_active = std::move(loop_active);
   rec.loop_idle = std::move(loop_idle);

@@ -31,7 +31,8 @@ std::string accel_help() {
   help +=
       "auto (builds each, renders a probe at a quarter of the size with each, again at half the "
       "size with those priced within 20% of the cheapest, and keeps the one the cost model "
-      "predicts cheapest on --profile). ";
+      "predicts cheapest on --profile; a probe stops once its passes' fixed costs alone price it "
+      "out). ";
   const size_t n = std::size(host::kAccelRows);
   for (size_t i = 1; i < n; ++i)
     help += (i == 1 ? "" : i + 1 < n ? ", " : " and ") + std::string(host::kAccelRows[i].name);

@@ -79,6 +79,7 @@ nlohmann::ordered_json accel_json(const FrameStatsInputs& in) {
             ? nlohmann::ordered_json{in.choice->refine_width, in.choice->refine_height}
             : nlohmann::ordered_json();  // half the size is no larger than the first probes
     au["refined"] = in.choice->refined;
+    au["stopped"] = in.choice->stopped;
     au["probe_passes"] = in.choice->probe_passes;
     au["probe_ms"] = in.choice->probe_ms;
     au["why"] = in.choice->why;

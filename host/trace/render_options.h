@@ -189,6 +189,10 @@ struct RenderOptions {
   // the kernels named here ("all": every one) run as their recordings. The images are the same;
   // for measuring the executor (bench/bench_recorded.cpp) and checking it.
   std::vector<std::string> recorded_programs;
+  // The emulator only: called with the frame's counters so far as each pass is counted; true
+  // stops the frame with vgpu::BudgetError (vgpu::Gpu::set_stop_when). --accel auto's probes,
+  // once their fixed costs alone price them out.
+  std::function<bool(const vgpu::Counters&)> stop_when;
   // The combinations of these options that cannot run are refused in one place,
   // host::validate (host/trace/validate.h).
 };

@@ -60,7 +60,8 @@ def sweep(exe, scenes, size, threads):
                     au = d["accel"]["auto"]
                     row["auto"] = {"chosen": d["accel"]["structure"], "probe_ms": au["probe_ms"],
                                    "init_ms": d["init_ms"], "render_ms": d["render_ms"],
-                                   "refined": au["refined"], "coarse_ms": au["coarse_ms"],
+                                   "refined": au["refined"], "stopped": au["stopped"],
+                                   "coarse_ms": au["coarse_ms"],
                                    "predicted_ms": au["predicted_ms"]}
                     rows.append(row)
                     print(f"{name:12} {mode:7} {walk:9} {prof:6} auto -> {row['auto']['chosen']:6}"
@@ -101,12 +102,13 @@ def section(rows):
          f"farthest is {worst[0]['scene']} ({worst[0]['rays']}, {worst[0]['walk']}, "
          f"{worst[0]['profile']}) at {worst[1]['ratio']:.3f}x.", ""]
     L += ["| scene | rays | walk | profile | cheapest | auto picks | x cheapest | probed again | "
-          "choice ms | frame ms | choice / frame |",
-          "|---|---|---|---|---|---|---:|---|---:|---:|---:|"]
+          "stopped | choice ms | frame ms | choice / frame |",
+          "|---|---|---|---|---|---|---:|---|---|---:|---:|---:|"]
     for r, j in js:
         L.append(f"| {r['scene']} | {r['rays']} | {r['walk']} | {r['profile']} | {j['cheapest']} "
                  f"| {r['auto']['chosen']} | {j['ratio']:.3f} | "
-                 f"{', '.join(r['auto']['refined']) or '-'} | {j['choice_ms']:,.0f} | "
+                 f"{', '.join(r['auto']['refined']) or '-'} | "
+                 f"{', '.join(r['auto']['stopped']) or '-'} | {j['choice_ms']:,.0f} | "
                  f"{j['frame_ms']:,.0f} | {j['cost']:.2f} |")
     costs = sorted(j["cost"] for _, j in js)
     quarter = sum(c <= 0.25 for c in costs)
@@ -115,7 +117,10 @@ def section(rows):
           f"{threads} host thread) over the frame's (the chosen structure's build and its render): "
           f"median {statistics.median(costs):.2f}, from {costs[0]:.2f} to {costs[-1]:.2f}; "
           f"multipass median {by_walk['multipass']:.2f}, looping {by_walk['looping']:.2f}. "
-          f"{quarter} of {len(costs)} choices cost at most a quarter of their frame."]
+          f"{quarter} of {len(costs)} choices cost at most a quarter of their frame. "
+          f"{sum(len(r['auto']['stopped']) for r in rows)} probes stopped once their fixed costs "
+          f"alone priced them out, in {sum(bool(r['auto']['stopped']) for r in rows)} of the "
+          f"{len(rows)} choices."]
     return "\n".join(L)
 
 

@@ -584,6 +584,19 @@ slow (the grid on stadium and scales) its probe alone outlasts the chosen frame,
 build is slow (scales: the kd-tree's 1.2 s) so does that. A choice within a quarter of the
 frame's host time needs a predictor that renders nothing: not built here.
 
+**Stopped probes.** A price only grows as a probe runs: its fixed costs (each pass, program
+load and read-back, priced as the model prices them) are counted in full, and every other term
+is positive. So a probe whose fixed costs so far pass the band of the cheapest first price so far
+cannot be in the band, and a second probe whose fixed costs pass the cheapest second price so
+far cannot be the pick; the emulator stops them there (the column "stopped"; their price in the
+JSON is that lower bound). The pick, the band and every other price are those of probes run to
+their ends (`tests/trace/test_structure_walks.cpp`, three scenes on three profiles). Measured
+with the sweep above: no pick changed; where a probe stopped, both rounds of probes took a median
+0.71x the host time they took before (0.40x to 1.29x over those 78 choices, one run each), and
+the choices cost a median 1.17x their frame instead of 1.43x (0.34x to 8.48x before; the
+previous commit's `results/structures/accel_auto.json`). Every stop was a kd-tree's multipass
+probe, whose restarts cost passes; a looping probe has few passes to stop on.
+
 **The longest-lane term (issue 34).** Until issue 34 the price of a candidate left out the
 cost model's `latency_ms` (a looping pass waits for its longest lane: `docs/studies/table1.md`),
 which only the looping kernels on the `h200` profile have. With `--kernels looping --profile

@@ -435,6 +435,7 @@ TEST_CASE(
   CHECK(au["probe_size"] == nlohmann::json::array({16, 16}));
   CHECK(au["refine_size"].is_null());
   CHECK(au["refined"].empty());
+  CHECK(au["stopped"].is_array());
   CHECK(au["coarse_ms"] == au["predicted_ms"]);
   const std::string why = au["why"].get<std::string>();
   CHECK(why.rfind(chosen + " predicted ", 0) == 0);  // a sentence naming the choice first

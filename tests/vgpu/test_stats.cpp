@@ -112,6 +112,35 @@ TEST_CASE("a pass's footprint counts each texture once, at most its size, and it
   CHECK(gpu.draw(Rect{0, 0, 2, 2}).counters.footprint_bytes == 128 + 64 + 64);
 }
 
+TEST_CASE("a frame stops with BudgetError at the first pass its stop condition holds for") {
+  Gpu gpu(profile("gf6600"), 1);
+  Texture in = gpu.make_texture("in", 4, 4, 4), out = gpu.make_texture("out", 4, 4, 4);
+  KernelProgram<vgpu_test::Copy> copy;
+  gpu.use_program(copy);
+  gpu.bind_texture(0, in);
+  gpu.set_targets({&out});
+  uint64_t seen = 0;  // the passes the condition was asked about
+  gpu.set_stop_when([&](const Counters& t) {
+    seen = t.passes;
+    return t.fragments_shaded > 2 * 16;
+  });
+  gpu.draw();
+  gpu.draw();
+  CHECK(seen == 2);
+  CHECK_THROWS_AS(gpu.draw(), BudgetError);  // the third pass: 48 fragments
+  CHECK(seen == 3);
+  CHECK(gpu.stats().totals.passes == 3);  // counted, then stopped
+  try {
+    gpu.draw();
+    FAIL("the fourth pass ran");
+  } catch (const Error& e) {  // a vgpu::Error, naming the passes
+    CHECK(std::string(e.what()).find("after 4 passes") != std::string::npos);
+  }
+  gpu.set_stop_when({});
+  gpu.draw();
+  CHECK(gpu.stats().totals.passes == 5);
+}
+
 TEST_CASE("a program load is counted only when the program changes, at 16 bytes an instruction") {
   Gpu gpu(profile("gf5700"), 1);
   KernelProgram<Add3> add3;

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <functional>
 #include <optional>
 
 #include "host/model/cost_model.h"
@@ -68,12 +69,29 @@ double probe_scale(const RenderOptions& options, const RenderOptions& probe) {
          (double(probe.width) * double(probe.height));
 }
 
+// A probe's fixed costs so far (per pass, program loads and read-backs, as predict prices them
+// from the counters): full_frame_ms keeps them as counted and adds only non-negative terms, so
+// a probe whose fixed costs pass `ms` is priced over `ms` whatever else it does.
+std::function<bool(const vgpu::Counters&)> over(double ms, const vgpu::Profile& profile) {
+  const CostParams p = defaults_for(profile);
+  return [=, bus = profile.bus_mbps](const vgpu::Counters& t) {
+    const double fixed =
+        1e-3 * (p.pass_us * double(t.passes) + p.program_load_us * double(t.program_loads) +
+                p.readback_us * double(t.query_readbacks)) +
+        1e3 * double(t.program_bytes) / (bus * 1e6);
+    return fixed > ms;
+  };
+}
+
 // One candidate's probe: its full-frame price (every term, full_frame_ms) and passes; throws
-// vgpu::Error where the profile's limits refuse it.
+// vgpu::Error where the profile's limits refuse it, vgpu::BudgetError where `stop` stops it
+// (the emulator's probes).
 std::pair<double, uint64_t> probe_price(const Scene& scene, const AccelCandidate& cand,
                                         RenderOptions probe, const RenderOptions& options,
-                                        const Camera& camera, const vgpu::Profile& profile) {
+                                        const Camera& camera, const vgpu::Profile& profile,
+                                        std::function<bool(const vgpu::Counters&)> stop = {}) {
   probe.formats = cand.formats;
+  probe.stop_when = std::move(stop);
   StreamTracer tracer(scene, *cand.accel, probe);
   const RenderResult r = tracer.render(camera);
   return {full_frame_ms(predict(r.stats, profile), probe_scale(options, probe)),
@@ -83,32 +101,49 @@ std::pair<double, uint64_t> probe_price(const Scene& scene, const AccelCandidate
 }  // namespace
 
 AccelChoice choose_accel(const Scene& scene, const std::vector<AccelCandidate>& candidates,
-                         const RenderOptions& options, const Camera& camera) {
+                         const RenderOptions& options, const Camera& camera, bool stop_early) {
   const auto t0 = std::chrono::steady_clock::now();
   AccelChoice c;
   const RenderOptions probe = probe_options(options, 4);
   c.probe_width = probe.width;
   c.probe_height = probe.height;
   const vgpu::Profile& profile = vgpu::profile(options.profile);
-  // The first round: every candidate at a quarter of the size.
+  // A probe stops once its passes alone price it over `ms`; its price is then only known to be
+  // over that: kept as `ms`, the candidate listed in `stopped`.
+  const bool emulated = options.device == "vgpu";
+  auto budget = [&](double ms) {
+    return stop_early && emulated ? over(ms, profile)
+                                  : std::function<bool(const vgpu::Counters&)>{};
+  };
+  auto stop = [&](const std::string& name, double ms) {
+    c.stopped.push_back(name);
+    return ms;
+  };
+  // The first round: every candidate at a quarter of the size. Once one is priced, a probe past
+  // the band of the cheapest so far cannot be in the band of the cheapest: it stops there.
   std::string refused;
   std::vector<const AccelCandidate*> priced;
   double cheapest = 0;
   for (const AccelCandidate& cand : candidates) {
     const std::string name(cand.accel->name());
+    const double bound = (1.0 + kAutoProbeBand) * cheapest;
     try {
-      const auto [ms, passes] = probe_price(scene, cand, probe, options, camera, profile);
+      const auto [ms, passes] = probe_price(scene, cand, probe, options, camera, profile,
+                                            priced.empty() ? nullptr : budget(bound));
       c.coarse_ms[name] = c.predicted_ms[name] = ms;
       c.probe_passes[name] = passes;
       cheapest = priced.empty() ? ms : std::min(cheapest, ms);
       priced.push_back(&cand);
+    } catch (const vgpu::BudgetError&) {
+      c.coarse_ms[name] = c.predicted_ms[name] = stop(name, bound);
     } catch (const vgpu::Error& e) {
       refused += (refused.empty() ? "" : "; ") + name + ": " + e.what();
     }
   }
   if (priced.empty()) throw vgpu::Error("--accel auto: no structure fits: " + refused);
   // The second round: those within kAutoProbeBand of the cheapest, at half the size (where that
-  // is larger than the first probes; at the first probes' size their prices stand).
+  // is larger than the first probes; at the first probes' size their prices stand), the cheapest
+  // first: a probe past the cheapest second price so far cannot be the pick, and stops there.
   const RenderOptions fine = probe_options(options, 2);
   const bool larger = fine.width > probe.width || fine.height > probe.height;
   if (larger) {
@@ -121,19 +156,36 @@ AccelChoice choose_accel(const Scene& scene, const std::vector<AccelCandidate>& 
       band.push_back(cand);
   const size_t probed_again = larger && band.size() > 1 ? band.size() : 0;
   if (probed_again) {
-    std::vector<const AccelCandidate*> kept;
-    for (const AccelCandidate* cand : band) {
+    std::vector<const AccelCandidate*> order = band, kept;
+    std::stable_sort(order.begin(), order.end(), [&](const auto* x, const auto* y) {
+      return c.coarse_ms.at(std::string(x->accel->name())) <
+             c.coarse_ms.at(std::string(y->accel->name()));
+    });
+    double best = 0;
+    for (const AccelCandidate* cand : order) {
       const std::string name(cand->accel->name());
       try {
-        c.predicted_ms[name] = probe_price(scene, *cand, fine, options, camera, profile).first;
-        c.refined.push_back(name);
+        const double ms = probe_price(scene, *cand, fine, options, camera, profile,
+                                      kept.empty() ? nullptr : budget(best))
+                              .first;
+        c.predicted_ms[name] = ms;
+        best = kept.empty() ? ms : std::min(best, ms);
         kept.push_back(cand);
+      } catch (const vgpu::BudgetError&) {
+        c.predicted_ms[name] = stop(name, best);
       } catch (const vgpu::Error& e) {  // the larger probe outgrew a limit: the frame would too
         c.predicted_ms.erase(name);
         refused += (refused.empty() ? "" : "; ") + name + ": " + e.what();
       }
     }
-    band = kept;
+    std::vector<const AccelCandidate*> still;  // in the candidates' order, for ties
+    for (const AccelCandidate* cand : band) {
+      const std::string name(cand->accel->name());
+      if (!c.predicted_ms.count(name)) continue;
+      c.refined.push_back(name);
+      if (std::find(kept.begin(), kept.end(), cand) != kept.end()) still.push_back(cand);
+    }
+    band = still;
     if (band.empty())  // every one refused: the cheapest of the others, at their first price
       for (const AccelCandidate* cand : priced)
         if (c.predicted_ms.count(std::string(cand->accel->name()))) band.push_back(cand);
@@ -152,9 +204,12 @@ AccelChoice choose_accel(const Scene& scene, const std::vector<AccelCandidate>& 
   for (const auto& [name, ms] : c.predicted_ms)
     if (name != accel_name(c.kind)) {
       const bool again = std::find(c.refined.begin(), c.refined.end(), name) != c.refined.end();
+      const bool stopped = std::find(c.stopped.begin(), c.stopped.end(), name) != c.stopped.end();
+      const char* first = again || c.refined.empty() ? "" : ", first probe";
       char part[128];
-      std::snprintf(part, sizeof part, "%s%s %.1f ms (%.2fx%s)", others.empty() ? "" : ", ",
-                    name.c_str(), ms, ms / best, again || c.refined.empty() ? "" : ", first probe");
+      std::snprintf(part, sizeof part, "%s%s %s%.1f ms (%.2fx%s%s)", others.empty() ? "" : ", ",
+                    name.c_str(), stopped ? "over " : "", ms, ms / best,
+                    stopped ? ", its probe stopped" : "", first);
       others += part;
     }
   char round2[96] = "";

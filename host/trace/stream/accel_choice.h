@@ -40,8 +40,13 @@ struct AccelChoice {
   // Per candidate, the full frame on options.profile: from the second probe where it had one,
   // else from the first; coarse_ms from the first probes alone.
   std::map<std::string, double> predicted_ms, coarse_ms;
-  std::vector<std::string> refined;              // the candidates probed again, in order
-  std::map<std::string, uint64_t> probe_passes;  // the first probes' passes
+  std::vector<std::string> refined;  // the candidates probed again, in order
+  // The candidates whose probe stopped once its passes alone priced it out (the first round:
+  // over the band of the cheapest so far; the second: over the cheapest second price so far).
+  // Their price in predicted_ms and coarse_ms is what they were known to pass, a lower bound;
+  // stopping never changes the pick. The emulator's probes only (RenderOptions::max_passes).
+  std::vector<std::string> stopped;
+  std::map<std::string, uint64_t> probe_passes;  // the first probes' passes (those not stopped)
   double probe_ms = 0;  // host wall time of both rounds of probes (the builds before them apart)
   std::string why;      // one sentence
 };
@@ -69,8 +74,10 @@ struct AccelCandidate {
   const Accel* accel;  // not owned
   Formats formats;
 };
+// stop_early false runs every probe to its end (the same pick; for the tests).
 AccelChoice choose_accel(const Scene& scene, const std::vector<AccelCandidate>& candidates,
-                         const RenderOptions& options, const Camera& camera);
+                         const RenderOptions& options, const Camera& camera,
+                         bool stop_early = true);
 
 // --beams auto: beams are kept only where the primary trace with beams is predicted at least this
 // share cheaper than without. The probes price the primary trace exactly (they are it), so the

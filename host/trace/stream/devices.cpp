@@ -24,6 +24,7 @@ std::unique_ptr<vgpu::Device> make_device(const RenderOptions& opt) {
     auto gpu = std::make_unique<vgpu::Gpu>(profile, opt.threads, opt.lanes);
     gpu->set_precision(opt.formats.finest());
     gpu->set_recorded(opt.recorded_programs);
+    gpu->set_stop_when(opt.stop_when);
     return gpu;
   }
   if (opt.device == "gl") {
