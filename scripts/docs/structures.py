@@ -591,11 +591,13 @@ cannot be in the band, and a second probe whose fixed costs pass the cheapest se
 far cannot be the pick; the emulator stops them there (the column "stopped"; their price in the
 JSON is that lower bound). The pick, the band and every other price are those of probes run to
 their ends (`tests/trace/test_structure_walks.cpp`, three scenes on three profiles). Measured
-with the sweep above: no pick changed; where a probe stopped, both rounds of probes took a median
-0.71x the host time they took before (0.40x to 1.29x over those 78 choices, one run each), and
-the choices cost a median 1.17x their frame instead of 1.43x (0.34x to 8.48x before; the
-previous commit's `results/structures/accel_auto.json`). Every stop was a kd-tree's multipass
-probe, whose restarts cost passes; a looping probe has few passes to stop on.
+with the sweep above against the same sweep before (the previous commit's
+`results/structures/accel_auto.json`, one run each): no pick changed; in the 78 choices where a
+probe stopped, both rounds of probes took a median 0.71x the host time they took before (0.40x
+to 1.29x), and those choices cost a median 1.35x their frame instead of 1.76x. The 78 choices
+without a stop took 0.66x to 1.72x their probes' earlier time (median 1.03x): run-to-run noise. Over all 156 the
+median went from 1.43x (0.34x to 8.48x) to 1.17x. Every stop was a kd-tree's multipass probe,
+whose restarts cost passes; a looping probe has few passes to stop on.
 
 **The longest-lane term (issue 34).** Until issue 34 the price of a candidate left out the
 cost model's `latency_ms` (a looping pass waits for its longest lane: `docs/studies/table1.md`),

@@ -3,8 +3,10 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <functional>
+#include <limits>
 #include <optional>
 
 #include "host/model/cost_model.h"
@@ -44,7 +46,8 @@ namespace {
 // of the model's total (CostBreakdown::total_ms). The costs that follow the pass count (per pass,
 // program loads, read-backs) and the looping passes' longest lanes (latency: one lane's chain,
 // which does not grow with the pixel count) as measured; the fragment work scaled by `scale`,
-// the full frame's pixels over the probe's. At scale 1 this is the probe's total_ms.
+// the full frame's pixels over the probe's. At scale 1 this is the probe's total_ms. Whether a
+// pass outgrows the profile's L2 is judged at the full frame's size (full_frame_profile).
 double full_frame_ms(const CostBreakdown& b, double scale) {
   return b.per_pass_ms + b.program_load_ms + b.readback_ms + b.latency_ms +
          scale * (b.arithmetic_ms + b.texture_ms + b.memory_ms + b.download_ms);
@@ -83,6 +86,15 @@ std::function<bool(const vgpu::Counters&)> over(double ms, const vgpu::Profile& 
   };
 }
 
+// The profile a probe is priced on: its L2 divided by `scale`, so that a probe's pass spills
+// where the same pass of the full frame would (a footprint taken to grow with the pixels, as the
+// ray-state textures do; a scene's own textures do not, so a large scene's is overstated).
+vgpu::Profile full_frame_profile(const vgpu::Profile& profile, double scale) {
+  vgpu::Profile p = profile;
+  p.l2_bytes /= scale;
+  return p;
+}
+
 // One candidate's probe: its full-frame price (every term, full_frame_ms) and passes; throws
 // vgpu::Error where the profile's limits refuse it, vgpu::BudgetError where `stop` stops it
 // (the emulator's probes).
@@ -94,7 +106,8 @@ std::pair<double, uint64_t> probe_price(const Scene& scene, const AccelCandidate
   probe.stop_when = std::move(stop);
   StreamTracer tracer(scene, *cand.accel, probe);
   const RenderResult r = tracer.render(camera);
-  return {full_frame_ms(predict(r.stats, profile), probe_scale(options, probe)),
+  const double scale = probe_scale(options, probe);
+  return {full_frame_ms(predict(r.stats, full_frame_profile(profile, scale)), scale),
           r.stats.totals.passes};
 }
 
@@ -115,9 +128,9 @@ AccelChoice choose_accel(const Scene& scene, const std::vector<AccelCandidate>& 
     return stop_early && emulated ? over(ms, profile)
                                   : std::function<bool(const vgpu::Counters&)>{};
   };
-  auto stop = [&](const std::string& name, double ms) {
+  auto stop = [&](const std::string& name, double ms) {  // strictly over: not a tie, not in band
     c.stopped.push_back(name);
-    return ms;
+    return std::nextafter(ms, std::numeric_limits<double>::infinity());
   };
   // The first round: every candidate at a quarter of the size. Once one is priced, a probe past
   // the band of the cheapest so far cannot be in the band of the cheapest: it stops there.

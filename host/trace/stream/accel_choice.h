@@ -4,8 +4,9 @@
 // statistics on the profile asked for: the per-pass, program-load and read-back costs and the
 // looping passes' longest lanes (latency) as measured (they follow the pass count and the
 // longest walk, which the image size hardly changes), the fragment work (arithmetic, texture,
-// memory, downloads) scaled by the pixel ratio: every term of the model's total, so that a
-// probe of the whole frame is priced at its predict().total_ms. The candidates priced within
+// memory, downloads) scaled by the pixel ratio, a pass's L2 spill judged at the full frame's
+// size: every term of the model's total, so that a probe of the whole frame is priced at its
+// predict().total_ms. The candidates priced within
 // kAutoProbeBand of the cheapest are probed again at half the size in x and y, and the cheapest
 // of those is taken.
 #pragma once
@@ -41,10 +42,13 @@ struct AccelChoice {
   // else from the first; coarse_ms from the first probes alone.
   std::map<std::string, double> predicted_ms, coarse_ms;
   std::vector<std::string> refined;  // the candidates probed again, in order
-  // The candidates whose probe stopped once its passes alone priced it out (the first round:
+  // The candidates whose probe stopped once its fixed costs alone priced it out (the first round:
   // over the band of the cheapest so far; the second: over the cheapest second price so far).
-  // Their price in predicted_ms and coarse_ms is what they were known to pass, a lower bound;
-  // stopping never changes the pick. The emulator's probes only (RenderOptions::max_passes).
+  // Their price in predicted_ms (and coarse_ms, for a first-round stop) is just over what they
+  // were known to pass: a lower bound, never equal to a band edge or the pick's price. Stopping
+  // never changes the pick, the band or the other prices; a probe that would have outgrown a
+  // limit later is reported stopped, not refused. The emulator's probes only
+  // (RenderOptions::stop_when).
   std::vector<std::string> stopped;
   std::map<std::string, uint64_t> probe_passes;  // the first probes' passes (those not stopped)
   double probe_ms = 0;  // host wall time of both rounds of probes (the builds before them apart)
