@@ -597,7 +597,9 @@ TEST_CASE("accel auto's stopped probes never change its pick, its band or the ot
         CHECK(whole.stopped.empty());
         CHECK(c.kind == whole.kind);
         CHECK(c.refined == whole.refined);
-        for (const auto& [k, ms] : whole.predicted_ms) {
+        for (const auto& entry : whole.predicted_ms) {
+          const std::string& k = entry.first;  // not a structured binding: CAPTURE's lambda
+          const double ms = entry.second;
           CAPTURE(k);
           if (!listed(c.stopped, k)) {
             CHECK(c.predicted_ms.at(k) == ms);
