@@ -134,6 +134,15 @@ void add_passes(const vgpu::Counters& c, double n, const vgpu::Profile& hw, cons
 
 }  // namespace
 
+FixedCosts fixed_costs(const vgpu::Counters& t, const vgpu::Profile& hw, const CostParams& p) {
+  FixedCosts f;
+  f.per_pass_ms = 1e-3 * p.pass_us * double(t.passes);
+  f.bus_ms = 1e3 * double(t.program_bytes) / (hw.bus_mbps * 1e6);
+  f.program_load_ms = f.bus_ms + 1e-3 * p.program_load_us * double(t.program_loads);
+  f.readback_ms = 1e-3 * p.readback_us * double(t.query_readbacks);
+  return f;
+}
+
 CostBreakdown predict(const vgpu::FrameStats& stats, const vgpu::Profile& profile) {
   return predict(stats, profile, defaults_for(profile));
 }
@@ -165,10 +174,11 @@ CostBreakdown predict(const vgpu::FrameStats& stats, const vgpu::Profile& hw, co
     b.memory_ms += clear_ms;
     b.memory_demand_ms += clear_ms;
   }
-  b.per_pass_ms = 1e-3 * p.pass_us * double(t.passes);
-  b.bus_ms = 1e3 * double(t.program_bytes) / (hw.bus_mbps * 1e6);
-  b.program_load_ms = b.bus_ms + 1e-3 * p.program_load_us * double(t.program_loads);
-  b.readback_ms = 1e-3 * p.readback_us * double(t.query_readbacks);
+  const FixedCosts f = fixed_costs(t, hw, p);
+  b.per_pass_ms = f.per_pass_ms;
+  b.bus_ms = f.bus_ms;
+  b.program_load_ms = f.program_load_ms;
+  b.readback_ms = f.readback_ms;
   if (hw.download_gbps > 0)
     b.download_ms = 1e-3 * hw.download_us * double(stats.downloads) +
                     1e3 * double(stats.download_bytes) / (hw.download_gbps * 1e9);

@@ -106,6 +106,16 @@ inline bool prices(const vgpu::Profile& profile, bool looping, int steps_per_pas
   return !looping || profile.max_loop_iterations >= steps_per_pass;
 }
 
+// A frame's fixed costs from its counters, as predict prices them: per pass, program loads (the
+// program bytes over the bus, bus_ms, plus program_load_us each) and query read-backs.
+struct FixedCosts {
+  double per_pass_ms = 0, program_load_ms = 0, bus_ms = 0, readback_ms = 0;
+  // What predict's total adds of them, in its order (program_load_ms holds bus_ms).
+  double total_ms() const { return per_pass_ms + program_load_ms + readback_ms; }
+};
+FixedCosts fixed_costs(const vgpu::Counters& totals, const vgpu::Profile& profile,
+                       const CostParams& params);
+
 // Uses stats.passes (one record per pass) when it holds every pass, else each program's totals
 // spread evenly over its passes.
 CostBreakdown predict(const vgpu::FrameStats& stats, const vgpu::Profile& profile);

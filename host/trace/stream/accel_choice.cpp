@@ -72,17 +72,12 @@ double probe_scale(const RenderOptions& options, const RenderOptions& probe) {
          (double(probe.width) * double(probe.height));
 }
 
-// A probe's fixed costs so far (per pass, program loads and read-backs, as predict prices them
-// from the counters): full_frame_ms keeps them as counted and adds only non-negative terms, so
-// a probe whose fixed costs pass `ms` is priced over `ms` whatever else it does.
+// A probe's fixed costs so far (fixed_costs, as predict prices them): full_frame_ms keeps them
+// as counted and adds only non-negative terms, so a probe whose fixed costs pass `ms` is priced
+// over `ms` whatever else it does.
 std::function<bool(const vgpu::Counters&)> over(double ms, const vgpu::Profile& profile) {
-  const CostParams p = defaults_for(profile);
-  return [=, bus = profile.bus_mbps](const vgpu::Counters& t) {
-    const double fixed =
-        1e-3 * (p.pass_us * double(t.passes) + p.program_load_us * double(t.program_loads) +
-                p.readback_us * double(t.query_readbacks)) +
-        1e3 * double(t.program_bytes) / (bus * 1e6);
-    return fixed > ms;
+  return [=, &profile, p = defaults_for(profile)](const vgpu::Counters& t) {
+    return fixed_costs(t, profile, p).total_ms() > ms;
   };
 }
 
@@ -121,8 +116,9 @@ AccelChoice choose_accel(const Scene& scene, const std::vector<AccelCandidate>& 
   c.probe_width = probe.width;
   c.probe_height = probe.height;
   const vgpu::Profile& profile = vgpu::profile(options.profile);
-  // A probe stops once its passes alone price it over `ms`; its price is then only known to be
-  // over that: kept as `ms`, the candidate listed in `stopped`.
+  auto name_of = [](const AccelCandidate* cand) { return std::string(cand->accel->name()); };
+  // A probe stops once its fixed costs alone price it over `ms`; its price is then only known to be
+  // over that: kept just over `ms`, the candidate listed in `stopped`.
   const bool emulated = options.device == "vgpu";
   auto budget = [&](double ms) {
     return stop_early && emulated ? over(ms, profile)
@@ -138,7 +134,7 @@ AccelChoice choose_accel(const Scene& scene, const std::vector<AccelCandidate>& 
   std::vector<const AccelCandidate*> priced;
   double cheapest = 0;
   for (const AccelCandidate& cand : candidates) {
-    const std::string name(cand.accel->name());
+    const std::string name = name_of(&cand);
     const double bound = (1.0 + kAutoProbeBand) * cheapest;
     try {
       const auto [ms, passes] = probe_price(scene, cand, probe, options, camera, profile,
@@ -165,18 +161,16 @@ AccelChoice choose_accel(const Scene& scene, const std::vector<AccelCandidate>& 
   }
   std::vector<const AccelCandidate*> band;
   for (const AccelCandidate* cand : priced)
-    if (c.coarse_ms.at(std::string(cand->accel->name())) <= (1.0 + kAutoProbeBand) * cheapest)
-      band.push_back(cand);
+    if (c.coarse_ms.at(name_of(cand)) <= (1.0 + kAutoProbeBand) * cheapest) band.push_back(cand);
   const size_t probed_again = larger && band.size() > 1 ? band.size() : 0;
   if (probed_again) {
     std::vector<const AccelCandidate*> order = band, kept;
     std::stable_sort(order.begin(), order.end(), [&](const auto* x, const auto* y) {
-      return c.coarse_ms.at(std::string(x->accel->name())) <
-             c.coarse_ms.at(std::string(y->accel->name()));
+      return c.coarse_ms.at(name_of(x)) < c.coarse_ms.at(name_of(y));
     });
     double best = 0;
     for (const AccelCandidate* cand : order) {
-      const std::string name(cand->accel->name());
+      const std::string name = name_of(cand);
       try {
         const double ms = probe_price(scene, *cand, fine, options, camera, profile,
                                       kept.empty() ? nullptr : budget(best))
@@ -193,7 +187,7 @@ AccelChoice choose_accel(const Scene& scene, const std::vector<AccelCandidate>& 
     }
     std::vector<const AccelCandidate*> still;  // in the candidates' order, for ties
     for (const AccelCandidate* cand : band) {
-      const std::string name(cand->accel->name());
+      const std::string name = name_of(cand);
       if (!c.predicted_ms.count(name)) continue;
       c.refined.push_back(name);
       if (std::find(kept.begin(), kept.end(), cand) != kept.end()) still.push_back(cand);
@@ -201,13 +195,13 @@ AccelChoice choose_accel(const Scene& scene, const std::vector<AccelCandidate>& 
     band = still;
     if (band.empty())  // every one refused: the cheapest of the others, at their first price
       for (const AccelCandidate* cand : priced)
-        if (c.predicted_ms.count(std::string(cand->accel->name()))) band.push_back(cand);
+        if (c.predicted_ms.count(name_of(cand))) band.push_back(cand);
     if (band.empty()) throw vgpu::Error("--accel auto: no structure fits: " + refused);
   }
   // The cheapest of the band, a tie going to the candidate listed first.
   double best = 0;
   for (size_t i = 0; i < band.size(); ++i) {
-    const double ms = c.predicted_ms.at(std::string(band[i]->accel->name()));
+    const double ms = c.predicted_ms.at(name_of(band[i]));
     if (i == 0 || ms < best) {
       best = ms;
       c.kind = band[i]->accel->kind();
