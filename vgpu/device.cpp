@@ -179,6 +179,7 @@ void add_loop_counters(Counters& c, const Program::Analysis& a, const Texture* c
   c.loop_span_iterations = n.most;
   c.loop_span_fetches = n.most * uint64_t(lp.chain_fetches);
   c.loop_span_operations = n.most * uint64_t(lp.chain_operations);
+  c.loop_dependent_instructions = n.iterations * uint64_t(lp.dependent_operations);
 }
 
 void count_program_load(FrameStats& stats, const Program& program, const Profile& profile) {

@@ -49,6 +49,9 @@ struct LoopTally {
   // and its other operations. Filled by Program::analyze from the recording.
   int chain_fetches = 0;
   int chain_operations = 0;
+  // Of body_instructions, the operations between two fetches of an iteration (vgpu/span.h's
+  // loop_dependent_operations). Filled by Program::analyze from the recording.
+  int dependent_operations = 0;
 };
 
 // Transposes between texels (4 channels each, contiguous) and registers (one per channel), for

@@ -42,6 +42,7 @@ Program::Analysis Program::analyze() const {
     struct Memo {
       std::vector<std::byte> uniforms;
       LoopChain chain;
+      int dependent = 0;
     };
     static thread_local std::unordered_map<uint32_t, Memo> memo;
     const std::span<const std::byte> bytes = uniform_bytes();
@@ -49,10 +50,13 @@ Program::Analysis Program::analyze() const {
     Memo& m = it->second;
     if (fresh || !std::equal(bytes.begin(), bytes.end(), m.uniforms.begin(), m.uniforms.end())) {
       m.uniforms.assign(bytes.begin(), bytes.end());
-      m.chain = loop_chain(record());
+      const Recording rec = record();
+      m.chain = loop_chain(rec);
+      m.dependent = loop_dependent_operations(rec);
     }
     a.loop.chain_fetches = m.chain.fetches;
     a.loop.chain_operations = m.chain.operations;
+    a.loop.dependent_operations = m.dependent;
   }
   return a;
 }

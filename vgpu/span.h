@@ -27,4 +27,13 @@ struct LoopChain {
 // two paths come close; the H200's measured ratio is about 100, docs/studies/structures.md).
 LoopChain loop_chain(const Recording& r, int fetch_units = 100);
 
+// The operations of one iteration of the loop of `r` (its first recorded copy) that depend on a
+// texel fetched in the same iteration and that a later fetch of it depends on: the arithmetic
+// between two fetches, an address computed from a fetched texel (the next cell's pointer, the
+// node's child, the triangle's vertices from its list entry). A lane cannot issue it before its
+// fetch returns, nor its next fetch before it is done, so it does not overlap with that lane's
+// fetches. Operations that cost nothing (constants, a texel's channels) are not counted; 0
+// without a loop.
+int loop_dependent_operations(const Recording& r);
+
 }  // namespace vgpu

@@ -90,13 +90,14 @@ std::string FrameStats::to_table() const {
     std::snprintf(line, sizeof line,
                   "%s: loop of %d iterations a pass, %s batch iterations, %s lane slots, %s "
                   "active, %s idle (%.1f%%); longest lanes %s iterations, waiting through %s "
-                  "fetches and %s operations\n",
+                  "fetches and %s operations; %s operations between fetches\n",
                   p.name.c_str(), p.loop_budget, human(c.loop_batch_iterations).c_str(),
                   human(c.loop_lane_slots).c_str(), human(c.loop_iterations).c_str(),
                   human(c.loop_lanes_idle).c_str(),
                   100.0 * double(c.loop_lanes_idle) / double(c.loop_lane_slots),
                   human(c.loop_span_iterations).c_str(), human(c.loop_span_fetches).c_str(),
-                  human(c.loop_span_operations).c_str());
+                  human(c.loop_span_operations).c_str(),
+                  human(c.loop_dependent_instructions).c_str());
     out += line;
   }
   return out;

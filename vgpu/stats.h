@@ -64,6 +64,10 @@ struct Counters {
   uint64_t loop_span_iterations = 0;
   uint64_t loop_span_fetches = 0;
   uint64_t loop_span_operations = 0;
+  // The body's operations that wait on a fetch of their own iteration and feed another of its
+  // fetches (an address computed from a fetched texel), once per active iteration: arithmetic
+  // a lane cannot overlap with its own fetches (Program::Analysis, vgpu/span.h).
+  uint64_t loop_dependent_instructions = 0;
 
   Counters& operator+=(const Counters& o);
   // Every integer counter equal (host_ms excluded).
@@ -101,7 +105,8 @@ inline constexpr std::pair<const char*, uint64_t Counters::*> kCounterFields[] =
     {"loop_idle_fetches", &Counters::loop_idle_fetches},
     {"loop_span_iterations", &Counters::loop_span_iterations},
     {"loop_span_fetches", &Counters::loop_span_fetches},
-    {"loop_span_operations", &Counters::loop_span_operations}};
+    {"loop_span_operations", &Counters::loop_span_operations},
+    {"loop_dependent_instructions", &Counters::loop_dependent_instructions}};
 
 // One pass as recorded: which program, what it drew, what it cost.
 struct PassRecord {

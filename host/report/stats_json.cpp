@@ -234,7 +234,7 @@ nlohmann::ordered_json frame_stats_json(const FrameStatsInputs& in) {
       for (const char* key :
            {"lanes_idle", "idle_in_batch32", "idle_in_batch1024", "loop_iterations",
             "loop_lane_slots", "loop_lanes_idle", "loop_batch_iterations", "loop_idle_instructions",
-            "loop_idle_fetches"}) {
+            "loop_idle_fetches", "loop_dependent_instructions"}) {
         stats["totals"][key] = nullptr;
         for (auto& k : stats["programs"]) k[key] = nullptr;
       }

@@ -1,6 +1,7 @@
 // The longest wait of one lane through a loop iteration (vgpu/span.h): in-order issue of the
 // recorded body, fetches and operations counted along the schedule's end, and the counters a
-// looping pass gets from it (the most iterations one fragment ran, times that chain).
+// looping pass gets from it (the most iterations one fragment ran, times that chain); and the
+// arithmetic between two fetches of an iteration (loop_dependent_operations).
 #include <doctest/doctest.h>
 
 #include "helpers.h"
@@ -70,6 +71,32 @@ struct FetchOrTwenty {
       F z = u;
       for (int i = 0; i < 20; ++i) z = z + F(1.0f);
       u = select(act, a + z, u);
+      return act;
+    });
+    f.out(0) = {u, u, u, u};
+  }
+};
+
+// One iteration: a fetch at u + 1 (an address from no fetch), two operations on its texel that
+// make the next fetch's address, that fetch, and two operations after it that feed no fetch.
+// through_select: the address is select(a > 0, a * 2 + 1, u) instead, a fetch made on one side.
+struct ChaseAddress {
+  static constexpr const char* name = "chase address";
+  static constexpr const char* paper_name = "-";
+  static constexpr int outputs = 1;
+  bool through_select = false;
+  template <class L>
+  void operator()(Fragments<L>& f) const {
+    using F = typename L::F;
+    using M = typename L::M;
+    const Vec4<F> s = f.fetch_own(0);
+    F u = s.x;
+    f.loop(4, s.w > F(0.0f), [&](const M& act) {
+      const F a = f.fetch(1, u + F(1.0f), F(0.5f)).x;
+      const F next =
+          through_select ? select(a > F(0.0f), a * F(2.0f) + F(1.0f), u) : a * F(2.0f) + F(1.0f);
+      const F b = f.fetch(1, next, F(0.5f)).x;
+      u = select(act, b + F(3.0f), u);
       return act;
     });
     f.out(0) = {u, u, u, u};
@@ -208,5 +235,36 @@ TEST_CASE("a looping pass counts its longest lane's iterations and their chain, 
       CHECK(r.counters.loop_span_operations == 7 * 5);
       gpu.draw();  // a second pass adds its own longest lane
       CHECK(gpu.stats().totals.loop_span_iterations == 14);
+    }
+}
+
+TEST_CASE("the arithmetic between two fetches of an iteration is counted once per iteration") {
+  // ChaseAddress: u + 1 feeds a fetch but waits on none; a * 2 + 1 waits on the first fetch and
+  // feeds the second (2 operations); b + 3 and the select wait on a fetch and feed none.
+  KernelProgram<ChaseAddress> p;
+  CHECK(loop_dependent_operations(p.record()) == 2);
+  CHECK(p.analyze().loop.dependent_operations == 2);
+  // TwoFetches: the second fetch's address is the first's texel itself, no operation between.
+  CHECK(loop_dependent_operations(KernelProgram<TwoFetches>(TwoFetches{true}).record()) == 0);
+  CHECK(loop_dependent_operations(KernelProgram<NoLoop>().record()) == 0);
+  // Through a select, the fetch is made on the select's side alone: the compare (its mask) and
+  // the select wait and feed it; a * 2 + 1, only through the select's value, is not counted.
+  CHECK(loop_dependent_operations(KernelProgram<ChaseAddress>(ChaseAddress{true}).record()) == 2);
+  // Lanes with w > 0 run all 4 iterations (the body keeps the mask): 3 of 8 fragments.
+  Texture start("start", 8, 1, 4), table("table", 16, 1, 4);
+  for (int x = 0; x < 8; ++x) start.set(x, 0, 3, x % 3 == 0 ? 1.0f : 0.0f);
+  for (int lanes : {1, 8})
+    for (int threads : {1, 3}) {
+      CAPTURE(lanes);
+      CAPTURE(threads);
+      Gpu gpu(profile("rtx4090"), threads, lanes);
+      Texture out("out", 8, 1, 4);
+      gpu.use_program(p);
+      gpu.bind_texture(0, start);
+      gpu.bind_texture(1, table);
+      gpu.set_targets({&out});
+      const Counters c = gpu.draw().counters;
+      CHECK(c.loop_iterations == 3 * 4);
+      CHECK(c.loop_dependent_instructions == 3 * 4 * 2);
     }
 }
