@@ -26,6 +26,7 @@ std::vector<std::pair<std::string, double>> CostBreakdown::items() const {
           {"download_ms", download_ms},
           {"wasted_ms", wasted_ms},
           {"l2_spill_ms", l2_spill_ms},
+          {"fetch_wait_ms", fetch_wait_ms},
           {"loop_idle_ms", loop_idle_ms},
           {"loop_overhead_ms", loop_overhead_ms},
           {"latency_ms", latency_ms},
@@ -93,7 +94,17 @@ void add_passes(const vgpu::Counters& c, double n, const vgpu::Profile& hw, cons
       (double(c.bytes_read) / n * keep + double(c.bytes_written) / n) / (hw.mem_gbps * 1e9);
   if (hw.output_bytes_per_clock > 0)
     mem_s = std::max(mem_s, double(c.bytes_written) / n / (hw.output_bytes_per_clock * hz));
-  const double work_s = std::max({arith_s, tex_s, mem_s});
+  // A loop body's arithmetic between two of its fetches (an address computed from a fetched
+  // texel) runs after one fetch returns and before the next issues: it does not overlap the
+  // fetches of its own lane. Where the profile models latencies, that share of the arithmetic
+  // time is added to the pass's bottleneck, at most the texture time it waits through.
+  double wait_s = 0;
+  if (hw.fetch_latency_clocks > 0 && c.loop_dependent_instructions > 0 && ops > 0) {
+    const double share = std::min(1.0, double(c.loop_dependent_instructions) / n / ops);
+    wait_s = std::min(tex_s, arith_s * share);
+  }
+  const double bottleneck_s = std::max({arith_s, tex_s, mem_s});
+  const double work_s = bottleneck_s + wait_s;
   // A looping pass lasts at least as long as its longest lane: that lane's iterations of the
   // body's longest chain of dependent operations (vgpu/span.h). The work of the other lanes is
   // spread over the pipelines, so the pass takes about the sum (a greedy schedule's bound:
@@ -107,10 +118,11 @@ void add_passes(const vgpu::Counters& c, double n, const vgpu::Profile& hw, cons
   out.arithmetic_demand_ms += arith_s * ms;
   out.texture_demand_ms += tex_s * ms;
   out.memory_demand_ms += mem_s * ms;
-  out.l2_spill_ms += std::max(0.0, work_s - std::max({arith_s, in_cache_s, mem_s})) * ms;
-  if (work_s == arith_s)
+  out.l2_spill_ms += std::max(0.0, bottleneck_s - std::max({arith_s, in_cache_s, mem_s})) * ms;
+  out.fetch_wait_ms += wait_s * ms;
+  if (bottleneck_s == arith_s)
     out.arithmetic_ms += work_s * ms;
-  else if (work_s == tex_s)
+  else if (bottleneck_s == tex_s)
     out.texture_ms += work_s * ms;
   else
     out.memory_ms += work_s * ms;
@@ -123,7 +135,9 @@ void add_passes(const vgpu::Counters& c, double n, const vgpu::Profile& hw, cons
     const double idle_arith = idle_rate_ops / packing / (hw.pipelines * hz * hw.alu_per_clock) +
                               overhead_s * double(c.loop_lanes_idle) / double(c.loop_lane_slots);
     const double idle_tex = idle_fetches / (hw.pipelines * hz * hw.texels_per_clock);
-    const double idle_s = work_s == arith_s ? idle_arith : work_s == tex_s ? idle_tex : 0.0;
+    const double idle_s = bottleneck_s == arith_s ? idle_arith
+                          : bottleneck_s == tex_s ? idle_tex
+                                                  : 0.0;
     const double share = work_s > 0 ? idle_s / work_s : 0.0;
     out.loop_idle_ms += work_s * ms * share;
     out.loop_overhead_ms += overhead_s * ms;

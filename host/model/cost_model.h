@@ -3,7 +3,7 @@
 // the paper's Table 1; docs/studies/table1.md lists every parameter with its source or marks it
 // fitted.
 //
-// Per pass:  time = max(arithmetic, texture, memory) + latency + pass_us
+// Per pass:  time = max(arithmetic, texture, memory) + fetch wait + latency + pass_us
 //   arithmetic = ALU instructions / (pipelines x clock x alu_per_clock x precision rate), each
 //                at the rate of the precision it ran at (Counters::alu_fp24 / alu_fp16,
 //                Profile::rate: NV3x fp16 full speed, fp32 and fp24 half)
@@ -21,6 +21,9 @@
 //                at Profile::fetch_latency_clocks, each operation at operation_latency_clocks
 //                (0 where the profile does not model them). Work over the pipelines plus the
 //                longest lane: the bound a greedy schedule keeps (Brent 1974).
+//   fetch wait = on the same profiles, a loop body's arithmetic between two of its fetches
+//                (Counters::loop_dependent_instructions) at the arithmetic rate, at most the
+//                texture time: added to the pass's bottleneck, not overlapped with it.
 // Per frame:  + program loads (bytes over the bus + program_load_us each)
 //             + query read-backs (readback_us each: a pipeline drain and a CPU round trip)
 //             + texture downloads (download_us each + bytes / download_gbps, where modelled,
@@ -87,6 +90,11 @@ struct CostBreakdown {
   // Of the pass work: what passes larger than the profile's L2 spend fetching beyond the
   // in-cache rate (Profile::l2_bytes, texture_spilled_bytes_per_clock).
   double l2_spill_ms = 0;
+  // Of the pass work: a looping body's arithmetic between two of its fetches
+  // (Counters::loop_dependent_instructions), which a lane runs after one fetch returns and before
+  // it issues the next, so that it adds to the pass's bottleneck instead of overlapping it
+  // (profiles with measured latencies: Profile::fetch_latency_clocks).
+  double fetch_wait_ms = 0;
   // Looping passes (Counters::loop_*): of the pass work, the lanes already out of the loop while
   // their batch iterates; of the arithmetic, the loop/break overhead (Profile).
   double loop_idle_ms = 0;

@@ -139,6 +139,31 @@ TEST_CASE("a pass whose footprint is larger than the profile's L2 fetches at the
   CHECK(alu.l2_spill_ms == doctest::Approx(0.240));
 }
 
+TEST_CASE(
+    "a loop body's arithmetic between two of its fetches adds to the pass's bottleneck where the "
+    "profile models latencies, at most the texture time") {
+  // Two passes: 4000 x 30 operations (200 us at the ALU) and 64000 B (640 us at 1 B a clock) a
+  // pass; half the operations sit between two fetches: 100 us of arithmetic that waits.
+  vgpu::Counters k = kernel_passes(2);
+  k.loop_dependent_instructions = 2 * 60000;
+  vgpu::Profile hw = card();
+  hw.mem_gbps = 1000;
+  hw.texture_bytes_per_clock = 1;
+  const host::CostBreakdown none = host::predict(frame(k, 1, 0), hw, params());
+  CHECK(none.texture_ms == doctest::Approx(1.280));  // no latencies modelled: overlapped
+  CHECK(none.fetch_wait_ms == 0.0);
+  hw.fetch_latency_clocks = 400;
+  const host::CostBreakdown b = host::predict(frame(k, 1, 0), hw, params());
+  CHECK(b.fetch_wait_ms == doctest::Approx(0.200));
+  CHECK(b.texture_ms == doctest::Approx(1.480));
+  CHECK(b.total_ms == doctest::Approx(none.total_ms + 0.200));
+  // Texture at 8 B a clock: 80 us a pass, under the ALU's 200; the wait is at most those 80.
+  hw.texture_bytes_per_clock = 8;
+  const host::CostBreakdown alu = host::predict(frame(k, 1, 0), hw, params());
+  CHECK(alu.fetch_wait_ms == doctest::Approx(0.160));
+  CHECK(alu.arithmetic_ms == doctest::Approx(0.560));
+}
+
 TEST_CASE("Texture downloads cost their fixed part and their bytes where a profile prices them") {
   vgpu::FrameStats s = frame(kernel_passes(2));
   s.downloads = 2;
