@@ -102,6 +102,9 @@ def main():
     ap.add_argument("--h200-sizes", nargs="*", default=[],
                     help="bench_gl JSON files of the same frames at several sizes "
                     "(results/structures/structures_h200_sizes_*.json)")
+    ap.add_argument("--loop-kernels", metavar="FILE",
+                    help="scripts/docs/loop_kernels.py's JSON (results/structures/"
+                    "loop_kernels.json): the fetch wait's section")
     ap.add_argument("--out", default=os.path.join(ROOT, "docs", "studies"),
                     help="where structures.md and structures.png go")
     ap.add_argument("--results", default=os.path.join(ROOT, "results", "structures"),
@@ -628,7 +631,7 @@ A first frame in a fresh process also pays the driver's compilation of every pro
 walk (99.5 ms multipass) where the warm frames below take a few ms (61 ms), so only warm frames
 are compared with the model, which has no compilation term.
 
-{h200_table(h200)}{looping_again(a.looping_first)}{st.looping_second(a)}{st.layout_trial(a.h200_layout)}{st.compiled_bodies(a)}{st.precise_trial(a.h200_precise)}{st.ablation_trial(a.h200_ablation)}{st.latency_term(a)}
+{h200_table(h200)}{looping_again(a.looping_first)}{st.looping_second(a)}{st.layout_trial(a.h200_layout)}{st.compiled_bodies(a)}{st.precise_trial(a.h200_precise)}{st.ablation_trial(a.h200_ablation)}{st.latency_term(a)}{st.fetch_wait(a)}
 
 ## Which structure wins where, and why
 
