@@ -539,7 +539,7 @@ json kernel_json(const FrameRun& fr, const vgpu::FrameStats::ProgramTotals& p, b
       k["predicted_" + hp.name + "_work_ms"] = b.arithmetic_ms + b.texture_ms + b.memory_ms;
       k["predicted_" + hp.name + "_latency_ms"] = b.latency_ms;
       k["predicted_" + hp.name + "_fetch_wait_ms"] = b.fetch_wait_ms;  // of the work
-      // The demands the work is the largest of (CostBreakdown): what a kernel's work is made of.
+      // The demands (CostBreakdown): the work is the largest of them plus the fetch wait.
       k["predicted_" + hp.name + "_arithmetic_demand_ms"] = b.arithmetic_demand_ms;
       k["predicted_" + hp.name + "_texture_demand_ms"] = b.texture_demand_ms;
       k["predicted_" + hp.name + "_memory_demand_ms"] = b.memory_demand_ms;

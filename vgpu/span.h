@@ -29,11 +29,15 @@ LoopChain loop_chain(const Recording& r, int fetch_units = 100);
 
 // The operations of one iteration of the loop of `r` (its first recorded copy) that depend on a
 // texel fetched in the same iteration and that a later fetch of it depends on: the arithmetic
-// between two fetches, an address computed from a fetched texel (the next cell's pointer, the
-// node's child, the triangle's vertices from its list entry). A lane cannot issue it before its
-// fetch returns, nor its next fetch before it is done, so it does not overlap with that lane's
-// fetches. Operations that cost nothing (constants, a texel's channels) are not counted; 0
-// without a loop.
+// between two fetches, an address computed from a fetched texel in the same iteration (the
+// two-level grid's sub-cell from its coarse cell, then the sub-cell's list). A lane cannot issue
+// it before its fetch returns, nor its next fetch before it is done, so it does not overlap
+// with that lane's fetches. Within one iteration only: an address carried to the next
+// iteration (the BVH's next node, the vertices of the triangle a list entry named) waits across
+// iterations, which loop_chain's longest lane prices. A fetch whose address passes through a
+// select's value is made on that side only (the driver turns selects into IF/ELSE blocks): what
+// feeds it through the select is not counted. Operations that cost nothing (constants, a
+// texel's channels) are not counted; 0 without a loop.
 int loop_dependent_operations(const Recording& r);
 
 }  // namespace vgpu

@@ -97,11 +97,13 @@ void add_passes(const vgpu::Counters& c, double n, const vgpu::Profile& hw, cons
   // A loop body's arithmetic between two of its fetches (an address computed from a fetched
   // texel) runs after one fetch returns and before the next issues: it does not overlap the
   // fetches of its own lane. Where the profile models latencies, that share of the arithmetic
-  // time is added to the pass's bottleneck, at most the texture time it waits through.
+  // time is added to the pass's bottleneck, at most the texture time it waits through. (The
+  // share is of the active lanes' arithmetic; the idle lane slots issue the same body, so it
+  // applies to theirs too, but not to the loop/break overhead, which sits between no fetches.)
   double wait_s = 0;
   if (hw.fetch_latency_clocks > 0 && c.loop_dependent_instructions > 0 && ops > 0) {
     const double share = std::min(1.0, double(c.loop_dependent_instructions) / n / ops);
-    wait_s = std::min(tex_s, arith_s * share);
+    wait_s = std::min(tex_s, (arith_s - overhead_s) * share);
   }
   const double bottleneck_s = std::max({arith_s, tex_s, mem_s});
   const double work_s = bottleneck_s + wait_s;
@@ -238,6 +240,13 @@ std::string describe(const CostBreakdown& c, const vgpu::Profile& profile) {
     std::snprintf(buf, sizeof buf,
                   "  latency    each looping pass's longest lane %.1f ms (%.0f%%)\n", c.latency_ms,
                   pct(c.latency_ms));
+    out += buf;
+  }
+  if (c.fetch_wait_ms > 0 || c.l2_spill_ms > 0) {
+    std::snprintf(buf, sizeof buf,
+                  "  of the pass work, loop arithmetic waiting on its fetches %.1f ms (%.0f%%), "
+                  "passes larger than the L2 %.1f ms (%.0f%%)\n",
+                  c.fetch_wait_ms, pct(c.fetch_wait_ms), c.l2_spill_ms, pct(c.l2_spill_ms));
     out += buf;
   }
   return out;

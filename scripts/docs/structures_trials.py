@@ -445,7 +445,7 @@ def fetch_wait(a):
     others = max(abs(after[k] / before[k] - 1) for k in before if k[1] != "grid2")
     bvh = sorted(r["gpu"] / r["with"] for r in rows if r["card"] == "h100" and r["accel"] == "bvh")
     pct = ", ".join(f"{100 * share[acc]:.0f}% of the {name}"
-                    for acc, name in (("grid", "grid's body"), ("grid2", "two-level grid's"),
+                    for acc, name in (("grid", "grid's arithmetic"), ("grid2", "two-level grid's"),
                                       ("bvh", "BVH's"), ("kdtree", "kd-tree's")))
     L = ["", "", "### The fetch wait: a loop body's arithmetic between two of its fetches", "",
          "The ablation above found the two-level grid's step running near the sum of its "
@@ -458,28 +458,33 @@ def fetch_wait(a):
          "depends on. A fetch whose address passes through a select's value is left out of that: "
          "the driver turns each select into an IF/ELSE block (above), so such a fetch is made on "
          "one side only, and what feeds it through the select waits only on the iterations that "
-         "take that side (the BVH's list entry, fetched when a walk enters a leaf, is one). "
-         "Counted once per active iteration (`loop_dependent_instructions`), the operations "
-         f"between fetches are {pct}.", "",
+         "take that side (the BVH's list entry, fetched when a walk enters a leaf, is one). It "
+         "counts within one iteration: an address carried to the next (the BVH's next node, the "
+         "vertices of the triangle a list entry named) is waited for across iterations, which "
+         "the longest lanes price. Counted once per active iteration "
+         "(`loop_dependent_instructions`), the operations between fetches are "
+         f"{pct} (of each traversal kernel's arithmetic, nearly all of it its loop body's).", "",
          "The cost model adds that share of a looping pass's arithmetic time to the pass's "
          "bottleneck, at most the texture time it waits through (`fetch_wait_ms`), on the "
-         "profiles whose latencies were measured (`h200`, `h100`; the 2004 cards' predictions "
-         "are unchanged). Nothing was fitted: the share is counted and the arithmetic rate is the "
-         "profile's. Each looping traversal kernel's GPU time over its price (pass work and "
+         "profiles whose latencies were measured (`h200`, `h100`; every other profile, the 2004 "
+         "cards and `rtx4090`, is priced as before). Nothing was fitted: the share is counted and "
+         "the arithmetic rate is the profile's. Each looping traversal kernel's GPU time over its price (pass work and "
          "longest lanes), on the H100's looping frames (256² to 1024², primary rays and full "
          "frames) and the H200's third warmed run (`scripts/docs/loop_kernels.py`, "
          "`results/structures/loop_kernels.json`):", "",
          loop_kernels.table(rows), "",
          f"The two-level grid comes from {before[('h100', 'grid2')]:.2f} to "
          f"{after[('h100', 'grid2')]:.2f} and {after[('h200', 'grid2')]:.2f} times its price "
-         f"(medians, H100 and H200), the others move by {100 * others:.0f}% at most. Over the "
-         "cells (\"Every cell against its target\", `docs/studies/real_gpu.md`), 94 of the H100's "
-         "116 looping cells are within 15% (87 before) and 55 of the H200's 67 (51). What the "
-         f"BVH's walk is priced over (its GPU time {bvh[0]:.2f} to {bvh[-1]:.2f} of its price on "
-         "the H100) is not this: its walk waits on little, and it was priced as high before. Nor "
-         f"is what the two-level grid is still priced under: {after[('h100', 'grid2')]:.2f} times "
-         "its price at the median is a wait beyond its counted share.", "",
-         "Tried and not kept:", "",
+         f"(medians, H100 and H200); the others' medians move by {100 * others:.0f}% at most. "
+         "Over the cells (\"Every cell against its target\", `docs/studies/real_gpu.md`), when "
+         "this was written, 94 of the H100's 116 looping cells were within 15% (87 before) and "
+         "55 of the H200's 67 (51). What the BVH's walk is priced over (its GPU time "
+         f"{bvh[0]:.2f} to {bvh[-1]:.2f} of its price on the H100) is not this term: its counted "
+         "share is 4%, and it was priced as high before. Nor does the count reach what the "
+         f"two-level grid is still priced under ({after[('h100', 'grid2')]:.2f} times its price "
+         "at the median).", "",
+         "Tried and not kept (experiments whose binaries were not kept: their figures are this "
+         "page's record, not regenerated):", "",
          "- **All the arithmetic between fetches, selects or not.** Following a fetch's address "
          "back through selects' values too counts 19%, 70%, 59% and 44% of the four bodies (the "
          "BVH's box test, which feeds the leaf's list entry through the select that loads it). It "
@@ -491,7 +496,8 @@ def fetch_wait(a):
          "bodies' bytes do (median 75%, the H100's 76 looping frames: the coherent walks of "
          "neighbouring primary rays), which a texture unit would serve once. Priced so, the rest "
          "at a rate fitted on the H100's 256² looping frames (46 bytes a clock), on top of the "
-         "fetch wait of the item above, the 256² cells went from 25 to 28 of 36 within 15% and "
+         "item above's fetch wait (selects followed), the 256² cells went from 25 to 28 of 36 "
+         "within 15% and "
          "the larger frames (512² to 1024², and full frames) from 33 to 8 of 40: what is "
          "repeated does not explain what grows with the image. Not kept, nor counted.",
          "- **A free least-squares fit** of the traversal kernels' GPU time at 256² (1.32 x "
