@@ -544,7 +544,9 @@ json kernel_json(const FrameRun& fr, const vgpu::FrameStats::ProgramTotals& p, b
       k["predicted_" + hp.name + "_texture_demand_ms"] = b.texture_demand_ms;
       k["predicted_" + hp.name + "_memory_demand_ms"] = b.memory_demand_ms;
     }
-    json counters;  // the emulator's counts of the kernel's passes (vgpu::kCounterFields)
+    // The emulator's counts of the kernel's passes, named as host::counters_json names them
+    // (bench_gl does not link host_report, which brings OpenImageIO, to travel to a GPU host).
+    json counters;
     for (const auto& [name, field] : vgpu::kCounterFields) counters[name] = p.counters.*field;
     k["counters"] = counters;
   }

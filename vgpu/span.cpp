@@ -20,6 +20,10 @@ bool free_op(Op o) {
          o == Op::mask_const;
 }
 
+bool fetch_op(Op o) {
+  return o == Op::fetch || o == Op::fetch_own;
+}
+
 }  // namespace
 
 LoopChain loop_chain(const Recording& r, int fetch_units) {
@@ -44,7 +48,7 @@ LoopChain loop_chain(const Recording& r, int fetch_units) {
     ++next.units;
     issue = later(next, operands);
     t = issue;
-    if (n.op == Op::fetch || n.op == Op::fetch_own)
+    if (fetch_op(n.op))
       ++t.fetches;
     else
       ++t.units;
@@ -57,14 +61,13 @@ int loop_dependent_operations(const Recording& r) {
   if (r.loops.empty()) return 0;
   const RecLoop& lp = r.loops.front();
   const int b = lp.begin, e = lp.mid;
-  auto fetch = [](Op o) { return o == Op::fetch || o == Op::fetch_own; };
   // after[i]: node i depends on a fetch of the iteration; before[i]: a fetch of it depends on i.
   std::vector<char> after(size_t(e - b), 0), before(size_t(e - b), 0);
   for (int i = b; i < e; ++i) {
     const RecNode& n = r.nodes[size_t(i)];
     for (int o : {n.a, n.b, n.c})
       if (o >= b && o < i)
-        after[size_t(i - b)] |= char(after[size_t(o - b)] || fetch(r.nodes[size_t(o)].op));
+        after[size_t(i - b)] |= char(after[size_t(o - b)] || fetch_op(r.nodes[size_t(o)].op));
   }
   // A fetch whose address passes through a select's value is a fetch the driver's code makes
   // only on that select's side (it turns each select into an IF/ELSE block): what feeds it
@@ -72,14 +75,14 @@ int loop_dependent_operations(const Recording& r) {
   // select's mask is followed back.
   for (int i = e - 1; i >= b; --i) {
     const RecNode& n = r.nodes[size_t(i)];
-    const char feeds = char(before[size_t(i - b)] || fetch(n.op));
+    const char feeds = char(before[size_t(i - b)] || fetch_op(n.op));
     for (int o : {n.a, n.b, n.c})
       if (o >= b && o < i && (n.op != Op::select || o == n.a)) before[size_t(o - b)] |= feeds;
   }
   int count = 0;
   for (int i = b; i < e; ++i) {
     const Op o = r.nodes[size_t(i)].op;
-    if (!free_op(o) && !fetch(o) && after[size_t(i - b)] && before[size_t(i - b)]) ++count;
+    if (!free_op(o) && !fetch_op(o) && after[size_t(i - b)] && before[size_t(i - b)]) ++count;
   }
   return count;
 }
