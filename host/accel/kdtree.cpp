@@ -2,6 +2,7 @@
 #include "host/accel/kdtree.h"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -24,6 +25,7 @@ class Builder {
     const size_t n = scene.triangle_count();
     tri_lo_.resize(n);
     tri_hi_.resize(n);
+    side_.resize(n);
     for (size_t i = 0; i < n; ++i) {
       const glm::dvec3 a(scene.p0[i]), b(scene.p1[i]), c(scene.p2[i]);
       tri_lo_[i] = glm::min(a, glm::min(b, c));
@@ -35,7 +37,38 @@ class Builder {
     out_.lists.push_back(-1);
   }
 
-  double build(const std::vector<uint32_t>& tris, const Box& box, int depth) {
+  // The node's triangles: in the order the leaf lists keep (the input's), and per axis sorted by
+  // their boxes' low and high ends. Clamping a box to the node's (max with its low end, min with
+  // its high end) keeps both orders, so each node's events come sorted from its parent's lists
+  // (filtered, in order): no node sorts (KdSpec::events).
+  struct End {
+    double at;   // the box's end on the list's axis, unclamped
+    uint32_t t;  // the triangle
+  };
+  struct Tris {
+    std::vector<uint32_t> order;
+    std::array<std::vector<End>, 3> by_lo, by_hi;  // each sorted by `at`
+  };
+
+  Tris root(size_t n) const {
+    Tris t;
+    t.order.resize(n);
+    for (size_t i = 0; i < n; ++i) t.order[i] = uint32_t(i);
+    if (spec_.events == KdEvents::per_node) return t;
+    auto by = [](const End& x, const End& y) { return x.at < y.at; };
+    for (int a = 0; a < 3; ++a) {
+      for (uint32_t i : t.order) {
+        t.by_lo[a].push_back({tri_lo_[i][a], i});
+        t.by_hi[a].push_back({tri_hi_[i][a], i});
+      }
+      std::sort(t.by_lo[a].begin(), t.by_lo[a].end(), by);
+      std::sort(t.by_hi[a].begin(), t.by_hi[a].end(), by);
+    }
+    return t;
+  }
+
+  double build(const Tris& node_tris, const Box& box, int depth) {
+    const std::vector<uint32_t>& tris = node_tris.order;
     out_.depth = std::max(out_.depth, depth + 1);
     const size_t me = out_.nodes.size();
     out_.nodes.emplace_back();
@@ -43,7 +76,12 @@ class Builder {
     const double leaf_cost = spec_.triangle_cost * n;
     int axis = -1;
     double split = 0, best = leaf_cost;
-    if (depth < max_depth_ && tris.size() > 1) find_split(tris, box, axis, split, best);
+    if (depth < max_depth_ && tris.size() > 1) {
+      if (spec_.events == KdEvents::per_node)
+        find_split_sorting(tris, box, axis, split, best);
+      else
+        find_split(node_tris, box, axis, split, best);
+    }
     if (axis < 0) {
       KdNode& node = out_.nodes[me];
       node.axis = 3;
@@ -60,12 +98,27 @@ class Builder {
     // agree on which side a point lies.
     const float fsplit = float(split);
     const double s = double(fsplit);
-    std::vector<uint32_t> left, right;
+    Tris left, right;
     for (uint32_t t : tris) {
       const double lo = std::max(tri_lo_[t][axis], box.lo[axis]);
       const double hi = std::min(tri_hi_[t][axis], box.hi[axis]);
-      if (lo <= s) left.push_back(t);
-      if (hi >= s) right.push_back(t);
+      side_[t] = uint8_t((lo <= s ? 1 : 0) | (hi >= s ? 2 : 0));
+      if (lo <= s) left.order.push_back(t);
+      if (hi >= s) right.order.push_back(t);
+    }
+    if (spec_.events == KdEvents::presorted) {
+      auto split_list = [&](const std::vector<End>& in, std::vector<End>& l, std::vector<End>& r) {
+        l.reserve(left.order.size());
+        r.reserve(right.order.size());
+        for (const End& e : in) {
+          if (side_[e.t] & 1) l.push_back(e);
+          if (side_[e.t] & 2) r.push_back(e);
+        }
+      };
+      for (int a = 0; a < 3; ++a) {
+        split_list(node_tris.by_lo[a], left.by_lo[a], right.by_lo[a]);
+        split_list(node_tris.by_hi[a], left.by_hi[a], right.by_hi[a]);
+      }
     }
     Box lb = box, rb = box;
     lb.hi[axis] = s;
@@ -73,6 +126,7 @@ class Builder {
     out_.nodes[me].axis = axis;
     out_.nodes[me].split = fsplit;
     const double cl = build(left, lb, depth + 1);
+    left = Tris{};  // the left subtree is built: its lists are not needed while the right builds
     out_.nodes[me].right = int32_t(out_.nodes.size());
     const double cr = build(right, rb, depth + 1);
     const double a = box.area();
@@ -80,9 +134,10 @@ class Builder {
   }
 
  private:
-  // The SAH's cheapest plane among the triangles' clipped box faces (strictly inside the box).
-  void find_split(const std::vector<uint32_t>& tris, const Box& box, int& best_axis,
-                  double& best_split, double& best) const {
+  // The SAH's cheapest plane among the triangles' clipped box faces (strictly inside the box):
+  // each axis's events sorted here (KdEvents::per_node, the reference).
+  void find_split_sorting(const std::vector<uint32_t>& tris, const Box& box, int& best_axis,
+                          double& best_split, double& best) const {
     const double area = box.area();
     if (!(area > 0)) return;
     const size_t n = tris.size();
@@ -102,25 +157,64 @@ class Builder {
         size_t ends = 0, starts = 0;
         for (; i < ev.size() && ev[i].first == p; ++i) (ev[i].second ? starts : ends) += 1;
         nr -= ends;  // boxes ending at p lie left of a plane just after it
-        if (p > box.lo[a] && p < box.hi[a]) {
-          Box lb = box, rb = box;
-          lb.hi[a] = p;
-          rb.lo[a] = p;
-          // Boxes touching the plane go to both sides (as the partition does).
-          const double cl = double(nl + starts), cr = double(nr + ends);
-          double cost =
-              spec_.node_cost + spec_.triangle_cost * (lb.area() * cl + rb.area() * cr) / area;
-          if (cl == 0 || cr == 0) cost *= 1.0 - spec_.empty_bonus;
-          if (cost < best) {
-            best = cost;
-            best_axis = a;
-            best_split = p;
-          }
-        }
+        if (p > box.lo[a] && p < box.hi[a])
+          consider(box, area, a, p, nl + starts, nr + ends, best_axis, best_split, best);
         nl += starts;
       }
     }
-    // A plane that would not move through float unchanged, or splits nothing off, is no split.
+    no_float_split(box, best_axis, best_split);
+  }
+
+  // The same plane from the node's presorted lists (KdEvents::presorted): the events of each
+  // axis merged in order of position, those at one position taken together, as the sort above
+  // leaves them: the same candidates in the same order, the same costs.
+  void find_split(const Tris& t, const Box& box, int& best_axis, double& best_split,
+                  double& best) const {
+    const double area = box.area();
+    if (!(area > 0)) return;
+    const size_t n = t.order.size();
+    for (int a = 0; a < 3; ++a) {
+      if (!(box.hi[a] > box.lo[a])) continue;
+      const std::vector<End>& starts_at = t.by_lo[a];
+      const std::vector<End>& ends_at = t.by_hi[a];
+      const double lo = box.lo[a], hi = box.hi[a];
+      auto start = [&](size_t i) { return std::max(starts_at[i].at, lo); };
+      auto end = [&](size_t i) { return std::min(ends_at[i].at, hi); };
+      size_t nl = 0, nr = n, i = 0, j = 0;
+      while (i < n || j < n) {
+        // The sort above puts an end before a start at one position.
+        const double p = j < n && (i == n || end(j) <= start(i)) ? end(j) : start(i);
+        size_t ends = 0, starts = 0;
+        for (; j < n && end(j) == p; ++j) ++ends;
+        for (; i < n && start(i) == p; ++i) ++starts;
+        nr -= ends;
+        if (p > box.lo[a] && p < box.hi[a])
+          consider(box, area, a, p, nl + starts, nr + ends, best_axis, best_split, best);
+        nl += starts;
+      }
+    }
+    no_float_split(box, best_axis, best_split);
+  }
+
+  // One candidate plane at p on axis a, with cl triangles' boxes on its left and cr on its right.
+  void consider(const Box& box, double area, int a, double p, size_t cl, size_t cr, int& best_axis,
+                double& best_split, double& best) const {
+    Box lb = box, rb = box;
+    lb.hi[a] = p;
+    rb.lo[a] = p;
+    // Boxes touching the plane go to both sides (as the partition does).
+    double cost = spec_.node_cost +
+                  spec_.triangle_cost * (lb.area() * double(cl) + rb.area() * double(cr)) / area;
+    if (cl == 0 || cr == 0) cost *= 1.0 - spec_.empty_bonus;
+    if (cost < best) {
+      best = cost;
+      best_axis = a;
+      best_split = p;
+    }
+  }
+
+  // A plane that would not move through float unchanged, or splits nothing off, is no split.
+  static void no_float_split(const Box& box, int& best_axis, double best_split) {
     if (best_axis >= 0) {
       const double s = double(float(best_split));
       if (!(s > box.lo[best_axis] && s < box.hi[best_axis])) best_axis = -1;
@@ -130,6 +224,7 @@ class Builder {
   const KdSpec& spec_;
   KdTree& out_;
   std::vector<glm::dvec3> tri_lo_, tri_hi_;
+  std::vector<uint8_t> side_;  // per triangle, the node being split's: 1 left, 2 right, 3 both
   int max_depth_ = 0;
 };
 
@@ -147,9 +242,7 @@ KdTree build_kdtree(const Scene& scene, glm::vec3 lo, glm::vec3 hi, const KdSpec
   kd.lo = lo;
   kd.hi = hi;
   Builder b(scene, spec, kd);
-  std::vector<uint32_t> all(scene.triangle_count());
-  for (size_t i = 0; i < all.size(); ++i) all[i] = uint32_t(i);
-  kd.sah_cost = b.build(all, Box{glm::dvec3(lo), glm::dvec3(hi)}, 0);
+  kd.sah_cost = b.build(b.root(scene.triangle_count()), Box{glm::dvec3(lo), glm::dvec3(hi)}, 0);
   kd.build_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   return kd;

@@ -4,8 +4,8 @@
 // its segment [tmin, tmax] reaches, tests that leaf's triangles (a hit counts only inside the
 // leaf's segment), and if none is hit restarts from the root with tmin moved to the leaf's exit.
 // Built on the host with the surface area heuristic over the triangles' bounding boxes clipped
-// to each node (Wald & Havran 2006's events, sorted per node); a triangle overlapping both sides
-// of a plane goes to both.
+// to each node (Wald & Havran 2006's events: sorted once, each node's taken in order from its
+// parent's, KdEvents); a triangle overlapping both sides of a plane goes to both.
 //
 // Node i of the layout, depth first:
 //   inner node: axis 0, 1 or 2 and the split position; its left child (below the plane) is node
@@ -23,11 +23,18 @@
 
 namespace host {
 
+// How a node finds its events in order: `presorted` sorts the triangles' box ends once per axis
+// and hands each child its parent's lists filtered (O(n log n) for the tree); `per_node` sorts
+// each node's events again (O(n log^2 n)), the reference the tests hold the other to. Both build
+// the same tree, to the bit.
+enum class KdEvents { presorted, per_node };
+
 struct KdSpec {
   double node_cost = 1.0;      // SAH: a node step (about two passes of the multipass walk)
   double triangle_cost = 1.5;  // SAH: a triangle test (about three: test, next entry, query)
   double empty_bonus = 0.2;    // SAH: a split with an empty side costs this much less
   int max_depth = 0;           // 0: 8 + 1.3 log2(triangles), Havran's rule of thumb
+  KdEvents events = KdEvents::presorted;
 };
 
 struct KdNode {

@@ -226,6 +226,42 @@ TEST_CASE("the kd-tree build is deterministic") {
                   host::build_kdtree(bunny, box.lo, box.hi)));
 }
 
+TEST_CASE("the kd-tree from events sorted once is the tree that sorts every node's, to the bit") {
+  auto both = [](const Scene& s, glm::vec3 lo, glm::vec3 hi, host::KdSpec spec = {}) {
+    spec.events = host::KdEvents::presorted;
+    const KdTree fast = host::build_kdtree(s, lo, hi, spec);
+    spec.events = host::KdEvents::per_node;
+    const KdTree reference = host::build_kdtree(s, lo, hi, spec);
+    CHECK(fast.nodes.size() > 1);
+    CHECK(same_tree(fast, reference));
+    CHECK(fast.empty_leaves == reference.empty_leaves);
+    CHECK(fast.max_leaf == reference.max_leaf);
+  };
+  for (unsigned seed : {1u, 5u, 9u}) {
+    CAPTURE(seed);
+    both(random_scene(seed, 300), glm::vec3(-4.5f), glm::vec3(14.5f));
+  }
+  // Triangles sharing box ends (a grid of axis-aligned quads): many events at one position.
+  std::vector<std::array<glm::vec3, 3>> quads;
+  for (int i = 0; i < 12; ++i)
+    for (int j = 0; j < 12; ++j) {
+      const glm::vec3 o(float(i), float(j), float((i + j) % 3));
+      quads.push_back({o, o + glm::vec3(1, 0, 0), o + glm::vec3(0, 1, 0)});
+      quads.push_back({o + glm::vec3(1, 0, 0), o + glm::vec3(1, 1, 0), o + glm::vec3(0, 1, 0)});
+    }
+  const Scene tiles = make_scene(quads);
+  both(tiles, glm::vec3(-0.5f), glm::vec3(13.5f));
+  host::KdSpec shallow;
+  shallow.max_depth = 4;
+  both(tiles, glm::vec3(-0.5f), glm::vec3(13.5f), shallow);
+  for (const char* name : {"bunny-low", "teapot"}) {
+    CAPTURE(std::string(name));
+    const Scene s = host::load_scene(host::resolve_scene(name));
+    const host::Grid box = host::build_grid(s, host::GridSpec{glm::ivec3(1)});
+    both(s, box.lo, box.hi);
+  }
+}
+
 TEST_CASE("an empty scene's kd-tree is one empty leaf pointing at the shared empty list") {
   const Scene s;
   const KdTree kd = host::build_kdtree(s, glm::vec3(0.0f), glm::vec3(1.0f));
