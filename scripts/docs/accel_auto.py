@@ -82,7 +82,8 @@ def judge(row):
             "ratio": s[chosen]["predicted_ms"] / s[cheapest]["predicted_ms"],
             "choice_ms": row["auto"]["probe_ms"] + others,
             "frame_ms": frame,
-            "cost": (row["auto"]["probe_ms"] + others) / frame}
+            "cost": (row["auto"]["probe_ms"] + others) / frame,
+            "builds": others / frame}
 
 
 def section(rows):
@@ -117,7 +118,9 @@ def section(rows):
           f"{threads} host thread) over the frame's (the chosen structure's build and its render): "
           f"median {statistics.median(costs):.2f}, from {costs[0]:.2f} to {costs[-1]:.2f}; "
           f"multipass median {by_walk['multipass']:.2f}, looping {by_walk['looping']:.2f}. "
-          f"{quarter} of {len(costs)} choices cost at most a quarter of their frame. "
+          f"{quarter} of {len(costs)} choices cost at most a quarter of their frame; in "
+          f"{sum(j['builds'] > 0.25 for _, j in js)} the other structures' builds alone cost "
+          f"more (median {statistics.median(j['builds'] for _, j in js):.2f} of the frame). "
           f"{sum(len(r['auto']['stopped']) for r in rows)} probes stopped once their fixed costs "
           f"alone priced them out, in {sum(bool(r['auto']['stopped']) for r in rows)} of the "
           f"{len(rows)} choices."]
