@@ -6,6 +6,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <stdexcept>
+#include <string>
 
 namespace host {
 
@@ -28,8 +30,17 @@ class Builder {
     side_.resize(n);
     for (size_t i = 0; i < n; ++i) {
       const glm::dvec3 a(scene.p0[i]), b(scene.p1[i]), c(scene.p2[i]);
-      tri_lo_[i] = glm::min(a, glm::min(b, c));
-      tri_hi_[i] = glm::max(a, glm::max(b, c));
+      // The sweep below needs every position to compare equal to itself.
+      auto finite = [](const glm::dvec3& v) {
+        return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+      };
+      if (!finite(a) || !finite(b) || !finite(c))
+        throw std::invalid_argument("kd-tree: triangle " + std::to_string(i) +
+                                    " has a vertex that is not finite");
+      // + 0.0 makes a -0 a +0, so that a plane at 0 is stored with one sign whichever of its
+      // events a sort puts first.
+      tri_lo_[i] = glm::min(a, glm::min(b, c)) + 0.0;
+      tri_hi_[i] = glm::max(a, glm::max(b, c)) + 0.0;
     }
     max_depth_ = spec.max_depth > 0
                      ? spec.max_depth
@@ -42,7 +53,7 @@ class Builder {
   // its high end) keeps both orders, so each node's events come sorted from its parent's lists
   // (filtered, in order): no node sorts (KdSpec::events).
   struct End {
-    double at;   // the box's end on the list's axis, unclamped
+    float at;    // the box's end on the list's axis, unclamped (a vertex's float: exact)
     uint32_t t;  // the triangle
   };
   struct Tris {
@@ -54,12 +65,12 @@ class Builder {
     Tris t;
     t.order.resize(n);
     for (size_t i = 0; i < n; ++i) t.order[i] = uint32_t(i);
-    if (spec_.events == KdEvents::per_node) return t;
+    if (!presorted()) return t;
     auto by = [](const End& x, const End& y) { return x.at < y.at; };
     for (int a = 0; a < 3; ++a) {
       for (uint32_t i : t.order) {
-        t.by_lo[a].push_back({tri_lo_[i][a], i});
-        t.by_hi[a].push_back({tri_hi_[i][a], i});
+        t.by_lo[a].push_back({float(tri_lo_[i][a]), i});
+        t.by_hi[a].push_back({float(tri_hi_[i][a]), i});
       }
       std::sort(t.by_lo[a].begin(), t.by_lo[a].end(), by);
       std::sort(t.by_hi[a].begin(), t.by_hi[a].end(), by);
@@ -67,7 +78,8 @@ class Builder {
     return t;
   }
 
-  double build(const Tris& node_tris, const Box& box, int depth) {
+  // Builds the node and its subtree; `node_tris` is emptied once its children's are made.
+  double build(Tris&& node_tris, const Box& box, int depth) {
     const std::vector<uint32_t>& tris = node_tris.order;
     out_.depth = std::max(out_.depth, depth + 1);
     const size_t me = out_.nodes.size();
@@ -76,11 +88,11 @@ class Builder {
     const double leaf_cost = spec_.triangle_cost * n;
     int axis = -1;
     double split = 0, best = leaf_cost;
-    if (depth < max_depth_ && tris.size() > 1) {
-      if (spec_.events == KdEvents::per_node)
-        find_split_sorting(tris, box, axis, split, best);
-      else
+    if (may_split(tris.size(), depth)) {
+      if (presorted())
         find_split(node_tris, box, axis, split, best);
+      else
+        find_split_sorting(tris, box, axis, split, best);
     }
     if (axis < 0) {
       KdNode& node = out_.nodes[me];
@@ -106,13 +118,17 @@ class Builder {
       if (lo <= s) left.order.push_back(t);
       if (hi >= s) right.order.push_back(t);
     }
-    if (spec_.events == KdEvents::presorted) {
+    // The children's sorted lists, for a child that may split (one at the depth limit, or of a
+    // single triangle, is a leaf and needs only its order).
+    const bool fill_left = presorted() && may_split(left.order.size(), depth + 1);
+    const bool fill_right = presorted() && may_split(right.order.size(), depth + 1);
+    if (fill_left || fill_right) {
       auto split_list = [&](const std::vector<End>& in, std::vector<End>& l, std::vector<End>& r) {
-        l.reserve(left.order.size());
-        r.reserve(right.order.size());
+        if (fill_left) l.reserve(left.order.size());
+        if (fill_right) r.reserve(right.order.size());
         for (const End& e : in) {
-          if (side_[e.t] & 1) l.push_back(e);
-          if (side_[e.t] & 2) r.push_back(e);
+          if (fill_left && (side_[e.t] & 1)) l.push_back(e);
+          if (fill_right && (side_[e.t] & 2)) r.push_back(e);
         }
       };
       for (int a = 0; a < 3; ++a) {
@@ -120,20 +136,23 @@ class Builder {
         split_list(node_tris.by_hi[a], left.by_hi[a], right.by_hi[a]);
       }
     }
+    node_tris = Tris{};  // `tris` is gone with it: what follows reads the children's
     Box lb = box, rb = box;
     lb.hi[axis] = s;
     rb.lo[axis] = s;
     out_.nodes[me].axis = axis;
     out_.nodes[me].split = fsplit;
-    const double cl = build(left, lb, depth + 1);
-    left = Tris{};  // the left subtree is built: its lists are not needed while the right builds
+    const double cl = build(std::move(left), lb, depth + 1);
     out_.nodes[me].right = int32_t(out_.nodes.size());
-    const double cr = build(right, rb, depth + 1);
+    const double cr = build(std::move(right), rb, depth + 1);
     const double a = box.area();
     return spec_.node_cost + (a > 0 ? (lb.area() * cl + rb.area() * cr) / a : cl + cr);
   }
 
  private:
+  bool presorted() const { return spec_.events != KdEvents::per_node; }
+  bool may_split(size_t triangles, int depth) const { return depth < max_depth_ && triangles > 1; }
+
   // The SAH's cheapest plane among the triangles' clipped box faces (strictly inside the box):
   // each axis's events sorted here (KdEvents::per_node, the reference).
   void find_split_sorting(const std::vector<uint32_t>& tris, const Box& box, int& best_axis,
@@ -178,8 +197,8 @@ class Builder {
       const std::vector<End>& starts_at = t.by_lo[a];
       const std::vector<End>& ends_at = t.by_hi[a];
       const double lo = box.lo[a], hi = box.hi[a];
-      auto start = [&](size_t i) { return std::max(starts_at[i].at, lo); };
-      auto end = [&](size_t i) { return std::min(ends_at[i].at, hi); };
+      auto start = [&](size_t i) { return std::max(double(starts_at[i].at), lo); };
+      auto end = [&](size_t i) { return std::min(double(ends_at[i].at), hi); };
       size_t nl = 0, nr = n, i = 0, j = 0;
       while (i < n || j < n) {
         // The sort above puts an end before a start at one position.
@@ -242,7 +261,8 @@ KdTree build_kdtree(const Scene& scene, glm::vec3 lo, glm::vec3 hi, const KdSpec
   kd.lo = lo;
   kd.hi = hi;
   Builder b(scene, spec, kd);
-  kd.sah_cost = b.build(b.root(scene.triangle_count()), Box{glm::dvec3(lo), glm::dvec3(hi)}, 0);
+  kd.sah_cost =
+      b.build(b.root(scene.triangle_count()), Box{glm::dvec3(lo) + 0.0, glm::dvec3(hi) + 0.0}, 0);
   kd.build_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   return kd;

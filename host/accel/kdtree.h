@@ -24,9 +24,9 @@
 namespace host {
 
 // How a node finds its events in order: `presorted` sorts the triangles' box ends once per axis
-// and hands each child its parent's lists filtered (O(n log n) for the tree); `per_node` sorts
-// each node's events again (O(n log^2 n)), the reference the tests hold the other to. Both build
-// the same tree, to the bit.
+// at the root and hands each child its parent's lists filtered, work linear in each node's
+// triangles after that one sort; `per_node` sorts each node's events again (a log factor more),
+// the reference the tests hold the other to. Both build the same tree, to the bit.
 enum class KdEvents { presorted, per_node };
 
 struct KdSpec {
@@ -56,6 +56,8 @@ struct KdTree {
 };
 
 // Builds the tree inside the box [lo, hi] (the padded scene box, Scene::box). Deterministic.
+// Throws std::invalid_argument for a vertex that is not finite (the glTF loader refuses those
+// first; a scene built in code may not).
 KdTree build_kdtree(const Scene& scene, glm::vec3 lo, glm::vec3 hi, const KdSpec& spec = {});
 
 // "kd-tree: 12,345 nodes, depth 21, 6,173 leaves (1,020 empty) of at most 9 triangles"

@@ -584,10 +584,12 @@ The choice is not cheap. The probes render at least four frames of a quarter of 
 up to three of half, and a probe costs more than its share of the pixels: a multipass walk runs
 as many passes at 64x64 as at 256x256, each with its fixed host work. Where one structure is
 slow (the grid on stadium and scales) its probe alone outlasts the chosen frame, and where a
-build is slow (scales: the two-level grid's 0.2 s and the kd-tree's, 0.4 s since it sorts its
-events once, 1.1 s before) so does that. A choice within a quarter of the frame's host time needs a
-predictor that renders nothing, and where the builds alone pass the quarter (the count above), one
-that builds nothing either: not built here.
+build is slow (scales: the kd-tree's 0.5 s) so does that. A choice within a quarter of the frame's
+host time needs a predictor that renders nothing, and where the builds alone pass the quarter (the
+count above), one that builds nothing either: not built here. (The kd-tree's build now sorts its
+events once: 1.9x to 2.6x faster, the same tree, `bench_builds`. The sweep before this one ran
+slower throughout, its two-level grid's build on scales 204 ms against 99 ms here, which nothing
+changed, so the change in the medians between the two sweeps is not the kd-tree's alone.)
 
 **Stopped probes.** A price only grows as a probe runs: its fixed costs (each pass, program
 load and read-back, priced as the model prices them) are counted in full, and every other term
