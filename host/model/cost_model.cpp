@@ -351,4 +351,15 @@ std::vector<std::pair<std::string, vgpu::FrameStats>> what_ifs(const vgpu::Frame
           {"mrt + resident programs", with_resident_programs(mrt)}};
 }
 
+RunningPrice::RunningPrice(const vgpu::Profile& profile, double scale)
+    : profile_(profile), params_(defaults_for(profile)), scale_(scale) {}
+
+double RunningPrice::add(const vgpu::Counters& totals) {
+  const vgpu::Counters pass = minus(totals, last_);
+  last_ = totals;
+  add_passes(pass, double(pass.passes), profile_, params_, work_);
+  return fixed_costs(totals, profile_, params_).total_ms() + work_.latency_ms +
+         scale_ * (work_.arithmetic_ms + work_.texture_ms + work_.memory_ms);
+}
+
 }  // namespace host

@@ -124,6 +124,27 @@ struct FixedCosts {
 FixedCosts fixed_costs(const vgpu::Counters& totals, const vgpu::Profile& profile,
                        const CostParams& params);
 
+// The price of a frame's passes so far, from its running totals after each pass (the pass: the
+// difference from the totals before it), each pass priced as predict() prices it: the fixed
+// costs and longest lanes as counted, and `scale` times the pass work (a probe's full-frame
+// price: host/trace/stream/accel_choice.h). Later passes only add to it, so a frame whose
+// running price passes a bound is priced over that bound at its end (a clear between two passes
+// is priced with the pass after it, at most what predict() gives it). --accel auto stops a probe
+// once its running price passes what could still be picked.
+class RunningPrice {
+ public:
+  RunningPrice(const vgpu::Profile& profile, double scale);
+  // Called after each pass with the frame's totals so far: the price so far.
+  double add(const vgpu::Counters& totals);
+
+ private:
+  vgpu::Profile profile_;
+  CostParams params_;
+  double scale_;
+  vgpu::Counters last_{};
+  CostBreakdown work_;  // the passes' work so far, unscaled
+};
+
 // Uses stats.passes (one record per pass) when it holds every pass, else each program's totals
 // spread evenly over its passes.
 CostBreakdown predict(const vgpu::FrameStats& stats, const vgpu::Profile& profile);

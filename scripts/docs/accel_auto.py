@@ -120,9 +120,10 @@ def section(rows):
           f"multipass median {by_walk['multipass']:.2f}, looping {by_walk['looping']:.2f}. "
           f"{quarter} of {len(costs)} choices cost at most a quarter of their frame; in "
           f"{sum(j['builds'] > 0.25 for _, j in js)} the other structures' builds alone cost "
-          f"more than a quarter of it (median {statistics.median(j['builds'] for _, j in js):.2f} of the frame). "
-          f"{sum(len(r['auto']['stopped']) for r in rows)} probes stopped once their fixed costs "
-          f"alone priced them out, in {sum(bool(r['auto']['stopped']) for r in rows)} of the "
+          f"more than a quarter of it (median "
+          f"{statistics.median(j['builds'] for _, j in js):.2f} of the frame). "
+          f"{sum(len(r['auto']['stopped']) for r in rows)} probes stopped once their price so "
+          f"far priced them out, in {sum(bool(r['auto']['stopped']) for r in rows)} of the "
           f"{len(rows)} choices."]
     return "\n".join(L)
 

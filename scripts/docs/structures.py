@@ -492,6 +492,29 @@ def frame_cost(h200_files, sizes_files):
                          break_on_hyphens=False, break_long_words=False).replace("\x00", " ") + "\n"
 
 
+# The "--accel auto" section's paragraphs on stopped probes (write_doc).
+STOPPED_PROBES = """**Stopped probes.** A price only grows as a probe runs: each pass adds its fixed costs (the
+pass, its program load and read-back), its longest lanes and its work, none of them negative.
+So a probe whose price so far passes the band of the cheapest first price so far cannot be in
+the band, and a second probe whose price so far passes the cheapest second price so far cannot
+be the pick; the emulator stops them there (the column "stopped"; their price in the JSON is
+that lower bound). The price so far is `RunningPrice` (`host/model/cost_model.h`): each pass
+priced as `predict` prices it, as the pass is counted, scaled as the probe's full frame is. The
+pick, the band and every other price are those of probes run to their ends
+(`tests/trace/test_structure_walks.cpp`, three scenes on three profiles; and the running price
+never passes the whole frame's, on every structure's frames of two scenes on four profiles).
+
+Until issue 51's later stops a probe stopped on its fixed costs alone, which only a multipass
+kd-tree probe (whose restarts cost passes) ever passed: measured then against no stops, both
+rounds of probes took a median 0.71x the host time in the 78 choices that stopped one. With the
+pass work counted too, looping probes and other structures stop as well. Measured in one run
+against the fixed-cost rule (bunny, teapot, classic, sphere, bunny-refl, glass and stadium at
+256x256, both walks, gf6600 and h200, primary rays and full frames: 56 choices, the median of 3
+alternated runs each): the probes' host time is a median 0.95x (0.75x to 1.09x), the full frames'
+the most (classic and bunny-refl multipass on h200 0.75x, glass looping on h200 0.83x); the
+same 56 picks."""
+
+
 def write_doc(a, rows, h200):
     size = f"{a.size}x{a.size}"
     within = [r for r in h200 if abs(r["predicted_ms"] / r["wall_ms"] - 1) <= 0.35]
@@ -584,27 +607,15 @@ The choice is not cheap. The probes render at least four frames of a quarter of 
 up to three of half, and a probe costs more than its share of the pixels: a multipass walk runs
 as many passes at 64x64 as at 256x256, each with its fixed host work. Where one structure is
 slow (the grid on stadium and scales) its probe alone outlasts the chosen frame, and where a
-build is slow (scales: the kd-tree's 0.5 s) so does that. A choice within a quarter of the frame's
+build is slow (scales: the kd-tree's 0.4 s) so does that. A choice within a quarter of the frame's
 host time needs a predictor that renders nothing, and where the builds alone pass the quarter (the
 count above), one that builds nothing either: not built here. (The kd-tree's build now sorts its
-events once: 1.9x to 2.6x faster, the same tree, `bench_builds`. The sweep before this one ran
-slower throughout, its two-level grid's build on scales 204 ms against 99 ms here, which nothing
-changed, so the change in the medians between the two sweeps is not the kd-tree's alone.)
+events once: 1.9x to 2.6x faster, the same tree, `bench_builds`. The sweep of issue 51's
+earlier stop ran slower throughout, its two-level grid's build on scales 204 ms against 91 to
+107 ms here, which nothing changed, so the medians' change since is not the kd-tree's or the
+stops' alone: each is measured in one run, `bench_builds` and "Stopped probes" below.)
 
-**Stopped probes.** A price only grows as a probe runs: its fixed costs (each pass, program
-load and read-back, priced as the model prices them) are counted in full, and every other term
-is positive. So a probe whose fixed costs so far pass the band of the cheapest first price so far
-cannot be in the band, and a second probe whose fixed costs pass the cheapest second price so
-far cannot be the pick; the emulator stops them there (the column "stopped"; their price in the
-JSON is that lower bound). The pick, the band and every other price are those of probes run to
-their ends (`tests/trace/test_structure_walks.cpp`, three scenes on three profiles). Measured
-with the sweep above against the same sweep before (the previous commit's
-`results/structures/accel_auto.json`, one run each): no pick changed; in the 78 choices where a
-probe stopped, both rounds of probes took a median 0.71x the host time they took before (0.40x
-to 1.29x), and those choices cost a median 1.35x their frame instead of 1.76x. The 78 choices
-without a stop took 0.66x to 1.72x their probes' earlier time (median 1.03x): run-to-run noise. Over all 156 the
-median went from 1.43x (0.34x to 8.48x) to 1.17x. Every stop was a kd-tree's multipass probe,
-whose restarts cost passes; a looping probe has few passes to stop on.
+{STOPPED_PROBES}
 
 **The longest-lane term (issue 34).** Until issue 34 the price of a candidate left out the
 cost model's `latency_ms` (a looping pass waits for its longest lane: `docs/studies/table1.md`),

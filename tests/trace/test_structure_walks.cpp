@@ -575,6 +575,60 @@ TEST_CASE("accel auto judges a probe's passes against the L2 at the full frame's
   CHECK(spilled == 4);  // every structure's frame spills
 }
 
+TEST_CASE("a frame's running price rises pass by pass to at most its price, within a tenth of it") {
+  // Every structure's frame of two scenes (one bounce, shadows) at 40x40 on four profiles, both
+  // walks where the profile loops: the running price after every pass (RunningPrice, at scale 1
+  // and at 16 on the profile with 1/16 of the L2, as a probe is priced) never falls, and at the
+  // end it is at most the frame's fixed costs, longest lanes and 1 or 16 times its pass work as
+  // predict prices them (a clear is priced with the pass after it, at most that), and at least
+  // nine tenths of it.
+  for (const char* name : {"bunny", "classic"}) {
+    const host::Scene scene = host::load_scene(host::resolve_scene(name));
+    const host::Camera cam = host::scene_camera(scene, 1.0f);
+    for (const char* profile_name : {"gf5700", "gf6600", "h200", "h100"})
+      for (const bool looping : {false, true}) {
+        if (looping && std::string(profile_name) == "gf5700") continue;  // fp30: no loops
+        const vgpu::Profile& profile = vgpu::profile(profile_name);
+        vgpu::Profile small_l2 = profile;
+        small_l2.l2_bytes /= 16;
+        const Candidates all(scene, profile);
+        for (const host::AccelCandidate& cand : all.candidates) {
+          CAPTURE(name);
+          CAPTURE(profile_name);
+          CAPTURE(looping);
+          CAPTURE(std::string(cand.accel->name()));
+          host::RenderOptions opt = options(40, 40, profile_name);
+          opt.looping = looping;
+          opt.bounces = 1;
+          opt.shadows = true;
+          opt.formats = cand.formats;
+          opt.keep_pass_records = true;
+          host::RunningPrice at1(profile, 1.0), at16(small_l2, 16.0);
+          std::vector<double> run1, run16;
+          opt.stop_when = [&](const vgpu::Counters& t) {
+            run1.push_back(at1.add(t));
+            run16.push_back(at16.add(t));
+            return false;
+          };
+          const host::RenderResult r = stream(scene, *cand.accel, cam, opt);
+          REQUIRE(run1.size() == r.stats.totals.passes);
+          CHECK(std::is_sorted(run1.begin(), run1.end()));
+          CHECK(std::is_sorted(run16.begin(), run16.end()));
+          const host::CostBreakdown b = host::predict(r.stats, profile);
+          const host::CostBreakdown b16 = host::predict(r.stats, small_l2);
+          const double fixed = b.per_pass_ms + b.program_load_ms + b.readback_ms + b.latency_ms;
+          const double whole = fixed + b.arithmetic_ms + b.texture_ms + b.memory_ms;
+          const double whole16 =
+              fixed + 16.0 * (b16.arithmetic_ms + b16.texture_ms + b16.memory_ms);
+          CHECK(run1.back() <= whole * (1 + 1e-12));
+          CHECK(run16.back() <= whole16 * (1 + 1e-12));
+          CHECK(run1.back() >= 0.9 * whole);
+          CHECK(run16.back() >= 0.9 * whole16);
+        }
+      }
+  }
+}
+
 TEST_CASE("accel auto's stopped probes never change its pick, its band or the others' prices") {
   // Three scenes' primary rays at 96x96 on three profiles, both walks where the profile loops:
   // the choice with stopped probes against the same choice with every probe run to its end.

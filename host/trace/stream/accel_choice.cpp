@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <functional>
 #include <limits>
+#include <memory>
 #include <optional>
 
 #include "host/model/cost_model.h"
@@ -72,12 +73,12 @@ double probe_scale(const RenderOptions& options, const RenderOptions& probe) {
          (double(probe.width) * double(probe.height));
 }
 
-// A probe's fixed costs so far (fixed_costs, as predict prices them): full_frame_ms keeps them
-// as counted and adds only non-negative terms, so a probe whose fixed costs pass `ms` is priced
-// over `ms` whatever else it does.
-std::function<bool(const vgpu::Counters&)> over(double ms, const vgpu::Profile& profile) {
-  return [=, &profile, p = defaults_for(profile)](const vgpu::Counters& t) {
-    return fixed_costs(t, profile, p).total_ms() > ms;
+// A probe's price so far (RunningPrice, on the profile it is priced on, at its scale) can only
+// grow, so a probe whose price so far passes `ms` is priced over `ms` whatever else it does.
+std::function<bool(const vgpu::Counters&)> over(double ms, const vgpu::Profile& profile,
+                                                double scale) {
+  return [=, price = std::make_shared<RunningPrice>(profile, scale)](const vgpu::Counters& t) {
+    return price->add(t) > ms;
   };
 }
 
@@ -117,11 +118,12 @@ AccelChoice choose_accel(const Scene& scene, const std::vector<AccelCandidate>& 
   c.probe_height = probe.height;
   const vgpu::Profile& profile = vgpu::profile(options.profile);
   auto name_of = [](const AccelCandidate* cand) { return std::string(cand->accel->name()); };
-  // A probe stops once its fixed costs alone price it over `ms`; its price is then only known to be
-  // over that: kept just over `ms`, the candidate listed in `stopped`.
+  // A probe stops once the floor of its price so far passes `ms` (over); its price is then only
+  // known to be over that: kept just over `ms`, the candidate listed in `stopped`.
   const bool emulated = options.device == "vgpu";
-  auto budget = [&](double ms) {
-    return stop_early && emulated ? over(ms, profile)
+  auto budget = [&](double ms, const RenderOptions& size) {
+    const double scale = probe_scale(options, size);
+    return stop_early && emulated ? over(ms, full_frame_profile(profile, scale), scale)
                                   : std::function<bool(const vgpu::Counters&)>{};
   };
   auto stop = [&](const std::string& name, double ms) {  // strictly over: not a tie, not in band
@@ -138,7 +140,7 @@ AccelChoice choose_accel(const Scene& scene, const std::vector<AccelCandidate>& 
     const double bound = (1.0 + kAutoProbeBand) * cheapest;
     try {
       const auto [ms, passes] = probe_price(scene, cand, probe, options, camera, profile,
-                                            priced.empty() ? nullptr : budget(bound));
+                                            priced.empty() ? nullptr : budget(bound, probe));
       c.coarse_ms[name] = c.predicted_ms[name] = ms;
       c.probe_passes[name] = passes;
       cheapest = priced.empty() ? ms : std::min(cheapest, ms);
@@ -173,7 +175,7 @@ AccelChoice choose_accel(const Scene& scene, const std::vector<AccelCandidate>& 
       const std::string name = name_of(cand);
       try {
         const double ms = probe_price(scene, *cand, fine, options, camera, profile,
-                                      kept.empty() ? nullptr : budget(best))
+                                      kept.empty() ? nullptr : budget(best, fine))
                               .first;
         c.predicted_ms[name] = ms;
         best = kept.empty() ? ms : std::min(best, ms);
