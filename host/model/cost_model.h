@@ -129,8 +129,10 @@ FixedCosts fixed_costs(const vgpu::Counters& totals, const vgpu::Profile& profil
 // costs and longest lanes as counted, and `scale` times the pass work (a probe's full-frame
 // price: host/trace/stream/accel_choice.h). Later passes only add to it, so a frame whose
 // running price passes a bound is priced over that bound at its end (a clear between two passes
-// is priced with the pass after it, at most what predict() gives it). --accel auto stops a probe
-// once its running price passes what could still be picked.
+// is priced with the pass after it, at most what predict() gives it). That holds where predict()
+// prices the frame pass by pass, from its records (RenderOptions::keep_pass_records, as the
+// probes keep them); from per-program averages predict() may price it lower. --accel auto stops
+// a probe once its running price passes what could still be picked.
 class RunningPrice {
  public:
   RunningPrice(const vgpu::Profile& profile, double scale);

@@ -191,7 +191,7 @@ struct RenderOptions {
   std::vector<std::string> recorded_programs;
   // The emulator only: called with the frame's counters so far as each pass is counted; true
   // stops the frame with vgpu::BudgetError (vgpu::Gpu::set_stop_when). --accel auto's probes,
-  // once the floor of their price so far prices them out (host::price_floor_ms).
+  // once their price so far prices them out (host::RunningPrice).
   std::function<bool(const vgpu::Counters&)> stop_when;
   // The combinations of these options that cannot run are refused in one place,
   // host::validate (host/trace/validate.h).

@@ -504,7 +504,7 @@ pick, the band and every other price are those of probes run to their ends
 (`tests/trace/test_structure_walks.cpp`, three scenes on three profiles; and the running price
 never passes the whole frame's, on every structure's frames of two scenes on four profiles).
 
-Until issue 51's later stops a probe stopped on its fixed costs alone, which only a multipass
+Before the running price, a probe stopped on its fixed costs alone, which only a multipass
 kd-tree probe (whose restarts cost passes) ever passed: measured then against no stops, both
 rounds of probes took a median 0.71x the host time in the 78 choices that stopped one. With the
 pass work counted too, looping probes and other structures stop as well. Measured in one run
@@ -610,7 +610,7 @@ slow (the grid on stadium and scales) its probe alone outlasts the chosen frame,
 build is slow (scales: the kd-tree's 0.4 s) so does that. A choice within a quarter of the frame's
 host time needs a predictor that renders nothing, and where the builds alone pass the quarter (the
 count above), one that builds nothing either: not built here. (The kd-tree's build now sorts its
-events once: 1.9x to 2.6x faster, the same tree, `bench_builds`. The sweep of issue 51's
+events once: 2.1x to 2.8x faster, the same tree, `bench_builds`. The sweep of issue 51's
 earlier stop ran slower throughout, its two-level grid's build on scales 204 ms against 91 to
 107 ms here, which nothing changed, so the medians' change since is not the kd-tree's or the
 stops' alone: each is measured in one run, `bench_builds` and "Stopped probes" below.)

@@ -78,7 +78,9 @@ double probe_scale(const RenderOptions& options, const RenderOptions& probe) {
 std::function<bool(const vgpu::Counters&)> over(double ms, const vgpu::Profile& profile,
                                                 double scale) {
   return [=, price = std::make_shared<RunningPrice>(profile, scale)](const vgpu::Counters& t) {
-    return price->add(t) > ms;
+    // (By more than rounding: the running price adds a clear's bytes within a pass, predict after
+    // the passes, so the two may differ in their last bits; a probe priced at `ms` runs on.)
+    return price->add(t) > ms * (1 + 1e-12);
   };
 }
 
@@ -118,7 +120,7 @@ AccelChoice choose_accel(const Scene& scene, const std::vector<AccelCandidate>& 
   c.probe_height = probe.height;
   const vgpu::Profile& profile = vgpu::profile(options.profile);
   auto name_of = [](const AccelCandidate* cand) { return std::string(cand->accel->name()); };
-  // A probe stops once the floor of its price so far passes `ms` (over); its price is then only
+  // A probe stops once its price so far passes `ms` (over); its price is then only
   // known to be over that: kept just over `ms`, the candidate listed in `stopped`.
   const bool emulated = options.device == "vgpu";
   auto budget = [&](double ms, const RenderOptions& size) {

@@ -42,8 +42,8 @@ struct AccelChoice {
   // else from the first; coarse_ms from the first probes alone.
   std::map<std::string, double> predicted_ms, coarse_ms;
   std::vector<std::string> refined;  // the candidates probed again, in order
-  // The candidates whose probe stopped once the floor of its price so far (price_floor_ms: its
-  // fixed costs, longest lanes and a floor of its pass work) priced it out (the first round:
+  // The candidates whose probe stopped once its price so far (RunningPrice: its passes so far,
+  // each priced as predict prices it) priced it out (the first round:
   // over the band of the cheapest so far; the second: over the cheapest second price so far).
   // Their price in predicted_ms (and coarse_ms, for a first-round stop) is just over what they
   // were known to pass: a lower bound, never equal to a band edge or the pick's price. Stopping
