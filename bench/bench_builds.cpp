@@ -8,7 +8,6 @@
 // Exit codes: 0 the trees are the same everywhere, 1 they differ somewhere, 2 bad arguments or a
 // scene that does not load (one line on stderr).
 #include <algorithm>
-#include <bit>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
@@ -29,21 +28,6 @@ constexpr const char* kUsage =
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   return v[v.size() / 2];
-}
-
-// Every node's fields (a split's bits), the lists and the tree's figures.
-bool same(const host::KdTree& a, const host::KdTree& b) {
-  if (a.nodes.size() != b.nodes.size() || a.lists != b.lists || a.sah_cost != b.sah_cost ||
-      a.depth != b.depth || a.leaves != b.leaves || a.empty_leaves != b.empty_leaves ||
-      a.max_leaf != b.max_leaf)
-    return false;
-  for (size_t i = 0; i < a.nodes.size(); ++i) {
-    const host::KdNode &x = a.nodes[i], &y = b.nodes[i];
-    if (std::bit_cast<uint32_t>(x.split) != std::bit_cast<uint32_t>(y.split) || x.axis != y.axis ||
-        x.right != y.right || x.leaf != y.leaf || x.count != y.count)
-      return false;
-  }
-  return true;
 }
 
 int refuse(const std::string& why) {
@@ -99,7 +83,7 @@ int main(int argc, char** argv) {
         ms[m].push_back(trees[m].build_ms);
       }
     const double slow = median(ms[0]), fast = median(ms[1]);
-    const bool ok = same(trees[0], trees[1]);
+    const bool ok = host::same_tree(trees[0], trees[1]);
     all_same = all_same && ok;
     std::printf("%-28s %10zu %12.1f %12.1f %6.2fx %s\n", name.c_str(), scene.triangle_count(), slow,
                 fast, slow / fast, ok ? "yes" : "NO");

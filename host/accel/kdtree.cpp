@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -266,6 +267,20 @@ KdTree build_kdtree(const Scene& scene, glm::vec3 lo, glm::vec3 hi, const KdSpec
   kd.build_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   return kd;
+}
+
+bool same_tree(const KdTree& a, const KdTree& b) {
+  if (a.nodes.size() != b.nodes.size() || a.lists != b.lists || a.depth != b.depth ||
+      a.leaves != b.leaves || a.empty_leaves != b.empty_leaves || a.max_leaf != b.max_leaf ||
+      a.sah_cost != b.sah_cost || a.lo != b.lo || a.hi != b.hi)
+    return false;
+  for (size_t i = 0; i < a.nodes.size(); ++i) {
+    const KdNode &x = a.nodes[i], &y = b.nodes[i];
+    if (std::bit_cast<uint32_t>(x.split) != std::bit_cast<uint32_t>(y.split) || x.axis != y.axis ||
+        x.right != y.right || x.leaf != y.leaf || x.count != y.count)
+      return false;
+  }
+  return true;
 }
 
 std::string describe(const KdTree& kd) {

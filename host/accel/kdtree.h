@@ -60,6 +60,10 @@ struct KdTree {
 // first; a scene built in code may not).
 KdTree build_kdtree(const Scene& scene, glm::vec3 lo, glm::vec3 hi, const KdSpec& spec = {});
 
+// Whether two trees are the same: every node's fields (a split's bits: -0 and +0 differ), the
+// lists, the depth, leaf counts and SAH cost (build_ms aside).
+bool same_tree(const KdTree& a, const KdTree& b);
+
 // "kd-tree: 12,345 nodes, depth 21, 6,173 leaves (1,020 empty) of at most 9 triangles"
 std::string describe(const KdTree& kd);
 

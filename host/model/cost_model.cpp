@@ -351,6 +351,11 @@ std::vector<std::pair<std::string, vgpu::FrameStats>> what_ifs(const vgpu::Frame
           {"mrt + resident programs", with_resident_programs(mrt)}};
 }
 
+double full_frame_ms(const CostBreakdown& b, double scale) {
+  return b.per_pass_ms + b.program_load_ms + b.readback_ms + b.latency_ms +
+         scale * (b.arithmetic_ms + b.texture_ms + b.memory_ms + b.download_ms);
+}
+
 RunningPrice::RunningPrice(const vgpu::Profile& profile, double scale)
     : profile_(profile), params_(defaults_for(profile)), scale_(scale) {}
 
@@ -358,8 +363,12 @@ double RunningPrice::add(const vgpu::Counters& totals) {
   const vgpu::Counters pass = minus(totals, last_);
   last_ = totals;
   add_passes(pass, double(pass.passes), profile_, params_, work_);
-  return fixed_costs(totals, profile_, params_).total_ms() + work_.latency_ms +
-         scale_ * (work_.arithmetic_ms + work_.texture_ms + work_.memory_ms);
+  CostBreakdown so_far = work_;
+  const FixedCosts f = fixed_costs(totals, profile_, params_);
+  so_far.per_pass_ms = f.per_pass_ms;
+  so_far.program_load_ms = f.program_load_ms;
+  so_far.readback_ms = f.readback_ms;
+  return full_frame_ms(so_far, scale_);
 }
 
 }  // namespace host

@@ -124,10 +124,18 @@ struct FixedCosts {
 FixedCosts fixed_costs(const vgpu::Counters& totals, const vgpu::Profile& profile,
                        const CostParams& params);
 
+// The price of a frame `scale` times larger in pixels than the one priced in `b` (a probe's full
+// frame, --accel auto: host/trace/stream/accel_choice.h), every term of b.total_ms: the costs
+// that follow the pass count (per pass, program loads, read-backs) and the looping passes'
+// longest lanes (latency: one lane's chain, which does not grow with the pixel count) as
+// counted, the fragment work and downloads times `scale`. At scale 1 this is b.total_ms. (Whether
+// a pass outgrows the L2 at that size is the profile's to say: price b on one whose l2_bytes is
+// divided by `scale`.)
+double full_frame_ms(const CostBreakdown& b, double scale);
+
 // The price of a frame's passes so far, from its running totals after each pass (the pass: the
-// difference from the totals before it), each pass priced as predict() prices it: the fixed
-// costs and longest lanes as counted, and `scale` times the pass work (a probe's full-frame
-// price: host/trace/stream/accel_choice.h). Later passes only add to it, so a frame whose
+// difference from the totals before it), each pass priced as predict() prices it, at `scale`
+// (full_frame_ms). Later passes only add to it, so a frame whose
 // running price passes a bound is priced over that bound at its end (a clear between two passes
 // is priced with the pass after it, at most what predict() gives it). That holds where predict()
 // prices the frame pass by pass, from its records (RenderOptions::keep_pass_records, as the

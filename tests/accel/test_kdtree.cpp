@@ -6,7 +6,6 @@
 
 #include <algorithm>
 #include <array>
-#include <bit>
 #include <cmath>
 #include <random>
 #include <string>
@@ -21,6 +20,7 @@ namespace {
 
 using host::KdNode;
 using host::KdTree;
+using host::same_tree;
 using host::Scene;
 
 Scene make_scene(const std::vector<std::array<glm::vec3, 3>>& tris) {
@@ -162,18 +162,6 @@ void check_tree(const Scene& s, const KdTree& kd, int max_depth) {
 // Havran's rule, written out: 8 + 1.3 log2(triangles), rounded.
 int default_max_depth(size_t triangles) {
   return int(std::lround(8.0 + 1.3 * std::log2(double(std::max<size_t>(triangles, 1)))));
-}
-
-// Every node's fields (a split's bits: -0 and +0 differ), the lists and the tree's figures.
-bool same_tree(const KdTree& a, const KdTree& b) {
-  if (a.nodes.size() != b.nodes.size() || a.lists != b.lists) return false;
-  for (size_t i = 0; i < a.nodes.size(); ++i) {
-    const KdNode &x = a.nodes[i], &y = b.nodes[i];
-    if (std::bit_cast<uint32_t>(x.split) != std::bit_cast<uint32_t>(y.split) || x.axis != y.axis ||
-        x.right != y.right || x.leaf != y.leaf || x.count != y.count)
-      return false;
-  }
-  return a.depth == b.depth && a.leaves == b.leaves && a.sah_cost == b.sah_cost;
 }
 
 }  // namespace

@@ -43,17 +43,6 @@ WalkWork walk_work(const vgpu::FrameStats& stats, uint64_t rays_traced) {
 
 namespace {
 
-// The price of a candidate: the full frame predicted from its probe's cost breakdown, every term
-// of the model's total (CostBreakdown::total_ms). The costs that follow the pass count (per pass,
-// program loads, read-backs) and the looping passes' longest lanes (latency: one lane's chain,
-// which does not grow with the pixel count) as measured; the fragment work scaled by `scale`,
-// the full frame's pixels over the probe's. At scale 1 this is the probe's total_ms. Whether a
-// pass outgrows the profile's L2 is judged at the full frame's size (full_frame_profile).
-double full_frame_ms(const CostBreakdown& b, double scale) {
-  return b.per_pass_ms + b.program_load_ms + b.readback_ms + b.latency_ms +
-         scale * (b.arithmetic_ms + b.texture_ms + b.memory_ms + b.download_ms);
-}
-
 // The options of a probe frame: 1/`divisor` of the size in x and y (at least 16x16), quiet.
 RenderOptions probe_options(const RenderOptions& options, int divisor = 4) {
   RenderOptions probe = options;
