@@ -47,6 +47,14 @@ double median(std::vector<double> v) {
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
+// Each series' median, by name (null where there are none: the emulator's frames).
+json medians(const std::map<std::string, std::vector<double>>& series) {
+  if (series.empty()) return json();
+  json out = json::object();
+  for (const auto& [name, v] : series) out[name] = median(v);
+  return out;
+}
+
 double ms_since(Clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
 }
@@ -286,6 +294,9 @@ bool parse_sampling(const std::string& text, host::RenderOptions& opt) {
 struct FrameRun {
   std::vector<double> wall, gpu, host, wait;
   std::map<std::string, std::vector<double>> kernel_gpu, kernel_host;
+  // The GL device's host time by call (gl::GlDevice::HostTimes) and the rest of the wall time,
+  // the host's own work between calls, each timed frame; and the GL objects it made in them.
+  std::map<std::string, std::vector<double>> split, made;
   vgpu::FrameStats stats;
   uint64_t rays_traced = 0;
   bool streams = false;  // the frame ran as ray streams (--ray-streams on, or a glass scene)
@@ -326,9 +337,28 @@ FrameRun run_frames(const host::Scene& scene, const host::Accel& accel, const ho
     }
     if (r == 1) fr.timed_from_s = unix_s();
     const double wait0 = gld ? gld->readback_wait_ms() : 0;
+    const gl::GlDevice::HostTimes h0 = gld ? gld->host_times() : gl::GlDevice::HostTimes{};
     const host::RenderResult res = tracer.render(cam);
     if (r == 0) continue;
     fr.wait.push_back(gld ? gld->readback_wait_ms() - wait0 : 0);
+    if (gld) {
+      const gl::GlDevice::HostTimes& h = gld->host_times();
+      const std::pair<const char*, double> calls[] = {{"draw", h.draw_ms - h0.draw_ms},
+                                                      {"query_wait", h.wait_ms - h0.wait_ms},
+                                                      {"download", h.download_ms - h0.download_ms},
+                                                      {"upload", h.upload_ms - h0.upload_ms},
+                                                      {"clear", h.clear_ms - h0.clear_ms},
+                                                      {"settle", h.settle_ms - h0.settle_ms}};
+      double in_calls = 0;
+      for (const auto& [name, ms] : calls) {
+        fr.split[name].push_back(ms);
+        in_calls += ms;
+      }
+      fr.split["between_calls"].push_back(res.render_ms - in_calls);
+      fr.made["textures"].push_back(double(h.textures_made - h0.textures_made));
+      fr.made["framebuffers"].push_back(double(h.framebuffers_made - h0.framebuffers_made));
+      fr.made["programs"].push_back(double(h.programs_linked - h0.programs_linked));
+    }
     fr.wall.push_back(res.render_ms);
     fr.gpu.push_back(res.stats.totals.device_ms);
     for (const auto& p : res.stats.programs) {
@@ -586,6 +616,8 @@ json frame_json(const FrameKey& key, const host::RenderOptions& opt, const Frame
             {"wall_runs_ms", fr.wall},  // every timed frame, in order
             {"gpu_ms", gl ? json(median(fr.gpu)) : json()},
             {"readback_wait_ms", gl ? json(median(fr.wait)) : json()},
+            {"host_split_ms", medians(fr.split)},
+            {"gl_objects_made", medians(fr.made)},
             {"gpu_runs_ms", gl ? json(fr.gpu) : json()},
             {"passes", fr.stats.totals.passes},
             {"query_readbacks", fr.stats.totals.query_readbacks},

@@ -117,6 +117,14 @@ std::string GlDevice::description() const {
   return ctx_->renderer() + ", OpenGL " + ctx_->version() + ", " + ctx_->platform();
 }
 
+namespace {
+
+double ms_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+}  // namespace
+
 GlDevice::GlTexture& GlDevice::texture(const Texture& t) {
   auto& slot = textures_[t.id()];
   if (!slot) {
@@ -144,28 +152,34 @@ GlDevice::GlTexture& GlDevice::texture(const Texture& t) {
     glTexImage2D(GL_TEXTURE_2D, 0, GLint(internal_format(t)), t.width(), t.height(), 0, g->format,
                  GL_FLOAT, t.data().data());
     slot = std::move(g);
+    ++times_.textures_made;
   }
   return *slot;
 }
 
 void GlDevice::upload(const Texture& t) {
   ctx_->make_current();
+  const auto t0 = std::chrono::steady_clock::now();
   const bool fresh = !textures_.count(t.id());
   GlTexture& g = texture(t);
-  if (fresh) return;  // created from the host's texels just now
-  glActiveTexture(kScratchUnit);
-  glBindTexture(GL_TEXTURE_2D, g.name);
-  glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, t.width(), t.height(), g.format, GL_FLOAT,
-                  t.data().data());
+  if (!fresh) {  // else created from the host's texels just now
+    glActiveTexture(kScratchUnit);
+    glBindTexture(GL_TEXTURE_2D, g.name);
+    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, t.width(), t.height(), g.format, GL_FLOAT,
+                    t.data().data());
+  }
+  times_.upload_ms += ms_since(t0);
 }
 
 void GlDevice::download(Texture& t) {
   ctx_->make_current();
+  const auto t0 = std::chrono::steady_clock::now();
   GlTexture& g = texture(t);
   glActiveTexture(kScratchUnit);
   glBindTexture(GL_TEXTURE_2D, g.name);
   glGetTexImage(GL_TEXTURE_2D, 0, g.format, GL_FLOAT, t.texel_mut(0, 0));
   vgpu::count_download(stats_, t);
+  times_.download_ms += ms_since(t0);
 }
 
 void GlDevice::use_program(const vgpu::Program& program) {
@@ -207,6 +221,7 @@ void GlDevice::set_work_mask(const vgpu::Stencil*) {
 
 void GlDevice::clear(Texture& t, std::initializer_list<float> value) {
   ctx_->make_current();
+  const auto t0 = std::chrono::steady_clock::now();
   if (int(value.size()) != t.channels())
     throw Error("clear of texture '" + t.name() + "': " + std::to_string(value.size()) +
                 " values for " + std::to_string(t.channels()) + " channels");
@@ -223,6 +238,7 @@ void GlDevice::clear(Texture& t, std::initializer_list<float> value) {
   c.clears = 1;
   c.bytes_written = t.bytes();
   stats_.totals += c;
+  times_.clear_ms += ms_since(t0);
 }
 
 GlDevice::GlProgram& GlDevice::program_for(const vgpu::Program& p) {
@@ -256,6 +272,7 @@ GlDevice::GlProgram& GlDevice::program_for(const vgpu::Program& p) {
       }
       if (!dump_dir_.empty()) dump(g->name, p.name(), r.glsl.source);
       g->constants = glGetUniformLocation(g->name, "k");
+      ++times_.programs_linked;
       for (const std::string& s : r.glsl.samplers)
         g->samplers.push_back(glGetUniformLocation(g->name, s.c_str()));
       slot = std::move(g);
@@ -306,6 +323,7 @@ unsigned GlDevice::framebuffer_for(const std::vector<Texture*>& targets) {
       bufs.push_back(GLenum(GL_COLOR_ATTACHMENT0 + i));
     }
     glDrawBuffers(GLsizei(bufs.size()), bufs.data());
+    ++times_.framebuffers_made;
     if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
       throw Error("render target '" + targets[0]->name() + "' (" +
                   std::to_string(targets[0]->channels()) +
@@ -368,8 +386,8 @@ const vgpu::PassRecord& GlDevice::draw(const vgpu::Rect& rect) {
 
   // Counted as if nothing were discarded until the driver says how many were (settle()).
   vgpu::Counters c = vgpu::pass_counters(a, units_.data(), targets_, rect.area(), rect.area(), 0);
-  c.host_ms =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  c.host_ms = ms_since(t0);
+  times_.draw_ms += c.host_ms;
   pend.area = rect.area();
   for (const Texture* t : targets_) pend.write_per_fragment += uint64_t(t->bytes_per_texel());
   pend.program = p.name();
@@ -389,7 +407,11 @@ const vgpu::PassRecord& GlDevice::draw(const vgpu::Rect& rect) {
   }
   pending_.push_back(std::move(pend));
   // Keep the number of queries in flight bounded on long frames (the oldest are long done).
-  if (pending_.size() >= 8192 && !query_active_) settle(1024);
+  if (pending_.size() >= 8192 && !query_active_) {
+    const auto t1 = std::chrono::steady_clock::now();
+    settle(1024);
+    times_.settle_ms += ms_since(t1);
+  }
   return *out;
 }
 
@@ -419,8 +441,7 @@ uint64_t GlDevice::end_query() {
     pending_[i].passed = int64_t(v);
     n += v;
   }
-  wait_ms_ +=
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  times_.wait_ms += ms_since(t0);
   vgpu::count_readback(stats_, program_, n);
   return n;
 }
@@ -459,12 +480,18 @@ void GlDevice::settle(size_t keep) {
 
 void GlDevice::finish() {
   ctx_->make_current();
+  const auto t0 = std::chrono::steady_clock::now();
   glFinish();
   settle(0);
+  times_.settle_ms += ms_since(t0);
 }
 
 vgpu::FrameStats& GlDevice::stats() {
-  if (!query_active_) settle(0);
+  if (!query_active_ && !pending_.empty()) {
+    const auto t0 = std::chrono::steady_clock::now();
+    settle(0);
+    times_.settle_ms += ms_since(t0);
+  }
   return stats_;
 }
 

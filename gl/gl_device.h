@@ -61,7 +61,17 @@ class GlDevice final : public vgpu::Device {
   ReadbackWait readback_wait() const { return wait_; }  // block or poll, never automatic
   // Host milliseconds spent waiting in end_query() since the device was made (a frame's share:
   // the difference of two readings).
-  double readback_wait_ms() const { return wait_ms_; }
+  double readback_wait_ms() const { return times_.wait_ms; }
+  // The host's time in the device's calls since it was made, by call (a frame's share: the
+  // difference of two readings). What a frame's wall time holds besides them is the host's own
+  // work between calls. download, upload and clear include making a texture they meet first
+  // (glTexImage2D); settle is stats() and finish() collecting the passes' queries, which waits
+  // for the GPU to finish them, as a download waits for the passes that write its texture.
+  struct HostTimes {
+    double draw_ms = 0, wait_ms = 0, download_ms = 0, upload_ms = 0, clear_ms = 0, settle_ms = 0;
+    uint64_t textures_made = 0, framebuffers_made = 0, programs_linked = 0;
+  };
+  const HostTimes& host_times() const { return times_; }
   // From now on, write each program the driver links to `dir` (which must exist): its GLSL
   // source (NN_name.glsl) and the driver's program binary (NN_name.bin, glGetProgramBinary:
   // NVIDIA's holds the compiled assembly as text, instruction and register counts included).
@@ -87,7 +97,7 @@ class GlDevice final : public vgpu::Device {
 
   vgpu::Profile profile_;
   ReadbackWait wait_ = ReadbackWait::block;
-  double wait_ms_ = 0;
+  HostTimes times_;
   std::unique_ptr<Context> ctx_;
   unsigned vao_ = 0, clear_fbo_ = 0;
   std::map<uint64_t, std::unique_ptr<GlTexture>> textures_;
