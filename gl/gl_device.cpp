@@ -244,42 +244,55 @@ void GlDevice::clear(Texture& t, std::initializer_list<float> value) {
 GlDevice::GlProgram& GlDevice::program_for(const vgpu::Program& p) {
   Recorded& r = recorded_[p.id()];
   const std::span<const std::byte> bytes = p.uniform_bytes();
-  if (!r.gl || r.uniforms.size() != bytes.size() ||
-      std::memcmp(r.uniforms.data(), bytes.data(), bytes.size()) != 0) {
-    r.uniforms.assign(bytes.begin(), bytes.end());
-    r.glsl = vgpu::to_glsl(p);
-    auto& slot = compiled_[r.glsl.source];
-    if (!slot) {
-      const std::string what = std::string("program '") + p.name() + "'";
-      const GLuint vs = compile(GL_VERTEX_SHADER, vgpu::fullscreen_vertex_shader(), what);
-      const GLuint fs = compile(GL_FRAGMENT_SHADER, r.glsl.source, what);
-      auto g = std::make_unique<GlProgram>();
-      g->name = glCreateProgram();
-      glAttachShader(g->name, vs);
-      glAttachShader(g->name, fs);
-      if (!dump_dir_.empty())
-        glProgramParameteri(g->name, GL_PROGRAM_BINARY_RETRIEVABLE_HINT, GL_TRUE);
-      glLinkProgram(g->name);
-      glDeleteShader(vs);
-      glDeleteShader(fs);
-      GLint ok = 0;
-      glGetProgramiv(g->name, GL_LINK_STATUS, &ok);
-      if (!ok) {
-        char log[1024] = {};
-        glGetProgramInfoLog(g->name, sizeof log, nullptr, log);
-        glDeleteProgram(g->name);
-        throw Error("the GL driver could not link " + what + ": " + log);
-      }
-      if (!dump_dir_.empty()) dump(g->name, p.name(), r.glsl.source);
-      g->constants = glGetUniformLocation(g->name, "k");
-      ++times_.programs_linked;
-      for (const std::string& s : r.glsl.samplers)
-        g->samplers.push_back(glGetUniformLocation(g->name, s.c_str()));
-      slot = std::move(g);
-    }
-    r.gl = slot.get();
+  auto same = [&](const Variant& v) {
+    return std::equal(v.uniforms.begin(), v.uniforms.end(), bytes.begin(), bytes.end());
+  };
+  if (r.current && same(*r.current)) return *r.current->gl;
+  const auto seen = std::find_if(r.variants.begin(), r.variants.end(),
+                                 [&](const std::unique_ptr<Variant>& v) { return same(*v); });
+  if (seen != r.variants.end()) {
+    r.current = seen->get();
+    ++times_.variants_reused;
+    return *r.current->gl;
   }
-  return *r.gl;
+  auto v = std::make_unique<Variant>();
+  v->uniforms.assign(bytes.begin(), bytes.end());
+  v->glsl = vgpu::to_glsl(p);
+  ++times_.variants_printed;
+  auto& slot = compiled_[v->glsl.source];
+  if (!slot) {
+    const std::string what = std::string("program '") + p.name() + "'";
+    const GLuint vs = compile(GL_VERTEX_SHADER, vgpu::fullscreen_vertex_shader(), what);
+    const GLuint fs = compile(GL_FRAGMENT_SHADER, v->glsl.source, what);
+    auto g = std::make_unique<GlProgram>();
+    g->name = glCreateProgram();
+    glAttachShader(g->name, vs);
+    glAttachShader(g->name, fs);
+    if (!dump_dir_.empty())
+      glProgramParameteri(g->name, GL_PROGRAM_BINARY_RETRIEVABLE_HINT, GL_TRUE);
+    glLinkProgram(g->name);
+    glDeleteShader(vs);
+    glDeleteShader(fs);
+    GLint ok = 0;
+    glGetProgramiv(g->name, GL_LINK_STATUS, &ok);
+    if (!ok) {
+      char log[1024] = {};
+      glGetProgramInfoLog(g->name, sizeof log, nullptr, log);
+      glDeleteProgram(g->name);
+      throw Error("the GL driver could not link " + what + ": " + log);
+    }
+    if (!dump_dir_.empty()) dump(g->name, p.name(), v->glsl.source);
+    g->constants = glGetUniformLocation(g->name, "k");
+    ++times_.programs_linked;
+    for (const std::string& s : v->glsl.samplers)
+      g->samplers.push_back(glGetUniformLocation(g->name, s.c_str()));
+    slot = std::move(g);
+  }
+  v->gl = slot.get();
+  r.current = v.get();
+  r.variants.push_back(std::move(v));
+  if (r.variants.size() > kRecordedVariants) r.variants.erase(r.variants.begin());
+  return *r.current->gl;
 }
 
 GlDevice::Linked GlDevice::link(const vgpu::Program& p) {
@@ -350,7 +363,7 @@ const vgpu::PassRecord& GlDevice::draw(const vgpu::Rect& rect) {
   vgpu::check_pass(profile_, p, a, units_.data(), targets_, rect);
 
   GlProgram& prog = program_for(p);
-  const vgpu::GlslProgram& glsl = recorded_[p.id()].glsl;
+  const vgpu::GlslProgram& glsl = recorded_[p.id()].current->glsl;
   // Targets first: creating a texture binds it to the active unit.
   framebuffer_for(targets_);
   glUseProgram(prog.name);

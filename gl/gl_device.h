@@ -70,6 +70,9 @@ class GlDevice final : public vgpu::Device {
   struct HostTimes {
     double draw_ms = 0, wait_ms = 0, download_ms = 0, upload_ms = 0, clear_ms = 0, settle_ms = 0;
     uint64_t textures_made = 0, framebuffers_made = 0, programs_linked = 0;
+    // Draws whose uniforms the program's last draw did not have: its GLSL printed again
+    // (variants_printed), or found among those kept (variants_reused).
+    uint64_t variants_printed = 0, variants_reused = 0;
   };
   const HostTimes& host_times() const { return times_; }
   // From now on, write each program the driver links to `dir` (which must exist): its GLSL
@@ -102,10 +105,18 @@ class GlDevice final : public vgpu::Device {
   unsigned vao_ = 0, clear_fbo_ = 0;
   std::map<uint64_t, std::unique_ptr<GlTexture>> textures_;
   std::map<std::string, std::unique_ptr<GlProgram>> compiled_;  // by source text
-  struct Recorded {
+  // A program's GLSL for one set of uniform values: printing it records the program again (tens
+  // to hundreds of us for a large kernel), so each program keeps the last kRecordedVariants
+  // sets it was drawn with (a scan's offsets, a sample frame's jitters: a frame repeats them).
+  struct Variant {
     std::vector<std::byte> uniforms;
     vgpu::GlslProgram glsl;
     GlProgram* gl = nullptr;
+  };
+  static constexpr size_t kRecordedVariants = 64;
+  struct Recorded {
+    std::vector<std::unique_ptr<Variant>> variants;  // oldest first
+    Variant* current = nullptr;                      // the one drawn last
   };
   std::map<uint32_t, Recorded> recorded_;  // by program id
   std::map<std::vector<uint64_t>, unsigned> fbos_;

@@ -4,6 +4,7 @@
 #include <doctest/doctest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -128,6 +129,69 @@ TEST_CASE("a uniform change reuses the compiled GLSL: constants are uniforms, no
   const vgpu::GlslProgram ga = vgpu::to_glsl(a), gb = vgpu::to_glsl(b);
   CHECK(ga.source == gb.source);
   CHECK(ga.constants != gb.constants);
+}
+
+namespace {
+
+// A pass whose output depends on a uniform: the source texel's x times `scale`.
+struct ScaleBy {
+  static constexpr const char* name = "scale by";
+  static constexpr const char* paper_name = "-";
+  static constexpr int outputs = 1;
+  static constexpr std::array<const char*, 1> units{"source"};
+  float scale = 1;
+  template <class L>
+  void operator()(vgpu::Fragments<L>& f) const {
+    const vgpu::Vec4<typename L::F> v = f.fetch_own(0);
+    f.out(0) = {v.x * typename L::F(scale), v.y, v.z, v.w};
+  }
+};
+
+}  // namespace
+
+TEST_CASE(
+    "a program drawn again with uniforms it was drawn with before draws with them, from the GLSL "
+    "the GL device kept for them, and a program keeps the GLSL of its last 64 uniform sets") {
+  gl::GlDevice& d = gltest::device();
+  vgpu::Texture src("scale source", 4, 2, 4), dst("scale target", 4, 2, 4);
+  for (int y = 0; y < 2; ++y)
+    for (int x = 0; x < 4; ++x) {
+      float* t = src.texel_mut(x, y);
+      t[0] = float(1 + x + 4 * y), t[1] = 0.5f, t[2] = -1.0f, t[3] = 1.0f;
+    }
+  d.upload(src);
+  vgpu::KernelProgram<ScaleBy> p;
+  auto draw = [&](float scale) {
+    p.kernel.scale = scale;
+    d.use_program(p);
+    d.bind_texture(0, src);
+    d.set_targets({&dst});
+    d.draw();
+    d.download(dst);
+    for (int y = 0; y < 2; ++y)
+      for (int x = 0; x < 4; ++x) {
+        CAPTURE(scale);
+        CHECK(dst.texel(x, y)[0] == float(1 + x + 4 * y) * scale);
+        CHECK(dst.texel(x, y)[1] == 0.5f);
+        CHECK(dst.texel(x, y)[2] == -1.0f);
+        CHECK(dst.texel(x, y)[3] == 1.0f);
+      }
+  };
+  const gl::GlDevice::HostTimes t0 = d.host_times();
+  draw(2.0f);
+  draw(3.0f);
+  draw(2.0f);  // the first set again: its GLSL kept, its constants drawn with
+  const gl::GlDevice::HostTimes t1 = d.host_times();
+  CHECK(t1.variants_printed - t0.variants_printed == 2);
+  CHECK(t1.variants_reused - t0.variants_reused == 1);
+  CHECK(t1.programs_linked == t0.programs_linked + 1);  // one text for all: constants are uniforms
+  // 64 more sets push out the oldest ones: 2 and 3 are printed again.
+  for (int i = 0; i < 64; ++i) draw(4.0f + float(i));
+  const gl::GlDevice::HostTimes t2 = d.host_times();
+  draw(3.0f);
+  draw(2.0f);
+  CHECK(d.host_times().variants_printed - t2.variants_printed == 2);
+  CHECK(d.host_times().variants_reused == t2.variants_reused);
 }
 
 TEST_CASE("the GL device refuses what it cannot do, naming it") {

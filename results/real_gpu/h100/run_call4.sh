@@ -3,7 +3,8 @@
 # (host_split_ms: draw, query_wait, download, upload, clear, settle, between_calls) and the GL
 # objects made in timed frames. Run from the repository's root on the GPU host with bench_gl in
 # .scalebin/ and the glvnd packages in .gl/; the files are tarred to $OUT as split.tgz. The card
-# is whatever the device gives: gpu.csv names it.
+# is whatever the device gives: gpu.csv names it. .scalebin/bench_gl_before is bench_gl of commit
+# 54e0641 (the split, without the GLSL kept per uniform set).
 set -u
 out=/tmp/o; mkdir -p $out
 . scripts/h200/env.sh
@@ -15,6 +16,10 @@ stage() { local name=$1; shift; local l; l=$(left)
   timeout "$l" "$@" > $out/$name.log 2>&1; echo "$name rc=$? at $(( $(date +%s) - t0 )) s"; }
 nvidia-smi --query-gpu=name,driver_version,clocks.max.sm,memory.total --format=csv > $out/gpu.csv; cat $out/gpu.csv
 common="--no-stream --readback-wait poll --no-fixed --sizes 256"
+# The GL device before it kept each program's GLSL per uniform set (bench_gl_before: it printed
+# the GLSL again at every uniform change), against it, alternated: the dense looping frames.
+for i in 1 2; do for b in before after; do bin=$B; [ $b = before ] && bin=${B}_before
+  stage glsl_${b}_$i $bin $common --runs 5 --grid auto --shadows --bounces 2 --variants looping --sampling undersample:2 adaptive:16 --warmup-ms 200 --scenes scenes/bunny.gltf scenes/classic.gltf --json $out/glsl_${b}_$i.json; done; done
 for s in bunny classic; do
   stage split_samp_$s $B $common --runs 5 --grid auto --shadows --bounces 2 --variants looping multipass --sampling spp:1 spp:4 adaptive:16 undersample:2 --warmup-ms 300 --scenes scenes/$s.gltf --json $out/split_samp_$s.json; done
 stage split_streams $B $common --runs 5 --grid auto --shadows --bounces 2 --variants looping multipass --ray-streams off on --warmup-ms 300 --scenes scenes/bunny-refl.gltf scenes/glass.gltf --json $out/split_streams.json
