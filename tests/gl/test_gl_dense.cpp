@@ -48,3 +48,37 @@ TEST_CASE(
                              frames[2].depth, frames[1].depth, frames[2].rgb, frames[1].rgb);
   }
 }
+
+TEST_CASE(
+    "adaptive frames on the GL device after the second make no texture and print no GLSL: they "
+    "keep the jitter table and the programs' uniform sets of those before, and give their image") {
+  const host::Scene scene = host::load_scene(host::resolve_scene("classic"));
+  const host::Camera cam = host::scene_camera(scene);
+  host::RenderOptions opt;
+  opt.width = 24;
+  opt.height = 16;
+  opt.spp = 16;
+  opt.adaptive = true;
+  opt.device = "gl";
+  opt.threads = 2;
+  const host::Grid grid =
+      host::build_grid(scene, host::grid_spec_for({}, scene, vgpu::profile(opt.profile)));
+  host::StreamTracer tracer(scene, grid, opt);
+  auto* gl = dynamic_cast<gl::GlDevice*>(&tracer.device());
+  REQUIRE(gl);
+  // The first frame grows the jitter table level by level; the second draws its first level's
+  // rays with the grown table's width, a uniform set the first did not have.
+  const host::RenderResult first = tracer.render(cam);
+  REQUIRE(first.compact.on);
+  CHECK(first.compact.packs >= 2);  // levels of more than one sample count
+  tracer.render(cam);
+  const gl::GlDevice::HostTimes before = gl->host_times();
+  const host::RenderResult third = tracer.render(cam);
+  const gl::GlDevice::HostTimes& after = gl->host_times();
+  CHECK(after.textures_made == before.textures_made);
+  CHECK(after.framebuffers_made == before.framebuffers_made);
+  CHECK(after.variants_printed == before.variants_printed);
+  CHECK(after.variants_reused > before.variants_reused);
+  CHECK(same_bits(first.rgb, third.rgb));
+  CHECK(first.rays_per_pixel == third.rays_per_pixel);
+}

@@ -74,9 +74,12 @@ vgpu::Rect MarkStreams::rect() const {
 }
 
 void MarkStreams::set_samples(const std::vector<glm::vec2>& offsets) {
+  // The table only grows (entries past this frame's are never read: generadorRayosDensos
+  // reads entries first .. first + samples - 1): a frame's levels ask for different counts, and
+  // a new texture at each would be a new texture on the device at each level.
   const int n = int(std::max<size_t>(offsets.size(), 1));
-  if (jitters_.width() != n) jitters_ = gpu_.make_texture("sample jitters", n, 1, 4, Format::fp32);
-  std::vector<float> texels(size_t(n) * 4, 0.0f);
+  if (jitters_.width() < n) jitters_ = gpu_.make_texture("sample jitters", n, 1, 4, Format::fp32);
+  std::vector<float> texels(size_t(jitters_.width()) * 4, 0.0f);
   // generadorRayosMuestra adds (jitter - 0.5) to the pixel's centre: the same float here.
   for (size_t k = 0; k < offsets.size(); ++k) {
     texels[k * 4] = offsets[k].x - 0.5f;
