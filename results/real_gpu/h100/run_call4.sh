@@ -4,7 +4,7 @@
 # objects made in timed frames. Run from the repository's root on the GPU host with bench_gl in
 # .scalebin/ and the glvnd packages in .gl/; the files are tarred to $OUT as split.tgz. The card
 # is whatever the device gives: gpu.csv names it. .scalebin/bench_gl_before is bench_gl of commit
-# 54e0641 (the split, without the GLSL kept per uniform set).
+# 54e0641 (the split, without the GLSL kept per uniform set); bench_gl is of commit 47fb4ce.
 set -u
 out=/tmp/o; mkdir -p $out
 . scripts/h200/env.sh
