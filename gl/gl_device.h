@@ -106,8 +106,10 @@ class GlDevice final : public vgpu::Device {
   std::map<uint64_t, std::unique_ptr<GlTexture>> textures_;
   std::map<std::string, std::unique_ptr<GlProgram>> compiled_;  // by source text
   // A program's GLSL for one set of uniform values: printing it records the program again (tens
-  // to hundreds of us for a large kernel), so each program keeps the last kRecordedVariants
-  // sets it was drawn with (a scan's offsets, a sample frame's jitters: a frame repeats them).
+  // to hundreds of us for a large kernel), so each program keeps the GLSL of the last
+  // kRecordedVariants sets it printed, the oldest printed going first (a scan's offsets, a
+  // sample frame's jitters: a frame repeats them; a program drawn with more distinct sets than
+  // that in a cycle prints every one, as before).
   struct Variant {
     std::vector<std::byte> uniforms;
     vgpu::GlslProgram glsl;
