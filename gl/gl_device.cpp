@@ -5,7 +5,6 @@
 #include <cctype>
 #include <chrono>
 #include <cstdio>
-#include <cstring>
 #include <fstream>
 
 #include "gl/context.h"
@@ -258,12 +257,17 @@ GlDevice::GlProgram& GlDevice::program_for(const vgpu::Program& p) {
   auto v = std::make_unique<Variant>();
   v->uniforms.assign(bytes.begin(), bytes.end());
   v->glsl = vgpu::to_glsl(p);
-  ++times_.variants_printed;
-  auto& slot = compiled_[v->glsl.source];
-  if (!slot) {
+  auto found = compiled_.find(v->glsl.source);
+  if (found == compiled_.end()) {  // compiled and linked before it is kept: a failure keeps none
     const std::string what = std::string("program '") + p.name() + "'";
     const GLuint vs = compile(GL_VERTEX_SHADER, vgpu::fullscreen_vertex_shader(), what);
-    const GLuint fs = compile(GL_FRAGMENT_SHADER, v->glsl.source, what);
+    GLuint fs = 0;
+    try {
+      fs = compile(GL_FRAGMENT_SHADER, v->glsl.source, what);
+    } catch (...) {
+      glDeleteShader(vs);
+      throw;
+    }
     auto g = std::make_unique<GlProgram>();
     g->name = glCreateProgram();
     glAttachShader(g->name, vs);
@@ -286,9 +290,12 @@ GlDevice::GlProgram& GlDevice::program_for(const vgpu::Program& p) {
     ++times_.programs_linked;
     for (const std::string& s : v->glsl.samplers)
       g->samplers.push_back(glGetUniformLocation(g->name, s.c_str()));
-    slot = std::move(g);
+    found = compiled_.emplace(v->glsl.source, std::move(g)).first;
   }
-  v->gl = slot.get();
+  ++times_.variants_printed;
+  v->gl = found->second.get();
+  // draw() needs the constants and units alone; the text is compiled_'s key already.
+  v->glsl.source = std::string();
   r.current = v.get();
   r.variants.push_back(std::move(v));
   if (r.variants.size() > kRecordedVariants) r.variants.erase(r.variants.begin());

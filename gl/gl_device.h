@@ -64,14 +64,18 @@ class GlDevice final : public vgpu::Device {
   double readback_wait_ms() const { return times_.wait_ms; }
   // The host's time in the device's calls since it was made, by call (a frame's share: the
   // difference of two readings). What a frame's wall time holds besides them is the host's own
-  // work between calls. download, upload and clear include making a texture they meet first
-  // (glTexImage2D); settle is stats() and finish() collecting the passes' queries, which waits
-  // for the GPU to finish them, as a download waits for the passes that write its texture.
+  // work between calls. draw is all of draw() but the settle below: the program's counting run
+  // and checks, printing and linking its GLSL where it must, making the textures and framebuffers
+  // it meets first, and the GL calls. download, upload and clear include making a texture they
+  // meet first (glTexImage2D). settle is stats(), finish() and draw()'s bound on the queries in
+  // flight collecting the passes' timer queries, which waits for the GPU to finish them, as a
+  // download waits for the passes that write its texture.
   struct HostTimes {
     double draw_ms = 0, wait_ms = 0, download_ms = 0, upload_ms = 0, clear_ms = 0, settle_ms = 0;
     uint64_t textures_made = 0, framebuffers_made = 0, programs_linked = 0;
-    // Draws whose uniforms the program's last draw did not have: its GLSL printed again
-    // (variants_printed), or found among those kept (variants_reused).
+    // Draws (and link()s) whose program's uniforms differ from its last draw's: its GLSL printed
+    // (variants_printed: its first, or a set none kept has) or found among those kept
+    // (variants_reused).
     uint64_t variants_printed = 0, variants_reused = 0;
   };
   const HostTimes& host_times() const { return times_; }

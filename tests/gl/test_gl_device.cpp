@@ -157,7 +157,10 @@ TEST_CASE(
   for (int y = 0; y < 2; ++y)
     for (int x = 0; x < 4; ++x) {
       float* t = src.texel_mut(x, y);
-      t[0] = float(1 + x + 4 * y), t[1] = 0.5f, t[2] = -1.0f, t[3] = 1.0f;
+      t[0] = float(1 + x + 4 * y);
+      t[1] = 0.5f;
+      t[2] = -1.0f;
+      t[3] = 1.0f;
     }
   d.upload(src);
   vgpu::KernelProgram<ScaleBy> p;

@@ -76,7 +76,9 @@ vgpu::Rect MarkStreams::rect() const {
 void MarkStreams::set_samples(const std::vector<glm::vec2>& offsets) {
   // The table only grows (entries past this frame's are never read: generadorRayosDensos
   // reads entries first .. first + samples - 1): a frame's levels ask for different counts, and
-  // a new texture at each would be a new texture on the device at each level.
+  // a new texture at each would be a new texture on the device at each level. (A pass's
+  // footprint counts a texture up to its size, so a level's grows by the unread entries, 16
+  // bytes each: a few hundred bytes at most.)
   const int n = int(std::max<size_t>(offsets.size(), 1));
   if (jitters_.width() < n) jitters_ = gpu_.make_texture("sample jitters", n, 1, 4, Format::fp32);
   std::vector<float> texels(size_t(jitters_.width()) * 4, 0.0f);

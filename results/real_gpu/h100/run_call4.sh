@@ -17,7 +17,9 @@ stage() { local name=$1; shift; local l; l=$(left)
 nvidia-smi --query-gpu=name,driver_version,clocks.max.sm,memory.total --format=csv > $out/gpu.csv; cat $out/gpu.csv
 common="--no-stream --readback-wait poll --no-fixed --sizes 256"
 # The GL device before it kept each program's GLSL per uniform set (bench_gl_before: it printed
-# the GLSL again at every uniform change), against it, alternated: the dense looping frames.
+# the GLSL again at every uniform change), against it, alternated: the dense looping frames. The
+# undersampled frames' difference is the GLSL's alone; the adaptive frames' also holds 47fb4ce's
+# jitter table (before it, two GL textures made a frame).
 for i in 1 2; do for b in before after; do bin=$B; [ $b = before ] && bin=${B}_before
   stage glsl_${b}_$i $bin $common --runs 5 --grid auto --shadows --bounces 2 --variants looping --sampling undersample:2 adaptive:16 --warmup-ms 200 --scenes scenes/bunny.gltf scenes/classic.gltf --json $out/glsl_${b}_$i.json; done; done
 for s in bunny classic; do
