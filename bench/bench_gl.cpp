@@ -292,7 +292,7 @@ bool parse_sampling(const std::string& text, host::RenderOptions& opt) {
 }
 
 struct FrameRun {
-  std::vector<double> wall, gpu, host, wait;
+  std::vector<double> wall, gpu, host;
   std::map<std::string, std::vector<double>> kernel_gpu, kernel_host;
   // The GL device's host time by call (gl::GlDevice::HostTimes) and the rest of the wall time,
   // the host's own work between calls, each timed frame; and the GL objects it made in them.
@@ -336,11 +336,9 @@ FrameRun run_frames(const host::Scene& scene, const host::Accel& accel, const ho
       fr.warmup_ms = ms_since(t0);
     }
     if (r == 1) fr.timed_from_s = unix_s();
-    const double wait0 = gld ? gld->readback_wait_ms() : 0;
     const gl::GlDevice::HostTimes h0 = gld ? gld->host_times() : gl::GlDevice::HostTimes{};
     const host::RenderResult res = tracer.render(cam);
     if (r == 0) continue;
-    fr.wait.push_back(gld ? gld->readback_wait_ms() - wait0 : 0);
     if (gld) {
       const gl::GlDevice::HostTimes& h = gld->host_times();
       const std::pair<const char*, double> calls[] = {{"draw", h.draw_ms - h0.draw_ms},
@@ -594,6 +592,8 @@ struct FrameKey {
 // One frame configuration's figures as JSON, and its line on stdout.
 json frame_json(const FrameKey& key, const host::RenderOptions& opt, const FrameRun& fr, int runs) {
   const bool gl = key.engine != "stream";
+  const auto waits = fr.split.find("query_wait");  // the read-backs' waits, GL frames only
+  const double wait = waits == fr.split.end() ? 0.0 : median(waits->second);
   json f = {{"scene", key.scene},
             {"accel", key.accel},
             {"bounces", opt.bounces},
@@ -617,7 +617,7 @@ json frame_json(const FrameKey& key, const host::RenderOptions& opt, const Frame
             {"wall_ms", median(fr.wall)},
             {"wall_runs_ms", fr.wall},  // every timed frame, in order
             {"gpu_ms", gl ? json(median(fr.gpu)) : json()},
-            {"readback_wait_ms", gl ? json(median(fr.wait)) : json()},
+            {"readback_wait_ms", gl ? json(wait) : json()},
             {"host_split_ms", medians(fr.split)},
             {"gl_objects_made", medians(fr.made)},
             {"gpu_runs_ms", gl ? json(fr.gpu) : json()},
@@ -648,7 +648,7 @@ json frame_json(const FrameKey& key, const host::RenderOptions& opt, const Frame
               key.engine.c_str(), key.streams.c_str(), key.mode.c_str(), key.beams.c_str(),
               median(fr.wall));
   if (gl)
-    std::printf("  gpu %9.1f ms  wait %8.1f ms  warm-up %d frames", median(fr.gpu), median(fr.wait),
+    std::printf("  gpu %9.1f ms  wait %8.1f ms  warm-up %d frames", median(fr.gpu), wait,
                 fr.warmup_frames);
   else
     std::printf("  h200 predicted %8.1f ms", f["predicted_ms"]["h200"].get<double>());

@@ -427,11 +427,7 @@ const vgpu::PassRecord& GlDevice::draw(const vgpu::Rect& rect) {
   }
   pending_.push_back(std::move(pend));
   // Keep the number of queries in flight bounded on long frames (the oldest are long done).
-  if (pending_.size() >= 8192 && !query_active_) {
-    const auto t1 = std::chrono::steady_clock::now();
-    settle(1024);
-    times_.settle_ms += ms_since(t1);
-  }
+  if (pending_.size() >= 8192 && !query_active_) settle(1024);
   return *out;
 }
 
@@ -468,6 +464,7 @@ uint64_t GlDevice::end_query() {
 
 void GlDevice::settle(size_t keep) {
   ctx_->make_current();
+  const auto t0 = std::chrono::steady_clock::now();
   const size_t n = pending_.size() > keep ? pending_.size() - keep : 0;
   for (size_t i = 0; i < n; ++i) {
     Pending& p = pending_[i];
@@ -496,22 +493,19 @@ void GlDevice::settle(size_t keep) {
   }
   pending_.erase(pending_.begin(), pending_.begin() + std::ptrdiff_t(n));
   if (query_active_) query_first_ -= std::min(query_first_, n);
+  times_.settle_ms += ms_since(t0);
 }
 
 void GlDevice::finish() {
   ctx_->make_current();
   const auto t0 = std::chrono::steady_clock::now();
   glFinish();
-  settle(0);
   times_.settle_ms += ms_since(t0);
+  settle(0);
 }
 
 vgpu::FrameStats& GlDevice::stats() {
-  if (!query_active_ && !pending_.empty()) {
-    const auto t0 = std::chrono::steady_clock::now();
-    settle(0);
-    times_.settle_ms += ms_since(t0);
-  }
+  if (!query_active_) settle(0);
   return stats_;
 }
 

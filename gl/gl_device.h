@@ -59,9 +59,6 @@ class GlDevice final : public vgpu::Device {
   // Waits for every pass issued so far (glFinish) and settles their counters and times.
   void finish();
   ReadbackWait readback_wait() const { return wait_; }  // block or poll, never automatic
-  // Host milliseconds spent waiting in end_query() since the device was made (a frame's share:
-  // the difference of two readings).
-  double readback_wait_ms() const { return times_.wait_ms; }
   // The host's time in the device's calls since it was made, by call (a frame's share: the
   // difference of two readings). What a frame's wall time holds besides them is the host's own
   // work between calls. draw is all of draw() but the settle below: the program's counting run
@@ -71,6 +68,7 @@ class GlDevice final : public vgpu::Device {
   // flight collecting the passes' timer queries, which waits for the GPU to finish them, as a
   // download waits for the passes that write its texture.
   struct HostTimes {
+    // wait_ms: waiting for occlusion-query results in end_query() (the read-backs).
     double draw_ms = 0, wait_ms = 0, download_ms = 0, upload_ms = 0, clear_ms = 0, settle_ms = 0;
     uint64_t textures_made = 0, framebuffers_made = 0, programs_linked = 0;
     // Draws (and link()s) whose program's uniforms differ from its last draw's: its GLSL printed
