@@ -356,6 +356,7 @@ FrameRun run_frames(const host::Scene& scene, const host::Accel& accel, const ho
       fr.made["textures"].push_back(double(h.textures_made - h0.textures_made));
       fr.made["framebuffers"].push_back(double(h.framebuffers_made - h0.framebuffers_made));
       fr.made["programs"].push_back(double(h.programs_linked - h0.programs_linked));
+      fr.made["textures_freed"].push_back(double(h.textures_freed - h0.textures_freed));
       fr.made["glsl_printed"].push_back(double(h.variants_printed - h0.variants_printed));
       fr.made["glsl_reused"].push_back(double(h.variants_reused - h0.variants_reused));
     }

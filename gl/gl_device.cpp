@@ -2,10 +2,14 @@
 #include "gl/gl_device.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cctype>
 #include <chrono>
 #include <cstdio>
 #include <fstream>
+#include <mutex>
+#include <unordered_set>
+#include <utility>
 
 #include "gl/context.h"
 #include "gl/gl.h"
@@ -35,6 +39,33 @@ struct GlDevice::Pending {
   uint64_t area = 0, write_per_fragment = 0;
   GLuint samples = 0, time = 0;
   int64_t passed = -1;  // samples that passed, once read
+};
+
+// The ids of the GL textures this device holds that no texture names any more. retired() runs
+// on whichever thread dropped the id; the device frees them at its next call, with its context
+// current. Only held ids are noted, so textures the device never met (an emulator's) cost one
+// set lookup.
+struct GlDevice::Retired final : vgpu::Texture::IdSink {
+  std::mutex lock;
+  std::unordered_set<uint64_t> held;
+  std::vector<uint64_t> ids;
+  std::atomic<bool> any{false};
+  void retired(uint64_t id) override {
+    std::lock_guard<std::mutex> hold(lock);
+    if (held.erase(id)) {
+      ids.push_back(id);
+      any.store(true, std::memory_order_release);
+    }
+  }
+  void hold(uint64_t id) {
+    std::lock_guard<std::mutex> hold(lock);
+    held.insert(id);
+  }
+  std::vector<uint64_t> take() {
+    std::lock_guard<std::mutex> hold(lock);
+    any.store(false, std::memory_order_relaxed);
+    return std::exchange(ids, {});
+  }
 };
 
 namespace {
@@ -83,7 +114,11 @@ GLuint compile(GLenum kind, const std::string& source, const std::string& what) 
 }  // namespace
 
 GlDevice::GlDevice(const vgpu::Profile& profile, const std::string& device, ReadbackWait wait)
-    : profile_(profile), wait_(wait), ctx_(std::make_unique<Context>(device)) {
+    : profile_(profile),
+      wait_(wait),
+      ctx_(std::make_unique<Context>(device)),
+      retired_(std::make_unique<Retired>()) {
+  vgpu::Texture::subscribe(retired_.get());
   if (wait_ == ReadbackWait::automatic)
     wait_ = ctx_->software() ? ReadbackWait::block : ReadbackWait::poll;
   glGenVertexArrays(1, &vao_);
@@ -98,6 +133,7 @@ GlDevice::GlDevice(const vgpu::Profile& profile, const std::string& device, Read
 }
 
 GlDevice::~GlDevice() {
+  vgpu::Texture::unsubscribe(retired_.get());
   ctx_->make_current();
   for (auto& [id, t] : textures_) glDeleteTextures(1, &t->name);
   for (auto& [src, p] : compiled_) glDeleteProgram(p->name);
@@ -151,13 +187,36 @@ GlDevice::GlTexture& GlDevice::texture(const Texture& t) {
     glTexImage2D(GL_TEXTURE_2D, 0, GLint(internal_format(t)), t.width(), t.height(), 0, g->format,
                  GL_FLOAT, t.data().data());
     slot = std::move(g);
+    retired_->hold(t.id());
     ++times_.textures_made;
   }
   return *slot;
 }
 
+void GlDevice::free_retired() {
+  if (!retired_->any.load(std::memory_order_acquire)) return;
+  for (uint64_t id : retired_->take()) {
+    if (auto it = textures_.find(id); it != textures_.end()) {
+      glDeleteTextures(1, &it->second->name);
+      textures_.erase(it);
+      ++times_.textures_freed;
+    }
+    // A framebuffer is kept per list of target ids: any list holding this one goes with it.
+    for (auto it = fbos_.begin(); it != fbos_.end();) {
+      if (std::find(it->first.begin(), it->first.end(), id) == it->first.end()) {
+        ++it;
+        continue;
+      }
+      glDeleteFramebuffers(1, &it->second);
+      it = fbos_.erase(it);
+      ++times_.framebuffers_freed;
+    }
+  }
+}
+
 void GlDevice::upload(const Texture& t) {
   ctx_->make_current();
+  free_retired();
   const auto t0 = std::chrono::steady_clock::now();
   const bool fresh = !textures_.count(t.id());
   GlTexture& g = texture(t);
@@ -172,6 +231,7 @@ void GlDevice::upload(const Texture& t) {
 
 void GlDevice::download(Texture& t) {
   ctx_->make_current();
+  free_retired();
   const auto t0 = std::chrono::steady_clock::now();
   GlTexture& g = texture(t);
   glActiveTexture(kScratchUnit);
@@ -220,6 +280,7 @@ void GlDevice::set_work_mask(const vgpu::Stencil*) {
 
 void GlDevice::clear(Texture& t, std::initializer_list<float> value) {
   ctx_->make_current();
+  free_retired();
   const auto t0 = std::chrono::steady_clock::now();
   if (int(value.size()) != t.channels())
     throw Error("clear of texture '" + t.name() + "': " + std::to_string(value.size()) +
@@ -363,6 +424,7 @@ const vgpu::PassRecord& GlDevice::draw() {
 
 const vgpu::PassRecord& GlDevice::draw(const vgpu::Rect& rect) {
   ctx_->make_current();
+  free_retired();
   const auto t0 = std::chrono::steady_clock::now();
   if (!program_) throw Error("draw: no program bound");
   const vgpu::Program& p = *program_;

@@ -71,12 +71,17 @@ class GlDevice final : public vgpu::Device {
     // wait_ms: waiting for occlusion-query results in end_query() (the read-backs).
     double draw_ms = 0, wait_ms = 0, download_ms = 0, upload_ms = 0, clear_ms = 0, settle_ms = 0;
     uint64_t textures_made = 0, framebuffers_made = 0, programs_linked = 0;
+    // GL textures, and the framebuffers they were attached to, deleted because their texture's
+    // id names no texture any more (vgpu::Texture::IdSink), at the device's next call after.
+    uint64_t textures_freed = 0, framebuffers_freed = 0;
     // Draws (and link()s) whose program's uniforms differ from its last draw's: its GLSL printed
     // (variants_printed: its first, or a set none kept has) or found among those kept
     // (variants_reused).
     uint64_t variants_printed = 0, variants_reused = 0;
   };
   const HostTimes& host_times() const { return times_; }
+  // The GL textures the device holds now: one per live texture it has met.
+  size_t textures_held() const { return textures_.size(); }
   // From now on, write each program the driver links to `dir` (which must exist): its GLSL
   // source (NN_name.glsl) and the driver's program binary (NN_name.bin, glGetProgramBinary:
   // NVIDIA's holds the compiled assembly as text, instruction and register counts included).
@@ -95,7 +100,9 @@ class GlDevice final : public vgpu::Device {
   struct GlTexture;
   struct GlProgram;
   struct Pending;
+  struct Retired;
   GlTexture& texture(const vgpu::Texture& t);
+  void free_retired();  // deletes the GL objects of the ids retired since the last call
   GlProgram& program_for(const vgpu::Program& p);
   unsigned framebuffer_for(const std::vector<vgpu::Texture*>& targets);
   void settle(size_t keep);
@@ -104,6 +111,7 @@ class GlDevice final : public vgpu::Device {
   ReadbackWait wait_ = ReadbackWait::block;
   HostTimes times_;
   std::unique_ptr<Context> ctx_;
+  std::unique_ptr<Retired> retired_;  // subscribed to vgpu::Texture's retired ids
   unsigned vao_ = 0, clear_fbo_ = 0;
   std::map<uint64_t, std::unique_ptr<GlTexture>> textures_;
   std::map<std::string, std::unique_ptr<GlProgram>> compiled_;  // by source text

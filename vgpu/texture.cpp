@@ -4,13 +4,52 @@
 #include <algorithm>
 #include <atomic>
 #include <bit>
+#include <mutex>
 #include <stdexcept>
 
 namespace vgpu {
 
 namespace {
 std::atomic<uint64_t> g_storage{0}, g_peak_storage{0};
+
+// The id sinks (Texture::subscribe). Allocated once and never freed, so that a texture destroyed
+// during the program's exit still finds it; `count` keeps the lock off every texture's
+// destruction while no device listens (the emulator alone).
+struct Sinks {
+  std::mutex lock;
+  std::vector<Texture::IdSink*> sinks;
+  std::atomic<size_t> count{0};
+};
+Sinks& sinks() {
+  static Sinks* s = new Sinks;
+  return *s;
+}
 }  // namespace
+
+void Texture::subscribe(IdSink* sink) {
+  Sinks& s = sinks();
+  std::lock_guard<std::mutex> hold(s.lock);
+  s.sinks.push_back(sink);
+  s.count.store(s.sinks.size(), std::memory_order_release);
+}
+
+void Texture::unsubscribe(IdSink* sink) {
+  Sinks& s = sinks();
+  std::lock_guard<std::mutex> hold(s.lock);
+  std::erase(s.sinks, sink);
+  s.count.store(s.sinks.size(), std::memory_order_release);
+}
+
+void Texture::retire(uint64_t uid) {
+  Sinks& s = sinks();
+  if (s.count.load(std::memory_order_acquire) == 0) return;
+  std::lock_guard<std::mutex> hold(s.lock);
+  for (IdSink* sink : s.sinks) sink->retired(uid);
+}
+
+Texture::~Texture() {
+  retire(uid_);
+}
 
 void Texture::count_storage(size_t bytes, bool allocated) {
   if (!allocated) {
@@ -58,6 +97,7 @@ Texture::Texture(Texture&& o) noexcept
       format_(o.format_),
       data_(std::move(o.data_)),
       uid_(fresh_uid()) {
+  retire(o.uid_);
   o.uid_ = fresh_uid();
 }
 
@@ -75,6 +115,8 @@ Texture& Texture::operator=(Texture&& o) noexcept {
   channels_ = o.channels_;
   format_ = o.format_;
   data_ = std::move(o.data_);
+  retire(uid_);
+  retire(o.uid_);
   uid_ = fresh_uid();
   o.uid_ = fresh_uid();
   return *this;

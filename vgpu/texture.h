@@ -27,10 +27,26 @@ class Texture {
   Texture(Texture&& o) noexcept;
   Texture& operator=(const Texture& o);
   Texture& operator=(Texture&& o) noexcept;
+  ~Texture();
 
   // Identity for devices that keep their own copy of a texture (the GL device's objects): the
   // same as the emulator's uid, new for a copy or a moved-to texture.
   uint64_t id() const { return uid_; }
+
+  // A device that keeps an object of its own per id (the GL device's GL textures) subscribes to
+  // learn which ids no longer name any texture: one destroyed, and both ids a move or an
+  // assignment drops (the moved-from texture's and the assigned-to texture's old ones; ids are
+  // never reused). retired() runs on the thread that dropped the id, under the subscribers'
+  // lock: it may only note the id, and free its object at its own next call.
+  class IdSink {
+   public:
+    virtual void retired(uint64_t id) = 0;
+
+   protected:
+    ~IdSink() = default;
+  };
+  static void subscribe(IdSink* sink);
+  static void unsubscribe(IdSink* sink);
 
   // The emulator's texel storage, every texture of the process together: 4 bytes a channel
   // whatever the format (bytes() is the modeled card's), counted when allocated, alive now and
@@ -70,6 +86,7 @@ class Texture {
  private:
   friend class Gpu;
   static uint64_t fresh_uid();
+  static void retire(uint64_t uid);  // tells the subscribers that uid names no texture now
   static void count_storage(size_t bytes, bool allocated);
   // Rows [y0, y1) only, each texel = texel, without a version step (Gpu::clear splits its rows
   // over the threads and steps the version once).

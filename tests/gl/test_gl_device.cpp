@@ -197,6 +197,65 @@ TEST_CASE(
   CHECK(d.host_times().variants_reused == t2.variants_reused);
 }
 
+TEST_CASE(
+    "a texture that is gone, moved from or assigned over has its GL texture and the framebuffers "
+    "it was a target of deleted at the GL device's next call, and passes after give every "
+    "channel") {
+  gl::GlDevice& d = gltest::device();
+  vgpu::Texture src("scale source", 4, 2, 4);
+  for (int y = 0; y < 2; ++y)
+    for (int x = 0; x < 4; ++x) {
+      float* t = src.texel_mut(x, y);
+      t[0] = float(1 + x + 4 * y);
+      t[1] = 0.5f;
+      t[2] = -1.0f;
+      t[3] = 1.0f;
+    }
+  d.upload(src);
+  vgpu::KernelProgram<ScaleBy> p;
+  p.kernel.scale = 2.0f;
+  auto draw_into = [&](vgpu::Texture& dst) {
+    d.use_program(p);
+    d.bind_texture(0, src);
+    d.set_targets({&dst});
+    d.draw();
+    d.download(dst);
+    for (int y = 0; y < 2; ++y)
+      for (int x = 0; x < 4; ++x) {
+        CHECK(dst.texel(x, y)[0] == float(1 + x + 4 * y) * 2.0f);
+        CHECK(dst.texel(x, y)[1] == 0.5f);
+        CHECK(dst.texel(x, y)[2] == -1.0f);
+        CHECK(dst.texel(x, y)[3] == 1.0f);
+      }
+  };
+  const size_t held = d.textures_held();
+  const gl::GlDevice::HostTimes t0 = d.host_times();
+  for (int i = 0; i < 3; ++i) {  // a frame's scratch target, made and dropped each time
+    vgpu::Texture dst("scale target", 4, 2, 4);
+    draw_into(dst);
+  }
+  d.upload(src);  // the next call after the last one is gone
+  const gl::GlDevice::HostTimes t1 = d.host_times();
+  CHECK(t1.textures_made - t0.textures_made == 3);
+  CHECK(t1.textures_freed - t0.textures_freed == 3);
+  CHECK(t1.framebuffers_made - t0.framebuffers_made == 3);
+  CHECK(t1.framebuffers_freed - t0.framebuffers_freed == 3);
+  CHECK(d.textures_held() == held);
+
+  // A move drops the moved-from texture's id, an assignment the assigned-to texture's old one:
+  // each a new texture for the device, drawn into again.
+  vgpu::Texture a("moved from", 4, 2, 4);
+  draw_into(a);
+  vgpu::Texture b(std::move(a));
+  draw_into(b);
+  CHECK(d.host_times().textures_freed - t1.textures_freed == 1);
+  CHECK(d.host_times().framebuffers_freed - t1.framebuffers_freed == 1);
+  b = vgpu::Texture("assigned", 4, 2, 4);
+  draw_into(b);
+  CHECK(d.host_times().textures_freed - t1.textures_freed == 2);
+  CHECK(d.textures_held() == held + 1);  // b's
+}
+
 TEST_CASE("the GL device refuses what it cannot do, naming it") {
   gl::GlDevice& d = gltest::device();
   vgpu::Stencil mask(4, 4);
