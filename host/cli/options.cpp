@@ -1,6 +1,7 @@
 // The render subcommand's options and validators (see options.h).
 #include "host/cli/options.h"
 
+#include <CLI/CLI.hpp>
 #include <iterator>
 #include <regex>
 #include <string>

@@ -2,7 +2,6 @@
 // checked as it is parsed, before any work; main.cpp checks their combinations.
 #pragma once
 
-#include <CLI/CLI.hpp>
 #include <glm/glm.hpp>
 #include <optional>
 #include <stdexcept>
@@ -11,6 +10,12 @@
 
 #include "host/trace/user_stage.h"
 #include "vgpu/lanes.h"
+
+// CLI11 is declared, not included: only the files that build or parse a command line compile
+// its header-only implementation (about 10 s of the build each).
+namespace CLI {
+class App;
+}
 
 namespace cli {
 
