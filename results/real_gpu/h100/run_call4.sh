@@ -20,7 +20,9 @@ common="--no-stream --readback-wait poll --no-fixed --sizes 256"
 # the GLSL again at every uniform change), against it, alternated: the dense looping frames. The
 # undersampled frames' difference is the GLSL's alone; the adaptive frames' also holds 47fb4ce's
 # jitter table (before it, two GL textures made a frame).
-for i in 1 2; do for b in before after; do bin=$B; [ $b = before ] && bin=${B}_before
+# Only where bench_gl_before was carried (the session that ran this call carried none: the
+# stored H100 runs, made before 54e0641, are the before).
+[ -x ${B}_before ] && for i in 1 2; do for b in before after; do bin=$B; [ $b = before ] && bin=${B}_before
   stage glsl_${b}_$i $bin $common --runs 5 --grid auto --shadows --bounces 2 --variants looping --sampling undersample:2 adaptive:16 --warmup-ms 200 --scenes scenes/bunny.gltf scenes/classic.gltf --json $out/glsl_${b}_$i.json; done; done
 for s in bunny classic; do
   stage split_samp_$s $B $common --runs 5 --grid auto --shadows --bounces 2 --variants looping multipass --sampling spp:1 spp:4 adaptive:16 undersample:2 --warmup-ms 300 --scenes scenes/$s.gltf --json $out/split_samp_$s.json; done
