@@ -51,18 +51,18 @@ struct GlDevice::Retired final : vgpu::Texture::IdSink {
   std::vector<uint64_t> ids;
   std::atomic<bool> any{false};
   void retired(uint64_t id) override {
-    std::lock_guard<std::mutex> hold(lock);
+    std::lock_guard<std::mutex> locked(lock);
     if (held.erase(id)) {
       ids.push_back(id);
       any.store(true, std::memory_order_release);
     }
   }
   void hold(uint64_t id) {
-    std::lock_guard<std::mutex> hold(lock);
+    std::lock_guard<std::mutex> locked(lock);
     held.insert(id);
   }
   std::vector<uint64_t> take() {
-    std::lock_guard<std::mutex> hold(lock);
+    std::lock_guard<std::mutex> locked(lock);
     any.store(false, std::memory_order_relaxed);
     return std::exchange(ids, {});
   }
@@ -161,36 +161,37 @@ double ms_since(std::chrono::steady_clock::time_point t0) {
 }  // namespace
 
 GlDevice::GlTexture& GlDevice::texture(const Texture& t) {
-  auto& slot = textures_[t.id()];
-  if (!slot) {
-    check_texture(t);
-    GLint max_size = 0;
-    glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_size);
-    if (t.width() > max_size || t.height() > max_size)
-      throw Error("texture '" + t.name() + "' is " + std::to_string(t.width()) + "x" +
-                  std::to_string(t.height()) + " texels; this GL driver allows " +
-                  std::to_string(max_size));
-    auto g = std::make_unique<GlTexture>();
-    g->width = t.width();
-    g->height = t.height();
-    g->channels = t.channels();
-    g->format = pixel_format(t.channels());
-    glGenTextures(1, &g->name);
-    glActiveTexture(kScratchUnit);
-    glBindTexture(GL_TEXTURE_2D, g->name);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAX_LEVEL, 0);
-    // A new texture holds what the host holds (zeros for a dynamic one, as on the emulator).
-    glTexImage2D(GL_TEXTURE_2D, 0, GLint(internal_format(t)), t.width(), t.height(), 0, g->format,
-                 GL_FLOAT, t.data().data());
-    slot = std::move(g);
-    retired_->hold(t.id());
-    ++times_.textures_made;
-  }
-  return *slot;
+  if (auto it = textures_.find(t.id()); it != textures_.end()) return *it->second;
+  // Everything that can refuse the texture comes before the GL name and the map's entry, so a
+  // refused texture leaves neither behind.
+  check_texture(t);
+  GLint max_size = 0;
+  glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_size);
+  if (t.width() > max_size || t.height() > max_size)
+    throw Error("texture '" + t.name() + "' is " + std::to_string(t.width()) + "x" +
+                std::to_string(t.height()) + " texels; this GL driver allows " +
+                std::to_string(max_size));
+  const GLenum internal = internal_format(t);
+  auto g = std::make_unique<GlTexture>();
+  g->width = t.width();
+  g->height = t.height();
+  g->channels = t.channels();
+  g->format = pixel_format(t.channels());
+  glGenTextures(1, &g->name);
+  glActiveTexture(kScratchUnit);
+  glBindTexture(GL_TEXTURE_2D, g->name);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAX_LEVEL, 0);
+  // A new texture holds what the host holds (zeros for a dynamic one, as on the emulator).
+  glTexImage2D(GL_TEXTURE_2D, 0, GLint(internal), t.width(), t.height(), 0, g->format, GL_FLOAT,
+               t.data().data());
+  GlTexture& made = *(textures_[t.id()] = std::move(g));
+  retired_->hold(t.id());
+  ++times_.textures_made;
+  return made;
 }
 
 void GlDevice::free_retired() {
@@ -216,8 +217,8 @@ void GlDevice::free_retired() {
 
 void GlDevice::upload(const Texture& t) {
   ctx_->make_current();
-  free_retired();
   const auto t0 = std::chrono::steady_clock::now();
+  free_retired();  // its GL deletions are this call's host time
   const bool fresh = !textures_.count(t.id());
   GlTexture& g = texture(t);
   if (!fresh) {  // else created from the host's texels just now
@@ -231,8 +232,8 @@ void GlDevice::upload(const Texture& t) {
 
 void GlDevice::download(Texture& t) {
   ctx_->make_current();
-  free_retired();
   const auto t0 = std::chrono::steady_clock::now();
+  free_retired();  // its GL deletions are this call's host time
   GlTexture& g = texture(t);
   glActiveTexture(kScratchUnit);
   glBindTexture(GL_TEXTURE_2D, g.name);
@@ -280,8 +281,8 @@ void GlDevice::set_work_mask(const vgpu::Stencil*) {
 
 void GlDevice::clear(Texture& t, std::initializer_list<float> value) {
   ctx_->make_current();
-  free_retired();
   const auto t0 = std::chrono::steady_clock::now();
+  free_retired();  // its GL deletions are this call's host time
   if (int(value.size()) != t.channels())
     throw Error("clear of texture '" + t.name() + "': " + std::to_string(value.size()) +
                 " values for " + std::to_string(t.channels()) + " channels");
@@ -424,8 +425,8 @@ const vgpu::PassRecord& GlDevice::draw() {
 
 const vgpu::PassRecord& GlDevice::draw(const vgpu::Rect& rect) {
   ctx_->make_current();
-  free_retired();
   const auto t0 = std::chrono::steady_clock::now();
+  free_retired();  // its GL deletions are this call's host time
   if (!program_) throw Error("draw: no program bound");
   const vgpu::Program& p = *program_;
   const vgpu::Program::Analysis a = p.analyze();

@@ -1,6 +1,8 @@
 // The GL device: the vgpu::Device operations on a real OpenGL 3.3 driver (headless, EGL).
-// Textures become GL textures (RGBA32F and the 1-4 channel fp32/fp16 formats), texture units
-// sampler units read with texelFetch, a program the GLSL printed from its functor's recording
+// Textures become GL textures (RGBA32F and the 1-4 channel fp32/fp16 formats; each deleted at the
+// device's next call after its id names no texture: destroyed, moved from or assigned over),
+// texture units sampler units read with texelFetch, a program the GLSL printed from its
+// functor's recording
 // (vgpu/glsl.h), a pass one triangle over the rectangle into a framebuffer with the targets
 // attached, a query GL_SAMPLES_PASSED. Every pass is also timed (GL_TIME_ELAPSED) and counted
 // (a GL_SAMPLES_PASSED of its own for its discards); those results are collected without

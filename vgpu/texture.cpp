@@ -40,6 +40,8 @@ void Texture::unsubscribe(IdSink* sink) {
   s.count.store(s.sinks.size(), std::memory_order_release);
 }
 
+// Called from the noexcept moves and the destructor: a lock or a sink that throws (a mutex's
+// system_error, a sink's bad_alloc) ends the program there, as any failure in them would.
 void Texture::retire(uint64_t uid) {
   Sinks& s = sinks();
   if (s.count.load(std::memory_order_acquire) == 0) return;

@@ -253,6 +253,14 @@ TEST_CASE(
   b = vgpu::Texture("assigned", 4, 2, 4);
   draw_into(b);
   CHECK(d.host_times().textures_freed - t1.textures_freed == 2);
+  CHECK(d.host_times().framebuffers_freed - t1.framebuffers_freed == 2);
+  // A move assignment between two textures the device holds drops both old ids.
+  vgpu::Texture c("moved into b", 4, 2, 4);
+  draw_into(c);
+  b = std::move(c);
+  draw_into(b);
+  CHECK(d.host_times().textures_freed - t1.textures_freed == 4);
+  CHECK(d.host_times().framebuffers_freed - t1.framebuffers_freed == 4);
   CHECK(d.textures_held() == held + 1);  // b's
 }
 
