@@ -196,23 +196,23 @@ GlDevice::GlTexture& GlDevice::texture(const Texture& t) {
 
 void GlDevice::free_retired() {
   if (!retired_->any.load(std::memory_order_acquire)) return;
-  for (uint64_t id : retired_->take()) {
+  const std::vector<uint64_t> ids = retired_->take();
+  for (uint64_t id : ids)
     if (auto it = textures_.find(id); it != textures_.end()) {
       glDeleteTextures(1, &it->second->name);
       textures_.erase(it);
       ++times_.textures_freed;
     }
-    // A framebuffer is kept per list of target ids: any list holding this one goes with it.
-    for (auto it = fbos_.begin(); it != fbos_.end();) {
-      if (std::find(it->first.begin(), it->first.end(), id) == it->first.end()) {
-        ++it;
-        continue;
-      }
-      glDeleteFramebuffers(1, &it->second);
-      it = fbos_.erase(it);
+  // A framebuffer is kept per list of target ids: one holding any retired id goes.
+  std::erase_if(fbos_, [&](const auto& entry) {
+    const bool gone = std::find_first_of(entry.first.begin(), entry.first.end(), ids.begin(),
+                                         ids.end()) != entry.first.end();
+    if (gone) {
+      glDeleteFramebuffers(1, &entry.second);
       ++times_.framebuffers_freed;
     }
-  }
+    return gone;
+  });
 }
 
 void GlDevice::upload(const Texture& t) {
@@ -568,7 +568,7 @@ void GlDevice::finish() {
 }
 
 vgpu::FrameStats& GlDevice::stats() {
-  if (!query_active_) settle(0);
+  if (!query_active_ && !pending_.empty()) settle(0);
   return stats_;
 }
 

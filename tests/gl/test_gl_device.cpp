@@ -147,13 +147,9 @@ struct ScaleBy {
   }
 };
 
-}  // namespace
-
-TEST_CASE(
-    "a program drawn again with uniforms it was drawn with before draws with them, from the GLSL "
-    "the GL device kept for them, and a program keeps the GLSL of its last 64 uniform sets") {
-  gl::GlDevice& d = gltest::device();
-  vgpu::Texture src("scale source", 4, 2, 4), dst("scale target", 4, 2, 4);
+// ScaleBy's 4x2 source: x channel 1..8 (row-major), then 0.5, -1 and 1.
+vgpu::Texture scale_source() {
+  vgpu::Texture src("scale source", 4, 2, 4);
   for (int y = 0; y < 2; ++y)
     for (int x = 0; x < 4; ++x) {
       float* t = src.texel_mut(x, y);
@@ -162,23 +158,41 @@ TEST_CASE(
       t[2] = -1.0f;
       t[3] = 1.0f;
     }
+  return src;
+}
+
+// One ScaleBy pass from src into dst at p's scale, read back, every channel of every texel checked.
+void draw_scaled(gl::GlDevice& d, const vgpu::KernelProgram<ScaleBy>& p, const vgpu::Texture& src,
+                 vgpu::Texture& dst) {
+  d.use_program(p);
+  d.bind_texture(0, src);
+  d.set_targets({&dst});
+  d.draw();
+  d.download(dst);
+  const float scale = p.kernel.scale;
+  for (int y = 0; y < 2; ++y)
+    for (int x = 0; x < 4; ++x) {
+      CAPTURE(scale);
+      CHECK(dst.texel(x, y)[0] == float(1 + x + 4 * y) * scale);
+      CHECK(dst.texel(x, y)[1] == 0.5f);
+      CHECK(dst.texel(x, y)[2] == -1.0f);
+      CHECK(dst.texel(x, y)[3] == 1.0f);
+    }
+}
+
+}  // namespace
+
+TEST_CASE(
+    "a program drawn again with uniforms it was drawn with before draws with them, from the GLSL "
+    "the GL device kept for them, and a program keeps the GLSL of its last 64 uniform sets") {
+  gl::GlDevice& d = gltest::device();
+  const vgpu::Texture src = scale_source();
+  vgpu::Texture dst("scale target", 4, 2, 4);
   d.upload(src);
   vgpu::KernelProgram<ScaleBy> p;
   auto draw = [&](float scale) {
     p.kernel.scale = scale;
-    d.use_program(p);
-    d.bind_texture(0, src);
-    d.set_targets({&dst});
-    d.draw();
-    d.download(dst);
-    for (int y = 0; y < 2; ++y)
-      for (int x = 0; x < 4; ++x) {
-        CAPTURE(scale);
-        CHECK(dst.texel(x, y)[0] == float(1 + x + 4 * y) * scale);
-        CHECK(dst.texel(x, y)[1] == 0.5f);
-        CHECK(dst.texel(x, y)[2] == -1.0f);
-        CHECK(dst.texel(x, y)[3] == 1.0f);
-      }
+    draw_scaled(d, p, src, dst);
   };
   const gl::GlDevice::HostTimes t0 = d.host_times();
   draw(2.0f);
@@ -202,32 +216,11 @@ TEST_CASE(
     "it was a target of deleted at the GL device's next call, and passes after give every "
     "channel") {
   gl::GlDevice& d = gltest::device();
-  vgpu::Texture src("scale source", 4, 2, 4);
-  for (int y = 0; y < 2; ++y)
-    for (int x = 0; x < 4; ++x) {
-      float* t = src.texel_mut(x, y);
-      t[0] = float(1 + x + 4 * y);
-      t[1] = 0.5f;
-      t[2] = -1.0f;
-      t[3] = 1.0f;
-    }
+  const vgpu::Texture src = scale_source();
   d.upload(src);
   vgpu::KernelProgram<ScaleBy> p;
   p.kernel.scale = 2.0f;
-  auto draw_into = [&](vgpu::Texture& dst) {
-    d.use_program(p);
-    d.bind_texture(0, src);
-    d.set_targets({&dst});
-    d.draw();
-    d.download(dst);
-    for (int y = 0; y < 2; ++y)
-      for (int x = 0; x < 4; ++x) {
-        CHECK(dst.texel(x, y)[0] == float(1 + x + 4 * y) * 2.0f);
-        CHECK(dst.texel(x, y)[1] == 0.5f);
-        CHECK(dst.texel(x, y)[2] == -1.0f);
-        CHECK(dst.texel(x, y)[3] == 1.0f);
-      }
-  };
+  auto draw_into = [&](vgpu::Texture& dst) { draw_scaled(d, p, src, dst); };
   const size_t held = d.textures_held();
   const gl::GlDevice::HostTimes t0 = d.host_times();
   for (int i = 0; i < 3; ++i) {  // a frame's scratch target, made and dropped each time
