@@ -50,11 +50,23 @@ glm::vec2 sample_offset(int spp, int s, uint64_t seed) {
   return {(float(s % n) + u) / float(n), (float(s / n) + v) / float(n)};
 }
 
+namespace {
+
+// adaptive_levels' sides one at a time, without building the list (adaptive_rays runs once per
+// pixel): the first level's side, then the one after `side`; 0 when there is none.
+int first_side(int n) {
+  return n > 1 ? 2 : 0;
+}
+int next_side(int side, int n) {
+  return side >= n ? 0 : std::min(side * 2, n);
+}
+
+}  // namespace
+
 std::vector<int> adaptive_levels(int spp) {
   const int n = side_of(spp);
   std::vector<int> levels;
-  for (int side = 2; side < n; side *= 2) levels.push_back(side);
-  if (n > 1) levels.push_back(n);
+  for (int side = first_side(n); side > 0; side = next_side(side, n)) levels.push_back(side);
   return levels;
 }
 
@@ -79,12 +91,7 @@ std::vector<std::vector<glm::vec2>> kept_level_samples(int spp, uint64_t seed) {
 }
 
 uint32_t adaptive_rays(int spp, int samples) {
-  uint32_t rays = 1;
-  for (const int side : adaptive_levels(spp)) {
-    if (side * side > samples) break;
-    rays += uint32_t(side * side);
-  }
-  return rays;
+  return adaptive_rays(spp, samples, 0);
 }
 
 std::vector<glm::vec2> adaptive_level_offsets(int spp, size_t level,
@@ -104,9 +111,10 @@ uint64_t budget_pixels(const std::vector<float>& shares, size_t level, uint64_t 
 uint32_t adaptive_rays(int spp, int samples, size_t kept) {
   uint32_t rays = 1;
   int before = 0;  // the samples the pixel held before the level
-  const std::vector<int> levels = adaptive_levels(spp);
-  for (size_t l = 0; l < levels.size(); ++l) {
-    const int m = levels[l] * levels[l];
+  const int n = side_of(spp);
+  size_t l = 0;
+  for (int side = first_side(n); side > 0; side = next_side(side, n), ++l) {
+    const int m = side * side;
     if (m > samples) break;
     rays += uint32_t(l > 0 && l < kept ? m - before : m);
     before = m;
@@ -138,6 +146,19 @@ bool on_lattice(int x, int y, int k, int width, int height) {
 glm::ivec4 lattice_cell(int x, int y, int k, int width, int height) {
   const int x0 = x / k * k, y0 = y / k * k;
   return {x0, std::min(x0 + k, width - 1), y0, std::min(y0 + k, height - 1)};
+}
+
+LatticeAxis lattice_axis(int n, int k) {
+  LatticeAxis a;
+  a.on.resize(size_t(std::max(n, 0)));
+  a.nearest.resize(a.on.size());
+  for (int x = 0; x < n; ++x) {
+    a.on[size_t(x)] = x % k == 0 || x == n - 1;
+    a.count += a.on[size_t(x)];
+    const int x0 = x / k * k, x1 = std::min(x0 + k, n - 1);  // lattice_cell's along the axis
+    a.nearest[size_t(x)] = x - x0 <= x1 - x ? x0 : x1;
+  }
+  return a;
 }
 
 GapTest undersample_gap_test(const std::vector<glm::dvec3>& colour, const std::vector<int>& key,

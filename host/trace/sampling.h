@@ -73,6 +73,16 @@ BudgetSearch budget_threshold(float floor, uint64_t budget,
 // (x0 <= x <= x1, y0 <= y <= y1).
 bool on_lattice(int x, int y, int k, int width, int height);
 glm::ivec4 lattice_cell(int x, int y, int k, int width, int height);  // x0, x1, y0, y1
+// The lattice along one axis of n pixels, for loops over every pixel of the image (on_lattice
+// and lattice_cell work per pixel): on[x] whether coordinate x is on it, nearest[x] the nearer
+// of its cell's two lattice coordinates (the lower where tied), count how many are on it.
+// Pixel (x, y) is on the lattice where both axes' on[] are.
+struct LatticeAxis {
+  std::vector<uint8_t> on;
+  std::vector<int> nearest;
+  uint64_t count = 0;
+};
+LatticeAxis lattice_axis(int n, int k);
 
 // What marcarHuecos looks at for pixel (x, y) off the lattice, from the lattice pixels' colours
 // and surface keys (row-major, width x height; only lattice pixels are read): the largest

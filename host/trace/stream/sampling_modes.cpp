@@ -192,12 +192,12 @@ void StreamTracer::render_undersampled(const Camera& cam, RenderResult& res,
   s.marks.make_current(1);  // guardarImpactos writes the lattice frame's keys into marks B
   s.sample_generate.kernel.jitter_x = s.sample_generate.kernel.jitter_y = 0.5f;
   s.sample_generate.kernel.gated = true;
+  // The lattice along each axis: the host's loops over every pixel below read it per row and
+  // column (on_lattice and lattice_cell per pixel cost about a millisecond at 256x256).
+  const LatticeAxis ax = lattice_axis(W, K), ay = lattice_axis(H, K);
   if (s.dense) {
     // The lattice's pixels, counted here (the host knows where they are), as a dense stream.
-    uint64_t lattice = 0;
-    for (int y = 0; y < H; ++y)
-      for (int x = 0; x < W; ++x) lattice += on_lattice(x, y, K, W, H) ? 1 : 0;
-    s.dense->pack(r, s.marks[0], lattice);
+    s.dense->pack(r, s.marks[0], ax.count * ay.count);
     s.dense->set_samples({glm::vec2(0.5f)});
     s.dense->frame_begins(0, 1);
   }
@@ -221,10 +221,12 @@ void StreamTracer::render_undersampled(const Camera& cam, RenderResult& res,
     accumulate_gated(&s.marks[0], false);
     // The AOVs: the gaps' from this frame, the lattice's from the first.
     gpu.download(s.marks[0]);
-    for (size_t i = 0; i < gap.size(); ++i) {
-      gap[i] = s.marks[0].texel(int(i % size_t(W)), int(i / size_t(W)))[0] > 0.0f;
-      if (!gap[i]) res.depth[i] = depth[i], res.hit_id[i] = hit_id[i];
-    }
+    for (int y = 0; y < H; ++y)
+      for (int x = 0; x < W; ++x) {
+        const size_t i = size_t(y) * size_t(W) + size_t(x);
+        gap[i] = s.marks[0].texel(x, y)[0] > 0.0f;
+        if (!gap[i]) res.depth[i] = depth[i], res.hit_id[i] = hit_id[i];
+      }
   }
   s.sample_generate.kernel.gated = false;
   s.accumulate.kernel.gated = false;
@@ -236,13 +238,11 @@ void StreamTracer::render_undersampled(const Camera& cam, RenderResult& res,
   for (int y = 0; y < H; ++y)
     for (int x = 0; x < W; ++x) {
       const size_t i = size_t(y) * size_t(W) + size_t(x);
-      if (on_lattice(x, y, K, W, H) || gap[i]) {
+      if ((ax.on[size_t(x)] && ay.on[size_t(y)]) || gap[i]) {
         res.rays_per_pixel[i] = 1;
         continue;
       }
-      const glm::ivec4 c = lattice_cell(x, y, K, W, H);
-      const int nx = x - c.x <= c.y - x ? c.x : c.y, ny = y - c.z <= c.w - y ? c.z : c.w;
-      const size_t j = size_t(ny) * size_t(W) + size_t(nx);
+      const size_t j = size_t(ay.nearest[size_t(y)]) * size_t(W) + size_t(ax.nearest[size_t(x)]);
       res.depth[i] = res.depth[j];
       res.hit_id[i] = res.hit_id[j];
     }
