@@ -10,10 +10,12 @@ measurements are the model of their day and are not read). A cell is within its 
 |predicted / wall - 1| is at most 10% for the multipass pipeline and 15% for the looping and
 MRT pipelines (issue 51's targets).
 
-Usage: /usr/bin/python3 scripts/docs/cells.py FILE.json[@GRID] ... [--bench build/bench/bench_gl]
-           [--scene-dir DIR ...] [--block DOC.md NAME] [--host-fit]
+Usage: /usr/bin/python3 scripts/docs/cells.py FILE.json[@GRID][+PIPELINE] ...
+           [--bench build/bench/bench_gl] [--scene-dir DIR ...] [--block DOC.md NAME] [--host-fit]
 FILE@GRID: the frames ran with bench_gl --grid GRID, for files written before bench_gl recorded
-it (default auto; a file that records its grid is refused another). --block writes the table
+it (default auto; a file that records its grid is refused another). FILE+PIPELINE: only the
+file's frames of that pipeline (multipass, mrt or looping), where a later call measured the
+others again after the program changed. --block writes the table
 between '<!-- NAME: begin -->' and '<!-- NAME: end -->' of DOC.md. --host-fit prints, instead,
 what the frames' wall time holds per pixel beyond the GPU and the modeled fixed costs."""
 import argparse
@@ -58,6 +60,9 @@ def emulate(bench, k, dirs, grid, cache):
 def cells(paths, bench, dirs):
     cache, rows = {}, []
     for spec in paths:
+        spec, plus, only = spec.partition("+")
+        if plus and only not in TARGETS:
+            fail(f"{spec}+{only}: the pipeline is one of {', '.join(TARGETS)}")
         path, at, grid = spec.rpartition("@")
         if not at:
             path, grid = spec, ""
@@ -76,6 +81,8 @@ def cells(paths, bench, dirs):
             if f["engine"].startswith("gl") and (key(f) not in gl or f["engine"] == "gl-poll"):
                 gl[key(f)] = f
         for k, f in gl.items():
+            if only and k[2] != only:
+                continue
             e = emulate(bench, k, dirs, grid, cache)
             pred = e["predicted_ms"].get(card)
             if pred is None:
@@ -161,7 +168,7 @@ def host_fit(rows):
 def main():
     ap = argparse.ArgumentParser(description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("files", nargs="+", metavar="FILE.json[@GRID]",
+    ap.add_argument("files", nargs="+", metavar="FILE.json[@GRID][+PIPELINE]",
                     help="bench_gl JSON measured on a GPU")
     ap.add_argument("--bench", default=os.path.join(ROOT, "build", "bench", "bench_gl"),
                     help="the bench_gl that emulates the frames here (default: %(default)s)")
