@@ -60,9 +60,11 @@ def emulate(bench, k, dirs, grid, cache):
 def cells(paths, bench, dirs):
     cache, rows = {}, []
     for spec in paths:
-        spec, plus, only = spec.partition("+")
-        if plus and only not in TARGETS:
-            fail(f"{spec}+{only}: the pipeline is one of {', '.join(TARGETS)}")
+        head, plus, only = spec.rpartition("+")
+        if plus and only in TARGETS:  # a path may hold '+' itself: only a pipeline's name ends it
+            spec = head
+        else:
+            only = ""
         path, at, grid = spec.rpartition("@")
         if not at:
             path, grid = spec, ""
