@@ -34,6 +34,7 @@
 #include "host/trace/sampling.h"
 #include "host/trace/stream/stream_tracer.h"
 #include "host/trace/validate.h"
+#include "vgpu/gpu.h"
 
 namespace {
 
@@ -138,6 +139,38 @@ struct AluChain {
       return act;
     });
     f.out(0) = {x, s.y, s.z, s.w};
+  }
+};
+
+// Coherence probes (--coherence): every fragment of a pass makes kSpreadSteps independent
+// fetches from one RGBA32F data texture, the k-th at its base texel + (k, 0) along the row
+// (wrapped), and sums them. Only the bases differ between the probes (the "bases" texture: x,
+// y as texel centres, the row's length, 1), so the vgpu counts the same fetches and bytes for
+// each and the cost model prices them alike; what a card's texture caches make of where the
+// lanes of one warp fetch is what differs.
+struct FetchSpread {
+  static constexpr const char* name = "fetch spread";
+  static constexpr const char* paper_name = "-";
+  static constexpr int outputs = 1;
+  static constexpr std::array<const char*, 2> units{"bases", "data"};
+  static constexpr int kSpreadSteps = 64;
+  template <class L>
+  void operator()(vgpu::Fragments<L>& f) const {
+    using F = typename L::F;
+    using M = typename L::M;
+    const vgpu::Vec4<F> b = f.fetch_own(0);
+    vgpu::Vec4<F> sum{F(0.0f), F(0.0f), F(0.0f), F(0.0f)};
+    F x = b.x;
+    f.loop(kSpreadSteps, b.w >= F(0.0f), [&](const M& act) {
+      const vgpu::Vec4<F> t = f.fetch(1, x, b.y);
+      sum =
+          vgpu::select(act, vgpu::Vec4<F>{sum.x + t.x, sum.y + t.y, sum.z + t.z, sum.w + t.w}, sum);
+      F next = x + F(1.0f);
+      next = vgpu::select(next >= b.z, next - b.z, next);
+      x = vgpu::select(act, next, x);
+      return act;
+    });
+    f.out(0) = sum;
   }
 };
 
@@ -259,6 +292,119 @@ nlohmann::ordered_json measure_latencies(gl::GlDevice& d, int runs, int warmup_m
   d.upload(seed);
   vgpu::KernelProgram<AluChain> a(AluChain{short_steps}), b(AluChain{long_steps});
   report("16 dependent multiply-adds", 1, a, b, seed, 2 * AluChain::kChain);
+  return rows;
+}
+
+// The coherence probes: GPU time of a 256x256 pass of FetchSpread over a 512x512 data texture
+// (4 MB, inside the L2) for four placements of the fragments' bases, against the cost model's
+// pass work on `card` (the same for all four: the counts do not see where a fetch goes).
+nlohmann::ordered_json measure_coherence(gl::GlDevice& d, int runs, int warmup_ms,
+                                         const vgpu::Profile& card) {
+  constexpr int kSize = 256, kSide = 512, kTile[2] = {8, 4};  // a warp's fragments: 8x4
+  nlohmann::ordered_json rows = nlohmann::ordered_json::array();
+  std::vector<float> values(size_t(kSide) * kSide * 4);
+  {
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    for (float& x : values) x = u(rng);
+  }
+  vgpu::Texture data = d.make_texture("data", kSide, kSide, 4);
+  data.replace(values);
+  d.upload(data);
+  vgpu::Texture target = d.make_texture("coherence target", kSize, kSize, 4);
+  d.upload(target);
+  const vgpu::KernelProgram<FetchSpread> program{FetchSpread{}};
+  // The pass's counts as the emulator makes them (the GL device does not count a loop's
+  // iterations lane by lane), priced on the card's profile.
+  auto emulated = [&](const std::vector<float>& base_texels) {
+    vgpu::Gpu emu(card);
+    vgpu::Texture eb = emu.make_texture("bases", kSize, kSize, 4);
+    eb.replace(base_texels);
+    vgpu::Texture ed = emu.make_texture("data", kSide, kSide, 4);
+    ed.replace(values);
+    vgpu::Texture et = emu.make_texture("coherence target", kSize, kSize, 4);
+    emu.upload(eb);
+    emu.upload(ed);
+    emu.stats().clear();
+    emu.use_program(program);
+    emu.bind_texture(0, eb);
+    emu.bind_texture(1, ed);
+    emu.set_targets({&et});
+    emu.draw();
+    return emu.stats();
+  };
+  // A random texel per key, drawn once per key (the same for both coordinates).
+  std::map<std::pair<int, int>, std::pair<int, int>> drawn;
+  auto random_texel = [&](int kx, int ky, std::mt19937& rng) {
+    auto [it, fresh] = drawn.try_emplace({kx, ky});
+    if (fresh) {
+      std::uniform_int_distribution<int> t(0, kSide - 1);
+      it->second = {t(rng), t(rng)};
+    }
+    return it->second;
+  };
+  std::printf(
+      "coherence probes (%dx%d pass, %d fetches a fragment from a %dx%d RGBA32F texture, "
+      "GPU timer queries, medians of %d passes; priced on %s):\n",
+      kSize, kSize, FetchSpread::kSpreadSteps, kSide, kSide, runs, card.name.c_str());
+  const char* names[] = {"one texel for every fragment", "one texel for each 8x4 tile (warp)",
+                         "each fragment its own texel, neighbours adjacent",
+                         "each fragment a random texel"};
+  for (int pattern = 0; pattern < 4; ++pattern) {
+    drawn.clear();
+    std::mt19937 rng(99);
+    vgpu::Texture bases = d.make_texture("bases", kSize, kSize, 4);
+    std::vector<float> v(size_t(kSize) * kSize * 4);
+    for (int y = 0; y < kSize; ++y)
+      for (int x = 0; x < kSize; ++x) {
+        std::pair<int, int> t{0, 0};
+        if (pattern == 1) t = random_texel(x / kTile[0], y / kTile[1], rng);
+        if (pattern == 2) t = {x, y};
+        if (pattern == 3) t = random_texel(x, y, rng);
+        float* at = v.data() + (size_t(y) * kSize + size_t(x)) * 4;
+        at[0] = float(t.first) + 0.5f;
+        at[1] = float(t.second) + 0.5f;
+        at[2] = float(kSide);
+        at[3] = 1.0f;
+      }
+    bases.replace(v);
+    d.upload(bases);
+    std::vector<double> gpu;
+    const vgpu::FrameStats one = emulated(v);
+    const auto t0 = Clock::now();
+    for (int r = 0; r < runs || ms_since(t0) < warmup_ms; ++r) {
+      d.finish();
+      d.stats().clear();
+      d.use_program(program);
+      d.unbind_textures();
+      d.bind_texture(0, bases);
+      d.bind_texture(1, data);
+      d.set_targets({&target});
+      d.draw();
+      d.finish();
+      gpu.push_back(1e3 * d.stats().totals.device_ms);
+    }
+    const double ms =
+        1e-3 * median({gpu.end() - std::min<ptrdiff_t>(runs, ptrdiff_t(gpu.size())), gpu.end()});
+    const host::CostBreakdown b = host::predict(one, card);
+    const double work = b.arithmetic_ms + b.texture_ms + b.memory_ms + b.latency_ms;
+    const double bytes = double(one.totals.bytes_read);
+    const double per_clock = ms > 0 ? bytes / (ms * 1e-3 * card.core_mhz * 1e6) : 0.0;
+    std::printf("  %-50s GPU %8.3f ms  priced work %8.3f ms  (%5.2fx)  %6.1f bytes a clock\n",
+                names[pattern], ms, work, work > 0 ? ms / work : 0.0, per_clock);
+    std::fflush(stdout);
+    rows.push_back({{"what", names[pattern]},
+                    {"size", kSize},
+                    {"data_side", kSide},
+                    {"fetches_per_fragment", FetchSpread::kSpreadSteps},
+                    {"texture_fetches", one.totals.texture_fetches},
+                    {"bytes_read", one.totals.bytes_read},
+                    {"gpu_ms", ms},
+                    {"card_profile", card.name},
+                    {"priced_work_ms", work},
+                    {"priced_texture_demand_ms", b.texture_demand_ms},
+                    {"bytes_per_clock", per_clock}});
+  }
   return rows;
 }
 
@@ -390,7 +536,7 @@ struct Args {
   std::vector<std::string> accels = {"grid"};
   int bounces = 2;
   std::vector<std::string> ray_streams = {"off"}, sampling = {"spp:1"}, beams = {"off"};
-  bool shadows = false, no_fixed = false, latency = false;
+  bool shadows = false, no_fixed = false, latency = false, coherence = false;
 };
 
 // Declares every option of bench_gl on app, bound to a.
@@ -476,6 +622,12 @@ void add_options(CLI::App& app, Args& a) {
                "Also measure latencies: one fragment following a chain of dependent texel "
                "fetches (RGBA32F textures of 16x16, 512x512 and 2048x2048 texels) and of "
                "dependent multiply-adds, GPU time per iteration (needs a GL device)");
+  app.add_flag("--coherence", a.coherence,
+               "Also measure where a warp's fetches go: a 256x256 pass of 64 independent "
+               "fetches a fragment from one 512x512 RGBA32F texture, with every fragment on one "
+               "texel, each 8x4 tile on one, neighbours on adjacent texels, and each on a random "
+               "one; GPU time against the cost model's price, the same for all four (needs a GL "
+               "device)");
   app.add_option("--json", a.json_path, "Also write every figure as JSON to this file");
 }
 
@@ -780,10 +932,9 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {  // --help exits 0; a bad option 2, as vgpu-rt does
     return app.exit(e) == 0 ? 0 : 2;
   }
-  if (a.latency && a.wait_mode == "none") {
-    std::fprintf(stderr,
-                 "bench_gl: --latency needs a GL device (--readback-wait block, poll or "
-                 "both)\n");
+  if ((a.latency || a.coherence) && a.wait_mode == "none") {
+    std::fprintf(stderr, "bench_gl: %s needs a GL device (--readback-wait block, poll or both)\n",
+                 a.latency ? "--latency" : "--coherence");
     return 2;
   }
   // Every frame's options, checked before any device or scene is built (host::validate).
@@ -810,6 +961,12 @@ int main(int argc, char** argv) {
     if (a.latency) {
       gl::GlDevice d(vgpu::profile("h200"), a.device, gl::GlDevice::ReadbackWait::poll);
       out["latency"] = measure_latencies(d, a.runs, std::max(a.warmup_ms, 200));
+    }
+    if (a.coherence) {
+      gl::GlDevice d(vgpu::profile("h200"), a.device, gl::GlDevice::ReadbackWait::poll);
+      const vgpu::Profile* card = vgpu::profile_for_renderer(d.context().renderer());
+      out["coherence"] = measure_coherence(d, a.runs, std::max(a.warmup_ms, 200),
+                                           card ? *card : vgpu::profile("h100"));
     }
     if (!a.no_frames) {
       out["grid"] = a.grid_text;  // --grid, which the frames record nowhere else

@@ -203,6 +203,36 @@ TEST_CASE("bench_gl --latency times one fragment's dependent fetches and multipl
   CHECK_FALSE(fs::exists(js));
 }
 
+TEST_CASE(
+    "bench_gl --coherence times four placements of one pass's fetches, which the model prices "
+    "alike") {
+  const fs::path js = json_path();
+  const Outcome o = bench(
+      "--coherence --no-fixed --no-frames --runs 1 --readback-wait poll --json " + js.string());
+  REQUIRE(o.status == 0);
+  std::ifstream f(js);
+  const nlohmann::json doc = nlohmann::json::parse(f);
+  fs::remove(js);
+  const auto& rows = doc["coherence"];
+  REQUIRE(rows.size() == 4);  // one texel for all, one a warp, neighbours adjacent, random
+  for (const auto& r : rows) {
+    INFO(r.dump());
+    // 256x256 fragments, each its own base texel and then 64 from the data texture, RGBA32F
+    // (hand count): the same for every placement, so the same price.
+    CHECK(r["texture_fetches"].get<uint64_t>() == 256u * 256u * 65u);
+    CHECK(r["bytes_read"].get<uint64_t>() == 256u * 256u * 65u * 16u);
+    CHECK(r["priced_work_ms"].get<double>() == rows[0]["priced_work_ms"].get<double>());
+    CHECK(r["priced_work_ms"].get<double>() > 0);
+    CHECK(r["gpu_ms"].get<double>() > 0);  // timed, not judged (llvmpipe here)
+  }
+  CHECK(rows[0]["what"] != rows[3]["what"]);
+  // Without a GL device there is nothing to time: refused, exit 2, nothing written.
+  const Outcome none = bench("--coherence --readback-wait none --json " + js.string());
+  CHECK(none.status == 2);
+  CHECK(none.err.find("--coherence needs a GL device") != std::string::npos);
+  CHECK_FALSE(fs::exists(js));
+}
+
 TEST_CASE("bench_gl runs GL and emulator frames with beams off and on, counting the same beams") {
   const fs::path js = json_path();
   const Outcome refused = bench("--readback-wait none --sizes 8 --beams maybe");
