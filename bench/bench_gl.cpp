@@ -22,6 +22,7 @@
 #include <regex>
 #include <sstream>
 
+#include "bench/gl_probes/gl_probes.h"
 #include "gl/context.h"
 #include "gl/gl_device.h"
 #include "host/accel/accel.h"
@@ -38,15 +39,10 @@
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
+using bench_gl_probes::Clock;
+using bench_gl_probes::median;
+using bench_gl_probes::ms_since;
 using json = nlohmann::ordered_json;
-
-double median(std::vector<double> v) {
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  const size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 // Each series' median, by name (null where there are none: the emulator's frames).
 json medians(const std::map<std::string, std::vector<double>>& series) {
@@ -54,10 +50,6 @@ json medians(const std::map<std::string, std::vector<double>>& series) {
   json out = json::object();
   for (const auto& [name, v] : series) out[name] = median(v);
   return out;
-}
-
-double ms_since(Clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
 }
 
 // Tiny programs for the fixed costs: copy the own texel (one fetch, one output), the same with
@@ -93,84 +85,6 @@ struct CopyTwice {
   void operator()(vgpu::Fragments<L>& f) const {
     f.out(0) = f.fetch_own(0);
     f.out(1) = f.fetch_own(1);
-  }
-};
-
-// Latency probes (--latency): one fragment follows a chain of dependent operations in a loop,
-// so the GPU time per iteration is how long one operation waits for the one before, not how
-// many the units can start. FetchChase: each texel holds the coordinates of the next texel to
-// fetch (one random cycle through the texture). AluChain: 16 dependent multiply-adds an
-// iteration (MUL then ADD: the GLSL's `precise` keeps them apart, as the vgpu counts them).
-struct FetchChase {
-  static constexpr const char* name = "fetch chase";
-  static constexpr const char* paper_name = "-";
-  static constexpr int outputs = 1;
-  static constexpr std::array<const char*, 1> units{"links"};
-  int steps = 256;
-  template <class L>
-  void operator()(vgpu::Fragments<L>& f) const {
-    using F = typename L::F;
-    using M = typename L::M;
-    vgpu::Vec4<F> at = f.fetch_own(0);
-    f.loop(steps, at.w >= F(0.0f), [&](const M& act) {
-      at = vgpu::select(act, f.fetch(0, at.x, at.y), at);
-      return act;
-    });
-    f.out(0) = at;
-  }
-};
-struct AluChain {
-  static constexpr const char* name = "arithmetic chain";
-  static constexpr const char* paper_name = "-";
-  static constexpr int outputs = 1;
-  static constexpr std::array<const char*, 1> units{"seed"};
-  static constexpr int kChain = 16;  // multiply-adds per iteration
-  int steps = 256;
-  template <class L>
-  void operator()(vgpu::Fragments<L>& f) const {
-    using F = typename L::F;
-    using M = typename L::M;
-    const vgpu::Vec4<F> s = f.fetch_own(0);  // x, a = 1, b = 0, w = 1: the texture decides
-    F x = s.x;
-    f.loop(steps, s.w >= F(0.0f), [&](const M& act) {
-      F y = x;
-      for (int i = 0; i < kChain; ++i) y = y * s.y + s.z;
-      x = vgpu::select(act, y, x);
-      return act;
-    });
-    f.out(0) = {x, s.y, s.z, s.w};
-  }
-};
-
-// Coherence probes (--coherence): every fragment of a pass makes kSpreadSteps independent
-// fetches from one RGBA32F data texture, the k-th at its base texel + (k, 0) along the row
-// (wrapped), and sums them. Only the bases differ between the probes (the "bases" texture: x,
-// y as texel centres, the row's length, 1), so the vgpu counts the same fetches and bytes for
-// each and the cost model prices them alike; what a card's texture caches make of where the
-// lanes of one warp fetch is what differs.
-struct FetchSpread {
-  static constexpr const char* name = "fetch spread";
-  static constexpr const char* paper_name = "-";
-  static constexpr int outputs = 1;
-  static constexpr std::array<const char*, 2> units{"bases", "data"};
-  static constexpr int kSpreadSteps = 64;
-  template <class L>
-  void operator()(vgpu::Fragments<L>& f) const {
-    using F = typename L::F;
-    using M = typename L::M;
-    const vgpu::Vec4<F> b = f.fetch_own(0);
-    vgpu::Vec4<F> sum{F(0.0f), F(0.0f), F(0.0f), F(0.0f)};
-    F x = b.x;
-    f.loop(kSpreadSteps, b.w >= F(0.0f), [&](const M& act) {
-      const vgpu::Vec4<F> t = f.fetch(1, x, b.y);
-      sum =
-          vgpu::select(act, vgpu::Vec4<F>{sum.x + t.x, sum.y + t.y, sum.z + t.z, sum.w + t.w}, sum);
-      F next = x + F(1.0f);
-      next = vgpu::select(next >= b.z, next - b.z, next);
-      x = vgpu::select(act, next, x);
-      return act;
-    });
-    f.out(0) = sum;
   }
 };
 
@@ -211,201 +125,6 @@ Fixed time_passes(gl::GlDevice& d, int size, int n, int runs, bool readback, con
     gpu.push_back(1e3 * d.stats().totals.device_ms / n);
   }
   return {median(wall), median(gpu)};
-}
-
-// GPU time of one pass of p over a 1x1 target reading `source`, median of `runs` after
-// `warmup_ms` of the same pass (a GPU that sat idle runs at a lower clock).
-double time_one_fragment(gl::GlDevice& d, const vgpu::Program& p, const vgpu::Texture& source,
-                         int runs, int warmup_ms) {
-  vgpu::Texture target = d.make_texture("latency target", 1, 1, 4);
-  d.upload(target);
-  std::vector<double> gpu;
-  const auto t0 = Clock::now();
-  for (int r = 0; r < runs || ms_since(t0) < warmup_ms; ++r) {
-    d.finish();
-    d.stats().clear();
-    d.use_program(p);
-    d.unbind_textures();
-    d.bind_texture(0, source);
-    d.set_targets({&target});
-    d.draw();
-    d.finish();
-    gpu.push_back(1e3 * d.stats().totals.device_ms);
-  }
-  return median({gpu.end() - std::min<ptrdiff_t>(runs, ptrdiff_t(gpu.size())), gpu.end()});
-}
-
-// The latency probes: per chain, GPU time per iteration from two loop lengths (the difference
-// removes the pass's fixed cost), in ns and in clocks of the h200 profile's boost clock.
-nlohmann::ordered_json measure_latencies(gl::GlDevice& d, int runs, int warmup_ms) {
-  nlohmann::ordered_json rows = nlohmann::ordered_json::array();
-  const int short_steps = 1024, long_steps = 8192;
-  const double mhz = vgpu::profile("h200").core_mhz;
-  auto report = [&](const std::string& what, int texels, const vgpu::Program& a,
-                    const vgpu::Program& b, const vgpu::Texture& t, int ops) {
-    const vgpu::LoopTally chain = a.analyze().loop;  // what the model's span counts of it
-    const double ta = time_one_fragment(d, a, t, runs, warmup_ms);
-    const double tb = time_one_fragment(d, b, t, runs, warmup_ms);
-    const double ns = 1e3 * (tb - ta) / (long_steps - short_steps);
-    std::printf(
-        "  %-34s %9d texels  %5d steps %9.1f us  %5d steps %9.1f us  => %7.1f ns, "
-        "%6.0f clocks an iteration\n",
-        what.c_str(), texels, short_steps, ta, long_steps, tb, ns, ns * mhz * 1e-3);
-    std::fflush(stdout);
-    rows.push_back({{"what", what},
-                    {"texels", texels},
-                    {"bytes", uint64_t(texels) * 16},
-                    {"ops_per_iteration", ops},
-                    {"chain_fetches", chain.chain_fetches},
-                    {"chain_operations", chain.chain_operations},
-                    {"short_steps", short_steps},
-                    {"short_us", ta},
-                    {"long_steps", long_steps},
-                    {"long_us", tb},
-                    {"ns_per_iteration", ns},
-                    {"clocks_per_iteration_at_boost", ns * mhz * 1e-3}});
-  };
-  std::printf("latency probes (one fragment, GPU timer queries, medians of %d passes):\n", runs);
-  for (int side : {16, 512, 2048}) {
-    // One random cycle through every texel: texel i holds the coordinates of texel perm[i + 1].
-    vgpu::Texture links = d.make_texture("links", side, side, 4);
-    std::vector<int> perm(size_t(side) * side);
-    for (size_t i = 0; i < perm.size(); ++i) perm[i] = int(i);
-    std::mt19937 rng(12345);
-    std::shuffle(perm.begin() + 1, perm.end(), rng);  // texel 0 (the fragment's own) starts
-    std::vector<float> data(perm.size() * 4);
-    for (size_t i = 0; i < perm.size(); ++i) {
-      const int next = perm[(i + 1) % perm.size()];
-      const size_t at = size_t(perm[i]) * 4;
-      data[at] = float(next % side) + 0.5f;
-      data[at + 1] = float(next / side) + 0.5f;
-      data[at + 2] = 0.0f;
-      data[at + 3] = 1.0f;
-    }
-    links.replace(data);
-    d.upload(links);
-    vgpu::KernelProgram<FetchChase> a(FetchChase{short_steps}), b(FetchChase{long_steps});
-    report("dependent fetch (RGBA32F)", side * side, a, b, links, 1);
-  }
-  vgpu::Texture seed = d.make_texture("seed", 1, 1, 4);
-  seed.fill(std::array<float, 4>{0.5f, 1.0f, 0.0f, 1.0f});
-  d.upload(seed);
-  vgpu::KernelProgram<AluChain> a(AluChain{short_steps}), b(AluChain{long_steps});
-  report("16 dependent multiply-adds", 1, a, b, seed, 2 * AluChain::kChain);
-  return rows;
-}
-
-// The coherence probes: GPU time of a 256x256 pass of FetchSpread over a 512x512 data texture
-// (4 MB, inside the L2) for four placements of the fragments' bases, against the cost model's
-// pass work on `card` (the same for all four: the counts do not see where a fetch goes).
-nlohmann::ordered_json measure_coherence(gl::GlDevice& d, int runs, int warmup_ms,
-                                         const vgpu::Profile& card) {
-  constexpr int kSize = 256, kSide = 512, kTile[2] = {8, 4};  // a warp's fragments: 8x4
-  nlohmann::ordered_json rows = nlohmann::ordered_json::array();
-  std::vector<float> values(size_t(kSide) * kSide * 4);
-  {
-    std::mt19937 rng(7);
-    std::uniform_real_distribution<float> u(0.0f, 1.0f);
-    for (float& x : values) x = u(rng);
-  }
-  vgpu::Texture data = d.make_texture("data", kSide, kSide, 4);
-  data.replace(values);
-  d.upload(data);
-  vgpu::Texture target = d.make_texture("coherence target", kSize, kSize, 4);
-  d.upload(target);
-  const vgpu::KernelProgram<FetchSpread> program{FetchSpread{}};
-  // The pass's counts as the emulator makes them (the GL device does not count a loop's
-  // iterations lane by lane), priced on the card's profile.
-  auto emulated = [&](const std::vector<float>& base_texels) {
-    vgpu::Gpu emu(card);
-    vgpu::Texture eb = emu.make_texture("bases", kSize, kSize, 4);
-    eb.replace(base_texels);
-    vgpu::Texture ed = emu.make_texture("data", kSide, kSide, 4);
-    ed.replace(values);
-    vgpu::Texture et = emu.make_texture("coherence target", kSize, kSize, 4);
-    emu.upload(eb);
-    emu.upload(ed);
-    emu.stats().clear();
-    emu.use_program(program);
-    emu.bind_texture(0, eb);
-    emu.bind_texture(1, ed);
-    emu.set_targets({&et});
-    emu.draw();
-    return emu.stats();
-  };
-  // A random texel per key, drawn once per key (the same for both coordinates).
-  std::map<std::pair<int, int>, std::pair<int, int>> drawn;
-  auto random_texel = [&](int kx, int ky, std::mt19937& rng) {
-    auto [it, fresh] = drawn.try_emplace({kx, ky});
-    if (fresh) {
-      std::uniform_int_distribution<int> t(0, kSide - 1);
-      it->second = {t(rng), t(rng)};
-    }
-    return it->second;
-  };
-  std::printf(
-      "coherence probes (%dx%d pass, %d fetches a fragment from a %dx%d RGBA32F texture, "
-      "GPU timer queries, medians of %d passes; priced on %s):\n",
-      kSize, kSize, FetchSpread::kSpreadSteps, kSide, kSide, runs, card.name.c_str());
-  const char* names[] = {"one texel for every fragment", "one texel for each 8x4 tile (warp)",
-                         "each fragment its own texel, neighbours adjacent",
-                         "each fragment a random texel"};
-  for (int pattern = 0; pattern < 4; ++pattern) {
-    drawn.clear();
-    std::mt19937 rng(99);
-    vgpu::Texture bases = d.make_texture("bases", kSize, kSize, 4);
-    std::vector<float> v(size_t(kSize) * kSize * 4);
-    for (int y = 0; y < kSize; ++y)
-      for (int x = 0; x < kSize; ++x) {
-        std::pair<int, int> t{0, 0};
-        if (pattern == 1) t = random_texel(x / kTile[0], y / kTile[1], rng);
-        if (pattern == 2) t = {x, y};
-        if (pattern == 3) t = random_texel(x, y, rng);
-        float* at = v.data() + (size_t(y) * kSize + size_t(x)) * 4;
-        at[0] = float(t.first) + 0.5f;
-        at[1] = float(t.second) + 0.5f;
-        at[2] = float(kSide);
-        at[3] = 1.0f;
-      }
-    bases.replace(v);
-    d.upload(bases);
-    std::vector<double> gpu;
-    const vgpu::FrameStats one = emulated(v);
-    const auto t0 = Clock::now();
-    for (int r = 0; r < runs || ms_since(t0) < warmup_ms; ++r) {
-      d.finish();
-      d.stats().clear();
-      d.use_program(program);
-      d.unbind_textures();
-      d.bind_texture(0, bases);
-      d.bind_texture(1, data);
-      d.set_targets({&target});
-      d.draw();
-      d.finish();
-      gpu.push_back(1e3 * d.stats().totals.device_ms);
-    }
-    const double ms =
-        1e-3 * median({gpu.end() - std::min<ptrdiff_t>(runs, ptrdiff_t(gpu.size())), gpu.end()});
-    const host::CostBreakdown b = host::predict(one, card);
-    const double work = b.arithmetic_ms + b.texture_ms + b.memory_ms + b.latency_ms;
-    const double bytes = double(one.totals.bytes_read);
-    const double per_clock = ms > 0 ? bytes / (ms * 1e-3 * card.core_mhz * 1e6) : 0.0;
-    std::printf("  %-50s GPU %8.3f ms  priced work %8.3f ms  (%5.2fx)  %6.1f bytes a clock\n",
-                names[pattern], ms, work, work > 0 ? ms / work : 0.0, per_clock);
-    std::fflush(stdout);
-    rows.push_back({{"what", names[pattern]},
-                    {"size", kSize},
-                    {"data_side", kSide},
-                    {"fetches_per_fragment", FetchSpread::kSpreadSteps},
-                    {"texture_fetches", one.totals.texture_fetches},
-                    {"bytes_read", one.totals.bytes_read},
-                    {"gpu_ms", ms},
-                    {"card_profile", card.name},
-                    {"priced_work_ms", work},
-                    {"priced_texture_demand_ms", b.texture_demand_ms},
-                    {"bytes_per_clock", per_clock}});
-  }
-  return rows;
 }
 
 // A sampling mode of --sampling: spp:N (N rays per pixel, the accumulation frames),
@@ -960,13 +679,13 @@ int main(int argc, char** argv) {
     if (a.wait_mode != "none" && !a.no_fixed) measure_fixed_costs(a, out);
     if (a.latency) {
       gl::GlDevice d(vgpu::profile("h200"), a.device, gl::GlDevice::ReadbackWait::poll);
-      out["latency"] = measure_latencies(d, a.runs, std::max(a.warmup_ms, 200));
+      out["latency"] = bench_gl_probes::measure_latencies(d, a.runs, std::max(a.warmup_ms, 200));
     }
     if (a.coherence) {
       gl::GlDevice d(vgpu::profile("h200"), a.device, gl::GlDevice::ReadbackWait::poll);
       const vgpu::Profile* card = vgpu::profile_for_renderer(d.context().renderer());
-      out["coherence"] = measure_coherence(d, a.runs, std::max(a.warmup_ms, 200),
-                                           card ? *card : vgpu::profile("h100"));
+      out["coherence"] = bench_gl_probes::measure_coherence(d, a.runs, std::max(a.warmup_ms, 200),
+                                                            card ? *card : vgpu::profile("h100"));
     }
     if (!a.no_frames) {
       out["grid"] = a.grid_text;  // --grid, which the frames record nowhere else
