@@ -3,7 +3,6 @@
 
 #include <array>
 #include <cstdio>
-#include <map>
 #include <random>
 #include <string>
 
@@ -93,26 +92,41 @@ struct FetchSpread {
   }
 };
 
-// GPU time of one pass of p over a 1x1 target reading `source`, median of `runs` after
-// `warmup_ms` of the same pass (a GPU that sat idle runs at a lower clock).
-double time_one_fragment(gl::GlDevice& d, const vgpu::Program& p, const vgpu::Texture& source,
-                         int runs, int warmup_ms) {
-  vgpu::Texture target = d.make_texture("latency target", 1, 1, 4);
-  d.upload(target);
+// One pass of p on `dev` (the GL device or the emulator): `sources` on units 0, 1, ..., drawn
+// into `target`.
+void draw_pass(vgpu::Device& dev, const vgpu::Program& p,
+               std::initializer_list<const vgpu::Texture*> sources, vgpu::Texture& target) {
+  dev.use_program(p);
+  dev.unbind_textures();
+  int unit = 0;
+  for (const vgpu::Texture* s : sources) dev.bind_texture(unit++, *s);
+  dev.set_targets({&target});
+  dev.draw();
+}
+
+// GPU time of that pass on the GL device, ms: the median of the last `runs` of passes drawn
+// for at least `warmup_ms` (a GPU that sat idle runs at a lower clock).
+double gpu_ms_of_pass(gl::GlDevice& d, const vgpu::Program& p,
+                      std::initializer_list<const vgpu::Texture*> sources, vgpu::Texture& target,
+                      int runs, int warmup_ms) {
   std::vector<double> gpu;
   const auto t0 = Clock::now();
   for (int r = 0; r < runs || ms_since(t0) < warmup_ms; ++r) {
     d.finish();
     d.stats().clear();
-    d.use_program(p);
-    d.unbind_textures();
-    d.bind_texture(0, source);
-    d.set_targets({&target});
-    d.draw();
+    draw_pass(d, p, sources, target);
     d.finish();
-    gpu.push_back(1e3 * d.stats().totals.device_ms);
+    gpu.push_back(d.stats().totals.device_ms);
   }
   return median({gpu.end() - std::min<ptrdiff_t>(runs, ptrdiff_t(gpu.size())), gpu.end()});
+}
+
+// GPU time of one pass of p over a 1x1 target reading `source`, us.
+double time_one_fragment(gl::GlDevice& d, const vgpu::Program& p, const vgpu::Texture& source,
+                         int runs, int warmup_ms) {
+  vgpu::Texture target = d.make_texture("latency target", 1, 1, 4);
+  d.upload(target);
+  return 1e3 * gpu_ms_of_pass(d, p, {&source}, target, runs, warmup_ms);
 }
 
 }  // namespace
@@ -205,22 +219,8 @@ nlohmann::ordered_json measure_coherence(gl::GlDevice& d, int runs, int warmup_m
     emu.upload(eb);
     emu.upload(ed);
     emu.stats().clear();
-    emu.use_program(program);
-    emu.bind_texture(0, eb);
-    emu.bind_texture(1, ed);
-    emu.set_targets({&et});
-    emu.draw();
+    draw_pass(emu, program, {&eb, &ed}, et);
     return emu.stats();
-  };
-  // A random texel per key, drawn once per key (the same for both coordinates).
-  std::map<std::pair<int, int>, std::pair<int, int>> drawn;
-  auto random_texel = [&](int kx, int ky, std::mt19937& rng) {
-    auto [it, fresh] = drawn.try_emplace({kx, ky});
-    if (fresh) {
-      std::uniform_int_distribution<int> t(0, kSide - 1);
-      it->second = {t(rng), t(rng)};
-    }
-    return it->second;
   };
   std::printf(
       "coherence probes (%dx%d pass, %d fetches a fragment from a %dx%d RGBA32F texture, "
@@ -230,16 +230,20 @@ nlohmann::ordered_json measure_coherence(gl::GlDevice& d, int runs, int warmup_m
                          "each fragment its own texel, neighbours adjacent",
                          "each fragment a random texel"};
   for (int pattern = 0; pattern < 4; ++pattern) {
-    drawn.clear();
     std::mt19937 rng(99);
+    std::uniform_int_distribution<int> pick(0, kSide - 1);
+    // A random texel for each 8x4 tile, and one for each fragment (drawn as it is placed).
+    std::vector<std::pair<int, int>> tiles(size_t(kSize / kTile[0]) * (kSize / kTile[1]));
+    for (auto& t : tiles) t = {pick(rng), pick(rng)};
     vgpu::Texture bases = d.make_texture("bases", kSize, kSize, 4);
     std::vector<float> v(size_t(kSize) * kSize * 4);
     for (int y = 0; y < kSize; ++y)
       for (int x = 0; x < kSize; ++x) {
         std::pair<int, int> t{0, 0};
-        if (pattern == 1) t = random_texel(x / kTile[0], y / kTile[1], rng);
+        if (pattern == 1)
+          t = tiles[size_t(y / kTile[1]) * (kSize / kTile[0]) + size_t(x / kTile[0])];
         if (pattern == 2) t = {x, y};
-        if (pattern == 3) t = random_texel(x, y, rng);
+        if (pattern == 3) t = {pick(rng), pick(rng)};
         float* at = v.data() + (size_t(y) * kSize + size_t(x)) * 4;
         at[0] = float(t.first) + 0.5f;
         at[1] = float(t.second) + 0.5f;
@@ -248,23 +252,8 @@ nlohmann::ordered_json measure_coherence(gl::GlDevice& d, int runs, int warmup_m
       }
     bases.replace(v);
     d.upload(bases);
-    std::vector<double> gpu;
     const vgpu::FrameStats one = emulated(v);
-    const auto t0 = Clock::now();
-    for (int r = 0; r < runs || ms_since(t0) < warmup_ms; ++r) {
-      d.finish();
-      d.stats().clear();
-      d.use_program(program);
-      d.unbind_textures();
-      d.bind_texture(0, bases);
-      d.bind_texture(1, data);
-      d.set_targets({&target});
-      d.draw();
-      d.finish();
-      gpu.push_back(1e3 * d.stats().totals.device_ms);
-    }
-    const double ms =
-        1e-3 * median({gpu.end() - std::min<ptrdiff_t>(runs, ptrdiff_t(gpu.size())), gpu.end()});
+    const double ms = gpu_ms_of_pass(d, program, {&bases, &data}, target, runs, warmup_ms);
     const host::CostBreakdown b = host::predict(one, card);
     const double work = b.arithmetic_ms + b.texture_ms + b.memory_ms + b.latency_ms;
     const double bytes = double(one.totals.bytes_read);
